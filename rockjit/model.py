@@ -1,0 +1,300 @@
+"""The rocking block: the one place where its physics is written.
+
+Everything that knows the equations of motion lives here: the restitution laws, the angular
+acceleration on either corner and its Jacobian, the forcing oscillator, the impact (jump) map and
+the saltation matrix. The compiled integrator (:mod:`rockjit.integrate`) and the scipy reference
+path call these same functions; nothing else writes an equation of motion.
+
+Conventions (SPEC.md §1–2). State ``(theta, dtheta)``; ``side = +1`` rocks on the corner reached
+for ``theta > 0`` and ``side = -1`` on the other one; ``side = 0`` is the block at rest. The
+forcing acceleration is ``f = aw2 * r`` with ``aw2 = alpha * omega**2`` and ``r`` either
+``sin(omega t + phi)`` (closed form) or the first component of the oscillator embedding.
+
+Notes
+-----
+Equations of motion: Housner (1963), in the dimensionless form of SPEC.md §1.
+Restitution: Housner (1963) angular-momentum law; Mao et al. (2024) kinetic-energy law.
+Saltation matrix: Müller (1995), specialised to the impact surface ``theta = 0`` (SPEC.md §5).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._jit import jit
+
+__all__ = [
+    "LAWS",
+    "Block",
+    "accel",
+    "accel_jac",
+    "delta_e_percent",
+    "e_housner",
+    "e_mao",
+    "forcing_closed",
+    "jump",
+    "oscillator",
+    "oscillator_jac",
+    "saltation",
+    "thc_from_hb",
+    "uplift_time",
+]
+
+LAWS = ("housner", "mao", "constant")
+HB_MIN_HOUSNER = 1.0 / math.sqrt(2.0)
+
+
+# --------------------------------------------------------------------------------------------
+# Restitution laws (plain NumPy: evaluated once per run, and vectorised for the figures)
+# --------------------------------------------------------------------------------------------
+
+def thc_from_hb(hb):
+    """Angle of the block's diagonal from the ground, ``arctan(h/b)``."""
+    return np.arctan(hb)
+
+
+def e_housner(thc):
+    """Housner's coefficient of restitution ``1 - 1.5 cos^2(thc)``.
+
+    Conserves angular momentum about the new corner (Housner 1963). Negative for
+    ``thc < arctan(1/sqrt(2))``, where the law has no physical meaning.
+    """
+    return 1.0 - 1.5 * np.cos(thc) ** 2
+
+
+def e_mao(thc):
+    """Mao et al. (2024) coefficient of restitution ``sqrt(N / D)`` (SPEC.md §2).
+
+    ``N = tan(thc)(tan^2(thc) - 3) + 3 tan^4(thc)(pi/2 - thc) + 3 thc`` and
+    ``D = 4 tan(thc) sec^2(thc)``.
+    """
+    t = np.tan(thc)
+    num = t * (t * t - 3.0) + 3.0 * t**4 * (0.5 * np.pi - thc) + 3.0 * thc
+    den = 4.0 * t / np.cos(thc) ** 2
+    return np.sqrt(num / den)
+
+
+def delta_e_percent(e1, e2):
+    """Symmetric percentage difference ``|e1 - e2| / (0.5 (e1 + e2)) * 100``."""
+    e1 = np.asarray(e1, dtype=float)
+    e2 = np.asarray(e2, dtype=float)
+    return np.abs(e1 - e2) / (0.5 * (e1 + e2)) * 100.0
+
+
+# --------------------------------------------------------------------------------------------
+# Validated parameters
+# --------------------------------------------------------------------------------------------
+
+def _finite(name, value):
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a real number (got {value!r})") from None
+    if not math.isfinite(value):
+        raise ValueError(f"{name} must be finite (got {value})")
+    return value
+
+
+@dataclass(frozen=True)
+class Block:
+    """A validated parameter set of the forced rocking block.
+
+    Parameters
+    ----------
+    hb : float
+        Slenderness ``h/b``, finite and ``> 0`` (``>= 1/sqrt(2)`` for the Housner law).
+    alpha : float
+        Forcing amplitude ``A/R``, ``>= 0``.
+    omega : float
+        Forcing frequency ``Omega/Omega0``, ``> 0``.
+    law : {"housner", "mao", "constant"}, optional
+        Restitution law; default ``"housner"``, or ``"constant"`` when ``e`` is given.
+    e : float, optional
+        Coefficient of restitution in ``[0, 1]``, only with the constant law.
+    xi : float
+        Viscous damping ``>= 0``; default the study's value (SPEC.md §1).
+    theta_over : float
+        Overturning threshold on ``|theta|``, in ``(0, pi/2]``; default ``pi/2``.
+    rest_speed : float
+        Impact speed ``|theta'|`` after the jump below which the block is put to rest (the Zeno
+        cut-off, SPEC.md §3), ``>= 0``; default ``1e-6``.
+    """
+
+    hb: float
+    alpha: float
+    omega: float
+    law: str | None = None
+    e: float | None = None
+    xi: float = 101.0 / (2e4 * 3.764**2 * math.sqrt(9.81 / 3.764))
+    theta_over: float = 0.5 * math.pi
+    rest_speed: float = 1e-6
+
+    def __post_init__(self):
+        hb = _finite("hb", self.hb)
+        if hb <= 0:
+            raise ValueError(f"hb must be > 0 (got {hb})")
+        law = self.law
+        if law is None:
+            law = "housner" if self.e is None else "constant"
+        if law not in LAWS:
+            raise ValueError(f"law must be one of {LAWS} (got {self.law!r})")
+        if law == "constant":
+            if self.e is None:
+                raise ValueError("e is required for law='constant' (a number in [0, 1])")
+            e = _finite("e", self.e)
+            if not 0.0 <= e <= 1.0:
+                raise ValueError(f"e must be in [0, 1] (got {e})")
+        elif self.e is not None:
+            raise ValueError(f"e is only given with law='constant' (law={law!r}, e={self.e})")
+        elif law == "housner" and hb < HB_MIN_HOUSNER:
+            raise ValueError(
+                f"hb must be >= 1/sqrt(2) = {HB_MIN_HOUSNER:.6f} for the Housner law "
+                f"(got {hb}); e_H would be negative"
+            )
+        alpha = _finite("alpha", self.alpha)
+        if alpha < 0:
+            raise ValueError(f"alpha must be >= 0 (got {alpha})")
+        omega = _finite("omega", self.omega)
+        if omega <= 0:
+            raise ValueError(f"omega must be > 0 (got {omega})")
+        xi = _finite("xi", self.xi)
+        if xi < 0:
+            raise ValueError(f"xi must be >= 0 (got {xi})")
+        theta_over = _finite("theta_over", self.theta_over)
+        if not 0.0 < theta_over <= 0.5 * math.pi:
+            raise ValueError(f"theta_over must be in (0, pi/2] (got {theta_over})")
+        rest_speed = _finite("rest_speed", self.rest_speed)
+        if rest_speed < 0:
+            raise ValueError(f"rest_speed must be >= 0 (got {rest_speed})")
+        for name, value in (("hb", hb), ("alpha", alpha), ("omega", omega), ("xi", xi),
+                            ("theta_over", theta_over), ("rest_speed", rest_speed),
+                            ("law", law)):
+            object.__setattr__(self, name, value)
+        if law == "constant":
+            object.__setattr__(self, "e", float(self.e))
+        else:
+            object.__setattr__(self, "e", None)
+
+    @property
+    def thc(self) -> float:
+        """``arctan(hb)``."""
+        return float(thc_from_hb(self.hb))
+
+    @property
+    def restitution(self) -> float:
+        """The coefficient of restitution of this block under its law."""
+        if self.law == "constant":
+            return self.e
+        if self.law == "housner":
+            return float(e_housner(self.thc))
+        return float(e_mao(self.thc))
+
+    @property
+    def cot(self) -> float:
+        """Uplift threshold ``cot(thc) = b/h`` on ``|f|``."""
+        return 1.0 / self.hb
+
+    @property
+    def period(self) -> float:
+        """Forcing period ``2 pi / omega``."""
+        return 2.0 * math.pi / self.omega
+
+    def replace(self, **changes) -> "Block":
+        """A copy with some fields changed (validated again)."""
+        fields = dict(hb=self.hb, alpha=self.alpha, omega=self.omega, law=self.law, e=self.e,
+                      xi=self.xi, theta_over=self.theta_over, rest_speed=self.rest_speed)
+        fields.update(changes)
+        if "law" in changes and "e" not in changes:
+            fields["e"] = None
+        if "e" in changes and "law" not in changes:
+            fields["law"] = None
+        return Block(**fields)
+
+
+# --------------------------------------------------------------------------------------------
+# Compiled physics, shared by the compiled integrator and the scipy reference path
+# --------------------------------------------------------------------------------------------
+
+@jit
+def forcing_closed(t, omega, phi):
+    """``r = sin(omega t + phi)``, the closed form of the forcing oscillator on its circle."""
+    return math.sin(omega * t + phi)
+
+
+@jit
+def accel(theta, dtheta, f, side, thc, xi):
+    """Angular acceleration ``theta''`` while rocking on corner ``side`` (+1 or -1).
+
+    ``f`` is the forcing acceleration ``alpha omega^2 r``. One formula serves both corners:
+    ``theta'' = 3/4 (f sin(thc + s theta) - s cos(thc + s theta) - xi theta')`` with ``s = side``
+    (SPEC.md §1). On ``side = 0`` (rest) the acceleration is zero.
+    """
+    if side == 0:
+        return 0.0
+    a = thc + side * theta
+    return 0.75 * (f * math.sin(a) - side * math.cos(a) - xi * dtheta)
+
+
+@jit
+def accel_jac(theta, dtheta, f, side, thc, xi):
+    """Partial derivatives of :func:`accel` with respect to ``theta``, ``theta'`` and ``f``."""
+    if side == 0:
+        return 0.0, 0.0, 0.0
+    a = thc + side * theta
+    return 0.75 * (side * f * math.cos(a) + math.sin(a)), -0.75 * xi, 0.75 * math.sin(a)
+
+
+@jit
+def uplift_time(t, aw2, cot, omega, phi):
+    """First time ``>= t`` at which the closed-form forcing lifts a block at rest.
+
+    The block at rest leaves it when ``|aw2 sin(omega t + phi)| > cot`` (SPEC.md §3). Returns
+    ``t`` itself if that already holds, and ``inf`` if ``aw2 <= cot`` (it never leaves).
+    """
+    if aw2 <= cot:
+        return math.inf
+    a = math.asin(cot / aw2)
+    psi = omega * t + phi
+    u = psi - math.pi * math.floor(psi / math.pi)  # phase modulo pi: |sin| has period pi
+    if a < u < math.pi - a:
+        return t
+    if u <= a:
+        return t + (a - u) / omega
+    return t + (math.pi - u + a) / omega
+
+
+@jit
+def oscillator(r, s, omega):
+    """Right-hand side ``(r', s')`` of the autonomous forcing oscillator (SPEC.md §1)."""
+    q = r * r + s * s
+    return r + omega * s - r * q, s - omega * r - s * q
+
+
+@jit
+def oscillator_jac(r, s, omega):
+    """Jacobian ``[[dr'/dr, dr'/ds], [ds'/dr, ds'/ds]]`` of :func:`oscillator`."""
+    q = r * r + s * s
+    return (1.0 - q - 2.0 * r * r, omega - 2.0 * r * s,
+            -omega - 2.0 * r * s, 1.0 - q - 2.0 * s * s)
+
+
+@jit
+def jump(dtheta_minus, e):
+    """Impact map on ``theta = 0``: ``theta'(+) = e theta'(-)``; the side changes sign."""
+    return e * dtheta_minus
+
+
+@jit
+def saltation(dtheta_minus, f, side_old, thc, xi, e):
+    """Lower-left entry of the saltation matrix of an impact on ``theta = 0``.
+
+    ``S = [[e, 0], [s10, e]]`` with ``s10 = (F+ - e F-) / theta'-``, ``F-`` the acceleration on
+    the old corner before the jump and ``F+`` on the new corner after it (SPEC.md §5; Müller
+    1995). Both come from :func:`accel`, so damping cancels exactly as it does analytically.
+    """
+    f_minus = accel(0.0, dtheta_minus, f, side_old, thc, xi)
+    f_plus = accel(0.0, jump(dtheta_minus, e), f, -side_old, thc, xi)
+    return (f_plus - e * f_minus) / dtheta_minus

@@ -1,0 +1,244 @@
+"""The scipy reference path: ``solve_ivp`` driven through the same model functions.
+
+This is how the study computed its trajectories (SPEC.md §4): ``solve_ivp`` (BDF, rtol 1e-6,
+atol 1e-9) on the 4-D embedding, with terminal events at ``theta = 0`` and ``|theta| = theta_over``
+and a restart after each impact. Any ``solve_ivp`` method and tolerance may be chosen; the rest and
+overturning rules, the jump and the Zeno cut-off are those of the compiled path, and every
+equation comes from :mod:`rockjit.model`. It is slow by design: it is the independent reference
+the compiled integrator is checked against.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .model import Block, accel, accel_jac, forcing_closed, jump, oscillator, oscillator_jac
+from .model import uplift_time
+
+# A point just off theta = 0 on the new corner after an impact, so that the impact event of the
+# next segment is not found again at its own starting instant.
+_TINY = np.finfo(float).tiny
+
+
+def _fields(block: Block, phi: float, embed4: bool):
+    thc, xi, aw2, omega = block.thc, block.xi, block.alpha * block.omega**2, block.omega
+
+    def forcing(t, z):
+        return z[2] if embed4 else forcing_closed(t, omega, phi)
+
+    def fun(t, z, side):
+        r = forcing(t, z)
+        out = np.empty(z.shape[0])
+        out[0] = z[1]
+        out[1] = accel(z[0], z[1], aw2 * r, side, thc, xi)
+        if embed4:
+            out[2], out[3] = oscillator(z[2], z[3], omega)
+        return out
+
+    def jac(t, z, side):
+        r = forcing(t, z)
+        ja, jb, jf = accel_jac(z[0], z[1], aw2 * r, side, thc, xi)
+        n = z.shape[0]
+        J = np.zeros((n, n))
+        J[0, 1] = 1.0
+        J[1, 0] = ja
+        J[1, 1] = jb
+        if embed4:
+            J[1, 2] = aw2 * jf
+            a, b, c, d = oscillator_jac(z[2], z[3], omega)
+            J[2, 2], J[2, 3], J[3, 2], J[3, 3] = a, b, c, d
+        return J
+
+    return fun, jac, forcing
+
+
+def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, forcing,
+                   ivp_method="BDF", rtol=1e-6, atol=1e-9, record_stride=None,
+                   max_impacts=100_000):
+    """Reference run through ``scipy.integrate.solve_ivp``; returns a :class:`Result`.
+
+    Called by :func:`rockjit.simulate` with ``method="scipy[:METHOD]"``, which validates the
+    inputs. Samples are taken at the compiled path's grid points (``T/2`` for the stroboscopic
+    sections, ``record_stride`` steps for the trajectory) from the solver's own output.
+    """
+    from .simulate import Result, initial_side
+
+    embed4 = forcing == "embedded"
+    fun, jac, forc = _fields(block, phi, embed4)
+    T = block.period
+    h = T / n_steps
+    t_end = periods * T
+    aw2, cot, omega, thover, e = (block.alpha * block.omega**2, block.cot, block.omega,
+                                  block.theta_over, block.restitution)
+    # sample times: the half-period grid, and the trajectory grid if asked
+    t_half = np.arange(2 * periods + 1) * (T / 2)
+    t_samp = t_half
+    if record_stride:
+        t_traj = np.arange(periods * n_steps // record_stride + 1) * (h * record_stride)
+        t_samp = np.union1d(t_half, t_traj)
+    samples = {}
+
+    def take(ts, ys):
+        for tk, yk in zip(ts, ys.T):
+            samples[float(tk)] = yk
+
+    def rest_sample(ts, rs=None):
+        for i, tk in enumerate(ts):
+            if embed4:
+                samples[float(tk)] = np.array([0.0, 0.0, rs[0, i], rs[1, i]])
+            else:
+                samples[float(tk)] = np.array([0.0, 0.0])
+
+    z = np.array([theta0, dtheta0, r0, s0] if embed4 else [theta0, dtheta0], dtype=float)
+    side = initial_side(theta0, dtheta0)
+    t = 0.0
+    status = None
+    impacts = []
+    nfev = 0
+    nsteps = 0
+    n_rest = 0
+    if side != 0 and side * z[0] >= thover:
+        status = "overturned"
+    take([0.0], z[:, None])
+
+    while status is None and t < t_end:
+        if side == 0:
+            # ---- at rest: wait for |f| > cot(thc) -----------------------------------------
+            if embed4:
+                rad = math.hypot(z[2], z[3])
+                if aw2 * max(1.0, rad) <= cot:
+                    status = "rest"
+                    break
+                if aw2 * abs(z[2]) > cot:
+                    side = 1 if z[2] > 0 else -1
+                    continue
+
+                def osc(tt, w):
+                    return np.array(oscillator(w[0], w[1], omega))
+
+                def lift(tt, w):
+                    return (aw2 * w[0]) ** 2 - cot**2
+                lift.terminal = True
+                lift.direction = 1
+                ts = t_samp[(t_samp > t) & (t_samp <= t_end)]
+                sol = solve_ivp(osc, (t, t_end), z[2:], method=ivp_method, rtol=rtol,
+                                atol=atol, events=lift, t_eval=ts)
+                nfev += sol.nfev
+                nsteps += len(sol.t)
+                rest_sample(sol.t, np.asarray(sol.y).reshape(2, -1))
+                if sol.status == 1:
+                    t = float(sol.t_events[0][0])
+                    z = np.array([0.0, 0.0, *sol.y_events[0][0]])
+                    side = 1 if z[2] > 0 else -1
+                else:
+                    t = t_end
+                    z = np.array([0.0, 0.0, *np.asarray(sol.y)[:, -1]])
+            else:
+                t_up = uplift_time(t, aw2, cot, omega, phi)
+                if t_up == math.inf:
+                    status = "rest"
+                    break
+                t_stop = min(t_up, t_end)
+                ts = t_samp[(t_samp > t) & (t_samp <= t_stop)]
+                rest_sample(ts)
+                t = t_stop
+                if t_up <= t_end:
+                    side = 1 if forcing_closed(t, omega, phi) > 0 else -1
+            continue
+
+        # ---- in flight on corner `side` ------------------------------------------------------
+        def impact(tt, zz, side=side):
+            return side * zz[0]
+        impact.terminal = True
+        impact.direction = -1
+
+        def over(tt, zz, side=side):
+            return thover - side * zz[0]
+        over.terminal = True
+        over.direction = -1
+
+        ts = t_samp[(t_samp > t) & (t_samp <= t_end)]
+        opts = {"jac": jac} if ivp_method in ("BDF", "Radau", "LSODA") else {}
+        sol = solve_ivp(fun, (t, t_end), z, method=ivp_method, rtol=rtol, atol=atol,
+                        events=(impact, over), t_eval=ts, args=(side,), **opts)
+        nfev += sol.nfev
+        nsteps += len(sol.t)
+        take(sol.t, np.asarray(sol.y).reshape(len(z), -1))
+        if sol.status == -1:
+            status = "nonfinite"
+            break
+        if sol.status == 0:
+            t = t_end
+            # the last sample point is t_end itself (t_half ends there)
+            z = np.asarray(sol.y)[:, -1]
+            break
+        if len(sol.t_events[1]):
+            t = float(sol.t_events[1][0])
+            z = sol.y_events[1][0].copy()
+            status = "overturned"
+            break
+        t = float(sol.t_events[0][0])
+        z = sol.y_events[0][0].copy()
+        dth_m = z[1]
+        dth_p = jump(dth_m, e)
+        impacts.append((t, dth_m, dth_p))
+        side = -side
+        z[0] = side * _TINY
+        z[1] = dth_p
+        if abs(dth_p) < block.rest_speed or dth_p == 0.0:
+            z[0] = 0.0
+            z[1] = 0.0
+            side = 0
+            n_rest += 1
+        if len(impacts) >= max_impacts:
+            status = "max_impacts"
+            break
+
+    if status is None:
+        status = "done"
+    # final state with (r, s)
+    if embed4:
+        state = np.array(z, dtype=float)
+    else:
+        psi = omega * t + phi
+        state = np.array([z[0], z[1], math.sin(psi), math.cos(psi)])
+
+    def full(tk, yk):
+        if embed4:
+            return yk
+        psi = omega * tk + phi
+        return np.array([yk[0], yk[1], math.sin(psi), math.cos(psi)])
+
+    have = np.array(sorted(samples))
+    # stroboscopic samples in order, only as far as the run went
+    k_full = [k for k in range(periods + 1) if (k * T) <= t + 1e-9 * T]
+    strobe = []
+    for k in range(len(k_full)):
+        tk = t_half[2 * k]
+        i = np.searchsorted(have, tk - 1e-9 * T)
+        if i < len(have) and abs(have[i] - tk) <= 1e-9 * T:
+            strobe.append(full(tk, samples[have[i]]))
+    strobe_half = []
+    for k in range(periods):
+        tk = t_half[2 * k + 1]
+        if tk > t:
+            break
+        i = np.searchsorted(have, tk - 1e-9 * T)
+        if i < len(have) and abs(have[i] - tk) <= 1e-9 * T:
+            strobe_half.append(full(tk, samples[have[i]]))
+    traj = None
+    if record_stride:
+        traj = np.array([[tk, *full(tk, samples[tk])] for tk in have
+                         if np.isclose(tk / (h * record_stride),
+                                       round(tk / (h * record_stride)), rtol=0, atol=1e-6)])
+    return Result(
+        block=block, method=f"scipy:{ivp_method}", status=status, t=float(t), state=state,
+        period=T, n_steps=n_steps, periods=periods,
+        strobe=np.array(strobe).reshape(-1, 4), strobe_half=np.array(strobe_half).reshape(-1, 4),
+        impacts=np.array(impacts).reshape(-1, 3), n_impacts=len(impacts),
+        n_grid_steps=nsteps, n_rhs=nfev, max_error_estimate=math.nan, trajectory=traj,
+        n_rest=n_rest,
+    )
