@@ -11,7 +11,12 @@ import numba
 FASTMATH = frozenset({"contract", "nsz"})
 
 
-def jit(func=None, *, parallel=False):
-    """``numba.njit`` with the project policy: cached, the one fastmath set."""
-    deco = numba.njit(cache=True, fastmath=set(FASTMATH), parallel=parallel, error_model="numpy")
+def jit(func=None, *, parallel=False, inline="never"):
+    """``numba.njit`` with the project policy: cached, the one fastmath set.
+
+    ``inline="always"`` inlines at numba's IR level: used for the few helpers called once per
+    step, whose many array arguments would otherwise cost more than their arithmetic.
+    """
+    deco = numba.njit(cache=True, fastmath=set(FASTMATH), parallel=parallel,
+                      error_model="numpy", inline=inline)
     return deco if func is None else deco(func)

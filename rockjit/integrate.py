@@ -78,17 +78,20 @@ STATUS_NAMES = {
 }
 
 # ---- layout of the float parameter vector ``par`` ---------------------------------------------
-P_THC, P_XI, P_E, P_AW2, P_OMEGA, P_PHI, P_COT, P_THOVER, P_REST, P_H = range(10)
-N_PAR = 10
+P_THC, P_XI, P_E, P_AW2, P_OMEGA, P_PHI, P_COT, P_THOVER, P_REST, P_H, P_SETTLE_TOL = range(11)
+N_PAR = 11
 
 # ---- layout of the integer settings ``ipar`` ---------------------------------------------------
-I_N, I_PERIODS, I_MAXIMP, I_STRIDE, I_WINDOW, I_SETTLE, I_QR = range(7)
-N_IPAR = 7  # I_QR: grid steps between renormalisations of the tangent vectors (0: never)
+I_N, I_PERIODS, I_MAXIMP, I_STRIDE, I_WINDOW, I_SETTLE, I_QR, I_PMAX = range(8)
+N_IPAR = 8
+# I_QR: grid steps between renormalisations of the tangent vectors (0: never).
+# I_SETTLE: repetitions of a period that count as settled (0: never stop early); I_PMAX: the
+# longest period looked for.
 
 # ---- layout of the integer outputs ``iout`` ----------------------------------------------------
 O_STATUS, O_STEPS, O_IMPACTS, O_RHS, O_NSTROBE, O_NHALF, O_NTRAJ, O_NREST, O_NREST_WIN, \
-    O_SUBSTEPS, O_NIMP_WIN = range(11)
-N_IOUT = 11
+    O_SUBSTEPS, O_NIMP_WIN, O_PERIOD = range(12)
+N_IOUT = 12
 
 # ---- layout of the float outputs ``fout`` ------------------------------------------------------
 F_T, F_TH, F_DTH, F_R, F_S, F_MAXERR, F_LAM1, F_LAM2, F_WINTIME, F_V = range(10)
@@ -101,7 +104,6 @@ BISECT_ITERS = 60
 NEWTON_ITERS = 8
 
 
-@functools.lru_cache(maxsize=None)
 def build(embed4: bool = False, tangent: bool = False, record: bool = False):
     """Compile (once, then from numba's cache) the integrator for one set of switches.
 
@@ -121,9 +123,48 @@ def build(embed4: bool = False, tangent: bool = False, record: bool = False):
         ``run(y0, side0, par, ipar, strobe, half, impacts, traj, lam_run, iout, fout)``,
         see :func:`run_docs`.
     """
-    EMBED4 = bool(embed4)
-    TANGENT = bool(tangent)
-    RECORD = bool(record)
+    return _build(bool(embed4), bool(tangent), bool(record))
+
+
+@jit
+def settled_period(strobe, half, per_imp, k, reps, pmax, tol):
+    """Smallest period p <= pmax that the last ``reps * p`` periods repeat, else 0.
+
+    Compares the stroboscopic samples at ``jT`` and ``jT + T/2`` with those ``p`` periods
+    earlier, to ``tol`` times the largest ``|theta|, |theta'|`` among them, and requires the same
+    number of impacts in each compared period (so that a transient which happens to be at rest
+    at the sampling instants is not taken for a periodic orbit).
+    """
+    for p in range(1, pmax + 1):
+        n = reps * p
+        if k - n - p < 0:
+            return 0
+        scale = 0.0
+        for j in range(k - n - p, k + 1):
+            for c in range(2):
+                scale = max(scale, abs(strobe[j, c]))
+                if j < k:
+                    scale = max(scale, abs(half[j, c]))
+        lim = tol * scale + 1e-300
+        ok = True
+        for j in range(k - n + 1, k + 1):
+            if per_imp[j] - per_imp[j - 1] != per_imp[j - p] - per_imp[j - p - 1]:
+                ok = False
+                break
+            for c in range(2):
+                if abs(strobe[j, c] - strobe[j - p, c]) > lim:
+                    ok = False
+                if abs(half[j - 1, c] - half[j - 1 - p, c]) > lim:
+                    ok = False
+            if not ok:
+                break
+        if ok:
+            return p
+    return 0
+
+
+@functools.lru_cache(maxsize=None)
+def _build(EMBED4, TANGENT, RECORD):
     NS = 4 if EMBED4 else 2          # state components: theta, theta' (, r, s)
     NY = NS + (4 if TANGENT else 0)  # plus the tangent matrix, column-major
 
@@ -172,7 +213,7 @@ def build(embed4: bool = False, tangent: bool = False, record: bool = False):
     def forcing_at(t, par):
         return forcing_closed(t, par[P_OMEGA], par[P_PHI])
 
-    @jit
+    @jit(inline="always")
     def rk_step(t, y, h, K, side, par, ytmp, ynew, rot):
         """One Dormand–Prince step of length h from (t, y); K[0] must hold f(t, y).
 
@@ -303,7 +344,7 @@ def build(embed4: bool = False, tangent: bool = False, record: bool = False):
             tau = tn
         return tau  # yev holds the state at this tau
 
-    @jit
+    @jit(inline="always")
     def detect(y, ynew, hh, K, side, par):
         """Look for an event in the step just taken; returns (kind, lo, hi)."""
         if side == 0:
@@ -394,7 +435,7 @@ def build(embed4: bool = False, tangent: bool = False, record: bool = False):
         y[NS + 3] = 1.0
 
     @jit
-    def run(y0, side0, par, ipar, strobe, half, impacts, traj, lam_run, iout, fout):
+    def run(y0, side0, par, ipar, strobe, half, impacts, traj, lam_run, per_imp, iout, fout):
         n_per = ipar[I_N]
         periods = ipar[I_PERIODS]
         max_imp = ipar[I_MAXIMP]
@@ -404,7 +445,7 @@ def build(embed4: bool = False, tangent: bool = False, record: bool = False):
         e = par[P_E]
         total = n_per * periods
         half_n = n_per // 2
-        qr_every = ipar[I_QR]
+        qr_every = ipar[I_QR] if ipar[I_QR] > 0 else total + 1
 
         K = np.zeros((N_STAGES + 1, NY))
         y = np.zeros(NY)
@@ -444,6 +485,12 @@ def build(embed4: bool = False, tangent: bool = False, record: bool = False):
         iout[O_RHS] += 1
 
         step = 0
+        j_per = 0   # grid steps into the current period
+        k_per = 0   # completed periods
+        j_qr = 0
+        j_rec = 0
+        settle_reps = ipar[I_SETTLE]
+        per_imp[0] = 0
         while step < total and status == RUNNING:
             t_grid = (step + 1) * h
             in_window = step >= win_step
@@ -542,10 +589,10 @@ def build(embed4: bool = False, tangent: bool = False, record: bool = False):
                 y[0] = 0.0
                 y[1] = dth_p
                 side = -side
-                if n_imp < n_imp_cap:
-                    impacts[n_imp, 0] = t
-                    impacts[n_imp, 1] = dth_m
-                    impacts[n_imp, 2] = dth_p
+                q = n_imp % n_imp_cap  # a ring: the latest impacts are kept
+                impacts[q, 0] = t
+                impacts[q, 1] = dth_m
+                impacts[q, 2] = dth_p
                 n_imp += 1
                 if in_window:
                     iout[O_NIMP_WIN] += 1
@@ -570,28 +617,43 @@ def build(embed4: bool = False, tangent: bool = False, record: bool = False):
             if not (math.isfinite(y[0]) and math.isfinite(y[1])):
                 status = NONFINITE
                 break
-            if TANGENT and side != 0 and qr_every > 0 and step % qr_every == 0:
-                qr_renormalise(y, lam_sum, in_window, lam_win)
-                # the first stage's tangent rows belong to the old vectors: refresh them (only
-                # them, so that the state's trajectory is the same with and without tangents)
-                tangent_rhs(par[P_AW2] * forcing_now(t, y, par), y, side, par, K, 0)
-            j = step % n_per
-            if j == 0:
-                k = step // n_per
-                sample(t, y, par, strobe[k])
-                iout[O_NSTROBE] = k + 1
+            if TANGENT:
+                j_qr += 1
+                if j_qr == qr_every:
+                    j_qr = 0
+                    if side != 0:
+                        qr_renormalise(y, lam_sum, in_window, lam_win)
+                        # the first stage's tangent rows belong to the old vectors: refresh
+                        # them (only them: the state's trajectory must not depend on tangents)
+                        tangent_rhs(par[P_AW2] * forcing_now(t, y, par), y, side, par, K, 0)
+            j_per += 1
+            if j_per == n_per:
+                j_per = 0
+                k_per += 1
+                sample(t, y, par, strobe[k_per])
+                iout[O_NSTROBE] = k_per + 1
+                per_imp[k_per] = n_imp
                 if TANGENT:
-                    lam_run[k, 0] = lam_sum[0] / t
-                    lam_run[k, 1] = lam_sum[1] / t
-            elif j == half_n:
-                k = step // n_per
-                sample(t, y, par, half[k])
-                iout[O_NHALF] = k + 1
-            if RECORD and step % stride == 0:
-                q = step // stride
-                traj[q, 0] = t
-                sample(t, y, par, traj[q, 1:])
-                iout[O_NTRAJ] = q + 1
+                    lam_run[k_per, 0] = lam_sum[0] / t
+                    lam_run[k_per, 1] = lam_sum[1] / t
+                if settle_reps > 0:
+                    p = settled_period(strobe, half, per_imp, k_per, settle_reps,
+                                       ipar[I_PMAX], par[P_SETTLE_TOL])
+                    if p > 0:
+                        iout[O_PERIOD] = p
+                        status = SETTLED
+                        break
+            elif j_per == half_n:
+                sample(t, y, par, half[k_per])
+                iout[O_NHALF] = k_per + 1
+            if RECORD:
+                j_rec += 1
+                if j_rec == stride:
+                    j_rec = 0
+                    q = step // stride
+                    traj[q, 0] = t
+                    sample(t, y, par, traj[q, 1:])
+                    iout[O_NTRAJ] = q + 1
 
         if status == RUNNING:
             status = DONE

@@ -324,10 +324,11 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
     n_traj = periods * n_steps // record_stride + 1 if record_stride else 1
     traj = np.zeros((n_traj, 5))
     lam_run = np.zeros((periods + 1 if lyapunov else 1, 2))
+    per_imp = np.zeros(periods + 1, dtype=np.int64)
     iout = np.zeros(ig.N_IOUT, dtype=np.int64)
     fout = np.zeros(ig.N_FOUT)
     code = run(y0, initial_side(theta0, dtheta0), par, ipar, strobe, half, impacts, traj,
-               lam_run, iout, fout)
+               lam_run, per_imp, iout, fout)
     status = ig.STATUS_NAMES[int(code)]
     n_imp = int(iout[ig.O_IMPACTS])
     ns = int(iout[ig.O_NSTROBE])
