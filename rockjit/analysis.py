@@ -30,6 +30,7 @@ mode stays available with ``early_stop=False``.
 
 from __future__ import annotations
 
+import functools
 import math
 import sys
 import time
@@ -128,126 +129,120 @@ def lam_between(lam_run, k0, k1):
     return l1, l2
 
 
-def _make_cell(tangent):
-    run = ig.build(False, tangent, False)
+@jit
+def _cell(TANGENT, y0, side0, par, ipar, cpar, strobe, half, impacts, traj, lam_run, per_imp,
+         iout, fout, res):
+    """Run one cell and classify it; scalar results go to ``res``."""
+    status = ig._run(False, TANGENT, False, y0, side0, par, ipar, strobe, half, impacts, traj,
+                     lam_run, per_imp, iout, fout)
+    k1 = iout[ig.O_NSTROBE] - 1
+    if status == ig.SETTLED:
+        p = iout[ig.O_PERIOD]
+        # exactly the samples settled_period compared: (k1 - reps p - p, k1]
+        k0 = max(0, k1 - ipar[ig.I_SETTLE] * p - p + 1)
+    else:
+        k0 = ipar[ig.I_WINDOW]
+    lam1 = math.nan
+    lam2 = math.nan
+    if TANGENT:
+        lam1, lam2 = lam_between(lam_run, k0, k1)
+    label = UNRESOLVED
+    period = 0
+    if status == ig.OVERTURNED:
+        label = OVERTURN
+    elif status == ig.REST:
+        label = REST
+        lam1 = -math.inf
+        lam2 = -math.inf
+    elif status == ig.DONE or status == ig.SETTLED:
+        label, period = classify(strobe, half, per_imp, k0, k1, lam1, TANGENT,
+                                 cpar[C_TOL], ipar[ig.I_PMAX], cpar[C_LAMTOL])
+    res[R_LABEL] = label
+    res[R_PERIOD] = period
+    res[R_LAM1] = lam1
+    res[R_LAM2] = lam2
+    res[R_T] = fout[ig.F_T]
+    res[R_NIMP] = iout[ig.O_IMPACTS]
+    res[R_K0] = k0
+    res[R_K1] = k1
+    res[R_STATUS] = status
+
+
+
+@jit(parallel=True)
+def _grid(TANGENT, y0s, aw2s, par0, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got,
+         n_imp_got):
+    """Cell i starts from ``y0s[i]`` with forcing ``aw2s[i]``.
+
+    Writes ``res[i]`` (scalars), and when ``n_pts > 0`` the last stroboscopic samples
+    ``pts[i, :, :]`` (``theta, theta'`` at kT over the classified stretch) and when
+    ``n_imp_pts > 0`` the impact section ``imp_pts[i, :, :]`` (``t mod T, theta'-``).
+    """
+    n = y0s.shape[0]
+    periods = ipar[ig.I_PERIODS]
+    T = par0[ig.P_H] * ipar[ig.I_N]
+    cap = max(n_imp_pts, 1)
+    for i in prange(n):
+        par = par0.copy()
+        par[ig.P_AW2] = aw2s[i]
+        strobe = np.zeros((periods + 1, 4))
+        half = np.zeros((periods + 1, 4))
+        impacts = np.zeros((cap, 3))
+        traj = np.zeros((1, 5))
+        lam_run = np.zeros((periods + 1 if TANGENT else 1, 2))
+        per_imp = np.zeros(periods + 1, dtype=np.int64)
+        iout = np.zeros(ig.N_IOUT, dtype=np.int64)
+        fout = np.zeros(ig.N_FOUT)
+        y0 = y0s[i]
+        side0 = 0
+        if y0[0] > 0.0 or (y0[0] == 0.0 and y0[1] > 0.0):
+            side0 = 1
+        elif y0[0] < 0.0 or (y0[0] == 0.0 and y0[1] < 0.0):
+            side0 = -1
+        _cell(TANGENT, y0, side0, par, ipar, cpar, strobe, half, impacts, traj, lam_run, per_imp,
+             iout, fout, res[i])
+        k0 = int(res[i, R_K0])
+        k1 = int(res[i, R_K1])
+        lab = int(res[i, R_LABEL])
+        bounded = lab != OVERTURN and lab != REST and lab != UNRESOLVED
+        if n_pts > 0:
+            m = 0
+            if bounded:
+                for k in range(max(k0, k1 - n_pts + 1), k1 + 1):
+                    pts[i, m, 0] = strobe[k, 0]
+                    pts[i, m, 1] = strobe[k, 1]
+                    m += 1
+            n_got[i] = m
+        if n_imp_pts > 0:
+            m = 0
+            if bounded:
+                nimp = iout[ig.O_IMPACTS]
+                t_from = k0 * T
+                first = max(0, nimp - cap)
+                for q in range(first, nimp):
+                    row = q % cap
+                    if impacts[row, 0] >= t_from:
+                        tt = impacts[row, 0]
+                        imp_pts[i, m, 0] = tt - T * math.floor(tt / T)
+                        imp_pts[i, m, 1] = impacts[row, 1]
+                        m += 1
+            n_imp_got[i] = m
+
+
+
+@functools.lru_cache(maxsize=None)
+def _kernel(tangent):
+    """The grid kernel with or without tangent vectors (a thin closure forwarding the flag as a
+    compile-time literal, so that the module-level kernels are specialised and cached)."""
     TANGENT = bool(tangent)
 
     @jit
-    def cell(y0, side0, par, ipar, cpar, strobe, half, impacts, traj, lam_run, per_imp,
-             iout, fout, res):
-        """Run one cell and classify it; scalar results go to ``res``."""
-        status = run(y0, side0, par, ipar, strobe, half, impacts, traj, lam_run, per_imp,
-                     iout, fout)
-        k1 = iout[ig.O_NSTROBE] - 1
-        if status == ig.SETTLED:
-            p = iout[ig.O_PERIOD]
-            # exactly the samples settled_period compared: (k1 - reps p - p, k1]
-            k0 = max(0, k1 - ipar[ig.I_SETTLE] * p - p + 1)
-        else:
-            k0 = ipar[ig.I_WINDOW]
-        lam1 = math.nan
-        lam2 = math.nan
-        if TANGENT:
-            lam1, lam2 = lam_between(lam_run, k0, k1)
-        label = UNRESOLVED
-        period = 0
-        if status == ig.OVERTURNED:
-            label = OVERTURN
-        elif status == ig.REST:
-            label = REST
-            lam1 = -math.inf
-            lam2 = -math.inf
-        elif status == ig.DONE or status == ig.SETTLED:
-            label, period = classify(strobe, half, per_imp, k0, k1, lam1, TANGENT,
-                                     cpar[C_TOL], ipar[ig.I_PMAX], cpar[C_LAMTOL])
-        res[R_LABEL] = label
-        res[R_PERIOD] = period
-        res[R_LAM1] = lam1
-        res[R_LAM2] = lam2
-        res[R_T] = fout[ig.F_T]
-        res[R_NIMP] = iout[ig.O_IMPACTS]
-        res[R_K0] = k0
-        res[R_K1] = k1
-        res[R_STATUS] = status
-
-    return cell
-
-
-def _make_grid_kernel(tangent):
-    """The parallel kernel: one cell per (initial state, forcing amplitude) row."""
-    cell = _make_cell(tangent)
-    TANGENT = bool(tangent)
-
-    @jit(parallel=True)
     def grid(y0s, aw2s, par0, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got,
              n_imp_got):
-        """Cell i starts from ``y0s[i]`` with forcing ``aw2s[i]``.
-
-        Writes ``res[i]`` (scalars), and when ``n_pts > 0`` the last stroboscopic samples
-        ``pts[i, :, :]`` (``theta, theta'`` at kT over the classified stretch) and when
-        ``n_imp_pts > 0`` the impact section ``imp_pts[i, :, :]`` (``t mod T, theta'-``).
-        """
-        n = y0s.shape[0]
-        periods = ipar[ig.I_PERIODS]
-        T = par0[ig.P_H] * ipar[ig.I_N]
-        cap = max(n_imp_pts, 1)
-        for i in prange(n):
-            par = par0.copy()
-            par[ig.P_AW2] = aw2s[i]
-            strobe = np.zeros((periods + 1, 4))
-            half = np.zeros((periods + 1, 4))
-            impacts = np.zeros((cap, 3))
-            traj = np.zeros((1, 5))
-            lam_run = np.zeros((periods + 1 if TANGENT else 1, 2))
-            per_imp = np.zeros(periods + 1, dtype=np.int64)
-            iout = np.zeros(ig.N_IOUT, dtype=np.int64)
-            fout = np.zeros(ig.N_FOUT)
-            y0 = y0s[i]
-            side0 = 0
-            if y0[0] > 0.0 or (y0[0] == 0.0 and y0[1] > 0.0):
-                side0 = 1
-            elif y0[0] < 0.0 or (y0[0] == 0.0 and y0[1] < 0.0):
-                side0 = -1
-            cell(y0, side0, par, ipar, cpar, strobe, half, impacts, traj, lam_run, per_imp,
-                 iout, fout, res[i])
-            k0 = int(res[i, R_K0])
-            k1 = int(res[i, R_K1])
-            lab = int(res[i, R_LABEL])
-            bounded = lab != OVERTURN and lab != REST and lab != UNRESOLVED
-            if n_pts > 0:
-                m = 0
-                if bounded:
-                    for k in range(max(k0, k1 - n_pts + 1), k1 + 1):
-                        pts[i, m, 0] = strobe[k, 0]
-                        pts[i, m, 1] = strobe[k, 1]
-                        m += 1
-                n_got[i] = m
-            if n_imp_pts > 0:
-                m = 0
-                if bounded:
-                    nimp = iout[ig.O_IMPACTS]
-                    t_from = k0 * T
-                    first = max(0, nimp - cap)
-                    for q in range(first, nimp):
-                        row = q % cap
-                        if impacts[row, 0] >= t_from:
-                            tt = impacts[row, 0]
-                            imp_pts[i, m, 0] = tt - T * math.floor(tt / T)
-                            imp_pts[i, m, 1] = impacts[row, 1]
-                            m += 1
-                n_imp_got[i] = m
+        _grid(TANGENT, y0s, aw2s, par0, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got,
+              n_imp_got)
 
     return grid
-
-
-_KERNELS = {}
-
-
-def _kernel(tangent):
-    key = bool(tangent)
-    if key not in _KERNELS:
-        _KERNELS[key] = _make_grid_kernel(key)
-    return _KERNELS[key]
 
 
 @contextmanager
@@ -542,7 +537,8 @@ def basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100, theta_range=
     settings.update(r0=r0, s0=s0, phase=phi, lyapunov=bool(lyapunov), law=block.law,
                     restitution=block.restitution)
     shape = (grid, grid)
-    return BasinResult(theta0=th, dtheta0=dth, label=res[:, R_LABEL].astype(np.int64).reshape(shape),
+    return BasinResult(theta0=th, dtheta0=dth,
+                       label=res[:, R_LABEL].astype(np.int64).reshape(shape),
                        period=res[:, R_PERIOD].astype(np.int64).reshape(shape),
                        lambda_max=res[:, R_LAM1].reshape(shape) if lyapunov else None,
                        t_end=res[:, R_T].reshape(shape), block=block, settings=settings)

@@ -163,517 +163,550 @@ def settled_period(strobe, half, per_imp, k, reps, pmax, tol):
     return 0
 
 
-@functools.lru_cache(maxsize=None)
-def _build(EMBED4, TANGENT, RECORD):
-    NS = 4 if EMBED4 else 2          # state components: theta, theta' (, r, s)
+@jit
+def rhs(EMBED4, TANGENT, r, y, side, par, K, i):
+    """Right-hand side at state y into stage row ``K[i]``; ``r`` is the closed-form forcing
+    value (ignored with the embedding, which reads ``r`` from y)."""
+    if EMBED4:
+        r = y[2]
+        dr, ds = oscillator(r, y[3], par[P_OMEGA])
+        K[i, 2] = dr
+        K[i, 3] = ds
+    f = par[P_AW2] * r
+    if side == 0:
+        K[i, 0] = 0.0
+        K[i, 1] = 0.0
+    else:
+        K[i, 0] = y[1]
+        K[i, 1] = accel(y[0], y[1], f, side, par[P_THC], par[P_XI])
+    if TANGENT:
+        tangent_rhs(EMBED4, f, y, side, par, K, i)
+
+
+@jit
+def tangent_rhs(EMBED4, f, y, side, par, K, i):
+    """Variational equations ``V' = J V`` into the tangent part of ``K[i]``."""
+    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
+    NY = NS + 4
+    if side == 0:
+        for m in range(NS, NY):
+            K[i, m] = 0.0
+    else:
+        ja, jb, _ = accel_jac(y[0], y[1], f, side, par[P_THC], par[P_XI])
+        K[i, NS] = y[NS + 1]
+        K[i, NS + 1] = ja * y[NS] + jb * y[NS + 1]
+        K[i, NS + 2] = y[NS + 3]
+        K[i, NS + 3] = ja * y[NS + 2] + jb * y[NS + 3]
+
+
+@jit
+def stage_rotations(omega, h, rot):
+    """cos and sin of the forcing's phase advance ``omega C_i h`` to each stage (and to 1)."""
+    for i in range(N_STAGES):
+        rot[0, i] = math.cos(omega * C[i] * h)
+        rot[1, i] = math.sin(omega * C[i] * h)
+    rot[0, N_STAGES] = math.cos(omega * h)
+    rot[1, N_STAGES] = math.sin(omega * h)
+
+
+@jit
+def forcing_at(t, par):
+    return forcing_closed(t, par[P_OMEGA], par[P_PHI])
+
+
+@jit(inline="always")
+def rk_step(EMBED4, TANGENT, t, y, h, K, side, par, ytmp, ynew, rot):
+    """One Dormand–Prince step of length h from (t, y); K[0] must hold f(t, y).
+
+    ``rot`` holds :func:`stage_rotations` for this ``h``: the closed-form forcing at each
+    stage is the step's one sine-cosine pair rotated by it, not a fresh ``sin``.
+    """
+    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
     NY = NS + (4 if TANGENT else 0)  # plus the tangent matrix, column-major
-
-    @jit
-    def rhs(r, y, side, par, K, i):
-        """Right-hand side at state y into stage row ``K[i]``; ``r`` is the closed-form forcing
-        value (ignored with the embedding, which reads ``r`` from y)."""
-        if EMBED4:
-            r = y[2]
-            dr, ds = oscillator(r, y[3], par[P_OMEGA])
-            K[i, 2] = dr
-            K[i, 3] = ds
-        f = par[P_AW2] * r
-        if side == 0:
-            K[i, 0] = 0.0
-            K[i, 1] = 0.0
-        else:
-            K[i, 0] = y[1]
-            K[i, 1] = accel(y[0], y[1], f, side, par[P_THC], par[P_XI])
-        if TANGENT:
-            tangent_rhs(f, y, side, par, K, i)
-
-    @jit
-    def tangent_rhs(f, y, side, par, K, i):
-        """Variational equations ``V' = J V`` into the tangent part of ``K[i]``."""
-        if side == 0:
-            for m in range(NS, NY):
-                K[i, m] = 0.0
-        else:
-            ja, jb, _ = accel_jac(y[0], y[1], f, side, par[P_THC], par[P_XI])
-            K[i, NS] = y[NS + 1]
-            K[i, NS + 1] = ja * y[NS] + jb * y[NS + 1]
-            K[i, NS + 2] = y[NS + 3]
-            K[i, NS + 3] = ja * y[NS + 2] + jb * y[NS + 3]
-
-    @jit
-    def stage_rotations(omega, h, rot):
-        """cos and sin of the forcing's phase advance ``omega C_i h`` to each stage (and to 1)."""
-        for i in range(N_STAGES):
-            rot[0, i] = math.cos(omega * C[i] * h)
-            rot[1, i] = math.sin(omega * C[i] * h)
-        rot[0, N_STAGES] = math.cos(omega * h)
-        rot[1, N_STAGES] = math.sin(omega * h)
-
-    @jit
-    def forcing_at(t, par):
-        return forcing_closed(t, par[P_OMEGA], par[P_PHI])
-
-    @jit(inline="always")
-    def rk_step(t, y, h, K, side, par, ytmp, ynew, rot):
-        """One Dormand–Prince step of length h from (t, y); K[0] must hold f(t, y).
-
-        ``rot`` holds :func:`stage_rotations` for this ``h``: the closed-form forcing at each
-        stage is the step's one sine-cosine pair rotated by it, not a fresh ``sin``.
-        """
-        sp = 0.0
-        cp = 0.0
-        if not EMBED4:
-            psi = par[P_OMEGA] * t + par[P_PHI]
-            sp = math.sin(psi)
-            cp = math.cos(psi)
-        for i in range(1, N_STAGES):
-            for m in range(NY):
-                acc = 0.0
-                for j in range(i):
-                    acc += A[i, j] * K[j, m]
-                ytmp[m] = y[m] + h * acc
-            rhs(sp * rot[0, i] + cp * rot[1, i], ytmp, side, par, K, i)
+    sp = 0.0
+    cp = 0.0
+    if not EMBED4:
+        psi = par[P_OMEGA] * t + par[P_PHI]
+        sp = math.sin(psi)
+        cp = math.cos(psi)
+    for i in range(1, N_STAGES):
         for m in range(NY):
             acc = 0.0
-            for j in range(N_STAGES):
-                acc += B[j] * K[j, m]
-            ynew[m] = y[m] + h * acc
-        rhs(sp * rot[0, N_STAGES] + cp * rot[1, N_STAGES], ynew, side, par, K, N_STAGES)
+            for j in range(i):
+                acc += A[i, j] * K[j, m]
+            ytmp[m] = y[m] + h * acc
+        rhs(EMBED4, TANGENT, sp * rot[0, i] + cp * rot[1, i], ytmp, side, par, K, i)
+    for m in range(NY):
+        acc = 0.0
+        for j in range(N_STAGES):
+            acc += B[j] * K[j, m]
+        ynew[m] = y[m] + h * acc
+    rhs(EMBED4, TANGENT, sp * rot[0, N_STAGES] + cp * rot[1, N_STAGES], ynew, side, par, K,
+        N_STAGES)
 
-    @jit
-    def dense_coeffs(K, m):
-        """Coefficients of the continuous extension of component m (scipy's ``Q = K.T P``)."""
-        q0 = 0.0
-        q1 = 0.0
-        q2 = 0.0
-        q3 = 0.0
-        for i in range(N_STAGES + 1):
-            k = K[i, m]
-            q0 += k * P[i, 0]
-            q1 += k * P[i, 1]
-            q2 += k * P[i, 2]
-            q3 += k * P[i, 3]
-        return q0, q1, q2, q3
 
-    @jit
-    def event_value(kind, y, side, par, t):
-        """Event function g (positive before the event) and its time derivative."""
-        if kind == EV_IMPACT:
-            return side * y[0], side * y[1]
-        if kind == EV_OVERTURN:
-            return par[P_THOVER] - side * y[0], -side * y[1]
-        # EV_UPLIFT, only reached with the embedding
-        r = y[2]
-        dr, _ = oscillator(r, y[3], par[P_OMEGA])
-        sg = 1.0 if r >= 0.0 else -1.0
-        return par[P_COT] - par[P_AW2] * abs(r), -par[P_AW2] * sg * dr
+@jit
+def dense_coeffs(K, m):
+    """Coefficients of the continuous extension of component m (scipy's ``Q = K.T P``)."""
+    q0 = 0.0
+    q1 = 0.0
+    q2 = 0.0
+    q3 = 0.0
+    for i in range(N_STAGES + 1):
+        k = K[i, m]
+        q0 += k * P[i, 0]
+        q1 += k * P[i, 1]
+        q2 += k * P[i, 2]
+        q3 += k * P[i, 3]
+    return q0, q1, q2, q3
 
-    @jit
-    def dense_event(kind, y0m, h, q0, q1, q2, q3, side, par, x):
-        """Event function evaluated on the continuous extension at x = tau/h."""
-        v = y0m + h * x * (q0 + x * (q1 + x * (q2 + x * q3)))
-        if kind == EV_IMPACT:
-            return side * v
-        if kind == EV_OVERTURN:
-            return par[P_THOVER] - side * v
-        return par[P_COT] - par[P_AW2] * abs(v)
 
-    @jit
-    def turning_point(q0, q1, q2, q3, sgn, want_max):
-        """x in [0, 1] where sgn * d/dx of the extension changes sign (bisection).
+@jit
+def event_value(kind, y, side, par, t):
+    """Event function g (positive before the event) and its time derivative."""
+    if kind == EV_IMPACT:
+        return side * y[0], side * y[1]
+    if kind == EV_OVERTURN:
+        return par[P_THOVER] - side * y[0], -side * y[1]
+    # EV_UPLIFT, only reached with the embedding
+    r = y[2]
+    dr, _ = oscillator(r, y[3], par[P_OMEGA])
+    sg = 1.0 if r >= 0.0 else -1.0
+    return par[P_COT] - par[P_AW2] * abs(r), -par[P_AW2] * sg * dr
 
-        With ``want_max`` the derivative goes from >= 0 to < 0 (a maximum of the signed
-        component), otherwise from <= 0 to > 0 (a minimum).
-        """
-        lo = 0.0
-        hi = 1.0
-        for _ in range(BISECT_ITERS):
-            mid = 0.5 * (lo + hi)
-            d = sgn * (q0 + mid * (2.0 * q1 + mid * (3.0 * q2 + mid * 4.0 * q3)))
-            if (d >= 0.0) == want_max:
-                lo = mid
-            else:
-                hi = mid
-        return 0.5 * (lo + hi)
 
-    @jit
-    def locate(kind, t, y, hh, lo, hi, K, side, par, ytmp, yev, counts, rot):
-        """Time tau in (lo, hi] of the event, with the state there in yev.
+@jit
+def dense_event(kind, y0m, h, q0, q1, q2, q3, side, par, x):
+    """Event function evaluated on the continuous extension at x = tau/h."""
+    v = y0m + h * x * (q0 + x * (q1 + x * (q2 + x * q3)))
+    if kind == EV_IMPACT:
+        return side * v
+    if kind == EV_OVERTURN:
+        return par[P_THOVER] - side * v
+    return par[P_COT] - par[P_AW2] * abs(v)
 
-        Bisection on the continuous extension of the step (K holds its stages) gives a first
-        estimate; Newton steps on genuinely re-taken RK steps from (t, y) polish it inside the
-        bracket, falling back to bisection of the bracket if Newton leaves it.
-        """
-        comp = 2 if kind == EV_UPLIFT else 0
-        q0, q1, q2, q3 = dense_coeffs(K, comp)
-        a = lo / hh
-        b = hi / hh
-        for _ in range(BISECT_ITERS):
-            mid = 0.5 * (a + b)
-            if dense_event(kind, y[comp], hh, q0, q1, q2, q3, side, par, mid) > 0.0:
-                a = mid
-            else:
-                b = mid
-            if b - a <= 1e-16:
-                break
-        tau = 0.5 * (a + b) * hh
-        lo_b = lo
-        hi_b = hi
-        # Below ~1e-12 h the event value is dominated by rounding in t + tau: stop there.
-        tol = 1e-12 * hh
-        for it in range(NEWTON_ITERS):
-            if not EMBED4:
-                stage_rotations(par[P_OMEGA], tau, rot)
-            rk_step(t, y, tau, K, side, par, ytmp, yev, rot)
-            counts[O_RHS] += N_STAGES
-            g, dg = event_value(kind, yev, side, par, t + tau)
-            if g == 0.0:
-                break
-            if g > 0.0:
-                lo_b = tau
-            else:
-                hi_b = tau
-            if dg != 0.0:
-                tn = tau - g / dg
-            else:
-                tn = 0.5 * (lo_b + hi_b)
-            if not (lo_b <= tn <= hi_b):
-                tn = 0.5 * (lo_b + hi_b)
-            if abs(tn - tau) <= tol or it == NEWTON_ITERS - 1:
-                break
-            tau = tn
-        return tau  # yev holds the state at this tau
 
-    @jit(inline="always")
-    def detect(y, ynew, hh, K, side, par):
-        """Look for an event in the step just taken; returns (kind, lo, hi)."""
-        if side == 0:
-            # At rest (embedding only): does |f| reach cot(thc) in the step?
-            aw2 = par[P_AW2]
-            cot = par[P_COT]
-            if aw2 * abs(ynew[2]) > cot:
-                return EV_UPLIFT, 0.0, hh
-            sg = 1.0 if y[2] >= 0.0 else -1.0
-            if sg * K[0, 2] > 0.0 and sg * K[N_STAGES, 2] < 0.0:
-                q0, q1, q2, q3 = dense_coeffs(K, 2)
-                x = turning_point(q0, q1, q2, q3, sg, True)
-                if dense_event(EV_UPLIFT, y[2], hh, q0, q1, q2, q3, side, par, x) < 0.0:
-                    return EV_UPLIFT, 0.0, x * hh
-            return EV_NONE, 0.0, 0.0
-        g0 = side * y[0]
-        g1 = side * ynew[0]
-        if g1 >= par[P_THOVER]:
-            return EV_OVERTURN, 0.0, hh
-        d0 = side * y[1]
-        d1 = side * ynew[1]
-        if g1 < 0.0:
-            if g0 > 0.0:
-                return EV_IMPACT, 0.0, hh
-            # started on theta = 0 (just after an impact or an uplift): bracket from the apex
-            q0, q1, q2, q3 = dense_coeffs(K, 0)
-            x = turning_point(q0, q1, q2, q3, side, True)
-            if dense_event(EV_IMPACT, y[0], hh, q0, q1, q2, q3, side, par, x) > 0.0:
-                return EV_IMPACT, x * hh, hh
-            return EV_IMPACT, 0.0, 0.0  # a flight too small to resolve: lo == hi marks it
-        if g0 > 0.0 and d0 < 0.0 and d1 > 0.0:
-            # grazing: theta may dip through 0 and come back within the step
-            q0, q1, q2, q3 = dense_coeffs(K, 0)
-            x = turning_point(q0, q1, q2, q3, side, False)
-            if dense_event(EV_IMPACT, y[0], hh, q0, q1, q2, q3, side, par, x) < 0.0:
-                return EV_IMPACT, 0.0, x * hh
-        return EV_NONE, 0.0, 0.0
+@jit
+def turning_point(q0, q1, q2, q3, sgn, want_max):
+    """x in [0, 1] where sgn * d/dx of the extension changes sign (bisection).
 
-    @jit
-    def forcing_now(t, y, par):
-        if EMBED4:
-            return y[2]
-        return forcing_closed(t, par[P_OMEGA], par[P_PHI])
-
-    @jit
-    def sample(t, y, par, out):
-        out[0] = y[0]
-        out[1] = y[1]
-        if EMBED4:
-            out[2] = y[2]
-            out[3] = y[3]
+    With ``want_max`` the derivative goes from >= 0 to < 0 (a maximum of the signed
+    component), otherwise from <= 0 to > 0 (a minimum).
+    """
+    lo = 0.0
+    hi = 1.0
+    for _ in range(BISECT_ITERS):
+        mid = 0.5 * (lo + hi)
+        d = sgn * (q0 + mid * (2.0 * q1 + mid * (3.0 * q2 + mid * 4.0 * q3)))
+        if (d >= 0.0) == want_max:
+            lo = mid
         else:
-            psi = par[P_OMEGA] * t + par[P_PHI]
-            out[2] = math.sin(psi)
-            out[3] = math.cos(psi)
+            hi = mid
+    return 0.5 * (lo + hi)
 
-    @jit
-    def qr_renormalise(y, lam_sum, in_window, lam_win):
-        """Gram–Schmidt on the tangent columns; logs of the stretches are accumulated."""
-        v00 = y[NS]
-        v10 = y[NS + 1]
-        v01 = y[NS + 2]
-        v11 = y[NS + 3]
-        n1 = math.sqrt(v00 * v00 + v10 * v10)
-        q00 = v00 / n1
-        q10 = v10 / n1
-        p = q00 * v01 + q10 * v11
-        w0 = v01 - p * q00
-        w1 = v11 - p * q10
-        n2 = math.sqrt(w0 * w0 + w1 * w1)
-        l1 = math.log(n1)
-        l2 = math.log(n2)
-        lam_sum[0] += l1
-        lam_sum[1] += l2
-        if in_window:
-            lam_win[0] += l1
-            lam_win[1] += l2
-        y[NS] = q00
-        y[NS + 1] = q10
-        y[NS + 2] = w0 / n2
-        y[NS + 3] = w1 / n2
 
-    @jit
-    def reset_tangent(y):
-        y[NS] = 1.0
-        y[NS + 1] = 0.0
-        y[NS + 2] = 0.0
-        y[NS + 3] = 1.0
+@jit
+def locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, ytmp, yev, counts, rot):
+    """Time tau in (lo, hi] of the event, with the state there in yev.
 
-    @jit
-    def run(y0, side0, par, ipar, strobe, half, impacts, traj, lam_run, per_imp, iout, fout):
-        n_per = ipar[I_N]
-        periods = ipar[I_PERIODS]
-        max_imp = ipar[I_MAXIMP]
-        stride = ipar[I_STRIDE]
-        win_step = ipar[I_WINDOW] * n_per
-        h = par[P_H]
-        e = par[P_E]
-        total = n_per * periods
-        half_n = n_per // 2
-        qr_every = ipar[I_QR] if ipar[I_QR] > 0 else total + 1
+    Bisection on the continuous extension of the step (K holds its stages) gives a first
+    estimate; Newton steps on genuinely re-taken RK steps from (t, y) polish it inside the
+    bracket, falling back to bisection of the bracket if Newton leaves it.
+    """
+    comp = 2 if kind == EV_UPLIFT else 0
+    q0, q1, q2, q3 = dense_coeffs(K, comp)
+    a = lo / hh
+    b = hi / hh
+    for _ in range(BISECT_ITERS):
+        mid = 0.5 * (a + b)
+        if dense_event(kind, y[comp], hh, q0, q1, q2, q3, side, par, mid) > 0.0:
+            a = mid
+        else:
+            b = mid
+        if b - a <= 1e-16:
+            break
+    tau = 0.5 * (a + b) * hh
+    lo_b = lo
+    hi_b = hi
+    # Below ~1e-12 h the event value is dominated by rounding in t + tau: stop there.
+    tol = 1e-12 * hh
+    for it in range(NEWTON_ITERS):
+        if not EMBED4:
+            stage_rotations(par[P_OMEGA], tau, rot)
+        rk_step(EMBED4, TANGENT, t, y, tau, K, side, par, ytmp, yev, rot)
+        counts[O_RHS] += N_STAGES
+        g, dg = event_value(kind, yev, side, par, t + tau)
+        if g == 0.0:
+            break
+        if g > 0.0:
+            lo_b = tau
+        else:
+            hi_b = tau
+        if dg != 0.0:
+            tn = tau - g / dg
+        else:
+            tn = 0.5 * (lo_b + hi_b)
+        if not (lo_b <= tn <= hi_b):
+            tn = 0.5 * (lo_b + hi_b)
+        if abs(tn - tau) <= tol or it == NEWTON_ITERS - 1:
+            break
+        tau = tn
+    return tau  # yev holds the state at this tau
 
-        K = np.zeros((N_STAGES + 1, NY))
-        y = np.zeros(NY)
-        ytmp = np.zeros(NY)
-        ynew = np.zeros(NY)
-        yev = np.zeros(NY)
-        lam_sum = np.zeros(2)
-        lam_win = np.zeros(2)
-        rot_h = np.zeros((2, N_STAGES + 1))  # for the full grid step h
-        rot = np.zeros((2, N_STAGES + 1))    # for substeps and re-steps
-        stage_rotations(par[P_OMEGA], h, rot_h)
-        for m in range(NS):
-            y[m] = y0[m]
-        if TANGENT:
-            reset_tangent(y)
-        for m in range(N_IOUT):
-            iout[m] = 0
-        side = side0
-        t = 0.0
-        status = RUNNING
-        max_err = 0.0
-        n_imp = 0
-        n_imp_cap = impacts.shape[0]
 
-        sample(t, y, par, strobe[0])
-        iout[O_NSTROBE] = 1
-        if RECORD:
-            traj[0, 0] = t
-            sample(t, y, par, traj[0, 1:])
-            iout[O_NTRAJ] = 1
-        if TANGENT:
-            lam_run[0, 0] = 0.0
-            lam_run[0, 1] = 0.0
-        if side != 0 and side * y[0] >= par[P_THOVER]:
-            status = OVERTURNED
-        rhs(forcing_at(t, par), y, side, par, K, 0)
-        iout[O_RHS] += 1
+@jit(inline="always")
+def detect(y, ynew, hh, K, side, par):
+    """Look for an event in the step just taken; returns (kind, lo, hi)."""
+    if side == 0:
+        # At rest (embedding only): does |f| reach cot(thc) in the step?
+        aw2 = par[P_AW2]
+        cot = par[P_COT]
+        if aw2 * abs(ynew[2]) > cot:
+            return EV_UPLIFT, 0.0, hh
+        sg = 1.0 if y[2] >= 0.0 else -1.0
+        if sg * K[0, 2] > 0.0 and sg * K[N_STAGES, 2] < 0.0:
+            q0, q1, q2, q3 = dense_coeffs(K, 2)
+            x = turning_point(q0, q1, q2, q3, sg, True)
+            if dense_event(EV_UPLIFT, y[2], hh, q0, q1, q2, q3, side, par, x) < 0.0:
+                return EV_UPLIFT, 0.0, x * hh
+        return EV_NONE, 0.0, 0.0
+    g0 = side * y[0]
+    g1 = side * ynew[0]
+    if g1 >= par[P_THOVER]:
+        return EV_OVERTURN, 0.0, hh
+    d0 = side * y[1]
+    d1 = side * ynew[1]
+    if g1 < 0.0:
+        if g0 > 0.0:
+            return EV_IMPACT, 0.0, hh
+        # started on theta = 0 (just after an impact or an uplift): bracket from the apex
+        q0, q1, q2, q3 = dense_coeffs(K, 0)
+        x = turning_point(q0, q1, q2, q3, side, True)
+        if dense_event(EV_IMPACT, y[0], hh, q0, q1, q2, q3, side, par, x) > 0.0:
+            return EV_IMPACT, x * hh, hh
+        return EV_IMPACT, 0.0, 0.0  # a flight too small to resolve: lo == hi marks it
+    if g0 > 0.0 and d0 < 0.0 and d1 > 0.0:
+        # grazing: theta may dip through 0 and come back within the step
+        q0, q1, q2, q3 = dense_coeffs(K, 0)
+        x = turning_point(q0, q1, q2, q3, side, False)
+        if dense_event(EV_IMPACT, y[0], hh, q0, q1, q2, q3, side, par, x) < 0.0:
+            return EV_IMPACT, 0.0, x * hh
+    return EV_NONE, 0.0, 0.0
 
-        step = 0
-        j_per = 0   # grid steps into the current period
-        k_per = 0   # completed periods
-        j_qr = 0
-        j_rec = 0
-        settle_reps = ipar[I_SETTLE]
-        per_imp[0] = 0
-        while step < total and status == RUNNING:
-            t_grid = (step + 1) * h
-            in_window = step >= win_step
-            fresh = True  # no event yet in this grid step
-            while True:
-                if side == 0 and not EMBED4:
-                    # at rest, closed-form forcing: jump straight to the uplift instant
-                    t_up = uplift_time(t, par[P_AW2], par[P_COT], par[P_OMEGA], par[P_PHI])
-                    if t_up == math.inf:
-                        status = REST
-                        break
-                    if t_up >= t_grid:
-                        t = t_grid
-                        break
-                    t = t_up
-                    fresh = False
-                    y[0] = 0.0
-                    y[1] = 0.0
-                    side = 1 if forcing_now(t, y, par) > 0.0 else -1
-                    rhs(forcing_at(t, par), y, side, par, K, 0)
-                    iout[O_RHS] += 1
-                    continue
-                if side == 0:
-                    rad = math.sqrt(y[2] * y[2] + y[3] * y[3])
-                    if par[P_AW2] * max(1.0, rad) <= par[P_COT]:
-                        status = REST
-                        break
-                    if par[P_AW2] * abs(y[2]) > par[P_COT]:
-                        side = 1 if y[2] > 0.0 else -1
-                        rhs(forcing_at(t, par), y, side, par, K, 0)
-                        iout[O_RHS] += 1
-                        continue
-                if fresh:
-                    # a whole grid step (t + h equals t_grid up to one rounding of t)
-                    hh = h
-                    rk_step(t, y, hh, K, side, par, ytmp, ynew, rot_h)
-                else:
-                    hh = t_grid - t
-                    if not EMBED4:
-                        stage_rotations(par[P_OMEGA], hh, rot)
-                    rk_step(t, y, hh, K, side, par, ytmp, ynew, rot)
-                iout[O_RHS] += N_STAGES
-                iout[O_SUBSTEPS] += 1
-                kind, lo, hi = detect(y, ynew, hh, K, side, par)
-                if kind == EV_NONE:
-                    if side != 0:
-                        e0 = 0.0
-                        e1 = 0.0
-                        for i in range(N_STAGES + 1):
-                            e0 += E[i] * K[i, 0]
-                            e1 += E[i] * K[i, 1]
-                        err = hh * max(abs(e0), abs(e1))
-                        if err > max_err:
-                            max_err = err
-                    for m in range(NY):
-                        y[m] = ynew[m]
-                        K[0, m] = K[N_STAGES, m]
+
+@jit
+def forcing_now(EMBED4, t, y, par):
+    if EMBED4:
+        return y[2]
+    return forcing_closed(t, par[P_OMEGA], par[P_PHI])
+
+
+@jit
+def sample(EMBED4, t, y, par, out):
+    out[0] = y[0]
+    out[1] = y[1]
+    if EMBED4:
+        out[2] = y[2]
+        out[3] = y[3]
+    else:
+        psi = par[P_OMEGA] * t + par[P_PHI]
+        out[2] = math.sin(psi)
+        out[3] = math.cos(psi)
+
+
+@jit
+def qr_renormalise(EMBED4, y, lam_sum, in_window, lam_win):
+    """Gram–Schmidt on the tangent columns; logs of the stretches are accumulated."""
+    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
+    v00 = y[NS]
+    v10 = y[NS + 1]
+    v01 = y[NS + 2]
+    v11 = y[NS + 3]
+    n1 = math.sqrt(v00 * v00 + v10 * v10)
+    q00 = v00 / n1
+    q10 = v10 / n1
+    p = q00 * v01 + q10 * v11
+    w0 = v01 - p * q00
+    w1 = v11 - p * q10
+    n2 = math.sqrt(w0 * w0 + w1 * w1)
+    l1 = math.log(n1)
+    l2 = math.log(n2)
+    lam_sum[0] += l1
+    lam_sum[1] += l2
+    if in_window:
+        lam_win[0] += l1
+        lam_win[1] += l2
+    y[NS] = q00
+    y[NS + 1] = q10
+    y[NS + 2] = w0 / n2
+    y[NS + 3] = w1 / n2
+
+
+@jit
+def reset_tangent(EMBED4, y):
+    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
+    y[NS] = 1.0
+    y[NS + 1] = 0.0
+    y[NS + 2] = 0.0
+    y[NS + 3] = 1.0
+
+
+@jit
+def _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, traj, lam_run,
+         per_imp, iout, fout):
+    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
+    NY = NS + (4 if TANGENT else 0)  # plus the tangent matrix, column-major
+    n_per = ipar[I_N]
+    periods = ipar[I_PERIODS]
+    max_imp = ipar[I_MAXIMP]
+    stride = ipar[I_STRIDE]
+    win_step = ipar[I_WINDOW] * n_per
+    h = par[P_H]
+    e = par[P_E]
+    total = n_per * periods
+    half_n = n_per // 2
+    qr_every = ipar[I_QR] if ipar[I_QR] > 0 else total + 1
+
+    K = np.zeros((N_STAGES + 1, NY))
+    y = np.zeros(NY)
+    ytmp = np.zeros(NY)
+    ynew = np.zeros(NY)
+    yev = np.zeros(NY)
+    lam_sum = np.zeros(2)
+    lam_win = np.zeros(2)
+    rot_h = np.zeros((2, N_STAGES + 1))  # for the full grid step h
+    rot = np.zeros((2, N_STAGES + 1))    # for substeps and re-steps
+    stage_rotations(par[P_OMEGA], h, rot_h)
+    for m in range(NS):
+        y[m] = y0[m]
+    if TANGENT:
+        reset_tangent(EMBED4, y)
+    for m in range(N_IOUT):
+        iout[m] = 0
+    side = side0
+    t = 0.0
+    status = RUNNING
+    max_err = 0.0
+    n_imp = 0
+    n_imp_cap = impacts.shape[0]
+
+    sample(EMBED4, t, y, par, strobe[0])
+    iout[O_NSTROBE] = 1
+    if RECORD:
+        traj[0, 0] = t
+        sample(EMBED4, t, y, par, traj[0, 1:])
+        iout[O_NTRAJ] = 1
+    if TANGENT:
+        lam_run[0, 0] = 0.0
+        lam_run[0, 1] = 0.0
+    if side != 0 and side * y[0] >= par[P_THOVER]:
+        status = OVERTURNED
+    rhs(EMBED4, TANGENT, forcing_at(t, par), y, side, par, K, 0)
+    iout[O_RHS] += 1
+
+    step = 0
+    j_per = 0   # grid steps into the current period
+    k_per = 0   # completed periods
+    j_qr = 0
+    j_rec = 0
+    settle_reps = ipar[I_SETTLE]
+    per_imp[0] = 0
+    while step < total and status == RUNNING:
+        t_grid = (step + 1) * h
+        in_window = step >= win_step
+        fresh = True  # no event yet in this grid step
+        while True:
+            if side == 0 and not EMBED4:
+                # at rest, closed-form forcing: jump straight to the uplift instant
+                t_up = uplift_time(t, par[P_AW2], par[P_COT], par[P_OMEGA], par[P_PHI])
+                if t_up == math.inf:
+                    status = REST
+                    break
+                if t_up >= t_grid:
                     t = t_grid
                     break
-                if hi > lo:
-                    tau = locate(kind, t, y, hh, lo, hi, K, side, par, ytmp, yev, iout, rot)
-                else:
-                    # an unresolvably small flight: take it as ending at rest where it started
-                    tau = 0.0
-                    for m in range(NY):
-                        yev[m] = y[m]
-                    yev[1] = 0.0
-                t = t + tau
+                t = t_up
                 fresh = False
-                for m in range(NY):
-                    y[m] = yev[m]
-                if kind == EV_OVERTURN:
-                    status = OVERTURNED
+                y[0] = 0.0
+                y[1] = 0.0
+                side = 1 if forcing_now(EMBED4, t, y, par) > 0.0 else -1
+                rhs(EMBED4, TANGENT, forcing_at(t, par), y, side, par, K, 0)
+                iout[O_RHS] += 1
+                continue
+            if side == 0:
+                rad = math.sqrt(y[2] * y[2] + y[3] * y[3])
+                if par[P_AW2] * max(1.0, rad) <= par[P_COT]:
+                    status = REST
                     break
-                if kind == EV_UPLIFT:
-                    y[0] = 0.0
-                    y[1] = 0.0
+                if par[P_AW2] * abs(y[2]) > par[P_COT]:
                     side = 1 if y[2] > 0.0 else -1
-                    rhs(forcing_at(t, par), y, side, par, K, 0)
+                    rhs(EMBED4, TANGENT, forcing_at(t, par), y, side, par, K, 0)
                     iout[O_RHS] += 1
                     continue
-                # impact: jump map, saltation, record
-                dth_m = y[1]
-                dth_p = jump(dth_m, e)
-                if TANGENT:
-                    if dth_m != 0.0:
-                        s10 = saltation(dth_m, par[P_AW2] * forcing_now(t, y, par), side,
-                                        par[P_THC], par[P_XI], e)
-                    else:
-                        s10 = 0.0
-                    for c in range(2):
-                        v0 = y[NS + 2 * c]
-                        v1 = y[NS + 2 * c + 1]
-                        y[NS + 2 * c] = e * v0
-                        y[NS + 2 * c + 1] = s10 * v0 + e * v1
-                y[0] = 0.0
-                y[1] = dth_p
-                side = -side
-                q = n_imp % n_imp_cap  # a ring: the latest impacts are kept
-                impacts[q, 0] = t
-                impacts[q, 1] = dth_m
-                impacts[q, 2] = dth_p
-                n_imp += 1
-                if in_window:
-                    iout[O_NIMP_WIN] += 1
-                if abs(dth_p) < par[P_REST] or dth_p == 0.0:
-                    # Zeno: the impacts would accumulate; the block is at rest from here
-                    y[1] = 0.0
-                    side = 0
-                    if TANGENT:
-                        # a rest phase leaves the tangent vectors alone; bank their growth
-                        qr_renormalise(y, lam_sum, in_window, lam_win)
-                    iout[O_NREST] += 1
-                    if in_window:
-                        iout[O_NREST_WIN] += 1
-                rhs(forcing_at(t, par), y, side, par, K, 0)
-                iout[O_RHS] += 1
-                if n_imp >= max_imp:
-                    status = MAX_IMPACTS
-                    break
-            if status != RUNNING:
-                break
-            step += 1
-            if not (math.isfinite(y[0]) and math.isfinite(y[1])):
-                status = NONFINITE
-                break
-            if TANGENT:
-                j_qr += 1
-                if j_qr == qr_every:
-                    j_qr = 0
-                    if side != 0:
-                        qr_renormalise(y, lam_sum, in_window, lam_win)
-                        # the first stage's tangent rows belong to the old vectors: refresh
-                        # them (only them: the state's trajectory must not depend on tangents)
-                        tangent_rhs(par[P_AW2] * forcing_now(t, y, par), y, side, par, K, 0)
-            j_per += 1
-            if j_per == n_per:
-                j_per = 0
-                k_per += 1
-                sample(t, y, par, strobe[k_per])
-                iout[O_NSTROBE] = k_per + 1
-                per_imp[k_per] = n_imp
-                if TANGENT:
-                    lam_run[k_per, 0] = lam_sum[0] / t
-                    lam_run[k_per, 1] = lam_sum[1] / t
-                if settle_reps > 0:
-                    p = settled_period(strobe, half, per_imp, k_per, settle_reps,
-                                       ipar[I_PMAX], par[P_SETTLE_TOL])
-                    if p > 0:
-                        iout[O_PERIOD] = p
-                        status = SETTLED
-                        break
-            elif j_per == half_n:
-                sample(t, y, par, half[k_per])
-                iout[O_NHALF] = k_per + 1
-            if RECORD:
-                j_rec += 1
-                if j_rec == stride:
-                    j_rec = 0
-                    q = step // stride
-                    traj[q, 0] = t
-                    sample(t, y, par, traj[q, 1:])
-                    iout[O_NTRAJ] = q + 1
-
-        if status == RUNNING:
-            status = DONE
-        iout[O_STATUS] = status
-        iout[O_STEPS] = step
-        iout[O_IMPACTS] = n_imp
-        fout[F_T] = t
-        sample(t, y, par, fout[F_TH:F_S + 1])
-        fout[F_MAXERR] = max_err
-        if TANGENT:
-            for m in range(4):
-                fout[F_V + m] = y[NS + m]
-            wt = t - win_step * h
-            fout[F_WINTIME] = wt
-            if wt > 0.0:
-                fout[F_LAM1] = lam_win[0] / wt
-                fout[F_LAM2] = lam_win[1] / wt
+            if fresh:
+                # a whole grid step (t + h equals t_grid up to one rounding of t)
+                hh = h
+                rk_step(EMBED4, TANGENT, t, y, hh, K, side, par, ytmp, ynew, rot_h)
             else:
-                fout[F_LAM1] = math.nan
-                fout[F_LAM2] = math.nan
-        return status
+                hh = t_grid - t
+                if not EMBED4:
+                    stage_rotations(par[P_OMEGA], hh, rot)
+                rk_step(EMBED4, TANGENT, t, y, hh, K, side, par, ytmp, ynew, rot)
+            iout[O_RHS] += N_STAGES
+            iout[O_SUBSTEPS] += 1
+            kind, lo, hi = detect(y, ynew, hh, K, side, par)
+            if kind == EV_NONE:
+                if side != 0:
+                    e0 = 0.0
+                    e1 = 0.0
+                    for i in range(N_STAGES + 1):
+                        e0 += E[i] * K[i, 0]
+                        e1 += E[i] * K[i, 1]
+                    err = hh * max(abs(e0), abs(e1))
+                    if err > max_err:
+                        max_err = err
+                for m in range(NY):
+                    y[m] = ynew[m]
+                    K[0, m] = K[N_STAGES, m]
+                t = t_grid
+                break
+            if hi > lo:
+                tau = locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, ytmp, yev,
+                             iout, rot)
+            else:
+                # an unresolvably small flight: take it as ending at rest where it started
+                tau = 0.0
+                for m in range(NY):
+                    yev[m] = y[m]
+                yev[1] = 0.0
+            t = t + tau
+            fresh = False
+            for m in range(NY):
+                y[m] = yev[m]
+            if kind == EV_OVERTURN:
+                status = OVERTURNED
+                break
+            if kind == EV_UPLIFT:
+                y[0] = 0.0
+                y[1] = 0.0
+                side = 1 if y[2] > 0.0 else -1
+                rhs(EMBED4, TANGENT, forcing_at(t, par), y, side, par, K, 0)
+                iout[O_RHS] += 1
+                continue
+            # impact: jump map, saltation, record
+            dth_m = y[1]
+            dth_p = jump(dth_m, e)
+            if TANGENT:
+                if dth_m != 0.0:
+                    s10 = saltation(dth_m, par[P_AW2] * forcing_now(EMBED4, t, y, par), side,
+                                    par[P_THC], par[P_XI], e)
+                else:
+                    s10 = 0.0
+                for c in range(2):
+                    v0 = y[NS + 2 * c]
+                    v1 = y[NS + 2 * c + 1]
+                    y[NS + 2 * c] = e * v0
+                    y[NS + 2 * c + 1] = s10 * v0 + e * v1
+            y[0] = 0.0
+            y[1] = dth_p
+            side = -side
+            q = n_imp % n_imp_cap  # a ring: the latest impacts are kept
+            impacts[q, 0] = t
+            impacts[q, 1] = dth_m
+            impacts[q, 2] = dth_p
+            n_imp += 1
+            if in_window:
+                iout[O_NIMP_WIN] += 1
+            if abs(dth_p) < par[P_REST] or dth_p == 0.0:
+                # Zeno: the impacts would accumulate; the block is at rest from here
+                y[1] = 0.0
+                side = 0
+                if TANGENT:
+                    # a rest phase leaves the tangent vectors alone; bank their growth
+                    qr_renormalise(EMBED4, y, lam_sum, in_window, lam_win)
+                iout[O_NREST] += 1
+                if in_window:
+                    iout[O_NREST_WIN] += 1
+            rhs(EMBED4, TANGENT, forcing_at(t, par), y, side, par, K, 0)
+            iout[O_RHS] += 1
+            if n_imp >= max_imp:
+                status = MAX_IMPACTS
+                break
+        if status != RUNNING:
+            break
+        step += 1
+        if not (math.isfinite(y[0]) and math.isfinite(y[1])):
+            status = NONFINITE
+            break
+        if TANGENT:
+            j_qr += 1
+            if j_qr == qr_every:
+                j_qr = 0
+                if side != 0:
+                    qr_renormalise(EMBED4, y, lam_sum, in_window, lam_win)
+                    # the first stage's tangent rows belong to the old vectors: refresh
+                    # them (only them: the state's trajectory must not depend on tangents)
+                    f_now = par[P_AW2] * forcing_now(EMBED4, t, y, par)
+                    tangent_rhs(EMBED4, f_now, y, side, par, K, 0)
+        j_per += 1
+        if j_per == n_per:
+            j_per = 0
+            k_per += 1
+            sample(EMBED4, t, y, par, strobe[k_per])
+            iout[O_NSTROBE] = k_per + 1
+            per_imp[k_per] = n_imp
+            if TANGENT:
+                lam_run[k_per, 0] = lam_sum[0] / t
+                lam_run[k_per, 1] = lam_sum[1] / t
+            if settle_reps > 0:
+                p = settled_period(strobe, half, per_imp, k_per, settle_reps,
+                                   ipar[I_PMAX], par[P_SETTLE_TOL])
+                if p > 0:
+                    iout[O_PERIOD] = p
+                    status = SETTLED
+                    break
+        elif j_per == half_n:
+            sample(EMBED4, t, y, par, half[k_per])
+            iout[O_NHALF] = k_per + 1
+        if RECORD:
+            j_rec += 1
+            if j_rec == stride:
+                j_rec = 0
+                q = step // stride
+                traj[q, 0] = t
+                sample(EMBED4, t, y, par, traj[q, 1:])
+                iout[O_NTRAJ] = q + 1
+
+    if status == RUNNING:
+        status = DONE
+    iout[O_STATUS] = status
+    iout[O_STEPS] = step
+    iout[O_IMPACTS] = n_imp
+    fout[F_T] = t
+    sample(EMBED4, t, y, par, fout[F_TH:F_S + 1])
+    fout[F_MAXERR] = max_err
+    if TANGENT:
+        for m in range(4):
+            fout[F_V + m] = y[NS + m]
+        wt = t - win_step * h
+        fout[F_WINTIME] = wt
+        if wt > 0.0:
+            fout[F_LAM1] = lam_win[0] / wt
+            fout[F_LAM2] = lam_win[1] / wt
+        else:
+            fout[F_LAM1] = math.nan
+            fout[F_LAM2] = math.nan
+    return status
+
+
+
+@functools.lru_cache(maxsize=None)
+def _build(EMBED4, TANGENT, RECORD):
+    # The closure only forwards its flags: numba types them as literals, so _run and its helpers
+    # are specialised (and cached, being module-level) once per combination of switches.
+    @jit
+    def run(y0, side0, par, ipar, strobe, half, impacts, traj, lam_run, per_imp, iout, fout):
+        return _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts,
+                    traj, lam_run, per_imp, iout, fout)
 
     return run
