@@ -1,0 +1,508 @@
+"""The study's figures (SPEC.md §7), one function each; matplotlib is imported lazily.
+
+Every function takes result objects (:class:`rockjit.Result`, :class:`rockjit.analysis.SweepResult`,
+:class:`rockjit.analysis.BasinResult`) and returns a :class:`matplotlib.figure.Figure` built
+without :mod:`matplotlib.pyplot`, so no GUI backend is needed and nothing is kept in pyplot's
+figure registry; save it with :func:`rockjit.io.save_figure` or ``fig.savefig``.
+
+Behaviours have one colour everywhere: :data:`BEHAVIOUR_COLOURS`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .analysis import BEHAVIOURS, classify_result, fractions
+from .model import delta_e_percent, e_housner, e_mao, thc_from_hb
+
+__all__ = ["BEHAVIOUR_COLOURS", "LAW_COLOURS", "agreement", "fig_basin", "fig_basin_compare",
+           "fig_bifurcation", "fig_gallery", "fig_laws_timeseries", "fig_restitution",
+           "fig_trajectory"]
+
+#: One colour per behaviour name (analysis.BEHAVIOURS), used by every figure.
+BEHAVIOUR_COLOURS = {
+    "overturn": "#3b3b3b",
+    "rest": "#bdbdbd",
+    "symmetric": "#1f77b4",
+    "asymmetric": "#2ca02c",
+    "multiperiodic": "#ff7f0e",
+    "chaotic": "#d62728",
+    "aperiodic": "#9467bd",
+    "unresolved": "#e377c2",
+}
+#: Colours of the restitution laws in comparisons.
+LAW_COLOURS = {"housner": "#1f77b4", "mao": "#d62728", "constant": "#2ca02c"}
+
+_LAW_NAMES = {"housner": "Housner", "mao": "Mao", "constant": "constant e"}
+_GREEK = {"theta": "\u03b8", "dtheta": "\u03b8\u2032", "lambda": "\u03bb", "alpha": "\u03b1",
+          "omega": "\u03c9"}
+
+
+def _figure(**kw):
+    from matplotlib.figure import Figure
+    kw.setdefault("layout", "constrained")
+    return Figure(**kw)
+
+
+def _law(block):
+    if block.law == "constant":
+        return f"e = {block.restitution:g}"
+    return _LAW_NAMES.get(block.law, block.law)
+
+
+def _params(block):
+    return (f"{_law(block)}, h/b = {block.hb:g}, \u03b1 = {block.alpha:g}, "
+            f"\u03c9 = {block.omega:g}")
+
+
+def agreement(label_a, label_b):
+    """Percentage of cells where two label arrays agree."""
+    a = np.asarray(label_a)
+    b = np.asarray(label_b)
+    if a.shape != b.shape:
+        raise ValueError(f"label arrays differ in shape ({a.shape} vs {b.shape})")
+    return 100.0 * np.count_nonzero(a == b) / a.size if a.size else math.nan
+
+
+def _cmap():
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+    cmap = ListedColormap([BEHAVIOUR_COLOURS[n] for n in BEHAVIOURS])
+    norm = BoundaryNorm(np.arange(len(BEHAVIOURS) + 1) - 0.5, cmap.N)
+    return cmap, norm
+
+
+def _behaviour_handles(names, labels=None, marker=False):
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+    out = []
+    for i, n in enumerate(names):
+        lab = n if labels is None else labels[i]
+        if marker:
+            out.append(Line2D([], [], ls="", marker="o", ms=5, color=BEHAVIOUR_COLOURS[n],
+                              label=lab))
+        else:
+            out.append(Patch(color=BEHAVIOUR_COLOURS[n], label=lab))
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# Figure 1: restitution laws
+# ---------------------------------------------------------------------------------------------
+
+def fig_restitution(hb_range=(1.0 / math.sqrt(2.0), 6.0), n=400, marks=(1.0, 2.0)):
+    """Figure 1: ``e_H`` and ``e_M`` against ``thc``, with ``Δe%`` on a twin axis.
+
+    Parameters
+    ----------
+    hb_range : (float, float)
+        Slenderness range; the Housner law needs ``hb >= 1/sqrt(2)``.
+    n : int
+        Number of points.
+    marks : sequence of float
+        Slenderness values marked with a vertical line and their values.
+    """
+    lo, hi = (float(v) for v in hb_range)
+    if not 1.0 / math.sqrt(2.0) - 1e-12 <= lo < hi:
+        raise ValueError(f"hb_range must satisfy 1/sqrt(2) <= start < end (got {lo}, {hi})")
+    thc = np.linspace(thc_from_hb(lo), thc_from_hb(hi), n)
+    eh, em = e_housner(thc), e_mao(thc)
+    de = delta_e_percent(em, eh)
+    fig = _figure(figsize=(7.0, 4.2))
+    ax = fig.add_subplot()
+    deg = np.degrees(thc)
+    ax.plot(deg, eh, color=LAW_COLOURS["housner"], label="$e_H$ (Housner 1963)")
+    ax.plot(deg, em, color=LAW_COLOURS["mao"], label="$e_M$ (Mao et al. 2024)")
+    ax.set_xlabel("$\\theta_c$ = arctan(h/b)  [degrees]")
+    ax.set_ylabel("coefficient of restitution $e$")
+    ax.set_ylim(0, 1.02)
+    ax2 = ax.twinx()
+    ax2.plot(deg, de, color="0.35", ls="--", label="$\\Delta e$ % (right axis)")
+    ax2.set_ylabel("$\\Delta e$  [%]")
+    ax2.set_ylim(0, max(1.0, float(np.nanmax(de))) * 1.05)
+    for hb in marks:
+        t = float(thc_from_hb(hb))
+        h, m = float(e_housner(t)), float(e_mao(t))
+        ax.axvline(np.degrees(t), color="0.6", lw=0.8, ls=":")
+        ax.plot([np.degrees(t)] * 2, [h, m], "o", color="k", ms=3.5, zorder=5)
+        # on the twin axes, which are drawn above the first ones: the box hides the curves
+        ax2.annotate(f"h/b = {hb:g}\n$e_H$ = {h:.3f}\n$e_M$ = {m:.3f}\n"
+                     f"$\\Delta e$ = {float(delta_e_percent(m, h)):.2f} %",
+                     (np.degrees(t), 0.03), xycoords=ax.transData, xytext=(4, 0),
+                     textcoords="offset points", fontsize=8, va="bottom", zorder=6,
+                     bbox=dict(boxstyle="round,pad=0.25", fc="white", ec="0.8"))
+    lines = ax.get_legend_handles_labels()
+    lines2 = ax2.get_legend_handles_labels()
+    ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], loc="center right", fontsize=9)
+    top = ax.secondary_xaxis("top", functions=(
+        lambda d: np.tan(np.radians(np.clip(d, 1e-3, 89.9))),
+        lambda hb: np.degrees(np.arctan(hb))))
+    top.set_xticks([1, 1.5, 2, 3, 4, 6, 10])
+    top.set_xticklabels(["1", "1.5", "2", "3", "4", "6", "10"])
+    top.set_xlabel("h/b")
+    ax.set_title("Coefficient of restitution: Housner vs Mao et al.")
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# Figure 2: one run
+# ---------------------------------------------------------------------------------------------
+
+def _window_start(result):
+    if result.window is not None:
+        return float(result.window[0])
+    return round(0.8 * result.periods) * result.period
+
+
+def _window_traj(result):
+    """Trajectory rows of the asymptotic window; the whole run when the window is empty."""
+    tr = result.trajectory
+    w = tr[tr[:, 0] >= _window_start(result) - 1e-9]
+    return (w, True) if w.shape[0] >= 2 else (tr, False)
+
+
+def _need_traj(result):
+    if result.trajectory is None or result.trajectory.shape[0] == 0:
+        raise ValueError("the result has no trajectory: simulate with record_stride=...")
+
+
+def _phase(ax, result, colour="k", label=None, strobe=True):
+    w, in_window = _window_traj(result)
+    ax.plot(w[:, 1], w[:, 2], lw=0.6, color=colour, label=label)
+    if strobe and in_window:
+        s = result.strobe
+        k0 = int(round(_window_start(result) / result.period))
+        s = s[k0:]
+        if s.shape[0]:
+            ax.plot(s[:, 0], s[:, 1], "o", ms=3.5, mfc="none", color="#d62728",
+                    label="t = kT" if label is None else None)
+    ax.set_xlabel("\u03b8")
+    ax.set_ylabel("\u03b8\u2032")
+    return in_window
+
+
+def fig_trajectory(result, title=None):
+    """Figure 2: ``θ(t)``, ``λ(t)`` and the phase portrait of the window for one run.
+
+    ``result`` needs a trajectory (``record_stride``); ``λ(t)`` is drawn when the run computed
+    Lyapunov exponents (``result.lyapunov_running`` at ``t = kT``).
+    """
+    _need_traj(result)
+    tr = result.trajectory
+    lam = result.lyapunov_running
+    fig = _figure(figsize=(10.5, 6.0))
+    gs = fig.add_gridspec(2, 2, width_ratios=(1.7, 1.0))
+    ax_t = fig.add_subplot(gs[0, 0])
+    ax_l = fig.add_subplot(gs[1, 0], sharex=ax_t)
+    ax_p = fig.add_subplot(gs[:, 1])
+    ax_t.plot(tr[:, 0], tr[:, 1], lw=0.5, color="k")
+    ax_t.set_ylabel("\u03b8  [rad]")
+    t_w = _window_start(result)
+    for ax in (ax_t, ax_l):
+        ax.axvspan(t_w, max(result.t, t_w), color="#1f77b4", alpha=0.08, lw=0)
+    ax_t.set_title("\u03b8(t); shaded: the asymptotic window", fontsize=10)
+    if lam is not None and lam.shape[0] > 1:
+        k = np.arange(1, lam.shape[0])
+        ax_l.plot(k * result.period, lam[1:, 0], color="#d62728", lw=1.0, label="\u03bb\u2081(t)")
+        ax_l.axhline(0, color="0.5", lw=0.6)
+        if result.lyapunov is not None and np.isfinite(result.lyapunov[0]):
+            ax_l.axhline(result.lyapunov[0], color="#d62728", lw=0.8, ls="--",
+                         label=f"\u03bb_max over the window = {result.lyapunov[0]:.4f}")
+        ax_l.legend(fontsize=8, loc="upper right")
+        ax_l.set_ylabel("\u03bb\u2081  (running estimate)")
+    else:
+        ax_l.text(0.5, 0.5, "Lyapunov exponents not computed", ha="center", va="center",
+                  transform=ax_l.transAxes, color="0.4")
+    ax_l.set_xlabel("t  (units of 1/\u03a9\u2080)")
+    in_window = _phase(ax_p, result)
+    ax_p.set_title("phase portrait, " + ("asymptotic window" if in_window else "whole run")
+                   + "\n(circles: stroboscopic points t = kT)", fontsize=10)
+    name, p = classify_result(result)
+    beh = name + (f", period {p}" if name == "multiperiodic" else "")
+    fig.suptitle(title or f"{_params(result.block)}: {beh} ({result.status})")
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# Figure 3: behaviour gallery
+# ---------------------------------------------------------------------------------------------
+
+def fig_gallery(results):
+    """Figure 3: ``θ(t)`` and phase portrait of each run, titled with its behaviour.
+
+    Parameters
+    ----------
+    results : dict of str -> Result
+        Caption -> run (each with a trajectory), one column each.
+    """
+    if not results:
+        raise ValueError("results must hold at least one run")
+    n = len(results)
+    fig = _figure(figsize=(3.6 * n, 6.2))
+    axes = fig.subplots(2, n, squeeze=False)
+    for c, (caption, res) in enumerate(results.items()):
+        _need_traj(res)
+        name, p = classify_result(res)
+        colour = BEHAVIOUR_COLOURS[name]
+        tr = res.trajectory
+        ax = axes[0, c]
+        ax.plot(tr[:, 0], tr[:, 1], lw=0.5, color=colour)
+        ax.set_xlabel("t")
+        if c == 0:
+            ax.set_ylabel("\u03b8  [rad]")
+        b = res.block
+        beh = name + (f" (period {p})" if name == "multiperiodic" else "")
+        ax.set_title(f"{caption}\n\u03b1={b.alpha:g}, \u03c9={b.omega:g}, h/b={b.hb:g}\n"
+                     f"classified: {beh}", fontsize=9,
+                     bbox=dict(boxstyle="round,pad=0.3", fc=colour, alpha=0.25, lw=0))
+        if res.status == "overturned":
+            ax.axhline(np.sign(tr[-1, 1]) * b.theta_over, color="0.5", ls=":", lw=0.8)
+        in_window = _phase(axes[1, c], res, colour=colour)
+        axes[1, c].set_title("window" if in_window else "whole run", fontsize=8)
+    fig.suptitle(f"Behaviour gallery ({_law(next(iter(results.values())).block)})")
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# Figure 4: Housner vs Mao time series
+# ---------------------------------------------------------------------------------------------
+
+def fig_laws_timeseries(runs, t_max=None):
+    """Figure 4: the two laws from the same initial states.
+
+    Parameters
+    ----------
+    runs : sequence of dict law -> Result
+        One row per initial state; in each row the runs of each law (with trajectories).
+    t_max : float, optional
+        Show ``θ(t)`` up to this time only (default: the whole run).
+    """
+    runs = list(runs)
+    if not runs:
+        raise ValueError("runs must hold at least one initial state")
+    fig = _figure(figsize=(11.0, 2.7 * len(runs) + 0.6))
+    gs = fig.add_gridspec(len(runs), 2, width_ratios=(2.2, 1.0))
+    for i, row in enumerate(runs):
+        ax_t = fig.add_subplot(gs[i, 0])
+        ax_p = fig.add_subplot(gs[i, 1])
+        z = None
+        for law, res in row.items():
+            _need_traj(res)
+            tr = res.trajectory
+            if t_max is not None:
+                tr = tr[tr[:, 0] <= t_max]
+            colour = LAW_COLOURS.get(law, None)
+            name, p = classify_result(res)
+            beh = name + (f" {p}" if name == "multiperiodic" else "")
+            lab = f"{_law(res.block)}: {beh}"
+            ax_t.plot(tr[:, 0], tr[:, 1], lw=0.6, color=colour, label=lab, alpha=0.85)
+            _phase(ax_p, res, colour=colour, strobe=False)
+            z = tr[0, 1:3]
+        ax_t.set_ylabel("\u03b8  [rad]")
+        ax_t.legend(fontsize=8, loc="upper right")
+        ax_t.set_title(f"(\u03b8\u2080, \u03b8\u2080\u2032) = ({z[0]:.4f}, {z[1]:.4f})",
+                       fontsize=10, loc="left")
+        ax_p.set_title("phase portrait: window (whole run if it overturned)", fontsize=9)
+        if i == len(runs) - 1:
+            ax_t.set_xlabel("t  (units of 1/\u03a9\u2080)")
+    b = next(iter(runs[0].values())).block
+    fig.suptitle(f"Housner vs Mao: h/b = {b.hb:g}, \u03b1 = {b.alpha:g}, \u03c9 = {b.omega:g}")
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# Figure 5: bifurcation diagrams
+# ---------------------------------------------------------------------------------------------
+
+def _bifurcation_column(fig, gs_col, sw, alpha_limits, show_y):
+    ax = fig.add_subplot(gs_col[0])
+    ax_s = fig.add_subplot(gs_col[1], sharex=ax)
+    ax_l = fig.add_subplot(gs_col[2], sharex=ax)
+    alpha = np.asarray(sw.alpha)
+    label = np.asarray(sw.label)
+    sel = np.ones(alpha.shape, bool)
+    if alpha_limits is not None:
+        sel = (alpha >= alpha_limits[0] - 1e-12) & (alpha <= alpha_limits[1] + 1e-12)
+    names = [str(n) for n in sw.names]
+    pts = sw.strobe[:, :, 1]
+    present = []
+    for code, name in enumerate(names):
+        m = sel & (label == code)
+        if not m.any():
+            continue
+        present.append(name)
+        a = np.repeat(alpha[m], pts.shape[1])
+        y = pts[m].ravel()
+        ok = np.isfinite(y)
+        ax.scatter(a[ok], y[ok], s=0.6, color=BEHAVIOUR_COLOURS[name], lw=0, rasterized=True)
+    ax.set_ylabel("\u03b8\u2032(kT)" if show_y else "")
+    ax.set_title(f"{_law(sw.block)}, h/b = {sw.block.hb:g}, \u03c9 = {sw.block.omega:g}",
+                 fontsize=10)
+    ax.tick_params(labelbottom=False)
+
+    # a strip: the behaviour of every alpha, including those without stroboscopic points
+    cmap, norm = _cmap()
+    if alpha.size > 1:
+        d = np.diff(alpha)
+        edges = np.concatenate([[alpha[0] - d[0] / 2], alpha[:-1] + d / 2,
+                                [alpha[-1] + d[-1] / 2]])
+    else:
+        edges = np.array([alpha[0] - 0.5e-3, alpha[0] + 0.5e-3])
+    ax_s.pcolormesh(edges, [0, 1], label[None, :], cmap=cmap, norm=norm, rasterized=True)
+    ax_s.set_yticks([])
+    ax_s.set_ylabel("class" if show_y else "", rotation=0, ha="right", va="center",
+                    fontsize=8)
+    ax_s.tick_params(labelbottom=False)
+
+    lam = np.asarray(sw.lambda_max, float)
+    if np.isfinite(lam[sel]).any():
+        fin = lam[sel & np.isfinite(lam)]
+        lo, hi = float(fin.min()), float(fin.max())
+        pad = 0.08 * max(hi - lo, 1e-3)
+        lo, hi = min(lo, 0.0) - pad, max(hi, 0.0) + pad
+    else:
+        lo, hi = -1.0, 0.5
+    ax_l.set_ylim(lo, hi)
+    show = sel & ~np.isnan(lam)
+    # a thin line through consecutive finite values, broken where there is none
+    ax_l.plot(alpha[sel], np.where(np.isfinite(lam[sel]), lam[sel], np.nan), lw=0.5,
+              color="0.6", zorder=1)
+    any_rest = False
+    for code, name in enumerate(names):
+        m = show & (label == code)
+        fin = m & np.isfinite(lam)
+        ax_l.scatter(alpha[fin], lam[fin], s=4, color=BEHAVIOUR_COLOURS[name], lw=0, zorder=2)
+        neg = m & np.isneginf(lam)
+        if neg.any():  # rest: lambda = -inf, drawn at the panel's bottom
+            any_rest = True
+            ax_l.scatter(alpha[neg], np.full(neg.sum(), lo), marker="v", s=14,
+                         color=BEHAVIOUR_COLOURS[name], zorder=3, clip_on=False)
+    ax_l.axhline(0, color="k", lw=0.6)
+    ax_l.set_xlabel("\u03b1")
+    ax_l.set_ylabel("\u03bb_max" if show_y else "")
+    if alpha_limits is not None:
+        ax.set_xlim(*alpha_limits)
+    elif alpha.size > 1:
+        ax.set_xlim(edges[0], edges[-1])
+    return present, any_rest
+
+
+def fig_bifurcation(sweeps, alpha_limits=None, title=None):
+    """Figure 5: stroboscopic ``θ'`` against ``α``, coloured by behaviour, ``λ_max`` below.
+
+    Parameters
+    ----------
+    sweeps : SweepResult or dict of str -> SweepResult
+        One sweep, or several drawn side by side (e.g. the two laws).
+    alpha_limits : (float, float), optional
+        Draw only this range of ``α`` (the zoom).
+    title : str, optional
+
+    Notes
+    -----
+    ``λ_max = -inf`` (rest) is drawn as a ``▼`` at the bottom of the lower panel; ``nan``
+    (overturn, or not computed) is skipped. A thin strip between the panels gives the
+    behaviour of every ``α``, including those with no stroboscopic points (rest, overturn).
+    """
+    if not isinstance(sweeps, dict):
+        sweeps = {"": sweeps}
+    if not sweeps:
+        raise ValueError("sweeps must hold at least one sweep")
+    if alpha_limits is not None:
+        alpha_limits = tuple(float(v) for v in alpha_limits)
+    n = len(sweeps)
+    from matplotlib.lines import Line2D
+    fig = _figure(figsize=(6.0 * n + 0.5, 6.6))
+    gs = fig.add_gridspec(3, n, height_ratios=(2.4, 0.12, 1.0), hspace=0.02)
+    present, any_rest = set(), False
+    for c, sw in enumerate(sweeps.values()):
+        got, rest = _bifurcation_column(fig, [gs[r, c] for r in range(3)], sw, alpha_limits, c == 0)
+        present |= set(got)
+        any_rest |= rest
+    order = [nm for nm in BEHAVIOURS if nm in present]
+    handles = _behaviour_handles(order, marker=True)
+    if any_rest:
+        handles.append(Line2D([], [], ls="", marker="v", ms=5, color=BEHAVIOUR_COLOURS["rest"],
+                              label="\u03bb = \u2212\u221e (rest)"))
+    fig.legend(handles=handles, loc="outside lower center", ncols=max(1, len(handles)),
+               fontsize=9, frameon=False)
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# Figure 6: basins
+# ---------------------------------------------------------------------------------------------
+
+def _basin_axes(ax, b, show_y=True):
+    cmap, norm = _cmap()
+    th, dth = np.asarray(b.theta0), np.asarray(b.dtheta0)
+    dx = (th[-1] - th[0]) / max(len(th) - 1, 1) / 2 if len(th) > 1 else 0.5
+    dy = (dth[-1] - dth[0]) / max(len(dth) - 1, 1) / 2 if len(dth) > 1 else 0.5
+    # label[i, j] belongs to theta0[i], dtheta0[j]: rows of the image are dtheta0
+    ax.imshow(np.asarray(b.label).T, origin="lower", cmap=cmap, norm=norm,
+              interpolation="nearest", aspect="auto",
+              extent=(th[0] - dx, th[-1] + dx, dth[0] - dy, dth[-1] + dy))
+    ax.set_xlabel("\u03b8\u2080")
+    if show_y:
+        ax.set_ylabel("\u03b8\u2080\u2032")
+
+
+def _basin_legend(ax, b):
+    fr = fractions(b.label)
+    names = [n for n in BEHAVIOURS if fr[n] > 0]
+    ax.legend(handles=_behaviour_handles(names, [f"{n} {fr[n]:.1f} %" for n in names]),
+              loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=2, fontsize=8,
+              frameon=False)
+
+
+def fig_basin(basin_result, title=None):
+    """Figure 6 (one law): the behaviour of each ``(θ0, θ0')``, with percentages."""
+    b = basin_result
+    fig = _figure(figsize=(5.2, 5.6))
+    ax = fig.add_subplot()
+    _basin_axes(ax, b)
+    _basin_legend(ax, b)
+    ax.set_title(title or f"Basins: {_params(b.block)}", fontsize=10)
+    return fig
+
+
+def fig_basin_compare(housner_basin, mao_basin, title=None):
+    """Figure 6: the basins under both laws and their point-wise agreement.
+
+    The third panel shows where the two laws give the same behaviour; its title gives the
+    agreement percentage.
+    """
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+    a, b = housner_basin, mao_basin
+    if np.shape(a.label) != np.shape(b.label) or not (
+            np.allclose(a.theta0, b.theta0) and np.allclose(a.dtheta0, b.dtheta0)):
+        raise ValueError("the two basins must be computed on the same grid")
+    agree = np.asarray(a.label) == np.asarray(b.label)
+    pct = agreement(a.label, b.label)
+    fig = _figure(figsize=(15.0, 5.8))
+    axes = fig.subplots(1, 3, sharey=True)
+    for i, res in enumerate((a, b)):
+        _basin_axes(axes[i], res, show_y=i == 0)
+        _basin_legend(axes[i], res)
+        axes[i].set_title(_law(res.block), fontsize=11)
+    th, dth = a.theta0, a.dtheta0
+    dx = (th[-1] - th[0]) / max(len(th) - 1, 1) / 2 if len(th) > 1 else 0.5
+    dy = (dth[-1] - dth[0]) / max(len(dth) - 1, 1) / 2 if len(dth) > 1 else 0.5
+    axes[2].imshow(agree.T.astype(int), origin="lower", interpolation="nearest",
+                   aspect="auto", cmap=ListedColormap(["#7b3294", "#e8e8e8"]), vmin=0, vmax=1,
+                   extent=(th[0] - dx, th[-1] + dx, dth[0] - dy, dth[-1] + dy))
+    axes[2].set_xlabel("\u03b8\u2080")
+    axes[2].set_title(f"agreement: {pct:.1f} % of cells", fontsize=11)
+    axes[2].legend(handles=[Patch(color="#e8e8e8", label=f"same behaviour {pct:.1f} %"),
+                            Patch(color="#7b3294", label=f"different {100 - pct:.1f} %")],
+                   loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=1, fontsize=8,
+                   frameon=False)
+    blk = a.block
+    fig.suptitle(title or f"Basins of attraction, h/b = {blk.hb:g}, \u03b1 = {blk.alpha:g}, "
+                 f"\u03c9 = {blk.omega:g}, (r\u2080, s\u2080) = "
+                 f"({a.settings.get('r0', 0):.4g}, {a.settings.get('s0', 1):.4g})")
+    return fig

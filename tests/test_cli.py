@@ -1,0 +1,326 @@
+"""The command line and the atomic writers.
+
+Commands run in-process through ``rockjit.cli.main`` on tiny settings; they share three
+compiled kernel variants (single run with exponents and recording, sweep grid with exponents,
+basin grid without), so that the module stays quick.
+"""
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import rockjit
+from rockjit import analysis
+from rockjit import io as rio
+from rockjit.analysis import BEHAVIOURS
+from rockjit.cli import main
+
+TINY = ["--periods", "20", "--n-steps", "64", "--quiet"]
+PNG = b"\x89PNG\r\n\x1a\n"
+BASIN = ["basin", "--hb", "1", "--alpha", "0.66", "--omega", "1.3", "--grid", "6"] + TINY
+
+
+def _summary(d):
+    return json.loads((d / "summary.json").read_text())
+
+
+def _is_png(path):
+    return path.read_bytes()[:8] == PNG
+
+
+def _check_fractions(fr):
+    assert list(fr) == list(BEHAVIOURS)
+    assert sum(fr.values()) == pytest.approx(100.0)
+
+
+def _no_temp_files(root):
+    return not [p for p in root.rglob("*") if p.name.endswith(rio.TMP_SUFFIX)]
+
+
+# ---------------------------------------------------------------------------------------------
+# the commands
+# ---------------------------------------------------------------------------------------------
+
+def test_trajectory(tmp_path):
+    out = tmp_path / "traj"
+    rc = main(["trajectory", "--hb", "1", "--alpha", "0.6", "--omega", "1.3", "--lyapunov",
+               "--max-points", "300", "--out", str(out)] + TINY)
+    assert rc == 0
+    z = np.load(out / "trajectory.npz")
+    for key in ("t", "theta", "dtheta", "strobe", "impacts", "lyapunov_running"):
+        assert key in z.files
+    assert 2 <= z["t"].size <= 300
+    assert z["strobe"].shape == (21, 4) and z["lyapunov_running"].shape == (21, 2)
+    np.testing.assert_allclose(z["strobe"][0], rockjit.Z0_STUDY, atol=1e-4)
+    s = _summary(out)
+    assert s["status"] == "done" and s["behaviour"] == "symmetric"
+    assert float(s["lambda_max"]) < 0 and s["rockjit_version"] == rockjit.__version__
+    assert s["inputs"]["alpha"] == 0.6 and s["wall_s"] > 0
+    assert _is_png(out / "trajectory.png")
+
+
+def test_sweep(tmp_path):
+    out = tmp_path / "sweep"
+    rc = main(["sweep", "--hb", "1", "--omega", "1.3", "--alpha-range", "0.5", "1.0",
+               "--alpha-step", "0.05", "--out", str(out)] + TINY)
+    assert rc == 0
+    z = np.load(out / "sweep.npz")
+    n = 11
+    np.testing.assert_allclose(z["alpha"], 0.5 + 0.05 * np.arange(n))
+    assert z["label"].shape == z["period"].shape == z["lambda_max"].shape == (n,)
+    assert z["strobe"].ndim == 3 and z["strobe"].shape[0] == n and z["strobe"].shape[2] == 2
+    assert z["impact_section"].shape[0] == n
+    assert list(z["names"]) == list(BEHAVIOURS) and z["label"].max() < len(z["names"])
+    s = _summary(out)
+    _check_fractions(s["fractions"])
+    for name, pct in s["fractions"].items():
+        code = BEHAVIOURS.index(name)
+        assert pct == pytest.approx(100 * np.mean(z["label"] == code))
+    assert s["n_alpha"] == n
+    assert _is_png(out / "bifurcation.png")
+
+
+def test_basin_one_law(tmp_path):
+    out = tmp_path / "basin"
+    assert main(BASIN + ["--law", "mao", "--out", str(out)]) == 0
+    z = np.load(out / "basin.npz")
+    np.testing.assert_allclose(z["theta0"], np.linspace(-1, 1, 6))
+    np.testing.assert_allclose(z["dtheta0"], np.linspace(-1, 1, 6))
+    assert z["label"].shape == (6, 6) and z["label"].dtype.kind == "i"
+    assert set(np.unique(z["label"])) <= set(range(len(z["names"])))
+    assert list(z["names"]) == list(BEHAVIOURS)
+    s = _summary(out)
+    _check_fractions(s["fractions"])
+    assert s["law"] == "mao" and s["r0"] == 0.0 and s["s0"] == 1.0
+    assert _is_png(out / "basin.png")
+
+
+def test_basin_both_laws_and_orientation(tmp_path):
+    out = tmp_path / "both"
+    assert main(BASIN + ["--law", "both", "--out", str(out)]) == 0
+    z = np.load(out / "basin.npz")
+    lh, lm = z["label_housner"], z["label_mao"]
+    assert lh.shape == lm.shape == (6, 6) and "label" not in z.files
+    s = _summary(out)
+    for law in ("housner", "mao"):
+        _check_fractions(s[law]["fractions"])
+    assert 0 <= s["agreement"] <= 100
+    assert s["agreement"] == pytest.approx(100.0 * np.count_nonzero(lh == lm) / lh.size)
+    # label[i, j] belongs to theta0[i], dtheta0[j]: check a cell the transpose would get wrong
+    over = BEHAVIOURS.index("overturn")
+    cells = [(i, j) for i in range(6) for j in range(6)
+             if (lh[i, j] == over) != (lh[j, i] == over)]
+    assert cells, "the test needs a basin that is not symmetric under transposition"
+    i, j = cells[0]
+    r = rockjit.simulate(1.0, 0.66, 1.3, "housner", theta0=z["theta0"][i],
+                         dtheta0=z["dtheta0"][j], r0=0.0, s0=1.0, periods=20, n_steps=64,
+                         lyapunov=True, record_stride=64)
+    assert (r.status == "overturned") == (lh[i, j] == over)
+
+
+def test_cor(tmp_path):
+    out = tmp_path / "cor"
+    assert main(["cor", "--hb-values", "1", "2", "--out", str(out), "--quiet"]) == 0
+    rows = (out / "e_table.csv").read_text().splitlines()
+    assert rows[0] == "hb,thc,e_H,e_M,delta_e_percent"
+    vals = [list(map(float, r.split(","))) for r in rows[1:]]
+    np.testing.assert_allclose([v[2] for v in vals], [0.25, 0.7], atol=1e-12)
+    np.testing.assert_allclose([v[3] for v in vals], [0.582, 0.830], atol=5e-4)
+    np.testing.assert_allclose([v[4] for v in vals], [79.85, 17.03], atol=5e-3)
+    md = (out / "e_table.md").read_text()
+    assert "| 1 | 0.7854 | 0.250 | 0.582 | 79.85 |" in md
+    assert _summary(out)["table"][1]["e_H"] == pytest.approx(0.7)
+    assert _is_png(out / "restitution.png")
+
+
+def test_paper_quick(tmp_path):
+    out = tmp_path / "paper"
+    rc = main(["paper", "--out", str(out), "--grid", "4", "--periods", "20", "--n-steps", "64",
+               "--alpha-step", "0.1", "--zoom-step", "0.05", "--quiet"])
+    assert rc == 0
+    figs = ["fig1_restitution", "fig2_reference", "fig3_gallery", "fig4_laws_timeseries",
+            "fig5_bifurcation_hb1", "fig5_bifurcation_hb2", "fig5_bifurcation_zoom",
+            "fig6_basin_hb1", "fig6_basin_hb2"]
+    for f in figs:
+        assert _is_png(out / f"{f}.png"), f
+    for t in ("e_table", "basin_table", "sweep_table"):
+        assert (out / f"{t}.csv").exists() and (out / f"{t}.md").exists()
+    s = _summary(out)
+    assert list(s["wall_s_parts"]) == ["fig1", "fig2", "fig3", "fig4", "fig5", "fig6"]
+    assert sorted(s["files"]) == sorted(p.name for p in out.iterdir())
+    for case, tag in zip(s["fig6"], ("hb1", "hb2")):
+        z = np.load(out / f"fig6_basin_{tag}.npz")
+        assert z["label_housner"].shape == (4, 4)
+        assert case["agreement"] == pytest.approx(
+            100 * np.mean(z["label_housner"] == z["label_mao"]))
+        _check_fractions(case["mao"]["fractions"])
+    basin_rows = (out / "basin_table.csv").read_text().splitlines()
+    assert len(basin_rows) == 1 + 4
+    z = np.load(out / "fig5_sweep_hb2_mao.npz")
+    np.testing.assert_allclose(z["alpha"], [0.1, 0.2, 0.3, 0.4, 0.5])
+    assert _no_temp_files(out)
+
+
+# ---------------------------------------------------------------------------------------------
+# bad input: one line, exit 2, nothing written
+# ---------------------------------------------------------------------------------------------
+
+TRAJ = ["trajectory", "--hb", "1", "--alpha", "0.6", "--omega", "1.3"]
+SWEEP = ["sweep", "--hb", "1", "--omega", "1.3", "--alpha-range", "0.5", "0.6"]
+
+
+@pytest.mark.parametrize("argv, word", [
+    (["basin", "--hb", "-1", "--alpha", "0.66", "--omega", "1.3"], "hb must be > 0 (got -1.0)"),
+    (BASIN + ["--law", "foo"], "law"),
+    (BASIN + ["--grid", "0"], "grid"),
+    (BASIN + ["--law", "both", "--e", "0.5"], "--e"),
+    (BASIN + ["--theta-range", "-2", "1"], "theta-range"),
+    (BASIN + ["--r0", "0.5", "--s0", "0.5"], "(r0, s0)"),
+    (BASIN + ["--threads", "0"], "threads"),
+    (BASIN + ["--periods", "0"], "periods"),
+    (BASIN + ["--n-steps", "63"], "n_steps"),
+    (TRAJ[:2] + ["nan"] + TRAJ[3:], "hb must be finite"),
+    (TRAJ + ["--law", "mao", "--e", "0.3"], "e is only given"),
+    (TRAJ + ["--alpha", "-0.1"], "alpha"),
+    (TRAJ + ["--method", "scipy:FOO"], "method"),
+    (TRAJ + ["--method", "scipy", "--lyapunov"], "--lyapunov"),
+    (TRAJ + ["--theta0", "2"], "theta0"),
+    (TRAJ + ["--omega", "abc"], "--omega"),
+    (TRAJ[:-2], "--omega"),
+    (SWEEP + ["--alpha-step", "0"], "alpha_step"),
+    (SWEEP[:6] + ["0.6", "0.5"], "alpha_range"),
+    (SWEEP + ["--hb", "0.5"], "hb must be >= 1/sqrt(2)"),
+    (["cor", "--hb-values", "0.5"], "hb"),
+    (["cor", "--hb-max", "0.7"], "hb"),
+    (["paper", "--grid", "-3"], "grid"),
+    (["paper", "--alpha-step", "-0.1"], "alpha-step"),
+    (["paper", "--zoom", "0.2", "0.3"], "zoom"),
+    (["paper", "--periods", "0"], "periods"),
+    (["frobnicate"], "invalid choice"),
+])
+def test_bad_input(argv, word, tmp_path, capsys):
+    out = tmp_path / "out"
+    rc = main(argv + ["--out", str(out)])
+    err = capsys.readouterr().err
+    assert rc == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("rockjit: error: ")
+    assert word in lines[0]
+    assert not out.exists()
+
+
+def test_out_is_a_file(tmp_path, capsys):
+    f = tmp_path / "file"
+    f.write_text("x")
+    assert main(["cor", "--out", str(f)]) == 2
+    assert "--out" in capsys.readouterr().err
+    assert f.read_text() == "x"
+
+
+def test_help(capsys):
+    assert main(["--help"]) == 0
+    assert "trajectory" in capsys.readouterr().out
+    assert main(["basin", "--help"]) == 0
+    assert "--law" in capsys.readouterr().out
+
+
+def test_python_m_rockjit_help():
+    p = subprocess.run([sys.executable, "-m", "rockjit", "--help"], capture_output=True,
+                       text=True, timeout=120)
+    assert p.returncode == 0
+    for cmd in ("trajectory", "sweep", "basin", "cor", "paper"):
+        assert cmd in p.stdout
+    p = subprocess.run([sys.executable, "-m", "rockjit", "cor", "--hb-values", "0.1",
+                        "--out", "unused"], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 2 and p.stderr.count("\n") == 1
+
+
+# ---------------------------------------------------------------------------------------------
+# interruptions leave nothing half-written
+# ---------------------------------------------------------------------------------------------
+
+def test_interrupt_during_computation(tmp_path, monkeypatch, capsys):
+    real = analysis.basin
+    calls = []
+
+    def basin_then_interrupt(*a, **kw):
+        calls.append(kw["law"])
+        if len(calls) == 2:  # mid-way: the first law done, the second interrupted
+            raise KeyboardInterrupt
+        return real(*a, **kw)
+
+    monkeypatch.setattr(analysis, "basin", basin_then_interrupt)
+    out = tmp_path / "out"
+    assert main(BASIN + ["--law", "both", "--out", str(out)]) == 130
+    assert calls == ["housner", "mao"]
+    assert "interrupted" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_interrupt_during_writing(tmp_path, monkeypatch):
+    real = rio.write_csv
+
+    def half_then_interrupt(path, header, rows):
+        with rio.atomic_open(path, "w") as fh:
+            fh.write(",".join(header)[:5])
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(rio, "write_csv", half_then_interrupt)
+    out = tmp_path / "out"
+    assert main(["cor", "--out", str(out), "--quiet"]) == 130
+    # the figure (written before) is complete; the table and the summary are absent
+    assert sorted(p.name for p in out.iterdir()) == ["restitution.png"]
+    assert _is_png(out / "restitution.png")
+    monkeypatch.setattr(rio, "write_csv", real)
+
+
+def test_atomic_writer_keeps_the_old_file(tmp_path):
+    target = tmp_path / "a.json"
+    rio.write_json(target, {"x": 1})
+    with pytest.raises(KeyboardInterrupt):
+        with rio.atomic_open(target, "w") as fh:
+            fh.write('{"x": 2, "trunc')
+            raise KeyboardInterrupt
+    assert json.loads(target.read_text()) == {"x": 1}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json"]
+
+
+def test_atomic_npz_interrupted(tmp_path, monkeypatch):
+    def boom(fh, **arrays):
+        fh.write(b"PK\x03\x04 partial")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(np, "savez", boom)
+    with pytest.raises(KeyboardInterrupt):
+        rio.write_npz(tmp_path / "d.npz", a=np.arange(3))
+    assert list(tmp_path.iterdir()) == []
+
+
+# ---------------------------------------------------------------------------------------------
+# writers
+# ---------------------------------------------------------------------------------------------
+
+def test_json_conventions(tmp_path):
+    obj = {"i": np.int64(3), "f": np.float32(0.5), "b": np.bool_(True), "t": (1, 2),
+           "a": np.array([[1.0, np.nan], [np.inf, -np.inf]]), "n": None, "m": -math.inf}
+    rio.write_json(tmp_path / "s.json", obj)
+    text = (tmp_path / "s.json").read_text()
+    back = json.loads(text, parse_constant=lambda c: pytest.fail(f"non-standard {c}"))
+    assert back == {"i": 3, "f": 0.5, "b": True, "t": [1, 2],
+                    "a": [[1.0, "nan"], ["inf", "-inf"]], "n": None, "m": "-inf"}
+    assert math.isinf(float(back["m"])) and math.isnan(float(back["a"][0][1]))
+    with pytest.raises(TypeError):
+        rio.write_json(tmp_path / "bad.json", {"x": object()})
+    assert not (tmp_path / "bad.json").exists() and _no_temp_files(tmp_path)
+
+
+def test_npz_and_csv_round_trip(tmp_path):
+    rio.write_npz(tmp_path / "d.npz", x=np.arange(4.0), names=np.array(BEHAVIOURS))
+    z = np.load(tmp_path / "d.npz")  # allow_pickle=False
+    assert list(z["names"]) == list(BEHAVIOURS) and z["x"].tolist() == [0, 1, 2, 3]
+    rio.write_csv(tmp_path / "t.csv", ["a", "b"], [[1, 0.1], ["x", -math.inf]])
+    assert (tmp_path / "t.csv").read_text().splitlines() == ["a,b", "1,0.1", "x,-inf"]

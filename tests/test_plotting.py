@@ -1,0 +1,181 @@
+"""The study's figures: each draws what its inputs say (data, colours, limits, percentages)."""
+
+import math
+
+import matplotlib
+import numpy as np
+import pytest
+
+matplotlib.use("Agg")
+
+from matplotlib.colors import to_hex  # noqa: E402
+
+import rockjit  # noqa: E402
+from rockjit import plotting as P  # noqa: E402
+from rockjit.analysis import BEHAVIOURS, BasinResult, SweepResult, fractions  # noqa: E402
+from rockjit.io import save_figure  # noqa: E402
+
+RUN = dict(periods=20, n_steps=64, record_stride=4, lyapunov=True)  # one compiled variant
+
+
+@pytest.fixture(scope="module")
+def ref_run():
+    return rockjit.simulate(1.0, 0.6, 1.3, "housner", z0=rockjit.Z0_STUDY, **RUN)
+
+
+@pytest.fixture(scope="module")
+def short_runs():
+    rest = rockjit.simulate(1.0, 0.15, 1.0, "housner", theta0=0.05, dtheta0=0.0, **RUN)
+    over = rockjit.simulate(2.0, 0.448, 1.3, "housner", z0=rockjit.Z0_STUDY, **RUN)
+    return {"rest": rest, "overturn": over}
+
+
+def _sweep():
+    """A synthetic sweep using every behaviour, NaN padding, lambda = -inf and nan."""
+    n, w = len(BEHAVIOURS) * 2, 5
+    alpha = 0.5 + 0.01 * np.arange(n)
+    label = np.repeat(np.arange(len(BEHAVIOURS)), 2)
+    strobe = np.full((n, w, 2), np.nan)
+    rng = np.random.default_rng(0)
+    for i, c in enumerate(label):
+        if BEHAVIOURS[c] not in ("overturn", "rest", "unresolved"):
+            k = 1 + i % w
+            strobe[i, :k] = rng.normal(size=(k, 2))
+    lam = rng.uniform(-0.5, 0.3, n)
+    lam[label == BEHAVIOURS.index("rest")] = -np.inf
+    lam[label == BEHAVIOURS.index("overturn")] = np.nan
+    block = rockjit.Block(hb=1.0, alpha=0.5, omega=1.3)
+    return SweepResult(alpha=alpha, label=label, period=np.zeros(n, int), lambda_max=lam,
+                       strobe=strobe, impact_section=np.full((n, 1, 2), np.nan),
+                       t_end=np.zeros(n), block=block)
+
+
+def _basin(law, seed, n=7):
+    rng = np.random.default_rng(seed)
+    label = rng.integers(0, 4, size=(n, n))
+    th = np.linspace(-1, 1, n)
+    return BasinResult(theta0=th, dtheta0=np.linspace(-0.5, 0.5, n), label=label,
+                       period=np.zeros((n, n), int), lambda_max=None, t_end=np.zeros((n, n)),
+                       block=rockjit.Block(hb=1.0, alpha=0.66, omega=1.3, law=law),
+                       settings=dict(r0=0.0, s0=1.0))
+
+
+def _scatter_points(ax):
+    return sum(c.get_offsets().shape[0] for c in ax.collections
+               if hasattr(c, "get_offsets") and c.get_offsets().ndim == 2)
+
+
+def test_one_colour_per_behaviour():
+    assert set(P.BEHAVIOUR_COLOURS) == set(BEHAVIOURS)
+    assert len({to_hex(c) for c in P.BEHAVIOUR_COLOURS.values()}) == len(BEHAVIOURS)
+
+
+def test_restitution_curves_and_marks():
+    fig = P.fig_restitution((1 / math.sqrt(2), 4.0), n=50)
+    ax = fig.axes[0]
+    lines = [ln for ln in ax.get_lines() if len(ln.get_xdata()) == 50]
+    thc = np.radians(lines[0].get_xdata())
+    np.testing.assert_allclose(lines[0].get_ydata(), rockjit.e_housner(thc))
+    np.testing.assert_allclose(lines[1].get_ydata(), rockjit.e_mao(thc))
+    texts = " ".join(t.get_text() for a in fig.axes for t in a.texts)
+    assert "0.250" in texts and "0.582" in texts and "79.85" in texts and "17.03" in texts
+    with pytest.raises(ValueError, match="hb_range"):
+        P.fig_restitution((0.5, 2.0))
+
+
+def test_trajectory_figure(ref_run, tmp_path):
+    fig = P.fig_trajectory(ref_run)
+    ax_t, ax_l, ax_p = fig.axes[:3]
+    np.testing.assert_array_equal(ax_t.get_lines()[0].get_ydata(), ref_run.trajectory[:, 1])
+    lam = ax_l.get_lines()[0]
+    k = np.arange(1, ref_run.lyapunov_running.shape[0])
+    np.testing.assert_allclose(lam.get_xdata(), k * ref_run.period)
+    np.testing.assert_array_equal(lam.get_ydata(), ref_run.lyapunov_running[1:, 0])
+    # phase portrait: the asymptotic window only
+    xs = ax_p.get_lines()[0].get_xdata()
+    w = ref_run.trajectory[ref_run.trajectory[:, 0] >= ref_run.window[0] - 1e-9]
+    np.testing.assert_array_equal(xs, w[:, 1])
+    assert 0 < len(xs) < ref_run.trajectory.shape[0]
+    assert "symmetric" in fig.get_suptitle()
+    save_figure(fig, tmp_path / "t.png")
+    assert (tmp_path / "t.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_trajectory_needs_a_trajectory(ref_run):
+    import dataclasses
+    with pytest.raises(ValueError, match="record_stride"):
+        P.fig_trajectory(dataclasses.replace(ref_run, trajectory=None))
+
+
+def test_gallery_titles_carry_the_classification(ref_run, short_runs):
+    fig = P.fig_gallery({"sym": ref_run, **short_runs})
+    titles = [ax.get_title() for ax in fig.axes[:3]]
+    assert "classified: symmetric" in titles[0]
+    assert "classified: rest" in titles[1]
+    assert "classified: overturn" in titles[2]
+    assert len(fig.axes) == 6
+
+
+def test_laws_timeseries(short_runs, ref_run):
+    fig = P.fig_laws_timeseries([{"housner": ref_run, "mao": short_runs["rest"]}], t_max=20.0)
+    ax_t = fig.axes[0]
+    assert max(ln.get_xdata().max() for ln in ax_t.get_lines()) <= 20.0
+    labels = [t.get_text() for t in ax_t.get_legend().get_texts()]
+    assert labels == ["Housner: symmetric", "Housner: rest"]
+
+
+def test_bifurcation_draws_every_finite_point_and_clips_rest():
+    sw = _sweep()
+    fig = P.fig_bifurcation(sw)
+    ax, ax_s, ax_l = fig.axes[:3]
+    assert _scatter_points(ax) == np.isfinite(sw.strobe[:, :, 1]).sum()
+    # the strip holds every alpha's code
+    np.testing.assert_array_equal(np.asarray(ax_s.collections[0].get_array()).ravel(),
+                                  sw.label)
+    lo = ax_l.get_ylim()[0]
+    rest = sw.label == BEHAVIOURS.index("rest")
+    marks = [c.get_offsets() for c in ax_l.collections if len(c.get_offsets())]
+    bottom = np.concatenate([m for m in marks if np.allclose(m[:, 1], lo)])
+    np.testing.assert_allclose(np.sort(bottom[:, 0]), np.sort(sw.alpha[rest]))
+    # finite exponents all drawn, nan ones skipped
+    n_fin = np.isfinite(sw.lambda_max).sum()
+    assert sum(len(m) for m in marks) == n_fin + rest.sum()
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert legend == list(BEHAVIOURS) + ["\u03bb = \u2212\u221e (rest)"]
+
+
+def test_bifurcation_zoom_and_pair():
+    sw = _sweep()
+    fig = P.fig_bifurcation(sw, alpha_limits=(0.55, 0.6))
+    assert fig.axes[0].get_xlim() == pytest.approx((0.55, 0.6))
+    inside = (sw.alpha >= 0.55 - 1e-12) & (sw.alpha <= 0.6 + 1e-12)
+    assert _scatter_points(fig.axes[0]) == np.isfinite(sw.strobe[inside, :, 1]).sum()
+    fig = P.fig_bifurcation({"a": sw, "b": sw})
+    assert len(fig.axes) == 6
+
+
+def test_basin_image_orientation_and_percentages():
+    b = _basin("housner", 1)
+    b.label[0, -1] = 5  # theta0 = -1, dtheta0 = +0.5: the upper-left corner
+    fig = P.fig_basin(b)
+    ax = fig.axes[0]
+    im = ax.images[0]
+    np.testing.assert_array_equal(im.get_array(), b.label.T)
+    assert im.origin == "lower"
+    x0, x1, y0, y1 = im.get_extent()
+    assert x0 < -1 < x1 and y0 < -0.5 and 0.5 < y1
+    fr = fractions(b.label)
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert legend == [f"{n} {fr[n]:.1f} %" for n in BEHAVIOURS if fr[n] > 0]
+
+
+def test_basin_compare_agreement():
+    a, b = _basin("housner", 1), _basin("mao", 2)
+    fig = P.fig_basin_compare(a, b)
+    pct = 100.0 * np.mean(a.label == b.label)
+    assert f"{pct:.1f} %" in fig.axes[2].get_title()
+    np.testing.assert_array_equal(fig.axes[2].images[0].get_array(),
+                                  (a.label == b.label).T.astype(int))
+    assert P.agreement(a.label, b.label) == pytest.approx(pct)
+    with pytest.raises(ValueError, match="same grid"):
+        P.fig_basin_compare(a, _basin("mao", 2, n=5))
