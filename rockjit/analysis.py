@@ -145,7 +145,9 @@ def _cell(TANGENT, y0, side0, par, ipar, cpar, strobe, half, impacts, traj, lam_
     lam1 = math.nan
     lam2 = math.nan
     if TANGENT:
-        lam1, lam2 = lam_between(lam_run, k0, k1)
+        la, lb = lam_between(lam_run, k0, k1)
+        lam1 = max(la, lb)  # sorted: lambda1 >= lambda2 (see rockjit.simulate)
+        lam2 = min(la, lb)
     label = UNRESOLVED
     period = 0
     if status == ig.OVERTURNED:

@@ -35,7 +35,7 @@ import math
 
 import numpy as np
 
-from ._jit import jit
+from ._jit import fma, jit
 from .model import accel, accel_jac, forcing_closed, jump, oscillator, saltation, uplift_time
 
 # ---- Dormand–Prince 5(4), scipy's names --------------------------------------------------------
@@ -126,7 +126,7 @@ def build(embed4: bool = False, tangent: bool = False, record: bool = False):
     return _build(bool(embed4), bool(tangent), bool(record))
 
 
-@jit
+@jit(nrt=False)
 def settled_period(strobe, half, per_imp, k, reps, pmax, tol):
     """Smallest period p <= pmax that the last ``reps * p`` periods repeat, else 0.
 
@@ -163,7 +163,7 @@ def settled_period(strobe, half, per_imp, k, reps, pmax, tol):
     return 0
 
 
-@jit
+@jit(nrt=False)
 def rhs(EMBED4, TANGENT, r, y, side, par, K, i):
     """Right-hand side at state y into stage row ``K[i]``; ``r`` is the closed-form forcing
     value (ignored with the embedding, which reads ``r`` from y)."""
@@ -183,7 +183,7 @@ def rhs(EMBED4, TANGENT, r, y, side, par, K, i):
         tangent_rhs(EMBED4, f, y, side, par, K, i)
 
 
-@jit
+@jit(nrt=False)
 def tangent_rhs(EMBED4, f, y, side, par, K, i):
     """Variational equations ``V' = J V`` into the tangent part of ``K[i]``."""
     NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
@@ -199,7 +199,7 @@ def tangent_rhs(EMBED4, f, y, side, par, K, i):
         K[i, NS + 3] = ja * y[NS + 2] + jb * y[NS + 3]
 
 
-@jit
+@jit(nrt=False)
 def stage_rotations(omega, h, rot):
     """cos and sin of the forcing's phase advance ``omega C_i h`` to each stage (and to 1)."""
     for i in range(N_STAGES):
@@ -209,43 +209,38 @@ def stage_rotations(omega, h, rot):
     rot[1, N_STAGES] = math.sin(omega * h)
 
 
-@jit
+@jit(nrt=False)
 def forcing_at(t, par):
     return forcing_closed(t, par[P_OMEGA], par[P_PHI])
 
 
-@jit(inline="always")
-def rk_step(EMBED4, TANGENT, t, y, h, K, side, par, ytmp, ynew, rot):
-    """One Dormand–Prince step of length h from (t, y); K[0] must hold f(t, y).
+@jit(nrt=False)
+def rk_step(EMBED4, TANGENT, sp, cp, y, h, K, side, par, ytmp, ynew, rot):
+    """One Dormand–Prince step of length h from y; K[0] must hold the field at the start.
 
-    ``rot`` holds :func:`stage_rotations` for this ``h``: the closed-form forcing at each
-    stage is the step's one sine-cosine pair rotated by it, not a fresh ``sin``.
+    ``sp, cp`` are sin and cos of the forcing phase ``omega t + phi`` at the step's start, and
+    ``rot`` holds :func:`stage_rotations` for this ``h``: the closed-form forcing at each stage
+    is that pair rotated, not a fresh ``sin`` (both are ignored with the embedding).
     """
     NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
     NY = NS + (4 if TANGENT else 0)  # plus the tangent matrix, column-major
-    sp = 0.0
-    cp = 0.0
-    if not EMBED4:
-        psi = par[P_OMEGA] * t + par[P_PHI]
-        sp = math.sin(psi)
-        cp = math.cos(psi)
     for i in range(1, N_STAGES):
         for m in range(NY):
             acc = 0.0
-            for j in range(i):
-                acc += A[i, j] * K[j, m]
-            ytmp[m] = y[m] + h * acc
-        rhs(EMBED4, TANGENT, sp * rot[0, i] + cp * rot[1, i], ytmp, side, par, K, i)
+            for j in range(i):  # the newest stage last: it is the one still being computed
+                acc = fma(A[i, j], K[j, m], acc)
+            ytmp[m] = fma(h, acc, y[m])
+        rhs(EMBED4, TANGENT, fma(sp, rot[0, i], cp * rot[1, i]), ytmp, side, par, K, i)
     for m in range(NY):
         acc = 0.0
         for j in range(N_STAGES):
-            acc += B[j] * K[j, m]
-        ynew[m] = y[m] + h * acc
-    rhs(EMBED4, TANGENT, sp * rot[0, N_STAGES] + cp * rot[1, N_STAGES], ynew, side, par, K,
+            acc = fma(B[j], K[j, m], acc)
+        ynew[m] = fma(h, acc, y[m])
+    rhs(EMBED4, TANGENT, fma(sp, rot[0, N_STAGES], cp * rot[1, N_STAGES]), ynew, side, par, K,
         N_STAGES)
 
 
-@jit
+@jit(nrt=False)
 def dense_coeffs(K, m):
     """Coefficients of the continuous extension of component m (scipy's ``Q = K.T P``)."""
     q0 = 0.0
@@ -261,7 +256,7 @@ def dense_coeffs(K, m):
     return q0, q1, q2, q3
 
 
-@jit
+@jit(nrt=False)
 def event_value(kind, y, side, par, t):
     """Event function g (positive before the event) and its time derivative."""
     if kind == EV_IMPACT:
@@ -275,7 +270,7 @@ def event_value(kind, y, side, par, t):
     return par[P_COT] - par[P_AW2] * abs(r), -par[P_AW2] * sg * dr
 
 
-@jit
+@jit(nrt=False)
 def dense_event(kind, y0m, h, q0, q1, q2, q3, side, par, x):
     """Event function evaluated on the continuous extension at x = tau/h."""
     v = y0m + h * x * (q0 + x * (q1 + x * (q2 + x * q3)))
@@ -286,7 +281,7 @@ def dense_event(kind, y0m, h, q0, q1, q2, q3, side, par, x):
     return par[P_COT] - par[P_AW2] * abs(v)
 
 
-@jit
+@jit(nrt=False)
 def turning_point(q0, q1, q2, q3, sgn, want_max):
     """x in [0, 1] where sgn * d/dx of the extension changes sign (bisection).
 
@@ -305,7 +300,7 @@ def turning_point(q0, q1, q2, q3, sgn, want_max):
     return 0.5 * (lo + hi)
 
 
-@jit
+@jit(nrt=False)
 def locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, ytmp, yev, counts, rot):
     """Time tau in (lo, hi] of the event, with the state there in yev.
 
@@ -328,12 +323,15 @@ def locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, ytmp, yev, cou
     tau = 0.5 * (a + b) * hh
     lo_b = lo
     hi_b = hi
+    psi = par[P_OMEGA] * t + par[P_PHI]
+    sp = math.sin(psi)
+    cp = math.cos(psi)
     # Below ~1e-12 h the event value is dominated by rounding in t + tau: stop there.
     tol = 1e-12 * hh
     for it in range(NEWTON_ITERS):
         if not EMBED4:
             stage_rotations(par[P_OMEGA], tau, rot)
-        rk_step(EMBED4, TANGENT, t, y, tau, K, side, par, ytmp, yev, rot)
+        rk_step(EMBED4, TANGENT, sp, cp, y, tau, K, side, par, ytmp, yev, rot)
         counts[O_RHS] += N_STAGES
         g, dg = event_value(kind, yev, side, par, t + tau)
         if g == 0.0:
@@ -354,7 +352,7 @@ def locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, ytmp, yev, cou
     return tau  # yev holds the state at this tau
 
 
-@jit(inline="always")
+@jit(nrt=False)
 def detect(y, ynew, hh, K, side, par):
     """Look for an event in the step just taken; returns (kind, lo, hi)."""
     if side == 0:
@@ -394,14 +392,14 @@ def detect(y, ynew, hh, K, side, par):
     return EV_NONE, 0.0, 0.0
 
 
-@jit
+@jit(nrt=False)
 def forcing_now(EMBED4, t, y, par):
     if EMBED4:
         return y[2]
     return forcing_closed(t, par[P_OMEGA], par[P_PHI])
 
 
-@jit
+@jit(nrt=False)
 def sample(EMBED4, t, y, par, out):
     out[0] = y[0]
     out[1] = y[1]
@@ -414,7 +412,7 @@ def sample(EMBED4, t, y, par, out):
         out[3] = math.cos(psi)
 
 
-@jit
+@jit(nrt=False)
 def qr_renormalise(EMBED4, y, lam_sum, in_window, lam_win):
     """Gram–Schmidt on the tangent columns; logs of the stretches are accumulated."""
     NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
@@ -442,7 +440,7 @@ def qr_renormalise(EMBED4, y, lam_sum, in_window, lam_win):
     y[NS + 3] = w1 / n2
 
 
-@jit
+@jit(nrt=False)
 def reset_tangent(EMBED4, y):
     NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
     y[NS] = 1.0
@@ -477,6 +475,12 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, t
     rot_h = np.zeros((2, N_STAGES + 1))  # for the full grid step h
     rot = np.zeros((2, N_STAGES + 1))    # for substeps and re-steps
     stage_rotations(par[P_OMEGA], h, rot_h)
+    # sin and cos of the forcing phase at the grid points of a period (the grid repeats)
+    ptab = np.zeros((2, n_per))
+    for j in range(n_per):
+        psi = par[P_PHI] + 2.0 * math.pi * j / n_per
+        ptab[0, j] = math.sin(psi)
+        ptab[1, j] = math.cos(psi)
     for m in range(NS):
         y[m] = y0[m]
     if TANGENT:
@@ -544,14 +548,17 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, t
                     iout[O_RHS] += 1
                     continue
             if fresh:
-                # a whole grid step (t + h equals t_grid up to one rounding of t)
+                # a whole grid step: the forcing phase there is phi + 2 pi j / N exactly
                 hh = h
-                rk_step(EMBED4, TANGENT, t, y, hh, K, side, par, ytmp, ynew, rot_h)
+                rk_step(EMBED4, TANGENT, ptab[0, j_per], ptab[1, j_per], y, hh, K, side, par,
+                        ytmp, ynew, rot_h)
             else:
                 hh = t_grid - t
+                psi = par[P_OMEGA] * t + par[P_PHI]
                 if not EMBED4:
                     stage_rotations(par[P_OMEGA], hh, rot)
-                rk_step(EMBED4, TANGENT, t, y, hh, K, side, par, ytmp, ynew, rot)
+                rk_step(EMBED4, TANGENT, math.sin(psi), math.cos(psi), y, hh, K, side, par,
+                        ytmp, ynew, rot)
             iout[O_RHS] += N_STAGES
             iout[O_SUBSTEPS] += 1
             kind, lo, hi = detect(y, ynew, hh, K, side, par)

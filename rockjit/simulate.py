@@ -352,5 +352,8 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
             # at rest for good every perturbation dies out in finite time
             res.lyapunov = np.array([-math.inf, -math.inf])
         else:
-            res.lyapunov = np.array([fout[ig.F_LAM1], fout[ig.F_LAM2]])
+            # Gram-Schmidt's first column carries the largest growth only asymptotically; over
+            # a finite window a (near-)degenerate pair may come out in either order
+            res.lyapunov = np.sort(fout[ig.F_LAM1:ig.F_LAM2 + 1])[::-1].copy()
+        res.lyapunov_running = -np.sort(-res.lyapunov_running, axis=1)
     return res
