@@ -1,0 +1,408 @@
+"""The compiled integrator (rockjit.integrate) against things that do not come from it.
+
+- the Dormand–Prince tableau against the Runge–Kutta order conditions, generated here from the
+  rooted trees (Butcher), for the 5th-order weights, the embedded 4th-order weights and the
+  continuous extension;
+- the empirical order of the fixed-step integrator against a tight scipy DOP853 solution on an
+  impact-free segment;
+- the tangent (variational + saltation) Jacobian against central finite differences of the
+  flow across impacts;
+- exact physics: energy conservation of undamped, unforced, elastic rocking;
+- rest and uplift: the scipy path and the closed-form uplift instant (conftest), and an
+  independent solve_ivp from that instant;
+- the 4-D oscillator embedding against the closed-form forcing and against the oscillator's
+  exact solution off the unit circle.
+"""
+
+import math
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+import rockjit
+from rockjit import integrate as ig
+
+DOP = dict(method="scipy:DOP853", rtol=1e-12, atol=1e-12)
+
+
+# ---- the tableau ------------------------------------------------------------------------------
+
+def _canon(tree):
+    return tuple(sorted(_canon(c) for c in tree))
+
+
+def _grow(tree):
+    """All trees with one more node, attached anywhere in ``tree``."""
+    yield _canon(tree + ((),))
+    for i, child in enumerate(tree):
+        for g in _grow(child):
+            yield _canon(tree[:i] + (g,) + tree[i + 1:])
+
+
+def _trees(max_order):
+    """Rooted trees up to ``max_order``; a tree is the sorted tuple of its subtrees."""
+    out = {1: {()}}
+    for n in range(2, max_order + 1):
+        out[n] = {g for t in out[n - 1] for g in _grow(t)}
+    return out
+
+
+def _order(tree):
+    return 1 + sum(_order(c) for c in tree)
+
+
+def _gamma(tree):
+    g = _order(tree)
+    for c in tree:
+        g *= _gamma(c)
+    return g
+
+
+def _phi(tree, A):
+    """Elementary weight vector: Phi_i(t) = prod over subtrees u of sum_j a_ij Phi_j(u)."""
+    v = np.ones(A.shape[0])
+    for c in tree:
+        v = v * (A @ _phi(c, A))
+    return v
+
+
+TREES = _trees(6)
+
+
+def _tableau():
+    """The 7-stage (FSAL) tableau: A padded square with the last row B, C with 1 appended."""
+    A = np.zeros((7, 7))
+    A[:6, :ig.A.shape[1]] = ig.A
+    A[6, :6] = ig.B
+    C = np.append(ig.C, 1.0)
+    b = np.append(ig.B, 0.0)
+    return A, C, b
+
+
+def test_tree_count():
+    # 1, 1, 2, 4, 9, 20 rooted trees of orders 1..6: the generator is complete
+    assert [len(TREES[n]) for n in range(1, 7)] == [1, 1, 2, 4, 9, 20]
+
+
+def test_tableau_shapes_and_simplifying_identities():
+    A, C, b = _tableau()
+    assert ig.C.shape == (6,) and ig.B.shape == (6,) and ig.E.shape == (7,)
+    assert ig.P.shape == (7, 4)
+    np.testing.assert_allclose(A.sum(axis=1), C, rtol=0, atol=1e-15)  # row sums are C
+    assert ig.B.sum() == pytest.approx(1.0, abs=1e-15)
+    assert ig.E.sum() == pytest.approx(0.0, abs=1e-15)
+    assert np.all(np.triu(A) == 0.0)  # explicit
+    assert ig.C[0] == 0.0
+
+
+@pytest.mark.parametrize("order", [1, 2, 3, 4, 5])
+def test_fifth_order_weights_satisfy_order_conditions(order):
+    A, _, b = _tableau()
+    for tree in TREES[order]:
+        assert b @ _phi(tree, A) == pytest.approx(1.0 / _gamma(tree), rel=1e-14, abs=1e-15), tree
+
+
+def test_fifth_order_weights_are_not_sixth_order():
+    A, _, b = _tableau()
+    misses = [abs(b @ _phi(t, A) - 1.0 / _gamma(t)) for t in TREES[6]]
+    assert max(misses) > 1e-5  # the test above could fail: not everything satisfies it
+
+
+def test_quadrature_conditions_spelled_out():
+    # sum b_i c_i^(k-1) = 1/k, k = 1..5, and the two classic order-3/4 tree conditions
+    A, C, b = _tableau()
+    for k in range(1, 6):
+        assert b @ C ** (k - 1) == pytest.approx(1.0 / k, rel=1e-14)
+    assert b @ (A @ C) == pytest.approx(1 / 6, rel=1e-14)
+    assert b @ (A @ C**2) == pytest.approx(1 / 12, rel=1e-14)
+    assert b @ (C * (A @ C)) == pytest.approx(1 / 8, rel=1e-14)
+    assert b @ (A @ (A @ C)) == pytest.approx(1 / 24, rel=1e-14)
+
+
+def test_embedded_weights_are_fourth_order():
+    """scipy's convention: the error estimate is h K^T E with E = b_hat - b (7 entries)."""
+    A, _, b = _tableau()
+    b_hat = b + ig.E
+    # Dormand & Prince (1980), Table 2, the 4th-order row, in exact fractions
+    dp4 = [Fraction(5179, 57600), 0, Fraction(7571, 16695), Fraction(393, 640),
+           Fraction(-92097, 339200), Fraction(187, 2100), Fraction(1, 40)]
+    np.testing.assert_allclose(b_hat, [float(x) for x in dp4], rtol=1e-14, atol=1e-16)
+    for order in range(1, 5):
+        for tree in TREES[order]:
+            assert b_hat @ _phi(tree, A) == pytest.approx(1.0 / _gamma(tree), rel=1e-13), tree
+    misses = [abs(b_hat @ _phi(t, A) - 1.0 / _gamma(t)) for t in TREES[5]]
+    assert max(misses) > 1e-5  # genuinely 4th order, so E is a genuine error estimate
+
+
+def test_dense_output_reproduces_the_step_and_is_fourth_order():
+    A, _, b = _tableau()
+    # at x = 1 the continuous extension is the step itself
+    np.testing.assert_allclose(ig.P.sum(axis=1), b, rtol=0, atol=1e-14)
+    # b_i(x) = sum_k P[i, k] x^(k+1) (scipy's RK45 dense output) satisfies the continuous order
+    # conditions sum_i b_i(x) Phi_i(t) = x^|t| / gamma(t) up to order 4
+    for x in (0.1, 0.37, 0.5, 0.81):
+        bx = ig.P @ x ** np.arange(1, 5)
+        for order in range(1, 5):
+            for tree in TREES[order]:
+                assert bx @ _phi(tree, A) == pytest.approx(x**order / _gamma(tree),
+                                                           rel=1e-12, abs=1e-15), (x, tree)
+
+
+# ---- empirical order on an impact-free segment --------------------------------------------------
+
+def test_empirical_order_is_five():
+    # slender block (hb=2) thrown up on its corner: no impact within the one period
+    kw = dict(hb=2.0, alpha=0.02, omega=5.0, law="housner", theta0=0.2, dtheta0=0.5,
+              phase=0.3, periods=1)
+    ref = rockjit.simulate(**kw, method="scipy:DOP853", rtol=1e-13, atol=1e-14)
+    assert ref.n_impacts == 0 and ref.status == "done"
+    ns = np.array([12, 16, 24, 32, 48, 64])
+    errs = []
+    for n in ns:
+        r = rockjit.simulate(**kw, n_steps=int(n))
+        assert r.n_impacts == 0 and r.status == "done"
+        errs.append(np.abs(r.state[:2] - ref.state[:2]).max())
+    errs = np.array(errs)
+    assert errs[-1] > 1e-13  # well above the reference's own error (~1e-15 here)
+    slope = -np.polyfit(np.log(ns), np.log(errs), 1)[0]
+    assert 4.7 <= slope <= 5.6, (slope, errs)
+    # the embedded estimate is an error indicator of the same size as the step's local error
+    assert r.max_error_estimate > 0.0
+
+
+# ---- the flow's Jacobian across impacts: tangent dynamics and saltation ---------------------
+
+# (hb, law, omega, alpha, theta0, dtheta0, phase): one period with 1-3 impacts, no rest
+SALTATION_CASES = [
+    (1.0, "housner", 6.0, 0.02, 0.1, -0.6, 2.0),
+    (1.0, "housner", 4.0, 0.05, -0.1, 0.5, 0.4),
+    (1.0, "mao", 6.0, 0.02, 0.1, -0.6, 2.0),
+    (1.0, "mao", 4.0, 0.05, 0.1, -0.5, 0.4),
+    (1.0, "mao", 4.0, 0.05, -0.1, 0.5, 0.4),
+    (2.0, "housner", 4.0, 0.05, 0.1, -0.5, 0.4),
+    (2.0, "housner", 4.0, 0.05, -0.1, 0.5, 0.4),
+    (2.0, "mao", 4.0, 0.05, 0.1, -0.5, 0.4),
+    (2.0, "mao", 4.0, 0.05, -0.1, 0.5, 0.4),
+]
+
+
+@pytest.mark.parametrize("hb, law, omega, alpha, th0, dth0, phase", SALTATION_CASES)
+def test_tangent_matches_finite_differences_across_impacts(hb, law, omega, alpha, th0, dth0,
+                                                           phase):
+    kw = dict(hb=hb, alpha=alpha, omega=omega, law=law, phase=phase, periods=1)
+    r = rockjit.simulate(**kw, theta0=th0, dtheta0=dth0, lyapunov=True, qr_every=0, window=0)
+    assert r.status == "done" and r.n_rest == 0 and 1 <= r.n_impacts <= 3
+    V = r.extra["tangent"]
+    eps = 1e-6
+    x = np.array([th0, dth0])
+    J = np.empty((2, 2))
+    for j in range(2):
+        d = np.zeros(2)
+        d[j] = eps
+        rp = rockjit.simulate(**kw, theta0=x[0] + d[0], dtheta0=x[1] + d[1])
+        rm = rockjit.simulate(**kw, theta0=x[0] - d[0], dtheta0=x[1] - d[1])
+        # the perturbation must not change the hybrid itinerary
+        assert rp.n_impacts == rm.n_impacts == r.n_impacts
+        J[:, j] = (rp.state[:2] - rm.state[:2]) / (2 * eps)
+    assert np.abs(J - V).max() <= 1e-6 * np.abs(V).max(), (J, V)
+    # and the product of the impacts' determinants e^2 shows up (det S = e^2, SPEC §5)
+    e = r.block.restitution
+    assert abs(np.linalg.det(V)) == pytest.approx(
+        e ** (2 * r.n_impacts) * math.exp(-0.75 * r.block.xi * r.t), rel=1e-8)
+
+
+# ---- exact physics: free elastic rocking conserves energy -----------------------------------
+
+@pytest.mark.parametrize("hb", [1.0, 2.0])
+def test_free_elastic_rocking_conserves_energy(hb):
+    thc = math.atan(hb)
+    th0, dth0 = 0.15, 0.0
+    # alpha = 0: omega only sets the grid, h = 2 pi / (5 * 256)
+    r = rockjit.simulate(hb, 0.0, 5.0, e=1.0, xi=0.0, theta0=th0, dtheta0=dth0, periods=1900,
+                         record_stride=5, max_impacts=5000)
+    assert r.status == "done" and r.n_impacts >= 1000
+
+    def energy(th, dth):
+        return 0.5 * dth**2 + 0.75 * np.sin(thc + np.abs(th))
+
+    e0 = energy(th0, dth0)
+    assert np.abs(energy(r.strobe[:, 0], r.strobe[:, 1]) / e0 - 1).max() < 1e-10
+    traj = r.trajectory
+    assert len(traj) == 1900 * 256 // 5 + 1
+    assert np.abs(energy(traj[:, 1], traj[:, 2]) / e0 - 1).max() < 1e-10
+    speeds = np.abs(r.impacts[:, 1])
+    v0 = math.sqrt(2 * (e0 - 0.75 * math.sin(thc)))  # the impact speed, from the energy
+    assert np.abs(speeds / v0 - 1).max() < 1e-10
+    assert np.array_equal(r.impacts[:, 1], r.impacts[:, 2])  # e = 1: the jump is the identity
+    # impacts alternate direction
+    assert np.all(np.sign(r.impacts[1:, 1]) == -np.sign(r.impacts[:-1, 1]))
+
+
+# ---- Zeno, rest and uplift (SPEC.md §3) ---------------------------------------------------------
+
+def test_zeno_cascade_comes_to_rest():
+    # hb = 2: cot(thc) = 0.5 > alpha omega^2 = 0.3: once at rest the block stays there
+    kw = dict(hb=2.0, alpha=0.3 / 9.0, omega=3.0, law="housner", theta0=0.05, dtheta0=0.0,
+              periods=50)
+    r = rockjit.simulate(**kw)
+    s = rockjit.simulate(**kw, **DOP)
+    assert r.status == s.status == "rest"
+    assert r.n_impacts == s.n_impacts < 1000
+    # bounded work: 50 periods on the grid would cost 50 * 256 * 6 = 76800 evaluations
+    assert r.n_rhs < 20_000
+    assert r.t == pytest.approx(s.t, abs=1e-8)
+    assert r.t < 50 * r.period
+    np.testing.assert_array_equal(r.state[:2], [0.0, 0.0])
+    np.testing.assert_allclose(r.impacts[:, 0], s.impacts[:, 0], rtol=0, atol=1e-8)
+    # the cascade: each flight shorter than the last, speeds falling by e
+    assert np.all(np.diff(r.impacts[-10:, 0]) > 0)
+    np.testing.assert_allclose(r.impacts[:, 2], r.block.restitution * r.impacts[:, 1],
+                               rtol=1e-15)
+
+
+@pytest.mark.parametrize("phase", [0.0, math.pi, 4.0, 1.5])
+def test_uplift_from_rest_at_the_analytic_instant(spec, phase):
+    hb, omega, aw2 = 2.0, 3.0, 0.6  # above the uplift threshold cot(thc) = 0.5
+    kw = dict(hb=hb, alpha=aw2 / omega**2, omega=omega, law="housner", theta0=0.0, dtheta0=0.0,
+              phase=phase, periods=1)
+    r = rockjit.simulate(**kw, record_stride=1)
+    t_u, side = spec.first_uplift(0.0, aw2, 1.0 / hb, omega, phase)
+    assert r.n_impacts >= 1
+    traj = r.trajectory
+    before = traj[:, 0] <= t_u
+    np.testing.assert_array_equal(traj[before, 1:3], 0.0)  # at rest up to t_u
+    t_imp = r.impacts[0, 0]
+    flight = (traj[:, 0] > t_u) & (traj[:, 0] < t_imp)
+    assert flight.sum() > 10
+    assert np.all(np.sign(traj[flight, 1]) == side)  # on the side of the sign of f
+    # an independent integration from (t_u, 0, 0) on that side: same flight, same landing
+    ref = spec.run(hb, kw["alpha"], omega, spec.e_housner(hb), theta0=0.0, dtheta0=0.0,
+                   phi=phase, t0=t_u, side=side, t_end=t_imp + 0.5, xi=r.block.xi,
+                   max_impacts=1, dense=True)
+    assert ref["impacts"][0, 0] == pytest.approx(t_imp, abs=1e-9)
+    _, _, sol = ref["segments"][0]
+    np.testing.assert_allclose(traj[flight, 1], sol(traj[flight, 0])[0], rtol=0, atol=1e-10)
+
+
+def test_release_after_zeno_rest(spec):
+    # hb = 1 at alpha omega^2 = 1.014 > cot(thc) = 1: the block comes to rest (Zeno) and is
+    # lifted again, over and over. Each departure is at the analytic uplift instant after the rest.
+    hb, alpha, omega, phase = 1.0, 0.6, 1.3, 2.5
+    r = rockjit.simulate(hb, alpha, omega, "housner", theta0=-0.2254, dtheta0=-0.1597,
+                         phase=phase, periods=6)
+    e = spec.e_housner(hb)
+    rests = np.nonzero(np.abs(r.impacts[:, 2]) < 1e-6)[0]
+    assert len(rests) >= 3
+    aw2 = alpha * omega**2
+    for i in rests[:4]:
+        t_u, side = spec.first_uplift(r.impacts[i, 0], aw2, 1.0 / hb, omega, phase)
+        ref = spec.run(hb, alpha, omega, e, theta0=0.0, dtheta0=0.0, phi=phase, t0=t_u,
+                       side=side, t_end=r.impacts[i + 1, 0] + 0.5, xi=r.block.xi,
+                       max_impacts=1)
+        assert ref["impacts"][0, 0] == pytest.approx(r.impacts[i + 1, 0], abs=1e-9)
+        assert ref["impacts"][0, 1] == pytest.approx(r.impacts[i + 1, 1], rel=1e-8)
+
+
+# ---- the oscillator embedding (SPEC.md §1) ---------------------------------------------------
+
+EMBED_CASES = [
+    (1.0, 0.6, 1.3, "housner", 0.0),
+    (1.0, 0.6, 1.3, "housner", 1.0),
+    (1.0, 0.6, 1.3, "housner", 2.5),        # with rests and uplifts
+    (1.0, 0.6, 1.3, "housner", -2.0),       # overturns
+    (2.0, 0.2, 1.6, "mao", math.atan2(-0.7778, 0.6284)),
+    (1.0, 0.8, 1.3, "housner", -0.9),
+]
+
+
+@pytest.mark.parametrize("hb, alpha, omega, law, phase", EMBED_CASES)
+def test_embedded_forcing_matches_closed_form(hb, alpha, omega, law, phase):
+    kw = dict(hb=hb, alpha=alpha, omega=omega, law=law, theta0=-0.2254, dtheta0=-0.1597,
+              r0=math.sin(phase), s0=math.cos(phase), periods=20, n_steps=512)
+    a = rockjit.simulate(**kw, forcing="closed")
+    b = rockjit.simulate(**kw, forcing="embedded")
+    assert a.status == b.status
+    assert a.n_impacts == b.n_impacts and a.n_rest == b.n_rest
+    np.testing.assert_allclose(a.impacts[:, 0], b.impacts[:, 0], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(a.state, b.state, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(a.strobe, b.strobe, rtol=0, atol=1e-9)
+    assert a.t == pytest.approx(b.t, abs=1e-9)
+
+
+def test_embedding_off_the_circle_follows_the_oscillator_exactly():
+    # r = rho sin(omega t + phi), s = rho cos(omega t + phi), rho' = rho (1 - rho^2):
+    # rho(t) = (1 + (1/rho0^2 - 1) exp(-2 t))^(-1/2)
+    omega, r0, s0 = 1.6, 0.3, -0.2
+    r = rockjit.simulate(2.0, 0.2, omega, "housner", theta0=0.1, dtheta0=0.0, r0=r0, s0=s0,
+                         forcing="embedded", periods=5)
+    rho0 = math.hypot(r0, s0)
+    phi = math.atan2(r0, s0)
+    t = np.arange(len(r.strobe)) * r.period
+    rho = 1.0 / np.sqrt(1.0 + (1.0 / rho0**2 - 1.0) * np.exp(-2.0 * t))
+    np.testing.assert_allclose(r.strobe[:, 2], rho * np.sin(omega * t + phi), atol=1e-9)
+    np.testing.assert_allclose(r.strobe[:, 3], rho * np.cos(omega * t + phi), atol=1e-9)
+    with pytest.raises(ValueError, match="r0"):
+        rockjit.simulate(2.0, 0.2, omega, "housner", theta0=0.1, dtheta0=0.0, r0=r0, s0=s0,
+                         forcing="closed", periods=5)
+
+
+# ---- bookkeeping --------------------------------------------------------------------------------
+
+def test_impact_bound_is_its_own_status():
+    r = rockjit.simulate(1.0, 0.6, 1.3, "housner", periods=20, max_impacts=7)
+    full = rockjit.simulate(1.0, 0.6, 1.3, "housner", periods=20)
+    assert full.n_impacts > 7
+    assert r.status == "max_impacts" and r.n_impacts == 7 and len(r.impacts) == 7
+    np.testing.assert_array_equal(r.impacts, full.impacts[:7])
+    assert r.t == full.impacts[6, 0]
+
+
+def test_overturn_threshold_is_a_parameter(spec):
+    # a tilted slender block falls over the threshold theta_over = 0.3
+    kw = dict(hb=2.0, alpha=0.0, omega=1.6, law="housner", theta0=0.5, dtheta0=0.2, periods=2)
+    r = rockjit.simulate(**kw, theta_over=0.3)
+    # theta0 = 0.5 is already past the threshold: overturned at once
+    assert r.status == "overturned" and r.t == 0.0 and r.n_impacts == 0
+    kw["theta0"] = 0.25
+    r = rockjit.simulate(**kw, theta_over=0.3)
+    ref = spec.run(2.0, 0.0, 1.6, spec.e_housner(2.0), theta0=0.25, dtheta0=0.2, phi=0.0,
+                   t_end=2 * r.period, xi=r.block.xi, theta_over=0.3)
+    assert r.status == ref["status"] == "overturned"
+    assert r.t == pytest.approx(ref["t"], abs=1e-10)
+    assert r.state[0] == pytest.approx(0.3, abs=1e-12)
+
+
+def test_coarse_grid_does_not_miss_short_flights():
+    # after each impact the flights get shorter until many fit in one grid step: with N = 16
+    # every one of them must still be found (two crossings in one step), as the scipy path does
+    kw = dict(hb=1.0, alpha=0.0, omega=1.3, e=0.6, xi=0.0, theta0=0.05, dtheta0=0.0,
+              periods=3)
+    r = rockjit.simulate(**kw, n_steps=16)
+    s = rockjit.simulate(**kw, **DOP)
+    h = r.period / 16
+    assert np.sum(np.diff(r.impacts[:, 0]) < h) >= 5  # there are flights shorter than a step
+    assert r.status == s.status == "rest"
+    assert r.n_impacts == s.n_impacts
+    # N = 16 is coarse (h = 0.3): the impact times carry its O(h^5) error, ~2e-6 here
+    np.testing.assert_allclose(r.impacts[:, 0], s.impacts[:, 0], rtol=0, atol=1e-5)
+    assert np.all(np.diff(np.sign(r.impacts[:, 1])) != 0)  # the corners alternate
+
+
+@pytest.mark.parametrize("th0, dth0", [(0.001, -0.05), (0.0005, -0.03), (0.002, -0.06)])
+def test_dip_through_zero_within_one_step_is_found(spec, th0, dth0):
+    # theta > 0 at both ends of a coarse step (h = 0.3) but it dips through 0 in between: the
+    # forcing (f = 2 > cot(thc) = 1) turns the block back. Two impacts hide inside that step.
+    alpha, omega, phase = 2.0 / 1.3**2, 1.3, 0.5 * math.pi
+    kw = dict(hb=1.0, alpha=alpha, omega=omega, law="housner", theta0=th0, dtheta0=dth0,
+              phase=phase, periods=1)
+    r = rockjit.simulate(**kw, n_steps=16)
+    ref = spec.run(1.0, alpha, omega, spec.e_housner(1.0), theta0=th0, dtheta0=dth0, phi=phase,
+                   xi=r.block.xi, t_end=r.period, max_step=1e-3)
+    h = r.period / 16
+    assert ref["impacts"][1, 0] < h  # the first two impacts lie in the first step
+    assert r.status == ref["status"]
+    assert r.n_impacts == len(ref["impacts"])
+    # coarse grid: the 3rd impact carries the O(h^5) error of N = 16
+    np.testing.assert_allclose(r.impacts[:, 0], ref["impacts"][:, 0], rtol=0, atol=1e-5)
+    np.testing.assert_allclose(r.impacts[:2, 0], ref["impacts"][:2, 0], rtol=0, atol=1e-9)

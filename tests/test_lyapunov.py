@@ -1,0 +1,168 @@
+"""Lyapunov exponents through impacts (SPEC.md §5) against what they must equal.
+
+- the exact identity ``lambda1 + lambda2 = -3/4 xi + 2 nu ln(e)``, with the impact rate ``nu``
+  counted here from the recorded impacts;
+- a stable period-1 orbit: ``log|mu| / T`` of the multipliers ``mu`` of the stroboscopic map,
+  whose Jacobian is taken here by central finite differences of one-period runs;
+- a chaotic orbit: a two-trajectory (Benettin) estimate computed here with repeated one-period
+  ``simulate`` calls, renormalised every period, on the same orbit segment;
+- the running estimate settles; switching tangents on does not change the trajectory.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+import rockjit
+
+Z0 = (-0.2254, -0.1597, -0.7778, 0.6284)  # SPEC.md §7
+PHI0 = math.atan2(Z0[2], Z0[3])
+
+ORBITS = {
+    "reference hb=1 housner a=0.6": dict(hb=1.0, alpha=0.6, omega=1.3, law="housner",
+                                         periods=500),
+    "asymmetric hb=1 housner a=0.8": dict(hb=1.0, alpha=0.8, omega=1.3, law="housner",
+                                          periods=500),
+    "hb=1 mao a=0.3": dict(hb=1.0, alpha=0.3, omega=1.3, law="mao", periods=500),
+    "hb=2 housner a=0.2": dict(hb=2.0, alpha=0.2, omega=1.6, law="housner", periods=500),
+    "hb=2 mao a=0.2": dict(hb=2.0, alpha=0.2, omega=1.6, law="mao", periods=500),
+    "chaotic hb=1 housner a=0.955": dict(hb=1.0, alpha=0.955, omega=1.3, law="housner",
+                                         periods=300),
+}
+
+
+@pytest.fixture(scope="module")
+def runs():
+    """The Lyapunov runs, computed once for the module."""
+    return {name: rockjit.simulate(**kw, z0=Z0, lyapunov=True) for name, kw in ORBITS.items()}
+
+
+def _one_period(kw, x):
+    """The stroboscopic map: one period from (theta, theta') at the strobe phase PHI0."""
+    r = rockjit.simulate(kw["hb"], kw["alpha"], kw["omega"], kw["law"], theta0=x[0],
+                         dtheta0=x[1], phase=PHI0, periods=1)
+    return r.state[:2]
+
+
+def _strobe_jacobian(kw, x, eps=1e-6):
+    J = np.empty((2, 2))
+    for j in range(2):
+        d = np.zeros(2)
+        d[j] = eps
+        J[:, j] = (_one_period(kw, x + d) - _one_period(kw, x - d)) / (2 * eps)
+    return J
+
+
+@pytest.mark.parametrize("name", list(ORBITS))
+def test_sum_of_exponents_is_exact(runs, name):
+    r = runs[name]
+    assert r.status == "done" and r.n_rest_window == 0
+    t0, t1 = r.window
+    assert t0 == pytest.approx(round(0.8 * r.periods) * r.period, rel=1e-14)
+    assert t1 == pytest.approx(r.periods * r.period, rel=1e-14)
+    # impacts in the window, counted here
+    n_win = int(np.sum((r.impacts[:, 0] >= t0) & (r.impacts[:, 0] <= t1)))
+    assert n_win == r.n_impacts_window > 0
+    nu = n_win / (t1 - t0)
+    want = -0.75 * r.block.xi + 2.0 * nu * math.log(r.block.restitution)
+    assert r.lyapunov.sum() == pytest.approx(want, abs=1e-6)
+
+
+def test_period_one_orbit_exponents_are_log_multipliers(runs):
+    """Asymmetric orbit (SPEC §7 gallery): real, distinct multipliers."""
+    name = "asymmetric hb=1 housner a=0.8"
+    kw, r = ORBITS[name], runs[name]
+    k = 400
+    x = r.strobe[k, :2]
+    np.testing.assert_allclose(r.strobe[k + 1, :2], x, rtol=0, atol=1e-10)  # period 1
+    np.testing.assert_allclose(_one_period(kw, x), r.strobe[k + 1, :2], rtol=0, atol=1e-11)
+    mu = np.linalg.eigvals(_strobe_jacobian(kw, x))
+    assert np.all(np.isreal(mu)) and np.all(np.abs(mu) < 1)
+    lam = np.sort(np.log(np.abs(mu)) / r.period)[::-1]
+    np.testing.assert_allclose(r.lyapunov, lam, rtol=1e-4)
+
+
+def test_reference_orbit_exponents_are_log_multipliers(runs):
+    """Reference symmetric orbit: a complex pair, so lambda1 = lambda2 = log|mu| / T exactly.
+
+    A finite window resolves the two only to O(1/window) (the QR estimate of a rotating pair
+    oscillates about the common value), so their mean is checked tightly and each one loosely.
+    """
+    name = "reference hb=1 housner a=0.6"
+    kw, r = ORBITS[name], runs[name]
+    k = 400
+    x = r.strobe[k, :2]
+    np.testing.assert_allclose(r.strobe[k + 1, :2], x, rtol=0, atol=1e-10)  # period 1
+    mu = np.linalg.eigvals(_strobe_jacobian(kw, x))
+    assert np.all(np.abs(mu.imag) > 1e-3) and np.all(np.abs(mu) < 1)
+    lam = math.log(abs(mu[0])) / r.period
+    assert r.lyapunov.mean() == pytest.approx(lam, rel=1e-6)
+    np.testing.assert_allclose(r.lyapunov, lam, rtol=1e-2)
+    # the running estimate over the whole run is closer still
+    np.testing.assert_allclose(r.lyapunov_running[-1], lam, rtol=1e-3)
+
+
+def test_reference_run_is_stable_and_settles(runs):
+    r = runs["reference hb=1 housner a=0.6"]
+    assert r.lambda_max < 0
+    run = r.lyapunov_running
+    assert run.shape == (r.periods + 1, 2)
+    assert np.all(run[0] == 0.0)
+    tail = run[int(0.8 * len(run)):, 0]
+    assert np.ptp(tail) < 2e-3 * abs(r.lambda_max)
+    assert np.all(tail < 0)
+
+
+def test_chaotic_run_matches_two_trajectory_estimate(runs):
+    name = "chaotic hb=1 housner a=0.955"
+    kw, r = ORBITS[name], runs[name]
+    assert r.status == "done" and r.n_rest == 0
+    assert r.lambda_max > 0.01
+    T = r.period
+    w0 = int(round(r.window[0] / T))
+    d0 = 1e-8
+    u = np.array([1.0, 1.0]) / math.sqrt(2.0)
+    total, n = 0.0, 0
+    # along the run's own strobe points; 20 periods before the window to align the direction
+    for k in range(w0 - 20, r.periods):
+        x = r.strobe[k, :2]
+        y0 = _one_period(kw, x)
+        dy = _one_period(kw, x + d0 * u) - y0
+        d = np.linalg.norm(dy)
+        u = dy / d
+        if k >= w0:
+            total += math.log(d / d0)
+            n += 1
+    lam = total / (n * T)
+    assert n == r.periods - w0
+    assert lam > 0
+    assert r.lambda_max == pytest.approx(lam, rel=1e-3)
+
+
+# ---- switches do not change the trajectory, bit for bit ----------------------------------------
+
+BIT_CASES = {
+    "reference": dict(hb=1.0, alpha=0.6, omega=1.3, law="housner", z0=Z0, periods=60),
+    "chaotic": dict(hb=1.0, alpha=0.955, omega=1.3, law="housner", z0=Z0, periods=60),
+    "rest and uplift": dict(hb=1.0, alpha=0.6, omega=1.3, law="housner", theta0=Z0[0],
+                            dtheta0=Z0[1], r0=math.sin(2.5), s0=math.cos(2.5), periods=20),
+}
+FIELDS = ("t", "status", "n_impacts", "state", "strobe", "strobe_half", "impacts")
+
+
+@pytest.mark.parametrize("forcing", ["closed", "embedded"])
+@pytest.mark.parametrize("name", list(BIT_CASES))
+def test_switches_do_not_change_the_trajectory(name, forcing):
+    """Tangent vectors and trajectory recording on or off: the same run to the last bit."""
+    kw = dict(BIT_CASES[name], forcing=forcing)
+    plain = rockjit.simulate(**kw)
+    tangent = rockjit.simulate(**kw, lyapunov=True)
+    recorded = rockjit.simulate(**kw, record_stride=3)
+    both = rockjit.simulate(**kw, lyapunov=True, record_stride=3)
+    for other in (tangent, recorded, both):
+        for field in FIELDS:
+            assert np.array_equal(getattr(other, field), getattr(plain, field)), field
+    assert np.array_equal(both.trajectory, recorded.trajectory)
+    assert np.array_equal(both.lyapunov, tangent.lyapunov)
+    assert np.array_equal(both.lyapunov_running, tangent.lyapunov_running)

@@ -1,0 +1,171 @@
+"""rockjit.model against independent statements of the same physics.
+
+- restitution laws: the values SPEC.md §2 quotes from the paper, and the SPEC formulas typed in
+  again in conftest;
+- ``accel``: the two corner equations of SPEC.md §1 written out separately (conftest);
+- ``accel_jac``, ``oscillator_jac``: central finite differences of ``accel``, ``oscillator``;
+- ``saltation``: the closed form of SPEC.md §5 written out here;
+- ``uplift_time``: a brute-force scan of the forcing, and the closed form in conftest.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from rockjit import model
+from rockjit.model import Block
+
+RNG_SEED = 20240607
+
+
+def _states(n=8, seed=RNG_SEED):
+    """A few (theta, theta', f) points spread over the physically relevant range."""
+    rng = np.random.default_rng(seed)
+    th = rng.uniform(-1.2, 1.2, n)
+    dth = rng.uniform(-2.0, 2.0, n)
+    f = rng.uniform(-3.0, 3.0, n)
+    return list(zip(th, dth, f))
+
+
+# ---- restitution (SPEC.md §2) -----------------------------------------------------------------
+
+@pytest.mark.parametrize("hb, e_h, e_m, delta", [(1.0, 0.250, 0.582, 79.85),
+                                                   (2.0, 0.700, 0.830, 17.03)])
+def test_restitution_matches_values_quoted_in_spec(hb, e_h, e_m, delta):
+    thc = model.thc_from_hb(hb)
+    eh = float(model.e_housner(thc))
+    em = float(model.e_mao(thc))
+    # to the quoted digits: within half a unit of the last quoted place
+    assert abs(eh - e_h) <= 0.5e-3
+    assert abs(em - e_m) <= 0.5e-3
+    assert abs(float(model.delta_e_percent(em, eh)) - delta) <= 0.5e-2
+    # Block picks the law it is given
+    assert Block(hb, 0.1, 1.0, "housner").restitution == eh
+    assert Block(hb, 0.1, 1.0, "mao").restitution == em
+    assert Block(hb, 0.1, 1.0, e=0.37).restitution == 0.37
+
+
+def test_restitution_laws_match_spec_formulas(spec):
+    for hb in np.linspace(1 / math.sqrt(2), 6.0, 25):
+        thc = model.thc_from_hb(hb)
+        assert float(model.e_housner(thc)) == pytest.approx(spec.e_housner(hb), rel=1e-13,
+                                                             abs=1e-15)
+        assert float(model.e_mao(thc)) == pytest.approx(spec.e_mao(hb), rel=1e-13)
+    # vectorised, for the figures
+    thc = model.thc_from_hb(np.array([1.0, 2.0]))
+    np.testing.assert_allclose(model.e_mao(thc), [spec.e_mao(1.0), spec.e_mao(2.0)], rtol=1e-13)
+
+
+def test_housner_law_vanishes_at_its_limit():
+    # e_H = 1 - 1.5 cos^2(thc) = 0 exactly when tan(thc) = 1/sqrt(2) (SPEC.md §2)
+    assert abs(float(model.e_housner(model.thc_from_hb(1 / math.sqrt(2))))) < 1e-15
+    assert float(model.e_housner(model.thc_from_hb(0.7))) < 0.0
+
+
+# ---- the vector field (SPEC.md §1) ------------------------------------------------------------
+
+@pytest.mark.parametrize("side", [1, -1])
+@pytest.mark.parametrize("hb", [1.0, 2.0, 0.8])
+def test_accel_matches_spec_equations(spec, side, hb):
+    thc = math.atan(hb)
+    xi = 0.07
+    omega, phi = 1.7, 0.3
+    for k, (th, dth, f) in enumerate(_states()):
+        # put the forcing value f at some time t through the SPEC's own sin(omega t + phi)
+        t = 0.1 * k
+        aw2 = f / math.sin(omega * t + phi)
+        want = spec.theta_ddot(t, th, dth, side, hb, aw2, omega, phi, xi)
+        got = model.accel(th, dth, aw2 * math.sin(omega * t + phi), side, thc, xi)
+        assert got == pytest.approx(want, rel=1e-12, abs=1e-14)
+    assert model.accel(0.3, 0.2, 1.0, 0, thc, xi) == 0.0  # at rest
+
+
+@pytest.mark.parametrize("side", [1, -1])
+@pytest.mark.parametrize("hb", [1.0, 2.0])
+def test_accel_jac_matches_finite_differences(side, hb):
+    thc = math.atan(hb)
+    xi = 0.05
+    eps = 1e-6
+    for th, dth, f in _states():
+        jac = np.array(model.accel_jac(th, dth, f, side, thc, xi))
+        x = np.array([th, dth, f])
+        fd = np.empty(3)
+        for i in range(3):
+            d = np.zeros(3)
+            d[i] = eps
+            fd[i] = (model.accel(*(x + d), side, thc, xi)
+                     - model.accel(*(x - d), side, thc, xi)) / (2 * eps)
+        np.testing.assert_allclose(jac, fd, rtol=1e-7, atol=1e-9)
+
+
+def test_oscillator_jac_matches_finite_differences():
+    eps = 1e-6
+    rng = np.random.default_rng(RNG_SEED)
+    for r, s, omega in zip(rng.uniform(-1.5, 1.5, 8), rng.uniform(-1.5, 1.5, 8),
+                           rng.uniform(0.5, 3.0, 8)):
+        jac = np.array(model.oscillator_jac(r, s, omega)).reshape(2, 2)
+        fd = np.empty((2, 2))
+        fd[:, 0] = (np.array(model.oscillator(r + eps, s, omega))
+                    - np.array(model.oscillator(r - eps, s, omega))) / (2 * eps)
+        fd[:, 1] = (np.array(model.oscillator(r, s + eps, omega))
+                    - np.array(model.oscillator(r, s - eps, omega))) / (2 * eps)
+        np.testing.assert_allclose(jac, fd, rtol=1e-7, atol=1e-9)
+
+
+def test_oscillator_on_the_circle_is_the_closed_form():
+    # r = sin(omega t + phi), s = cos(omega t + phi) solves r' = omega s, s' = -omega r there
+    omega, phi = 1.3, 0.7
+    for t in np.linspace(0.0, 5.0, 11):
+        r, s = math.sin(omega * t + phi), math.cos(omega * t + phi)
+        dr, ds = model.oscillator(r, s, omega)
+        assert dr == pytest.approx(omega * s, abs=1e-14)
+        assert ds == pytest.approx(-omega * r, abs=1e-14)
+        assert model.forcing_closed(t, omega, phi) == pytest.approx(r, abs=1e-15)
+
+
+# ---- the impact (SPEC.md §2, §5) --------------------------------------------------------------
+
+def test_jump_map():
+    assert model.jump(-0.4, 0.25) == -0.1
+    assert model.jump(0.8, 1.0) == 0.8
+
+
+@pytest.mark.parametrize("xi", [0.0, 0.3])
+@pytest.mark.parametrize("hb", [0.8, 1.0, 2.0, 4.0])
+def test_saltation_matches_spec_closed_form(hb, xi):
+    """S[1, 0] = 3/4 [(1-e) aw2 r sin(thc) - sgn(theta'-)(1+e) cos(thc)] / theta'- (SPEC §5)."""
+    thc = math.atan(hb)
+    rng = np.random.default_rng(RNG_SEED)
+    for _ in range(20):
+        dm = rng.choice([-1, 1]) * rng.uniform(1e-3, 2.0)
+        f = rng.uniform(-3.0, 3.0)  # f = aw2 * r
+        e = rng.uniform(0.0, 1.0)
+        side_old = -int(np.sign(dm))  # theta'- < 0 on the corner theta > 0, and vice versa
+        want = 0.75 * ((1 - e) * f * math.sin(thc)
+                       - np.sign(dm) * (1 + e) * math.cos(thc)) / dm
+        got = model.saltation(dm, f, side_old, thc, xi, e)
+        assert got == pytest.approx(want, rel=1e-12, abs=1e-12 / abs(dm))
+
+
+# ---- rest and uplift (SPEC.md §3) -------------------------------------------------------------
+
+@pytest.mark.parametrize("t0, aw2, cot, omega, phi", [
+    (0.0, 0.6, 0.5, 3.0, 0.0),
+    (0.0, 0.6, 0.5, 3.0, math.pi),
+    (0.0, 0.6, 0.5, 3.0, 4.0),
+    (1.234, 1.2, 1.0, 1.3, 0.2),
+    (7.5, 0.9, 0.5, 2.0, -2.0),
+    (0.0, 0.6, 0.5, 3.0, 1.5),   # already lifting at t0
+])
+def test_uplift_time(spec, t0, aw2, cot, omega, phi):
+    got = model.uplift_time(t0, aw2, cot, omega, phi)
+    want, _ = spec.first_uplift(t0, aw2, cot, omega, phi)
+    assert got == pytest.approx(want, rel=0, abs=1e-12)
+    # brute force: scan one forcing period on a fine grid
+    ts = t0 + np.linspace(0.0, 2 * math.pi / omega, 400_001)
+    lifted = np.abs(aw2 * np.sin(omega * ts + phi)) > cot
+    t_scan = ts[np.argmax(lifted)]
+    assert abs(got - t_scan) <= (ts[1] - ts[0])
+    # a block that can never be lifted
+    assert model.uplift_time(t0, cot, cot, omega, phi) == math.inf

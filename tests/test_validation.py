@@ -1,0 +1,107 @@
+"""Input checking of ``rockjit.simulate``: every invalid input is a ValueError naming the parameter.
+
+Checked against SPEC.md's ranges (§1-3) and STYLE.md 12, on both the compiled and the scipy path
+(the wrapper validates before it dispatches, so no integration runs in these tests).
+"""
+
+import math
+
+import pytest
+
+import rockjit
+
+BASE = dict(hb=1.0, alpha=0.6, omega=1.3, periods=1)
+NAN = math.nan
+
+# (changes to BASE, regular expression the message must match)
+CASES = [
+    (dict(hb=0.0), "hb"),
+    (dict(hb=-1.0), "hb"),
+    (dict(hb=math.inf), "hb"),
+    (dict(hb=NAN), "hb"),
+    (dict(hb="tall"), "hb"),
+    (dict(hb=0.5, law="housner"), "hb"),               # e_H < 0 below 1/sqrt(2)
+    (dict(hb=0.5), "hb"),                              # Housner is the default law
+    (dict(e=1.5), r"^e\b"),
+    (dict(e=-0.1), r"^e\b"),
+    (dict(e=NAN), r"^e\b"),
+    (dict(e=0.5, law="mao"), r"^e\b"),
+    (dict(e=0.5, law="housner"), r"^e\b"),
+    (dict(law="constant"), r"^e\b"),                   # constant law without e
+    (dict(law="coulomb"), "law"),
+    (dict(omega=0.0), "omega"),
+    (dict(omega=-1.3), "omega"),
+    (dict(omega=NAN), "omega"),
+    (dict(alpha=-0.1), "alpha"),
+    (dict(alpha=NAN), "alpha"),
+    (dict(alpha=math.inf), "alpha"),
+    (dict(xi=-1e-3), "xi"),
+    (dict(xi=NAN), "xi"),
+    (dict(periods=0), "periods"),
+    (dict(periods=2.5), "periods"),
+    (dict(periods=NAN), "periods"),
+    (dict(n_steps=255), "n_steps"),
+    (dict(n_steps=6), "n_steps"),
+    (dict(n_steps=100.5), "n_steps"),
+    (dict(theta_over=0.0), "theta_over"),
+    (dict(theta_over=2.0), "theta_over"),
+    (dict(theta_over=-0.3), "theta_over"),
+    (dict(theta_over=NAN), "theta_over"),
+    (dict(rest_speed=-1.0), "rest_speed"),
+    (dict(max_impacts=0), "max_impacts"),
+    (dict(window=1), "window"),                        # must be < periods
+    (dict(window=-1), "window"),
+    (dict(record_stride=0), "record_stride"),
+    (dict(forcing="open"), "forcing"),
+    (dict(r0=0.5, s0=0.5), "r0"),                      # off the circle with closed forcing
+    (dict(r0=0.0), "r0"),                              # r0 without s0
+    (dict(s0=1.0), "s0"),                              # s0 without r0
+    (dict(r0=0.0, s0=0.0, forcing="embedded"), "r0"),  # no phase at the origin
+    (dict(r0=NAN, s0=1.0), "r0"),
+    (dict(phase=NAN), "phase"),
+    (dict(phase=0.3, r0=0.0, s0=1.0), "phase"),
+    (dict(z0=(0.1, 0.2, 0.3)), "z0"),
+    (dict(z0=(0.1, 0.2, 0.0, 1.0), theta0=0.1), "z0"),
+    (dict(z0=(NAN, 0.2, 0.0, 1.0)), "theta0|z0"),
+    (dict(theta0=NAN), "theta0"),
+    (dict(dtheta0=NAN), "dtheta0"),
+    (dict(theta0=math.inf), "theta0"),
+]
+
+
+def _id(case):
+    changes, _ = case
+    return ",".join(f"{k}={v!r}" for k, v in changes.items())
+
+
+@pytest.mark.parametrize("method", ["rockjit", "scipy:DOP853"])
+@pytest.mark.parametrize("case", CASES, ids=[_id(c) for c in CASES])
+def test_invalid_input_names_the_parameter(case, method):
+    changes, match = case
+    with pytest.raises(ValueError, match=match):
+        rockjit.simulate(**{**BASE, "method": method, **changes})
+
+
+@pytest.mark.parametrize("changes, match", [
+    (dict(method="rk4"), "method"),
+    (dict(method="scipy:NOPE"), "method"),
+    (dict(method=None), "method"),
+    (dict(qr_every=-1, lyapunov=True), "qr_every"),
+    (dict(method="scipy:DOP853", lyapunov=True), "lyapunov"),
+    (dict(method="scipy:DOP853", rtol=NAN), "rtol"),
+    (dict(method="scipy:DOP853", atol=NAN), "atol"),
+], ids=lambda v: repr(v) if isinstance(v, dict) else v)
+def test_invalid_settings_name_the_setting(changes, match):
+    with pytest.raises(ValueError, match=match):
+        rockjit.simulate(**{**BASE, **changes})
+
+
+def test_valid_edge_values_are_accepted():
+    # the edges of the allowed ranges are allowed (a guard against over-eager checks)
+    r = rockjit.simulate(1.0 / math.sqrt(2.0) + 1e-12, 0.0, 1.3, periods=1, theta0=0.1,
+                         dtheta0=0.0, n_steps=8, theta_over=0.5 * math.pi)
+    assert r.status in ("done", "rest")
+    r = rockjit.simulate(1.0, 0.6, 1.3, e=0.0, periods=1, n_steps=8)
+    assert r.status in ("done", "rest", "overturned")
+    r = rockjit.simulate(1.0, 0.6, 1.3, e=1.0, periods=1.0, n_steps=8.0)
+    assert r.periods == 1 and r.n_steps == 8
