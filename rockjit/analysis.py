@@ -44,14 +44,19 @@ from numba import prange
 from . import integrate as ig
 from ._jit import jit
 from .model import Block
-from .simulate import DEFAULT_N, Z0_STUDY, _int, _real, check_settings, forcing_phase
+from .simulate import Z0_STUDY, _int, _real, check_settings, forcing_phase
 from .simulate import initial_side, pack
 
-__all__ = ["BEHAVIOURS", "BasinResult", "SweepResult", "basin", "classify_result", "sweep"]
+__all__ = ["BEHAVIOURS", "GRID_N", "BasinResult", "SweepResult", "basin", "classify_result",
+           "sweep"]
 
 BEHAVIOURS = ("overturn", "rest", "symmetric", "asymmetric", "multiperiodic", "chaotic",
               "aperiodic", "unresolved")
 OVERTURN, REST, SYMMETRIC, ASYMMETRIC, MULTIPERIODIC, CHAOTIC, APERIODIC, UNRESOLVED = range(8)
+
+#: Steps per period of sweeps and basins: they need labels and lambda_max, not 1e-10 event
+#: times; benchmarks/README.md ("Grid resolution") measures their agreement with N = 256.
+GRID_N = 128
 
 #: Defaults of the classification (documented in the module docstring and the README).
 TOL = 1e-6
@@ -434,7 +439,7 @@ def alpha_grid(alpha_range, alpha_step):
 
 
 def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None,
-          alpha_step=0.001, z0=Z0_STUDY, periods=500, n_steps=DEFAULT_N, window=None,
+          alpha_step=0.001, z0=Z0_STUDY, periods=500, n_steps=GRID_N, window=None,
           lyapunov=True, early_stop=True, threads=None, progress=False, tol=TOL, pmax=PMAX,
           lam_tol=LAM_TOL, max_impacts=100_000, settle_tol=SETTLE_TOL,
           settle_reps=SETTLE_REPS, n_points=None, n_impact_points=400) -> SweepResult:
@@ -503,7 +508,7 @@ def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None
 
 def basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100, theta_range=(-1.0, 1.0),
           dtheta_range=(-1.0, 1.0), r0=None, s0=None, phase=None, periods=500,
-          n_steps=DEFAULT_N, window=None, lyapunov=False, early_stop=True, threads=None,
+          n_steps=GRID_N, window=None, lyapunov=False, early_stop=True, threads=None,
           progress=False, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL, max_impacts=100_000,
           settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS) -> BasinResult:
     """Basin of attraction over ``(theta0, theta0')`` on a ``grid x grid`` lattice.

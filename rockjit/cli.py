@@ -415,7 +415,7 @@ def _cor_run(args, kw):
 
 def _paper_validate(args):
     from .analysis import alpha_grid
-    _settings(args.periods, args.n_steps)
+    _settings(args.periods, args.n_steps or 8)
     _check_positive_int("grid", args.grid)
     if not args.alpha_step > 0 or not math.isfinite(args.alpha_step):
         raise UsageError(f"alpha-step must be > 0 (got {args.alpha_step})")
@@ -446,8 +446,12 @@ def _paper_run(args, kw):
     walls = {}
     results = {}
     n_parts = 6
-    stride = max(1, math.ceil(args.periods * args.n_steps / MAX_TRAJ_POINTS))
-    run_kw = dict(periods=args.periods, n_steps=args.n_steps, record_stride=stride,
+    from .analysis import GRID_N
+    from .simulate import DEFAULT_N
+    n_single = args.n_steps or DEFAULT_N
+    n_grid = args.n_steps or GRID_N
+    stride = max(1, math.ceil(args.periods * n_single / MAX_TRAJ_POINTS))
+    run_kw = dict(periods=args.periods, n_steps=n_single, record_stride=stride,
                   lyapunov=True)
     t_all = time.perf_counter()
 
@@ -512,7 +516,7 @@ def _paper_run(args, kw):
     # 5. bifurcation diagrams
     t0 = part(5, "fig5", "bifurcation sweeps (4 + zoom)")
     sweeps = {}
-    skw = dict(periods=args.periods, n_steps=args.n_steps, threads=args.threads,
+    skw = dict(periods=args.periods, n_steps=n_grid, threads=args.threads,
                progress=not args.quiet, lyapunov=True)
     sweep_rows = []
     for (hb, law), alphas in kw["grids"].items():
@@ -555,7 +559,7 @@ def _paper_run(args, kw):
         for law in ("housner", "mao"):
             _say(args, f"paper: basin {law} hb={hb:g} alpha={alpha:g} omega={omega:g}")
             bs[law] = basin(hb, alpha, omega, law=law, grid=args.grid, r0=0.0, s0=1.0,
-                            periods=args.periods, n_steps=args.n_steps, threads=args.threads,
+                            periods=args.periods, n_steps=n_grid, threads=args.threads,
                             progress=not args.quiet)
         agree = agreement(bs["housner"].label, bs["mao"].label)
         tag = f"hb{hb:g}"
@@ -600,12 +604,19 @@ def _add_block(p, alpha=True, omega=True, law_choices="housner, mao or constant"
                        help="forcing frequency Omega/Omega0")
 
 
-def _add_run(p, periods=500):
+def _add_run(p, periods=500, grid=False, both=False):
+    from .analysis import GRID_N
     from .simulate import DEFAULT_N
     p.add_argument("--periods", type=int, default=periods,
                    help=f"forcing periods to integrate (default {periods})")
-    p.add_argument("--n-steps", type=int, default=DEFAULT_N,
-                   help=f"steps per forcing period, even (default {DEFAULT_N})")
+    if both:
+        note = f"default {DEFAULT_N} for single runs, {GRID_N} for sweeps and basins"
+        default = None
+    else:
+        default = GRID_N if grid else DEFAULT_N
+        note = f"default {default}"
+    p.add_argument("--n-steps", type=int, default=default,
+                   help=f"steps per forcing period, even ({note})")
 
 
 def _add_state(p, default_note):
@@ -666,7 +677,7 @@ def build_parser():
                    metavar=("START", "END"), help="amplitudes from START to END (included)")
     p.add_argument("--alpha-step", type=float, default=0.001, help="step (default 0.001)")
     _add_state(p, "default: the study's z0")
-    _add_run(p)
+    _add_run(p, grid=True)
     p.add_argument("--no-lyapunov", action="store_true",
                    help="skip the exponents (chaotic is then reported as aperiodic)")
     p.add_argument("--full-length", action="store_true", help="disable early stopping")
@@ -685,7 +696,7 @@ def build_parser():
     p.add_argument("--dtheta-range", type=float, nargs=2, default=(-1.0, 1.0),
                    metavar=("LO", "HI"), help="dtheta0 range (default -1 1)")
     _add_phase(p, "default (r0, s0) = (0, 1)")
-    _add_run(p)
+    _add_run(p, grid=True)
     p.add_argument("--lyapunov", action="store_true",
                    help="compute exponents (tells chaotic from aperiodic)")
     p.add_argument("--full-length", action="store_true", help="disable early stopping")
@@ -705,7 +716,7 @@ def build_parser():
                        description="Regenerate figures 1-6 and the tables of the study. "
                        "Smaller --grid, --periods, --alpha-step give a quick version.")
     p.add_argument("--grid", type=int, default=100, help="basin cells per side (default 100)")
-    _add_run(p)
+    _add_run(p, both=True)
     p.add_argument("--alpha-step", type=float, default=0.001, help="sweep step (default 0.001)")
     p.add_argument("--zoom", type=float, nargs=2, default=ZOOM, metavar=("START", "END"),
                    help=f"alpha range of the zoomed Housner hb=1 diagram (default "

@@ -98,9 +98,9 @@ def test_transient_chaos_is_resolved():
 def test_sweep_matches_single_runs():
     """Every cell of a small sweep equals a separate single run (full length, same window)."""
     alphas = np.array([0.55, 0.62, 0.78, 0.85, 0.93, 0.99])
-    sw = an.sweep(1, 1.3, alphas, periods=PERIODS, early_stop=False)
+    sw = an.sweep(1, 1.3, alphas, periods=PERIODS, early_stop=False, n_steps=an.GRID_N)
     for a, lab, lam, pts in zip(alphas, sw.label, sw.lambda_max, sw.strobe):
-        res = rockjit.simulate(1, a, 1.3, periods=PERIODS, lyapunov=True)
+        res = rockjit.simulate(1, a, 1.3, periods=PERIODS, lyapunov=True, n_steps=an.GRID_N)
         assert an.BEHAVIOURS[lab] == slow_classify(res, int(0.8 * PERIODS))[0]
         if res.status == "done":
             assert lam == pytest.approx(res.lyapunov[0], rel=1e-9, abs=1e-12)
