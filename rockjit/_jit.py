@@ -8,6 +8,10 @@ switch-independence of trajectories is a promise (tests/test_lyapunov.py); measu
 reference run, contraction bought no speed distinguishable from the noise of this machine.
 """
 
+import hashlib
+import os
+from pathlib import Path
+
 import numba
 from llvmlite import ir
 from numba import types
@@ -52,3 +56,51 @@ def fma(typingctx, a, b, c):
         return builder.call(fn, vals)
 
     return sig, codegen
+
+
+# ---- keeping numba's on-disk cache honest ------------------------------------------------------
+# numba invalidates a cached function only when its own source file changes; the kernels inline
+# code from other modules (model.py, _jit.py), and an edit there would leave stale machine code
+# in use. The package's compiled sources are hashed at import, and numba's cache files of this
+# package are dropped whenever the hash differs from the one stamped beside them.
+
+_SOURCES = ("_jit.py", "model.py", "integrate.py", "analysis.py")
+
+
+def _cache_dirs(pkg):
+    dirs = [pkg / "__pycache__"]
+    root = os.environ.get("NUMBA_CACHE_DIR")
+    if root and Path(root).is_dir():
+        dirs += [Path(d) for d, _, _ in os.walk(root) if "rockjit" in Path(d).name]
+    return dirs
+
+
+def check_cache(pkg=None):
+    """Drop numba's cache files of the package when its compiled sources changed."""
+    pkg = Path(__file__).resolve().parent if pkg is None else Path(pkg)
+    h = hashlib.sha256()
+    for name in _SOURCES:
+        try:
+            h.update((pkg / name).read_bytes())
+        except OSError:
+            return
+    digest = h.hexdigest()
+    for d in _cache_dirs(pkg):
+        stamp = d / "rockjit-sources.sha256"
+        try:
+            if stamp.read_text() == digest:
+                continue
+        except OSError:
+            pass
+        try:
+            for f in d.glob("*.nb[ic]"):
+                f.unlink(missing_ok=True)
+            d.mkdir(parents=True, exist_ok=True)
+            tmp = d / f"rockjit-sources.sha256.{os.getpid()}"
+            tmp.write_text(digest)
+            os.replace(tmp, stamp)
+        except OSError:
+            pass  # a read-only install: numba then caches elsewhere or not at all
+
+
+check_cache()

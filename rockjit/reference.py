@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
 from .model import Block, accel, accel_jac, forcing_closed, jump, oscillator, oscillator_jac
 from .model import uplift_time
@@ -114,6 +115,7 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
                     break
                 if aw2 * abs(z[2]) > cot:
                     side = 1 if z[2] > 0 else -1
+                    z[0] = side * _TINY
                     continue
 
                 def osc(tt, w):
@@ -133,6 +135,7 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
                     t = float(sol.t_events[0][0])
                     z = np.array([0.0, 0.0, *sol.y_events[0][0]])
                     side = 1 if z[2] > 0 else -1
+                    z[0] = side * _TINY
                 else:
                     t = t_end
                     z = np.array([0.0, 0.0, *np.asarray(sol.y)[:, -1]])
@@ -147,6 +150,7 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
                 t = t_stop
                 if t_up <= t_end:
                     side = 1 if forcing_closed(t, omega, phi) > 0 else -1
+                    z = np.array([side * _TINY, 0.0])
             continue
 
         # ---- in flight on corner `side` ------------------------------------------------------
@@ -160,28 +164,56 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
         over.terminal = True
         over.direction = -1
 
+        def turn(tt, zz, side=side):
+            # the lowest point of side * theta: solve_ivp sees sign changes only between its
+            # own steps, so a dip through theta = 0 and back within one step is found here
+            return side * zz[1]
+        turn.direction = 1
+
         ts = t_samp[(t_samp > t) & (t_samp <= t_end)]
         opts = {"jac": jac} if ivp_method in ("BDF", "Radau", "LSODA") else {}
         sol = solve_ivp(fun, (t, t_end), z, method=ivp_method, rtol=rtol, atol=atol,
-                        events=(impact, over), t_eval=ts, args=(side,), **opts)
+                        events=(impact, over, turn), t_eval=ts, args=(side,),
+                        dense_output=True, **opts)
         nfev += sol.nfev
-        nsteps += len(sol.t)
-        take(sol.t, np.asarray(sol.y).reshape(len(z), -1))
         if sol.status == -1:
             status = "nonfinite"
             break
-        if sol.status == 0:
+        sol_t = np.asarray(sol.t, dtype=float)
+        sol_y = np.asarray(sol.y, dtype=float).reshape(len(z), -1)
+        t_stop = t_end if sol.status == 0 else min(
+            (float(ev[0]) for ev in sol.t_events[:2] if len(ev)), default=t_end)
+        dip = None
+        t_left = t
+        for t_turn in sol.t_events[2]:
+            if t_turn >= t_stop:
+                break
+            if t_turn > t and side * sol.sol(t_turn)[0] < 0.0:
+                dip = brentq(lambda tt: side * sol.sol(tt)[0], t_left, t_turn,
+                             xtol=4 * np.finfo(float).eps * max(1.0, abs(t_turn)))
+                break
+            t_left = t_turn
+        keep = sol_t <= (dip if dip is not None else t_stop)
+        nsteps += int(np.count_nonzero(keep))
+        take(sol_t[keep], sol_y[:, keep])
+        if dip is not None:
+            t = float(dip)
+            z = sol.sol(t).copy()
+            z[0] = 0.0
+        elif sol.status == 0:
             t = t_end
             # the last sample point is t_end itself (t_half ends there)
-            z = np.asarray(sol.y)[:, -1]
+            z = sol_y[:, -1]
             break
-        if len(sol.t_events[1]):
+        elif len(sol.t_events[1]) and (not len(sol.t_events[0])
+                                       or sol.t_events[1][0] <= sol.t_events[0][0]):
             t = float(sol.t_events[1][0])
             z = sol.y_events[1][0].copy()
             status = "overturned"
             break
-        t = float(sol.t_events[0][0])
-        z = sol.y_events[0][0].copy()
+        else:
+            t = float(sol.t_events[0][0])
+            z = sol.y_events[0][0].copy()
         dth_m = z[1]
         dth_p = jump(dth_m, e)
         impacts.append((t, dth_m, dth_p))

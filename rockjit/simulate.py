@@ -261,8 +261,8 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
         Zeno cut-off: an impact leaving with ``|theta'| < rest_speed`` puts the block at rest.
     qr_every : int, optional
         Grid steps between Gram–Schmidt renormalisations of the tangent vectors; default
-        ``n_steps // 2``; 0 never renormalises, so that ``result.extra["tangent"]`` is the
-        Jacobian of the whole flow (for short runs and tests).
+        ``n_steps // 2``; 0 renormalises only on entering rest, so that for a run without rest
+        phases ``result.extra["tangent"]`` is the Jacobian of the whole flow (short runs, tests).
 
     Returns
     -------

@@ -161,13 +161,9 @@ def test_study_damping_value():
     assert xi == pytest.approx(2.208e-4, rel=1e-3)
 
 
-SCIPY_MISSES_DIP = (
-    "rockjit.reference relies on solve_ivp's event detection, which only sees sign changes "
-    "between solver steps: an impact whose dip through theta = 0 fits in one step is lost")
-
-
-@pytest.mark.xfail(strict=True, reason=SCIPY_MISSES_DIP)
 def test_scipy_path_finds_a_dip_through_zero(spec):
+    """solve_ivp sees sign changes only between its steps; the reference path also checks the
+    turning points of theta, so a dip through 0 and back within one step is an impact."""
     # theta dips to -3.5e-4 on the old corner's field for ~0.07 time units: a genuine impact
     alpha, omega, phase = 2.0 / 1.3**2, 1.3, 0.5 * math.pi
     kw = dict(hb=1.0, alpha=alpha, omega=omega, law="housner", theta0=0.0005, dtheta0=-0.03,
