@@ -9,6 +9,7 @@ import numpy as np
 
 from . import integrate as ig
 from .model import Block
+from .model import _finite as _real
 
 __all__ = ["Result", "simulate", "Z0_STUDY", "DEFAULT_N", "STATUS_MESSAGES"]
 
@@ -126,16 +127,6 @@ def _int(name, value, lo, hi=None):
     if value < lo or (hi is not None and value > hi):
         rng = f">= {lo}" if hi is None else f"in [{lo}, {hi}]"
         raise ValueError(f"{name} must be {rng} (got {value})")
-    return value
-
-
-def _real(name, value):
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number (got {value!r})") from None
-    if not math.isfinite(value):
-        raise ValueError(f"{name} must be finite (got {value})")
     return value
 
 
