@@ -32,8 +32,6 @@ from __future__ import annotations
 
 import functools
 import math
-import sys
-import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
@@ -41,13 +39,15 @@ import numba
 import numpy as np
 from numba import prange
 
+from . import chunks
 from . import integrate as ig
 from ._jit import jit
 from .model import Block
 from .simulate import Z0_STUDY, _int, _real, check_settings, forcing_phase
 from .simulate import initial_side, pack
 
-__all__ = ["BEHAVIOURS", "GRID_N", "BasinResult", "SweepResult", "basin", "classify_result",
+__all__ = ["BEHAVIOURS", "GRID_N", "BasinResult", "PlaneResult", "SweepResult", "basin",
+           "classify_result", "plane",
            "sweep"]
 
 BEHAVIOURS = ("overturn", "rest", "symmetric", "asymmetric", "multiperiodic", "chaotic",
@@ -177,9 +177,9 @@ def _cell(TANGENT, y0, side0, par, ipar, cpar, strobe, half, impacts, traj, lam_
 
 
 @jit(parallel=True)
-def _grid(TANGENT, y0s, aw2s, par0, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got,
-         n_imp_got):
-    """Cell i starts from ``y0s[i]`` with forcing ``aw2s[i]``.
+def _grid(TANGENT, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got,
+          n_imp_got):
+    """Cell i starts from ``y0s[i]`` with the parameter row ``pars[i]`` (integrate's layout).
 
     Writes ``res[i]`` (scalars), and when ``n_pts > 0`` the last stroboscopic samples
     ``pts[i, :, :]`` (``theta, theta'`` at kT over the classified stretch) and when
@@ -187,11 +187,10 @@ def _grid(TANGENT, y0s, aw2s, par0, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_
     """
     n = y0s.shape[0]
     periods = ipar[ig.I_PERIODS]
-    T = par0[ig.P_H] * ipar[ig.I_N]
     cap = max(n_imp_pts, 1)
     for i in prange(n):
-        par = par0.copy()
-        par[ig.P_AW2] = aw2s[i]
+        par = pars[i]
+        T = par[ig.P_H] * ipar[ig.I_N]
         strobe = np.zeros((periods + 1, 4))
         half = np.zeros((periods + 1, 4))
         impacts = np.zeros((cap, 3))
@@ -244,9 +243,8 @@ def _kernel(tangent):
     TANGENT = bool(tangent)
 
     @jit
-    def grid(y0s, aw2s, par0, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got,
-             n_imp_got):
-        _grid(TANGENT, y0s, aw2s, par0, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got,
+    def grid(y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got):
+        _grid(TANGENT, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got,
               n_imp_got)
 
     return grid
@@ -268,52 +266,40 @@ def _threads(threads):
         numba.set_num_threads(old)
 
 
-class _Progress:
-    """A one-line progress report on stderr, for runs longer than a moment."""
+def run_chunk(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=None):
+    """Run the grid kernel on one chunk of cells; returns its outputs by name.
 
-    def __init__(self, total, label, enabled):
-        self.total = total
-        self.label = label
-        self.enabled = enabled
-        self.t0 = time.perf_counter()
-        self.done = 0
-
-    def update(self, n):
-        self.done += n
-        if not self.enabled:
-            return
-        el = time.perf_counter() - self.t0
-        eta = el / self.done * (self.total - self.done) if self.done else math.nan
-        sys.stderr.write(f"\r{self.label}: {self.done}/{self.total} cells, {el:6.1f} s"
-                         f" elapsed, ~{eta:5.1f} s left ")
-        sys.stderr.flush()
-
-    def close(self):
-        if self.enabled:
-            sys.stderr.write("\n")
-            sys.stderr.flush()
-
-
-def _run_grid(y0s, aw2s, par0, ipar, cpar, *, tangent, n_pts, n_imp_pts, threads, progress,
-              label, chunk=None):
+    The unit of work of :func:`rockjit.chunks.run_chunks`, in this process or on a Dask worker.
+    """
     n = y0s.shape[0]
-    res = np.zeros((n, N_RES))
-    pts = np.full((n, max(n_pts, 1), 2), np.nan)
-    imp = np.full((n, max(n_imp_pts, 1), 2), np.nan)
-    n_got = np.zeros(n, dtype=np.int64)
-    n_imp_got = np.zeros(n, dtype=np.int64)
-    kern = _kernel(tangent)
-    if chunk is None:
-        chunk = max(64, n // 20)
-    bar = _Progress(n, label, progress)
+    out = dict(res=np.zeros((n, N_RES)), pts=np.full((n, max(n_pts, 1), 2), np.nan),
+               imp=np.full((n, max(n_imp_pts, 1), 2), np.nan),
+               n_got=np.zeros(n, dtype=np.int64), n_imp_got=np.zeros(n, dtype=np.int64))
     with _threads(threads):
-        for a in range(0, n, chunk):
-            b = min(n, a + chunk)
-            kern(y0s[a:b], aw2s[a:b], par0, ipar, cpar, n_pts, n_imp_pts, res[a:b],
-                 pts[a:b], imp[a:b], n_got[a:b], n_imp_got[a:b])
-            bar.update(b - a)
-    bar.close()
-    return res, pts, imp, n_got, n_imp_got
+        _kernel(tangent)(np.ascontiguousarray(y0s), np.ascontiguousarray(pars), ipar, cpar,
+                         n_pts, n_imp_pts, out["res"], out["pts"], out["imp"], out["n_got"],
+                         out["n_imp_got"])
+    return out
+
+
+def _run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, threads, progress, label,
+              chunk=None, client=None, store=None):
+    """All cells through :func:`run_chunk`, chunk by chunk (progress between chunks)."""
+    n = y0s.shape[0]
+    chunk = max(64, -(-n // 20)) if chunk is None else _int("chunk", chunk, 1)
+    outputs = dict(res=np.zeros((n, N_RES)), pts=np.full((n, max(n_pts, 1), 2), np.nan),
+                   imp=np.full((n, max(n_imp_pts, 1), 2), np.nan),
+                   n_got=np.zeros(n, dtype=np.int64), n_imp_got=np.zeros(n, dtype=np.int64))
+    cs = None
+    if store is not None:
+        key = chunks.fingerprint((y0s, pars, ipar, cpar),
+                                 dict(tangent=bool(tangent), n_pts=n_pts, n_imp_pts=n_imp_pts))
+        cs = chunks.ChunkStore(store, key, n, chunk)
+    chunks.run_chunks(run_chunk, (bool(tangent), y0s, pars, ipar, cpar, n_pts, n_imp_pts,
+                                  threads), n, chunk, outputs, client=client, store=cs,
+                      progress=progress, label=label)
+    return (outputs["res"], outputs["pts"], outputs["imp"], outputs["n_got"],
+            outputs["n_imp_got"])
 
 
 def _settings(block, phi, periods, n_steps, window, early_stop, tol, pmax, lam_tol,
@@ -442,7 +428,8 @@ def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None
           alpha_step=0.001, z0=Z0_STUDY, periods=500, n_steps=GRID_N, window=None,
           lyapunov=True, early_stop=True, threads=None, progress=False, tol=TOL, pmax=PMAX,
           lam_tol=LAM_TOL, max_impacts=100_000, settle_tol=SETTLE_TOL,
-          settle_reps=SETTLE_REPS, n_points=None, n_impact_points=400) -> SweepResult:
+          settle_reps=SETTLE_REPS, n_points=None, n_impact_points=400, client=None,
+          store=None, chunk=None) -> SweepResult:
     """Bifurcation sweep over the forcing amplitude ``alpha`` (SPEC.md §7).
 
     Parameters
@@ -471,6 +458,14 @@ def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None
         Stroboscopic samples kept per alpha (default the window length).
     n_impact_points : int
         Impact-section points kept per alpha.
+    client : dask.distributed.Client, optional
+        Run the chunks of cells on this cluster (:mod:`rockjit.chunks`).
+    store : path, optional
+        Directory for finished chunks: a rerun with the same inputs computes only what is
+        missing.
+    chunk : int, optional
+        Cells per chunk (the unit of progress, of Dask tasks and of resumption); default
+        about a twentieth of the grid, at least 64.
     """
     if alphas is None:
         if alpha_range is None:
@@ -494,10 +489,12 @@ def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None
     n_points = w if n_points is None else _int("n_points", n_points, 1)
     n_impact_points = _int("n_impact_points", n_impact_points, 0)
     y0s = np.tile(np.array([z[0], z[1], r0, s0]), (n, 1))
-    aw2s = alphas * block.omega**2
+    pars = np.tile(par, (n, 1))
+    pars[:, ig.P_AW2] = alphas * block.omega**2
     res, pts, imp, n_got, n_imp_got = _run_grid(
-        y0s, aw2s, par, ipar, cpar, tangent=lyapunov, n_pts=n_points,
-        n_imp_pts=n_impact_points, threads=threads, progress=progress, label="sweep")
+        y0s, pars, ipar, cpar, tangent=lyapunov, n_pts=n_points,
+        n_imp_pts=n_impact_points, threads=threads, progress=progress, label="sweep",
+        client=client, store=store, chunk=chunk)
     settings.update(z0=tuple(z), lyapunov=bool(lyapunov), law=block.law,
                     restitution=block.restitution)
     return SweepResult(alpha=alphas, label=res[:, R_LABEL].astype(np.int64),
@@ -510,11 +507,13 @@ def basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100, theta_range=
           dtheta_range=(-1.0, 1.0), r0=None, s0=None, phase=None, periods=500,
           n_steps=GRID_N, window=None, lyapunov=False, early_stop=True, threads=None,
           progress=False, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL, max_impacts=100_000,
-          settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS) -> BasinResult:
+          settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS, client=None,
+          store=None, chunk=None) -> BasinResult:
     """Basin of attraction over ``(theta0, theta0')`` on a ``grid x grid`` lattice.
 
     The forcing phase is fixed (default ``(r0, s0) = (0, 1)``, SPEC.md §7). ``label[i, j]``
-    belongs to ``theta0[i]``, ``dtheta0[j]``. Other parameters as in :func:`sweep`.
+    belongs to ``theta0[i]``, ``dtheta0[j]``. Other parameters (``client`` and ``store``
+    included) as in :func:`sweep`.
     """
     block = _block(hb, alpha, omega, law, e, xi)
     grid = _int("grid", grid, 1)
@@ -538,9 +537,10 @@ def basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100, theta_range=
     dth = np.linspace(*rngs[1], grid)
     TH, DTH = np.meshgrid(th, dth, indexing="ij")
     y0s = np.stack([TH.ravel(), DTH.ravel(), np.full(TH.size, r0), np.full(TH.size, s0)], 1)
-    aw2s = np.full(TH.size, block.alpha * block.omega**2)
-    res, *_ = _run_grid(y0s, aw2s, par, ipar, cpar, tangent=lyapunov, n_pts=0, n_imp_pts=0,
-                        threads=threads, progress=progress, label="basin")
+    pars = np.tile(par, (TH.size, 1))
+    res, *_ = _run_grid(y0s, pars, ipar, cpar, tangent=lyapunov, n_pts=0, n_imp_pts=0,
+                        threads=threads, progress=progress, label="basin", client=client,
+                        store=store, chunk=chunk)
     settings.update(r0=r0, s0=s0, phase=phi, lyapunov=bool(lyapunov), law=block.law,
                     restitution=block.restitution)
     shape = (grid, grid)
@@ -577,3 +577,97 @@ def classify_result(result, *, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL):
     code, p = classify(result.strobe, half, per_imp, k0, k1, lam, not math.isnan(lam),
                        float(tol), int(pmax), float(lam_tol))
     return BEHAVIOURS[code], int(p)
+
+
+@dataclass
+class PlaneResult:
+    """Behaviours over the forcing plane ``(alpha, omega)`` from one or more initial states.
+
+    ``label[m, i, j]`` belongs to initial state ``z0[m]``, ``alpha[i]``, ``omega[j]``.
+    """
+
+    alpha: np.ndarray
+    omega: np.ndarray
+    z0: np.ndarray
+    label: np.ndarray
+    period: np.ndarray
+    lambda_max: np.ndarray
+    t_end: np.ndarray
+    block: Block
+    settings: dict = field(default_factory=dict)
+    names: np.ndarray = field(default_factory=_names_array)
+
+    def fractions(self):
+        return fractions(self.label)
+
+
+def _range(name, rng, lo_open=False):
+    try:
+        a, b = (float(v) for v in rng)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be two numbers (got {rng!r})") from None
+    ok = math.isfinite(a) and math.isfinite(b) and b >= a and (a > 0 if lo_open else a >= 0)
+    if not ok:
+        cond = "0 < start <= end" if lo_open else "0 <= start <= end"
+        raise ValueError(f"{name} must satisfy {cond} (got {a}, {b})")
+    return a, b
+
+
+def plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None, xi=None,
+          z0=Z0_STUDY, periods=500, n_steps=GRID_N, window=None, lyapunov=True,
+          early_stop=True, threads=None, progress=False, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL,
+          max_impacts=100_000, settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS, client=None,
+          store=None, chunk=None) -> PlaneResult:
+    """Behaviour and ``lambda_max`` at each ``(alpha, omega)`` of a grid (a rocking chart).
+
+    Parameters
+    ----------
+    hb : float
+        Slenderness.
+    alpha_range, omega_range : pair of float
+        Ranges, ends included: ``0 <= alpha0 <= alpha1`` and ``0 < omega0 <= omega1``.
+    grid : pair of int
+        Points ``(NA, NW)`` along alpha and omega.
+    z0 : array_like, shape (4,) or (m, 4)
+        Initial state(s) ``(theta, theta', r, s)``; ``(r, s)`` fixes the forcing phase.
+    Other parameters as in :func:`sweep` (``client`` and ``store`` included).
+    """
+    a0, a1 = _range("alpha_range", alpha_range)
+    w0, w1 = _range("omega_range", omega_range, lo_open=True)
+    try:
+        na, nw = (int(v) for v in grid)
+    except (TypeError, ValueError):
+        raise ValueError(f"grid must be two integers (got {grid!r})") from None
+    na = _int("grid", na, 1)
+    nw = _int("grid", nw, 1)
+    block = _block(hb, a0, w0, law, e, xi)
+    z = np.atleast_2d(np.asarray(z0, dtype=float))
+    if z.ndim != 2 or z.shape[1] != 4 or z.shape[0] == 0 or not np.all(np.isfinite(z)):
+        raise ValueError("z0 must be 4 finite numbers (theta, theta', r, s) or m rows of them")
+    phis = [forcing_phase(None, r, s, "closed")[0] for r, s in z[:, 2:]]
+    par, ipar, cpar, settings = _settings(block, phis[0], periods, n_steps, window, early_stop,
+                                          tol, pmax, lam_tol, max_impacts, settle_tol,
+                                          settle_reps)
+    alphas = np.linspace(a0, a1, na)
+    omegas = np.linspace(w0, w1, nw)
+    M = z.shape[0]
+    Z, A, W = np.meshgrid(np.arange(M), alphas, omegas, indexing="ij")
+    n = Z.size
+    pars = np.tile(par, (n, 1))
+    pars[:, ig.P_OMEGA] = W.ravel()
+    pars[:, ig.P_AW2] = A.ravel() * W.ravel() ** 2
+    pars[:, ig.P_H] = 2.0 * math.pi / W.ravel() / settings["n_steps"]
+    pars[:, ig.P_PHI] = np.asarray(phis)[Z.ravel()]
+    zz = z[Z.ravel()]
+    y0s = np.stack([zz[:, 0], zz[:, 1], np.sin(pars[:, ig.P_PHI]), np.cos(pars[:, ig.P_PHI])],
+                   1)
+    res, *_ = _run_grid(y0s, pars, ipar, cpar, tangent=lyapunov, n_pts=0, n_imp_pts=0,
+                        threads=threads, progress=progress, label="plane", client=client,
+                        store=store, chunk=chunk)
+    shape = (M, na, nw)
+    settings.update(lyapunov=bool(lyapunov), law=block.law, restitution=block.restitution)
+    return PlaneResult(alpha=alphas, omega=omegas, z0=z,
+                       label=res[:, R_LABEL].astype(np.int64).reshape(shape),
+                       period=res[:, R_PERIOD].astype(np.int64).reshape(shape),
+                       lambda_max=res[:, R_LAM1].reshape(shape),
+                       t_end=res[:, R_T].reshape(shape), block=block, settings=settings)

@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import shutil
 import sys
 import time
 from pathlib import Path
@@ -236,6 +237,52 @@ def _trajectory_run(args, kw):
 
 
 # ---------------------------------------------------------------------------------------------
+# grids: where chunks run (in-process or Dask) and where finished chunks wait (resumable)
+# ---------------------------------------------------------------------------------------------
+
+def _dist_validate(args):
+    if getattr(args, "scheduler", None):
+        try:
+            import dask.distributed  # noqa: F401
+        except ImportError:
+            raise UsageError("--scheduler needs dask: pip install 'rockjit[dask]'") from None
+
+
+def _chunk_dir(args, name):
+    """Finished chunks of grid ``name`` wait in ``<out>.chunks/name`` until the command ends:
+    a rerun of an interrupted command resumes from them; ``--out`` itself is written only
+    once everything is computed."""
+    return Path(str(Path(args.out)) + ".chunks") / name
+
+
+class _Grids:
+    """Keyword arguments for the analysis functions: the Dask client and the chunk stores."""
+
+    def __init__(self, args):
+        self.args = args
+        self.client = None
+        if getattr(args, "scheduler", None):
+            from dask.distributed import Client
+            _say(args, f"{args.command}: connecting to the Dask scheduler at {args.scheduler}")
+            try:
+                self.client = Client(args.scheduler, timeout="15s")
+            except (OSError, TimeoutError) as exc:
+                raise UsageError(f"cannot reach the Dask scheduler at {args.scheduler} "
+                                 f"({exc})") from None
+
+    def kw(self, name):
+        return dict(client=self.client, store=_chunk_dir(self.args, name))
+
+    def finish(self):
+        """Everything is written: the resumable chunks are no longer needed."""
+        shutil.rmtree(Path(str(Path(self.args.out)) + ".chunks"), ignore_errors=True)
+
+    def close(self):
+        if self.client is not None:
+            self.client.close()
+
+
+# ---------------------------------------------------------------------------------------------
 # sweep
 # ---------------------------------------------------------------------------------------------
 
@@ -253,6 +300,7 @@ def _sweep_validate(args):
     _, r0, s0 = _forcing(args, Z0_STUDY[2:])
     _check_threads(args.threads)
     _check_out(args.out)
+    _dist_validate(args)
     return dict(alphas=alphas, law=block.law, e=block.e, z0=(theta0, dtheta0, r0, s0))
 
 
@@ -266,10 +314,14 @@ def _sweep_run(args, kw):
     from .analysis import sweep
     from .plotting import fig_bifurcation
     t0 = time.perf_counter()
-    sw = sweep(args.hb, args.omega, kw["alphas"], law=kw["law"], e=kw["e"], z0=kw["z0"],
-               periods=args.periods, n_steps=args.n_steps, lyapunov=not args.no_lyapunov,
-               early_stop=not args.full_length, threads=args.threads,
-               progress=not args.quiet)
+    grids = _Grids(args)
+    try:
+        sw = sweep(args.hb, args.omega, kw["alphas"], law=kw["law"], e=kw["e"], z0=kw["z0"],
+                   periods=args.periods, n_steps=args.n_steps, lyapunov=not args.no_lyapunov,
+                   early_stop=not args.full_length, threads=args.threads,
+                   progress=not args.quiet, **grids.kw("sweep"))
+    finally:
+        grids.close()
     wall = time.perf_counter() - t0
     out = _Out(args.out)
     out.npz("sweep.npz", **_sweep_arrays(sw))
@@ -277,6 +329,7 @@ def _sweep_run(args, kw):
     out.json("summary.json", _summary(
         args, wall, files=list(out.written) + ["summary.json"], n_alpha=int(sw.alpha.size),
         fractions=sw.fractions(), settings=sw.settings, restitution=sw.block.restitution))
+    grids.finish()
     _say(args, f"sweep: {sw.alpha.size} amplitudes in {wall:.1f} s; wrote {args.out}")
 
 
@@ -308,6 +361,7 @@ def _basin_validate(args):
     _, r0, s0 = _forcing(args, (0.0, 1.0))
     _check_threads(args.threads)
     _check_out(args.out)
+    _dist_validate(args)
     return dict(blocks=blocks, r0=r0, s0=s0)
 
 
@@ -319,22 +373,27 @@ def basin_summary(b):
                 counts=counts, settings=b.settings)
 
 
-def _basin_compute(args, block, r0, s0, label=""):
+def _basin_compute(args, block, r0, s0, grids):
     from .analysis import basin
     return basin(block.hb, block.alpha, block.omega, law=block.law, e=block.e, grid=args.grid,
                  theta_range=args.theta_range, dtheta_range=args.dtheta_range, r0=r0, s0=s0,
                  periods=args.periods, n_steps=args.n_steps, lyapunov=args.lyapunov,
                  early_stop=not args.full_length, threads=args.threads,
-                 progress=not args.quiet)
+                 progress=not args.quiet, **grids.kw(block.law))
 
 
 def _basin_run(args, kw):
     from .plotting import agreement, fig_basin, fig_basin_compare
     t0 = time.perf_counter()
     res = {}
-    for block in kw["blocks"]:
-        _say(args, f"basin: {block.law}, {args.grid}x{args.grid} cells, {args.periods} periods")
-        res[block.law] = _basin_compute(args, block, kw["r0"], kw["s0"])
+    grids = _Grids(args)
+    try:
+        for block in kw["blocks"]:
+            _say(args, f"basin: {block.law}, {args.grid}x{args.grid} cells, "
+                       f"{args.periods} periods")
+            res[block.law] = _basin_compute(args, block, kw["r0"], kw["s0"], grids)
+    finally:
+        grids.close()
     wall = time.perf_counter() - t0
     first = next(iter(res.values()))
     arrays = dict(theta0=first.theta0, dtheta0=first.dtheta0,
@@ -360,7 +419,61 @@ def _basin_run(args, kw):
     out.figure("basin.png", fig)
     out.json("summary.json", _summary(args, wall, files=list(out.written) + ["summary.json"],
                                       grid=args.grid, r0=kw["r0"], s0=kw["s0"], **results))
+    grids.finish()
     _say(args, f"basin: done in {wall:.1f} s; wrote {args.out}")
+
+
+# ---------------------------------------------------------------------------------------------
+# plane
+# ---------------------------------------------------------------------------------------------
+
+def _plane_validate(args):
+    from .simulate import Z0_STUDY, _real
+    lo, hi = _range("alpha-range", args.alpha_range)
+    if lo < 0:
+        raise UsageError(f"alpha-range must satisfy 0 <= start <= end (got {lo}, {hi})")
+    wlo, whi = _range("omega-range", args.omega_range)
+    if wlo <= 0:
+        raise UsageError(f"omega-range must satisfy 0 < start <= end (got {wlo}, {whi})")
+    block = _block(args.hb, lo, wlo, args.law, args.e)
+    for g in args.grid:
+        _check_positive_int("grid", g)
+    _settings(args.periods, args.n_steps)
+    theta0 = _real("theta0", Z0_STUDY[0] if args.theta0 is None else args.theta0)
+    dtheta0 = _real("dtheta0", Z0_STUDY[1] if args.dtheta0 is None else args.dtheta0)
+    if abs(theta0) >= block.theta_over:
+        raise UsageError(f"theta0 must satisfy |theta0| < pi/2 (got {theta0})")
+    _, r0, s0 = _forcing(args, Z0_STUDY[2:])
+    _check_threads(args.threads)
+    _check_out(args.out)
+    _dist_validate(args)
+    return dict(law=block.law, e=block.e, z0=(theta0, dtheta0, r0, s0))
+
+
+def _plane_run(args, kw):
+    from .analysis import plane
+    from .plotting import fig_plane
+    t0 = time.perf_counter()
+    grids = _Grids(args)
+    try:
+        p = plane(args.hb, args.alpha_range, args.omega_range, grid=args.grid, law=kw["law"],
+                  e=kw["e"], z0=kw["z0"], periods=args.periods, n_steps=args.n_steps,
+                  lyapunov=not args.no_lyapunov, early_stop=not args.full_length,
+                  threads=args.threads, progress=not args.quiet, **grids.kw("plane"))
+    finally:
+        grids.close()
+    wall = time.perf_counter() - t0
+    out = _Out(args.out)
+    out.npz("plane.npz", alpha=p.alpha, omega=p.omega, z0=p.z0, label=p.label[0],
+            period=p.period[0], lambda_max=p.lambda_max[0], t_end=p.t_end[0],
+            names=np.asarray(p.names, dtype=str))
+    out.figure("plane.png", fig_plane(p))
+    out.json("summary.json", _summary(
+        args, wall, files=list(out.written) + ["summary.json"], grid=list(args.grid),
+        fractions=p.fractions(), settings=p.settings, restitution=p.block.restitution,
+        scheduler=args.scheduler))
+    grids.finish()
+    _say(args, f"plane: {p.label.size} cells in {wall:.1f} s; wrote {args.out}")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -634,6 +747,12 @@ def _add_phase(p, default_note):
                    help=f"forcing oscillator s(0) (with --r0); {default_note}")
 
 
+def _add_scheduler(p):
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run the chunks of cells on this Dask scheduler (e.g. "
+                        "tcp://host:8786); default in this process")
+
+
 def _add_common(p, threads=True):
     p.add_argument("--out", required=True, help="output directory (created if missing)")
     if threads:
@@ -682,6 +801,7 @@ def build_parser():
                    help="skip the exponents (chaotic is then reported as aperiodic)")
     p.add_argument("--full-length", action="store_true", help="disable early stopping")
     _add_common(p)
+    _add_scheduler(p)
     p.set_defaults(validate=_sweep_validate, func=_sweep_run)
 
     p = sub.add_parser("basin", help="basin of attraction: basin.npz, basin.png",
@@ -701,7 +821,29 @@ def build_parser():
                    help="compute exponents (tells chaotic from aperiodic)")
     p.add_argument("--full-length", action="store_true", help="disable early stopping")
     _add_common(p)
+    _add_scheduler(p)
     p.set_defaults(validate=_basin_validate, func=_basin_run)
+
+    p = sub.add_parser("plane", help="behaviours over (alpha, omega): plane.npz, plane.png",
+                       description="Classify a grid over the forcing plane (alpha, omega) "
+                       "from one initial state; write plane.npz (label[i, j] belongs to "
+                       "alpha[i], omega[j]), plane.png and summary.json. Runs in-process or, "
+                       "with --scheduler, on a Dask cluster; an interrupted run resumes.")
+    _add_block(p, law_choices="housner, mao or constant", alpha=False, omega=False)
+    p.add_argument("--alpha-range", type=float, nargs=2, required=True,
+                   metavar=("START", "END"), help="amplitudes (ends included)")
+    p.add_argument("--omega-range", type=float, nargs=2, required=True,
+                   metavar=("START", "END"), help="frequencies (ends included)")
+    p.add_argument("--grid", type=int, nargs=2, default=(50, 50), metavar=("NA", "NW"),
+                   help="points along alpha and omega (default 50 50)")
+    _add_state(p, "default: the study's z0")
+    _add_run(p, grid=True)
+    p.add_argument("--no-lyapunov", action="store_true",
+                   help="skip the exponents (chaotic is then reported as aperiodic)")
+    p.add_argument("--full-length", action="store_true", help="disable early stopping")
+    _add_common(p)
+    _add_scheduler(p)
+    p.set_defaults(validate=_plane_validate, func=_plane_run)
 
     p = sub.add_parser("cor", help="restitution laws: figure 1 and the e-table",
                        description="Figure 1 (e_H, e_M against thc, with delta e %) and a "
@@ -754,6 +896,6 @@ def main(argv=None):
     except KeyboardInterrupt:
         print(f"\n{PROG}: interrupted; no file was left half-written", file=sys.stderr)
         return 130
-    except ValueError as exc:  # a check the library makes only once running
+    except (UsageError, ValueError) as exc:  # a check made only once running
         return _error(exc)
     return 0

@@ -506,3 +506,47 @@ def fig_basin_compare(housner_basin, mao_basin, title=None):
                  f"\u03c9 = {blk.omega:g}, (r\u2080, s\u2080) = "
                  f"({a.settings.get('r0', 0):.4g}, {a.settings.get('s0', 1):.4g})")
     return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# Parameter plane (rocking chart)
+# ---------------------------------------------------------------------------------------------
+
+def _extent(x, y):
+    dx = (x[-1] - x[0]) / max(len(x) - 1, 1) / 2 if len(x) > 1 else 0.5
+    dy = (y[-1] - y[0]) / max(len(y) - 1, 1) / 2 if len(y) > 1 else 0.5
+    return (x[0] - dx, x[-1] + dx, y[0] - dy, y[-1] + dy)
+
+
+def fig_plane(plane_result, state=0, title=None):
+    """Behaviour over the forcing plane (omega across, alpha up) and lambda_max beside it.
+
+    ``plane_result.label[state, i, j]`` belongs to ``alpha[i]``, ``omega[j]``.
+    """
+    p = plane_result
+    lab = np.asarray(p.label)[state]
+    lam = np.array(p.lambda_max, dtype=float)[state]
+    ext = _extent(np.asarray(p.omega), np.asarray(p.alpha))
+    cmap, norm = _cmap()
+    fig = _figure(figsize=(11.5, 5.6))
+    ax, axl = fig.subplots(1, 2, sharey=True)
+    ax.imshow(lab, origin="lower", cmap=cmap, norm=norm, interpolation="nearest",
+              aspect="auto", extent=ext)
+    ax.set_xlabel("\u03c9")
+    ax.set_ylabel("\u03b1")
+    fr = fractions(lab)
+    names = [n for n in BEHAVIOURS if fr[n] > 0]
+    ax.legend(handles=_behaviour_handles(names, [f"{n} {fr[n]:.1f} %" for n in names]),
+              loc="upper center", bbox_to_anchor=(0.5, -0.12), ncols=3, fontsize=8,
+              frameon=False)
+    finite = lam[np.isfinite(lam)]
+    lim = max(float(np.abs(finite).max()), 1e-3) if finite.size else 1.0
+    im = axl.imshow(np.where(np.isfinite(lam), lam, np.nan), origin="lower", cmap="RdBu_r",
+                    vmin=-lim, vmax=lim, interpolation="nearest", aspect="auto", extent=ext)
+    fig.colorbar(im, ax=axl, label="\u03bb\u2098\u2090\u2093 (blank: overturn, rest, not "
+                 "computed)")
+    axl.set_xlabel("\u03c9")
+    z = np.asarray(p.z0)[state]
+    fig.suptitle(title or f"{_law(p.block)}, h/b = {p.block.hb:g}, from (\u03b8, \u03b8\u2032,"
+                 f" r, s) = ({z[0]:g}, {z[1]:g}, {z[2]:g}, {z[3]:g})", fontsize=11)
+    return fig
