@@ -747,6 +747,20 @@ def _add_phase(p, default_note):
                    help=f"forcing oscillator s(0) (with --r0); {default_note}")
 
 
+def _add_grid_run(p, lyapunov_default):
+    """Options of the grid commands (sweep, basin, plane)."""
+    _add_run(p, grid=True)
+    if lyapunov_default:
+        p.add_argument("--no-lyapunov", action="store_true",
+                       help="skip the exponents (chaotic is then reported as aperiodic)")
+    else:
+        p.add_argument("--lyapunov", action="store_true",
+                       help="compute exponents (tells chaotic from aperiodic)")
+    p.add_argument("--full-length", action="store_true", help="disable early stopping")
+    _add_common(p)
+    _add_scheduler(p)
+
+
 def _add_scheduler(p):
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="run the chunks of cells on this Dask scheduler (e.g. "
@@ -796,12 +810,7 @@ def build_parser():
                    metavar=("START", "END"), help="amplitudes from START to END (included)")
     p.add_argument("--alpha-step", type=float, default=0.001, help="step (default 0.001)")
     _add_state(p, "default: the study's z0")
-    _add_run(p, grid=True)
-    p.add_argument("--no-lyapunov", action="store_true",
-                   help="skip the exponents (chaotic is then reported as aperiodic)")
-    p.add_argument("--full-length", action="store_true", help="disable early stopping")
-    _add_common(p)
-    _add_scheduler(p)
+    _add_grid_run(p, lyapunov_default=True)
     p.set_defaults(validate=_sweep_validate, func=_sweep_run)
 
     p = sub.add_parser("basin", help="basin of attraction: basin.npz, basin.png",
@@ -816,12 +825,7 @@ def build_parser():
     p.add_argument("--dtheta-range", type=float, nargs=2, default=(-1.0, 1.0),
                    metavar=("LO", "HI"), help="dtheta0 range (default -1 1)")
     _add_phase(p, "default (r0, s0) = (0, 1)")
-    _add_run(p, grid=True)
-    p.add_argument("--lyapunov", action="store_true",
-                   help="compute exponents (tells chaotic from aperiodic)")
-    p.add_argument("--full-length", action="store_true", help="disable early stopping")
-    _add_common(p)
-    _add_scheduler(p)
+    _add_grid_run(p, lyapunov_default=False)
     p.set_defaults(validate=_basin_validate, func=_basin_run)
 
     p = sub.add_parser("plane", help="behaviours over (alpha, omega): plane.npz, plane.png",
@@ -837,12 +841,7 @@ def build_parser():
     p.add_argument("--grid", type=int, nargs=2, default=(50, 50), metavar=("NA", "NW"),
                    help="points along alpha and omega (default 50 50)")
     _add_state(p, "default: the study's z0")
-    _add_run(p, grid=True)
-    p.add_argument("--no-lyapunov", action="store_true",
-                   help="skip the exponents (chaotic is then reported as aperiodic)")
-    p.add_argument("--full-length", action="store_true", help="disable early stopping")
-    _add_common(p)
-    _add_scheduler(p)
+    _add_grid_run(p, lyapunov_default=True)
     p.set_defaults(validate=_plane_validate, func=_plane_run)
 
     p = sub.add_parser("cor", help="restitution laws: figure 1 and the e-table",
