@@ -43,7 +43,7 @@ from . import chunks
 from . import integrate as ig
 from ._jit import jit
 from .model import Block
-from .simulate import Z0_STUDY, _int, _real, check_settings, forcing_phase
+from .simulate import Z0_STUDY, _int, steps_per_period, _real, check_settings, forcing_phase
 from .simulate import initial_side, pack
 
 __all__ = ["BEHAVIOURS", "GRID_N", "BasinResult", "PlaneResult", "SweepResult", "basin",
@@ -54,9 +54,11 @@ BEHAVIOURS = ("overturn", "rest", "symmetric", "asymmetric", "multiperiodic", "c
               "aperiodic", "unresolved")
 OVERTURN, REST, SYMMETRIC, ASYMMETRIC, MULTIPERIODIC, CHAOTIC, APERIODIC, UNRESOLVED = range(8)
 
-#: Steps per period of sweeps and basins: they need labels and lambda_max, not 1e-10 event
-#: times; benchmarks/README.md ("Grid resolution") measures their agreement with N = 256.
-GRID_N = 128
+#: Steps per period of sweeps, basins and planes: they need labels and lambda_max, not 1e-10
+#: event times. On the study's four basins and its 501-amplitude sweep, N = 64 gives the labels
+#: of N = 256 in every cell (benchmarks/README.md, "Grid resolution"). Raised like DEFAULT_N
+#: when the forcing is slow (MAX_STEP).
+GRID_N = 64
 
 #: Defaults of the classification (documented in the module docstring and the README).
 TOL = 1e-6
@@ -129,6 +131,8 @@ def lam_between(lam_run, k0, k1):
     """
     if k1 <= k0:
         return math.nan, math.nan
+    if lam_run[k1, 0] == -math.inf:  # the tangent vectors collapsed (an impact with e = 0)
+        return -math.inf, -math.inf
     l1 = (lam_run[k1, 0] * k1 - lam_run[k0, 0] * k0) / (k1 - k0)
     l2 = (lam_run[k1, 1] * k1 - lam_run[k0, 1] * k0) / (k1 - k0)
     return l1, l2
@@ -304,6 +308,8 @@ def _run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, threads, prog
 
 def _settings(block, phi, periods, n_steps, window, early_stop, tol, pmax, lam_tol,
               max_impacts, settle_tol, settle_reps):
+    if n_steps is None:
+        n_steps = steps_per_period(block.period, GRID_N)
     periods, n_steps, max_impacts, w0, _ = check_settings(periods, n_steps, max_impacts,
                                                           window, None)
     pmax = _int("pmax", pmax, 1)
@@ -425,7 +431,7 @@ def alpha_grid(alpha_range, alpha_step):
 
 
 def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None,
-          alpha_step=0.001, z0=Z0_STUDY, periods=500, n_steps=GRID_N, window=None,
+          alpha_step=0.001, z0=Z0_STUDY, periods=500, n_steps=None, window=None,
           lyapunov=True, early_stop=True, threads=None, progress=False, tol=TOL, pmax=PMAX,
           lam_tol=LAM_TOL, max_impacts=100_000, settle_tol=SETTLE_TOL,
           settle_reps=SETTLE_REPS, n_points=None, n_impact_points=400, client=None,
@@ -443,7 +449,8 @@ def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None
     z0 : sequence of 4 floats
         ``(theta0, theta0', r0, s0)``, default the study's.
     periods, n_steps, window :
-        As in :func:`rockjit.simulate`; the window is the classified stretch of a full run.
+        As in :func:`rockjit.simulate` (``n_steps`` defaults to :data:`GRID_N`); the window is
+        the classified stretch of a full run.
     lyapunov : bool
         Compute ``lambda_max`` (needed to tell chaotic from aperiodic).
     early_stop : bool
@@ -505,7 +512,7 @@ def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None
 
 def basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100, theta_range=(-1.0, 1.0),
           dtheta_range=(-1.0, 1.0), r0=None, s0=None, phase=None, periods=500,
-          n_steps=GRID_N, window=None, lyapunov=False, early_stop=True, threads=None,
+          n_steps=None, window=None, lyapunov=False, early_stop=True, threads=None,
           progress=False, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL, max_impacts=100_000,
           settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS, client=None,
           store=None, chunk=None) -> BasinResult:
@@ -614,7 +621,7 @@ def _range(name, rng, lo_open=False):
 
 
 def plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None, xi=None,
-          z0=Z0_STUDY, periods=500, n_steps=GRID_N, window=None, lyapunov=True,
+          z0=Z0_STUDY, periods=500, n_steps=None, window=None, lyapunov=True,
           early_stop=True, threads=None, progress=False, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL,
           max_impacts=100_000, settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS, client=None,
           store=None, chunk=None) -> PlaneResult:

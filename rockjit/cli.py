@@ -92,10 +92,15 @@ def _block(hb, alpha, omega, law, e):
     return Block(hb=hb, alpha=alpha, omega=omega, law=law, e=e)
 
 
-def _settings(periods, n_steps):
-    from .simulate import check_settings
-    periods, n_steps, *_ = check_settings(periods, n_steps, 100_000, None, None)
-    return periods, n_steps
+def _settings(periods, n_steps, period=None, default=None):
+    """Validated periods and steps per period; ``n_steps=None`` resolves to the library's
+    default for a forcing period ``period`` (or stays None when that is not known here)."""
+    from .simulate import check_settings, steps_per_period
+    if n_steps is None and period is not None:
+        n_steps = steps_per_period(period, default)
+    periods, n_checked, *_ = check_settings(periods, 8 if n_steps is None else n_steps,
+                                            100_000, None, None)
+    return periods, (None if n_steps is None else n_checked)
 
 
 def _forcing(args, default):
@@ -188,8 +193,9 @@ def _check_method(method, lyapunov):
 
 def _trajectory_validate(args):
     from .simulate import Z0_STUDY, _real
+    from .simulate import DEFAULT_N
     block = _block(args.hb, args.alpha, args.omega, args.law, args.e)
-    periods, n_steps = _settings(args.periods, args.n_steps)
+    periods, n_steps = _settings(args.periods, args.n_steps, block.period, DEFAULT_N)
     _check_method(args.method, args.lyapunov)
     theta0 = _real("theta0", Z0_STUDY[0] if args.theta0 is None else args.theta0)
     dtheta0 = _real("dtheta0", Z0_STUDY[1] if args.dtheta0 is None else args.dtheta0)
@@ -528,7 +534,7 @@ def _cor_run(args, kw):
 
 def _paper_validate(args):
     from .analysis import alpha_grid
-    _settings(args.periods, args.n_steps or 8)
+    _settings(args.periods, args.n_steps)
     _check_positive_int("grid", args.grid)
     if not args.alpha_step > 0 or not math.isfinite(args.alpha_step):
         raise UsageError(f"alpha-step must be > 0 (got {args.alpha_step})")
@@ -561,9 +567,9 @@ def _paper_run(args, kw):
     n_parts = 6
     from .analysis import GRID_N
     from .simulate import DEFAULT_N
-    n_single = args.n_steps or DEFAULT_N
-    n_grid = args.n_steps or GRID_N
-    stride = max(1, math.ceil(args.periods * n_single / MAX_TRAJ_POINTS))
+    n_single = args.n_steps  # None: the library's defaults (DEFAULT_N, GRID_N)
+    n_grid = args.n_steps
+    stride = max(1, math.ceil(args.periods * (n_single or DEFAULT_N) / MAX_TRAJ_POINTS))
     run_kw = dict(periods=args.periods, n_steps=n_single, record_stride=stride,
                   lyapunov=True)
     t_all = time.perf_counter()
@@ -719,15 +725,15 @@ def _add_block(p, alpha=True, omega=True, law_choices="housner, mao or constant"
 
 def _add_run(p, periods=500, grid=False, both=False):
     from .analysis import GRID_N
-    from .simulate import DEFAULT_N
+    from .simulate import DEFAULT_N, MAX_STEP
     p.add_argument("--periods", type=int, default=periods,
                    help=f"forcing periods to integrate (default {periods})")
     if both:
         note = f"default {DEFAULT_N} for single runs, {GRID_N} for sweeps and basins"
         default = None
     else:
-        default = GRID_N if grid else DEFAULT_N
-        note = f"default {default}"
+        default = None
+        note = f"default {GRID_N if grid else DEFAULT_N}, raised if T/N > {MAX_STEP}"
     p.add_argument("--n-steps", type=int, default=default,
                    help=f"steps per forcing period, even ({note})")
 

@@ -414,13 +414,23 @@ def sample(EMBED4, t, y, par, out):
 
 @jit(nrt=False)
 def qr_renormalise(EMBED4, y, lam_sum, in_window, lam_win):
-    """Gram–Schmidt on the tangent columns; logs of the stretches are accumulated."""
+    """Gram–Schmidt on the tangent columns; logs of the stretches are accumulated.
+
+    Returns True if the tangent vectors had collapsed (an impact with ``e = 0`` maps every
+    perturbation of the velocity to zero: ``det S = e^2``). The logs would be ``-inf``; they are
+    not added, the vectors restart as the identity, and the caller counts the collapse (the
+    exponents over a stretch with a collapse are ``-inf``).
+    """
     NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
     v00 = y[NS]
     v10 = y[NS + 1]
     v01 = y[NS + 2]
     v11 = y[NS + 3]
     n1 = math.sqrt(v00 * v00 + v10 * v10)
+    det = abs(v00 * v11 - v10 * v01)
+    if not (n1 > 0.0 and det > 1e-300 * max(n1, 1.0) and math.isfinite(det)):
+        reset_tangent(EMBED4, y)
+        return True
     q00 = v00 / n1
     q10 = v10 / n1
     p = q00 * v01 + q10 * v11
@@ -438,6 +448,7 @@ def qr_renormalise(EMBED4, y, lam_sum, in_window, lam_win):
     y[NS + 1] = q10
     y[NS + 2] = w0 / n2
     y[NS + 3] = w1 / n2
+    return False
 
 
 @jit(nrt=False)
@@ -514,6 +525,8 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, t
     j_qr = 0
     j_rec = 0
     settle_reps = ipar[I_SETTLE]
+    n_col = 0      # collapses of the tangent vectors (impacts with e = 0)
+    n_col_win = 0
     per_imp[0] = 0
     while step < total and status == RUNNING:
         t_grid = (step + 1) * h
@@ -630,7 +643,10 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, t
                 side = 0
                 if TANGENT:
                     # a rest phase leaves the tangent vectors alone; bank their growth
-                    qr_renormalise(EMBED4, y, lam_sum, in_window, lam_win)
+                    if qr_renormalise(EMBED4, y, lam_sum, in_window, lam_win):
+                        n_col += 1
+                        if in_window:
+                            n_col_win += 1
                 iout[O_NREST] += 1
                 if in_window:
                     iout[O_NREST_WIN] += 1
@@ -650,7 +666,10 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, t
             if j_qr == qr_every:
                 j_qr = 0
                 if side != 0:
-                    qr_renormalise(EMBED4, y, lam_sum, in_window, lam_win)
+                    if qr_renormalise(EMBED4, y, lam_sum, in_window, lam_win):
+                        n_col += 1
+                        if in_window:
+                            n_col_win += 1
                     # the first stage's tangent rows belong to the old vectors: refresh
                     # them (only them: the state's trajectory must not depend on tangents)
                     f_now = par[P_AW2] * forcing_now(EMBED4, t, y, par)
@@ -663,8 +682,8 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, t
             iout[O_NSTROBE] = k_per + 1
             per_imp[k_per] = n_imp
             if TANGENT:
-                lam_run[k_per, 0] = lam_sum[0] / t
-                lam_run[k_per, 1] = lam_sum[1] / t
+                lam_run[k_per, 0] = lam_sum[0] / t if n_col == 0 else -math.inf
+                lam_run[k_per, 1] = lam_sum[1] / t if n_col == 0 else -math.inf
             if settle_reps > 0:
                 p = settled_period(strobe, half, per_imp, k_per, settle_reps,
                                    ipar[I_PMAX], par[P_SETTLE_TOL])
@@ -698,8 +717,8 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, t
         wt = t - win_step * h
         fout[F_WINTIME] = wt
         if wt > 0.0:
-            fout[F_LAM1] = lam_win[0] / wt
-            fout[F_LAM2] = lam_win[1] / wt
+            fout[F_LAM1] = lam_win[0] / wt if n_col_win == 0 else -math.inf
+            fout[F_LAM2] = lam_win[1] / wt if n_col_win == 0 else -math.inf
         else:
             fout[F_LAM1] = math.nan
             fout[F_LAM2] = math.nan

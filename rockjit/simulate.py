@@ -11,13 +11,27 @@ from . import integrate as ig
 from .model import Block
 from .model import _finite as _real
 
-__all__ = ["Result", "simulate", "Z0_STUDY", "DEFAULT_N", "STATUS_MESSAGES"]
+__all__ = ["Result", "simulate", "Z0_STUDY", "DEFAULT_N", "MAX_STEP", "STATUS_MESSAGES",
+           "steps_per_period"]
 
 #: Initial state ``(theta, theta', r, s)`` of the study's single runs and sweeps (SPEC.md §7).
 Z0_STUDY = (-0.2254, -0.1597, -0.7778, 0.6284)
 
-#: Default number of steps per forcing period (chosen in benchmarks/README.md).
+#: Default number of steps per forcing period of single runs: the smallest N at which impact
+#: times agree with DOP853 (rtol 1e-12) to 1e-10 on demanding orbits (benchmarks/README.md).
 DEFAULT_N = 256
+
+#: Largest step (in units of 1/Omega0) a default N may give: at slow forcing, N steps per period
+#: would be coarse against the block's own time scale, so N is raised until h <= MAX_STEP.
+MAX_STEP = 0.1
+
+
+def steps_per_period(period, default):
+    """``default``, or the smallest even N with ``period / N <= MAX_STEP`` if that is larger."""
+    n = int(default)
+    if period / n > MAX_STEP:
+        n = 2 * math.ceil(period / (2 * MAX_STEP))
+    return n
 
 STATUS_MESSAGES = {
     "done": "reached the requested number of periods",
@@ -202,7 +216,7 @@ def pack(block: Block, phi: float, n_steps: int):
 
 
 def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta0=None,
-             z0=None, phase=None, r0=None, s0=None, periods=500, n_steps=DEFAULT_N,
+             z0=None, phase=None, r0=None, s0=None, periods=500, n_steps=None,
              forcing="closed", method="rockjit", rtol=1e-6, atol=1e-9, lyapunov=False,
              window=None, record_stride=None, max_impacts=100_000,
              theta_over=0.5 * math.pi, rest_speed=1e-6, qr_every=None) -> Result:
@@ -228,8 +242,9 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
         Initial point of the forcing oscillator; default ``(0, 1)``.
     periods : int
         Number of forcing periods to integrate (``>= 1``), default 500.
-    n_steps : int
-        Steps per period ``N`` (even, ``>= 8``); default :data:`DEFAULT_N`.
+    n_steps : int, optional
+        Steps per period ``N`` (even, ``>= 8``); default :data:`DEFAULT_N`, raised for slow
+        forcing so that the step ``T/N`` stays below :data:`MAX_STEP`.
     forcing : {"closed", "embedded"}
         Closed-form forcing, or the 4-D oscillator embedding integrated with the block.
     method : str
@@ -282,6 +297,8 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
         kw["xi"] = xi
     block = Block(**kw)
     phi, r0, s0 = forcing_phase(phase, r0, s0, forcing)
+    if n_steps is None:
+        n_steps = steps_per_period(block.period, DEFAULT_N)
     periods, n_steps, max_impacts, w0, record_stride = check_settings(
         periods, n_steps, max_impacts, window, record_stride)
 
