@@ -68,11 +68,16 @@ _SOURCES = ("_jit.py", "model.py", "integrate.py", "analysis.py")
 
 
 def _cache_dirs(pkg):
-    dirs = [pkg / "__pycache__"]
+    """``(stamp folder, folders whose numba files it vouches for)`` pairs."""
+    pairs = [(pkg / "__pycache__", [pkg / "__pycache__"])]
     root = os.environ.get("NUMBA_CACHE_DIR")
-    if root and Path(root).is_dir():
-        dirs += [Path(d) for d, _, _ in os.walk(root) if "rockjit" in Path(d).name]
-    return dirs
+    if root:
+        # numba makes its per-package folders there only when it first compiles, so the stamp
+        # lives at the root and covers every folder of this package below it
+        subs = [Path(d) for d, _, _ in os.walk(root) if "rockjit" in Path(d).name] \
+            if Path(root).is_dir() else []
+        pairs.append((Path(root), subs))
+    return pairs
 
 
 def check_cache(pkg=None):
@@ -85,18 +90,19 @@ def check_cache(pkg=None):
         except OSError:
             return
     digest = h.hexdigest()
-    for d in _cache_dirs(pkg):
-        stamp = d / "rockjit-sources.sha256"
+    for home, dirs in _cache_dirs(pkg):
+        stamp = home / "rockjit-sources.sha256"
         try:
             if stamp.read_text() == digest:
                 continue
         except OSError:
             pass
         try:
-            for f in d.glob("*.nb[ic]"):
-                f.unlink(missing_ok=True)
-            d.mkdir(parents=True, exist_ok=True)
-            tmp = d / f"rockjit-sources.sha256.{os.getpid()}"
+            for d in dirs:
+                for f in d.glob("*.nb[ic]"):
+                    f.unlink(missing_ok=True)
+            home.mkdir(parents=True, exist_ok=True)
+            tmp = home / f"rockjit-sources.sha256.{os.getpid()}"
             tmp.write_text(digest)
             os.replace(tmp, stamp)
         except OSError:

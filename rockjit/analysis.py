@@ -43,7 +43,7 @@ from . import chunks
 from . import integrate as ig
 from ._jit import jit
 from .model import Block
-from .simulate import Z0_STUDY, _int, steps_per_period, _real, check_settings, forcing_phase
+from .simulate import Z0_STUDY, _int, check_step, steps_per_period, _real, check_settings, forcing_phase
 from .simulate import initial_side, pack
 
 __all__ = ["BEHAVIOURS", "GRID_N", "BasinResult", "PlaneResult", "SweepResult", "basin",
@@ -310,6 +310,8 @@ def _settings(block, phi, periods, n_steps, window, early_stop, tol, pmax, lam_t
               max_impacts, settle_tol, settle_reps):
     if n_steps is None:
         n_steps = steps_per_period(block.period, GRID_N)
+    else:
+        check_step(block.period, _int("n_steps", n_steps, 8))
     periods, n_steps, max_impacts, w0, _ = check_settings(periods, n_steps, max_impacts,
                                                           window, None)
     pmax = _int("pmax", pmax, 1)

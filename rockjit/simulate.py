@@ -12,7 +12,7 @@ from .model import Block
 from .model import _finite as _real
 
 __all__ = ["Result", "simulate", "Z0_STUDY", "DEFAULT_N", "MAX_STEP", "STATUS_MESSAGES",
-           "steps_per_period"]
+           "STEP_LIMIT", "check_step", "steps_per_period"]
 
 #: Initial state ``(theta, theta', r, s)`` of the study's single runs and sweeps (SPEC.md §7).
 Z0_STUDY = (-0.2254, -0.1597, -0.7778, 0.6284)
@@ -24,6 +24,33 @@ DEFAULT_N = 256
 #: Largest step (in units of 1/Omega0) a default N may give: at slow forcing, N steps per period
 #: would be coarse against the block's own time scale, so N is raised until h <= MAX_STEP.
 MAX_STEP = 0.1
+
+
+#: Coarsest step accepted at all: the block's own time scale is ~1, so a longer step is no
+#: integration of it (and a stress case: omega = 0.05 with N = 8 gave h = 16).
+STEP_LIMIT = 1.0
+
+
+def check_step(period, n_steps, forcing="closed", radius=1.0):
+    """Reject a grid too coarse to integrate: ``ValueError`` naming ``n_steps``.
+
+    Any forcing: ``h = T/N <= STEP_LIMIT``. The embedding also integrates the oscillator's
+    radial contraction, of rate ``3 rho^2 - 1`` from radius ``rho``, which an explicit step
+    only follows stably for ``h (3 rho^2 + 1) <= 1.5`` (found by the stress suite: beyond it
+    r, s overflow).
+    """
+    h_max = STEP_LIMIT
+    why = f"the step T/N must be <= {STEP_LIMIT}"
+    if forcing == "embedded":
+        h_emb = 1.5 / (3.0 * max(radius, 1.0) ** 2 + 1.0)
+        if h_emb < h_max:
+            h_max = h_emb
+            why = (f"the embedded oscillator from |(r0, s0)| = {radius:.3g} needs a step "
+                   f"<= {h_emb:.3g}")
+    if period / n_steps > h_max:
+        need = 2 * math.ceil(period / (2 * h_max))
+        raise ValueError(f"n_steps must be >= {need} here: {why} (got n_steps = {n_steps}, "
+                         f"T/N = {period / n_steps:.3g})")
 
 
 def steps_per_period(period, default):
@@ -301,6 +328,7 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
         n_steps = steps_per_period(block.period, DEFAULT_N)
     periods, n_steps, max_impacts, w0, record_stride = check_settings(
         periods, n_steps, max_impacts, window, record_stride)
+    check_step(block.period, n_steps, forcing, math.hypot(r0, s0))
 
     if isinstance(method, str) and (method == "scipy" or method.startswith("scipy:")):
         if lyapunov:

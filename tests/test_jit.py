@@ -50,3 +50,20 @@ def test_cache_dropped_when_a_compiled_source_changes(tmp_path, monkeypatch):
     _jit.check_cache(pkg)
     assert not list(cache.glob("*.nb[ic]"))
     assert (cache / "rockjit-sources.sha256").read_text() != stamp
+
+
+def test_cache_dir_elsewhere_survives_a_cold_start(tmp_path, monkeypatch):
+    # NUMBA_CACHE_DIR: numba creates the package's folders there only when it compiles, after
+    # the import-time check; the next process must keep what the first one compiled
+    root = tmp_path / "numba-cache"
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(root))
+    pkg, _ = _fake_package(tmp_path)
+    _jit.check_cache(pkg)  # cold: nothing there yet
+    compiled = root / "work_main_rockjit"
+    compiled.mkdir(parents=True)
+    (compiled / "integrate._run-1.py311.nbi").write_text("fresh")
+    _jit.check_cache(pkg)  # a second process, sources unchanged
+    assert (compiled / "integrate._run-1.py311.nbi").exists()
+    (pkg / "integrate.py").write_text("# integrate.py, edited\n")
+    _jit.check_cache(pkg)
+    assert not list(compiled.glob("*.nb[ic]"))

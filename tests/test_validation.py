@@ -6,9 +6,11 @@ Checked against SPEC.md's ranges (§1-3) and STYLE.md 12, on both the compiled a
 
 import math
 
+import numpy as np
 import pytest
 
 import rockjit
+from rockjit.simulate import MAX_STEP
 
 BASE = dict(hb=1.0, alpha=0.6, omega=1.3, periods=1)
 NAN = math.nan
@@ -105,3 +107,32 @@ def test_valid_edge_values_are_accepted():
     assert r.status in ("done", "rest", "overturned")
     r = rockjit.simulate(1.0, 0.6, 1.3, e=1.0, periods=1.0, n_steps=8.0)
     assert r.periods == 1 and r.n_steps == 8
+
+
+# Grids too coarse to integrate, found by the stress suite: they ended in overflow ('nonfinite')
+# before the step was checked; now they are refused up front, naming n_steps and its minimum.
+COARSE = [
+    dict(hb=11.194041521341587, alpha=1.2893302282542554, omega=0.5017722545517583, law="mao",
+         n_steps=8, periods=3, theta0=-0.0453, dtheta0=-0.0764, forcing="embedded",
+         r0=-0.1572209610859118, s0=-0.9875634508198561),
+    dict(hb=1.9357337261955216, alpha=0.5743672537145474, omega=0.2853226042346317,
+         law="mao", n_steps=32, periods=3, theta0=-0.248, dtheta0=-0.453, forcing="embedded",
+         r0=-1.3785167226179953, s0=0.634529364573173),
+    dict(hb=2.0, alpha=0.3, omega=0.05, n_steps=64, periods=1, theta0=0.1, dtheta0=0.0),
+]
+
+
+@pytest.mark.parametrize("kw", COARSE, ids=["embedded h=1.6", "embedded rho=1.5", "h=2"])
+def test_too_coarse_a_grid_is_refused(kw):
+    with pytest.raises(ValueError, match=r"n_steps must be >= (\d+)") as err:
+        rockjit.simulate(**kw)
+    need = int(err.value.args[0].split(">= ")[1].split()[0])
+    res = rockjit.simulate(**dict(kw, n_steps=need))  # the minimum it names is accepted
+    assert res.status in ("done", "overturned", "rest", "max_impacts")
+    assert np.all(np.isfinite(res.state))
+
+
+def test_slow_forcing_raises_the_default_step_count():
+    res = rockjit.simulate(hb=2.0, alpha=0.3, omega=0.05, periods=1, theta0=0.1, dtheta0=0.0)
+    assert res.period / res.n_steps <= MAX_STEP
+    assert res.n_steps > rockjit.DEFAULT_N
