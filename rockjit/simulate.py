@@ -356,7 +356,7 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
     y0 = np.array([theta0, dtheta0, r0, s0])
     strobe = np.zeros((periods + 1, 4))
     half = np.zeros((periods, 4))
-    impacts = np.zeros((max_impacts, 3))
+    impacts = np.empty((max_impacts, 3))  # only the rows filled are exposed: no need to zero
     n_traj = periods * n_steps // record_stride + 1 if record_stride else 1
     traj = np.zeros((n_traj, 5))
     lam_run = np.zeros((periods + 1 if lyapunov else 1, 2))
