@@ -9,8 +9,8 @@ conservation (e = 1, xi = 0, no forcing), the mirror symmetry (exact with the em
 run's rounding horizon with the closed form) and 1 against 2 threads. tests/test_stress.py runs a
 fast subset of the same generator.
 
-    python benchmarks/bench_stress.py           # full run (~5 min)
-    python benchmarks/bench_stress.py --quick   # smoke mode (~30 s with warm caches)
+    python benchmarks/bench_stress.py           # full run (~1 min)
+    python benchmarks/bench_stress.py --quick   # smoke mode (~10 s with warm caches)
 
 Writes stress.{md,csv,json,png} to benchmarks/results/ (benchmarks/results/quick/ with --quick,
 or --out DIR). Failing cases are listed with their ids and inputs; ``--case ID`` reruns one.
@@ -212,7 +212,9 @@ def main(argv=None):
                                 [""]))
     obs_rows = [["impact bound hit (status `max_impacts`)", obs["impact_bound"]],
                 [f"overturned off the threshold on a grid with h > {S.H_RESOLVED:g}",
-                 obs["coarse_overturn_off_threshold"]]]
+                 obs["coarse_overturn_off_threshold"]],
+                [f"Zeno cascade stalled (> {S.STALL} impacts at one instant) with the cut-off "
+                 "off, `rest_speed = 0`", obs["zeno_stall_without_cutoff"]]]
 
     fail_rows = []
     for k in S.RUN_CHECKS:

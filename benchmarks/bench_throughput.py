@@ -13,7 +13,7 @@ Measured here, each as a table:
 - peak memory of a 400 x 400 basin (ru_maxrss of a fresh process, and tracemalloc's peak of the
   NumPy allocations made around the kernel).
 
-    python benchmarks/bench_throughput.py           # full (~8 min)
+    python benchmarks/bench_throughput.py           # full (~10 min)
     python benchmarks/bench_throughput.py --quick   # smoke (~40 s; no compile probes)
 
 Writes throughput.{md,csv,json,png} to benchmarks/results/ (benchmarks/results/quick/ with

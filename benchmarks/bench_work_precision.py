@@ -25,7 +25,7 @@ resolved. A run with another status or another number of impacts than the refere
 not silently plotted. A last table shows the transient-chaos case hb=1, alpha=0.969, omega=1.3,
 whose overturning time no double-precision method determines.
 
-    python benchmarks/bench_work_precision.py           # full (~5 min)
+    python benchmarks/bench_work_precision.py           # full (~7 min)
     python benchmarks/bench_work_precision.py --quick   # smoke (~30 s)
 
 Writes work_precision.{md,csv,json} and work_precision_<scene>.png to benchmarks/results/

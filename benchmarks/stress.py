@@ -47,7 +47,10 @@ Checks of every run (:func:`check_run`; each returns a list of problems, empty w
     ``n_impacts <= max_impacts``, the bound reached exactly when the status says so, impact times
     ordered within ``[0, t]``, ``theta'+ = e theta'-`` exactly, ``|theta| <= theta_over`` at
     every sample, an overturned run ends on the threshold, a run at rest ends at
-    ``theta = theta' = 0`` with forcing too weak to lift it.
+    ``theta = theta' = 0`` with forcing too weak to lift it;
+``progress``
+    impacts advance time: no more than ``STALL`` (100) of them at one floating-point instant
+    (with ``rest_speed = 0``, which turns the Zeno cut-off off, such a stall is reported instead).
 
 Hitting the impact bound is not a failure; it is counted and reported as such. Neither is the
 refusal of a grid too coarse to integrate (``T/N`` above rockjit's step limit, or an embedded
@@ -88,7 +91,7 @@ from rockjit.simulate import steps_per_period
 RANGES = dict(hb=(0.75, 20.0), alpha=(0.0, 3.0), omega=(0.05, 20.0), e=(0.0, 1.0))
 CATEGORIES = ("random", "near_zero", "grazing", "near_overturn", "long_horizon",
               "impact_bound")
-RUN_CHECKS = ("status", "finite", "time", "work", "bookkeeping")
+RUN_CHECKS = ("status", "finite", "time", "work", "bookkeeping", "progress")
 EXACT_CHECKS = ("energy", "mirror_embedded", "mirror_closed", "threads")
 KNOWN_STATUS = ("done", "overturned", "rest", "max_impacts")
 HALF_PI = 0.5 * math.pi
@@ -96,6 +99,9 @@ HALF_PI = 0.5 * math.pi
 #: Steps longer than this do not resolve the rocking (its time scale is 1): an event located
 #: inside one is only as good as the step (see :func:`observations`).
 H_RESOLVED = 1.0
+
+#: ``progress``: more impacts than this at one floating-point instant is a stall.
+STALL = 100
 
 #: rhs evaluations an event may cost beyond its grid step: 8 Newton re-steps of 6 stages, the
 #: re-started rest of the step (6) and the refreshed first stage (1), rounded up
@@ -446,19 +452,47 @@ def overturn_offset(kw, res):
 
 
 def observations(kw, res):
-    """Outcomes that are reported, not failed: the impact bound reached, and an overturn on a
-    grid too coarse to resolve the rocking (``h > H_RESOLVED``) that ended off the threshold."""
+    """Outcomes that are reported, not failed: the impact bound reached; an overturn on a grid
+    too coarse to resolve the rocking (``h > H_RESOLVED``) that ended off the threshold; a Zeno
+    cascade that, with the cut-off off (``rest_speed = 0``), stalls at one instant."""
     out = []
     if res.status == "max_impacts":
         out.append("impact_bound")
     if res.status == "overturned" and res.period / res.n_steps > H_RESOLVED and \
             overturn_offset(kw, res) > 1e-9:
         out.append("coarse_overturn_off_threshold")
+    if res.block.rest_speed == 0 and longest_stall(res)[0] > STALL:
+        out.append("zeno_stall_without_cutoff")
     return out
 
 
+def longest_stall(res):
+    """``(k, t)``: the most impacts recorded at one and the same time ``t``, in a row."""
+    t = res.impacts[:, 0]
+    if t.size < 2:
+        return int(t.size), (float(t[0]) if t.size else math.nan)
+    same = np.concatenate(([False], t[1:] == t[:-1], [False]))
+    # runs of True in `same`: a run of length L means L + 1 impacts at one instant
+    edges = np.flatnonzero(np.diff(same.astype(np.int8)))
+    if edges.size == 0:
+        return 1, float(t[0])
+    starts, ends = edges[::2], edges[1::2]
+    i = int(np.argmax(ends - starts))
+    return int(ends[i] - starts[i] + 1), float(t[starts[i]])
+
+
+def check_progress(kw, res):
+    """Impacts must advance time: more than ``STALL`` of them at one instant is a stall. With
+    ``rest_speed = 0`` the Zeno cut-off is off by request, and a cascade that stalls is reported
+    (see :func:`observations`), not failed."""
+    k, t = longest_stall(res)
+    if k > STALL and res.block.rest_speed > 0:
+        return [f"{k} impacts at the one instant t = {t!r} (the run makes no progress)"]
+    return []
+
+
 RUN_CHECK_FUNCS = dict(status=check_status, finite=check_finite, time=check_time,
-                       work=check_work, bookkeeping=check_bookkeeping)
+                       work=check_work, bookkeeping=check_bookkeeping, progress=check_progress)
 
 
 def check_run(kw, res):

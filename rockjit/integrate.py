@@ -526,12 +526,18 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, t
     j_rec = 0
     settle_reps = ipar[I_SETTLE]
     n_col = 0      # collapses of the tangent vectors (impacts with e = 0)
+    t_lift = -math.inf  # instant of the latest uplift
     n_col_win = 0
     per_imp[0] = 0
     while step < total and status == RUNNING:
         t_grid = (step + 1) * h
         in_window = step >= win_step
         fresh = True  # no event yet in this grid step
+        # Held at rest until the grid point: set when a flight that began at an uplift ends at
+        # rest within rounding of that instant (forcing a hair above the uplift threshold, where
+        # the acceleration rounds to zero); otherwise the uplift would be found again at the
+        # same instant forever (found by the stress suite).
+        hold = False
         while True:
             if side == 0 and not EMBED4:
                 # at rest, closed-form forcing: jump straight to the uplift instant
@@ -539,10 +545,11 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, t
                 if t_up == math.inf:
                     status = REST
                     break
-                if t_up >= t_grid:
+                if t_up >= t_grid or hold:
                     t = t_grid
                     break
                 t = t_up
+                t_lift = t
                 fresh = False
                 y[0] = 0.0
                 y[1] = 0.0
@@ -555,8 +562,9 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, t
                 if par[P_AW2] * max(1.0, rad) <= par[P_COT]:
                     status = REST
                     break
-                if par[P_AW2] * abs(y[2]) > par[P_COT]:
+                if not hold and par[P_AW2] * abs(y[2]) > par[P_COT]:
                     side = 1 if y[2] > 0.0 else -1
+                    t_lift = t
                     rhs(EMBED4, TANGENT, forcing_at(t, par), y, side, par, K, 0)
                     iout[O_RHS] += 1
                     continue
@@ -575,6 +583,8 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, t
             iout[O_RHS] += N_STAGES
             iout[O_SUBSTEPS] += 1
             kind, lo, hi = detect(y, ynew, hh, K, side, par)
+            if hold and kind == EV_UPLIFT:
+                kind = EV_NONE
             if kind == EV_NONE:
                 if side != 0:
                     e0 = 0.0
@@ -610,6 +620,7 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, t
                 y[0] = 0.0
                 y[1] = 0.0
                 side = 1 if y[2] > 0.0 else -1
+                t_lift = t
                 rhs(EMBED4, TANGENT, forcing_at(t, par), y, side, par, K, 0)
                 iout[O_RHS] += 1
                 continue
@@ -641,6 +652,8 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, t
                 # Zeno: the impacts would accumulate; the block is at rest from here
                 y[1] = 0.0
                 side = 0
+                if t - t_lift <= 1e-9 * h:
+                    hold = True
                 if TANGENT:
                     # a rest phase leaves the tangent vectors alone; bank their growth
                     if qr_renormalise(EMBED4, y, lam_sum, in_window, lam_win):

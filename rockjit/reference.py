@@ -96,6 +96,8 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
     z = np.array([theta0, dtheta0, r0, s0] if embed4 else [theta0, dtheta0], dtype=float)
     side = initial_side(theta0, dtheta0)
     t = 0.0
+    t_lift = -math.inf
+    hold_until = -math.inf
     status = None
     impacts = []
     nfev = 0
@@ -140,7 +142,9 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
                     t = t_end
                     z = np.array([0.0, 0.0, *np.asarray(sol.y)[:, -1]])
             else:
-                t_up = uplift_time(t, aw2, cot, omega, phi)
+                # held at rest to the grid point after a flight too short to resolve (the
+                # compiled path's rule: forcing a hair above the threshold would stall here)
+                t_up = uplift_time(max(t, hold_until), aw2, cot, omega, phi)
                 if t_up == math.inf:
                     status = "rest"
                     break
@@ -149,6 +153,7 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
                 rest_sample(ts)
                 t = t_stop
                 if t_up <= t_end:
+                    t_lift = t
                     side = 1 if forcing_closed(t, omega, phi) > 0 else -1
                     z = np.array([side * _TINY, 0.0])
             continue
@@ -225,6 +230,8 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
             z[1] = 0.0
             side = 0
             n_rest += 1
+            if t - t_lift <= 1e-9 * h:
+                hold_until = (math.floor(t / h) + 1) * h
         if len(impacts) >= max_impacts:
             status = "max_impacts"
             break

@@ -94,6 +94,12 @@ def test_status_time_work_and_bookkeeping_checks_catch_faults(good):
     assert not _failed(capped, dataclasses.replace(res, status="max_impacts"))
     assert S.observations(capped, dataclasses.replace(res, status="max_impacts")) == \
         ["impact_bound"]
+    # impacts that stop advancing time: a stall (reported instead with rest_speed = 0)
+    imp = np.repeat(res.impacts[:1], S.STALL + 1, axis=0)
+    stalled = dataclasses.replace(res, impacts=imp, n_impacts=len(imp))
+    assert "progress" in _failed(kw, stalled)
+    assert "progress" not in _failed(kw, dataclasses.replace(
+        stalled, block=res.block.replace(rest_speed=0.0)))
 
 
 def test_energy_check_catches_a_drift():
@@ -235,6 +241,21 @@ def test_exponents_with_e0_are_minus_inf_not_nan():
     assert res.n_impacts > 0
     assert S.check_finite(kw, res) == []
     assert np.all(res.lyapunov == -np.inf)
+
+
+def test_uplift_at_the_threshold_makes_progress():
+    """A block at rest under forcing a hair above the uplift threshold (alpha omega^2 = (1 +
+    1e-12) cot thc): at the uplift instant the acceleration rounds to <= 0, the flight is too
+    short to resolve and ends at rest at the same instant, and the uplift is found again at that
+    instant: 100 000 zero-velocity impacts at t = 2.1416, status max_impacts (10 million with
+    max_impacts=1e7). Found by the stress suite (s0-872, s0-1556, s0-2312, s0-2474). Fixed: a
+    flight ending at rest within rounding of its uplift holds the block at rest until the grid
+    point (both paths)."""
+    kw = dict(hb=2.0, alpha=0.5 * (1 + 1e-12) / 0.5**2, omega=0.5, law="housner", theta0=0.0,
+              dtheta0=0.0, phase=0.5, periods=2)
+    res = rockjit.simulate(**kw)
+    probs = S.check_run(kw, res)
+    assert not any(probs.values()), probs
 
 
 def test_embedding_far_off_the_circle_stays_finite_or_is_refused():
