@@ -21,15 +21,22 @@ from numba.extending import intrinsic
 FASTMATH = frozenset({"nsz"})
 
 
-def jit(func=None, *, parallel=False, nrt=True):
+def jit(func=None, *, parallel=False, nrt=True, inline=False):
     """``numba.njit`` with the project policy: cached, the one fastmath set.
 
     ``nrt=False`` compiles without numba's reference-counting runtime: for the helpers of the
     hot loop, which read and write arrays they are given but never allocate. With the runtime,
     every call increments and decrements the count of each array argument with a locked
     (serialising) instruction, which cost a third of a step's time.
+
+    ``inline=True`` inlines the function into its callers in numba's own IR (``inline=
+    "always"``). For the pieces of the step: LLVM declines to inline a function that large at
+    more than one call site, and an out-of-line call passes every array as seven scalars on the
+    stack and hides the stage chain from the scheduler.
     """
     opts = dict(cache=True, fastmath=set(FASTMATH), parallel=parallel, error_model="numpy")
+    if inline:
+        opts["inline"] = "always"
     if not nrt:
         opts["_nrt"] = False
     deco = numba.njit(**opts)

@@ -31,6 +31,8 @@ __all__ = [
     "Block",
     "accel",
     "accel_jac",
+    "accel_pq",
+    "corner",
     "delta_e_percent",
     "e_housner",
     "e_mao",
@@ -39,6 +41,9 @@ __all__ = [
     "oscillator",
     "oscillator_jac",
     "saltation",
+    "sincos",
+    "sincos_poly",
+    "slope_pq",
     "thc_from_hb",
     "uplift_time",
 ]
@@ -218,46 +223,55 @@ class Block:
 # Compiled physics, shared by the compiled integrator and the scipy reference path
 # --------------------------------------------------------------------------------------------
 
-# sin x = x S(x^2), cos x = C(x^2) on |x| <= 2.46: Chebyshev fits (degree 10 in x^2, made with
-# mpmath at 50 digits; maximum error 8e-16 on the range, against libm). The angles a block takes
-# while rocking, thc + side * theta with |theta| <= pi/2, are covered after a shift by pi/4.
+# sin x = x S(x^2), cos x = C(x^2) on |x| <= 1.75: least-squares fits of degree 8 in x^2 at
+# Chebyshev nodes (made with mpmath at 50 digits; maximum error 2.3e-16 on the range, against
+# mpmath). The block's angle theta lies in [-pi/2, pi/2] until it overturns; a step may overshoot
+# that a little, and beyond 1.75 the libm functions take over.
 _S = (
-    1.0, -0.16666666666666666, 0.008333333333333331, -0.00019841269841269367,
-    2.7557319223923157e-06, -2.505210838059967e-08, 1.6059043603750737e-10,
-    -7.647156522876653e-13, 2.8113138707045463e-15, -8.202889660381247e-18,
-    1.832523981647964e-20,
+    1.0, -0.1666666666666666, 0.008333333333332672, -0.000198412698410478,
+    2.7557319186664126e-06, -2.505210486029754e-08, 1.6058848125936605e-10,
+    -7.640822990840576e-13, 2.70032005075978e-15,
 )
 _C = (
-    1.0, -0.5, 0.04166666666666662, -0.0013888888888887803, 2.4801587301443696e-05,
-    -2.755731921290086e-07, 2.087675645423076e-09, -1.147072908935356e-11,
-    4.7791488981895744e-14, -1.5578540451748877e-16, 3.8241258890291884e-19,
+    1.0, -0.49999999999999856, 0.04166666666665413, -0.0013888888888468477,
+    2.480158723091546e-05, -2.755731254792034e-07, 2.0876386266285834e-09,
+    -1.1458730661760175e-11, 4.5687420770339104e-14,
 )
-_SHIFT = 0.25 * math.pi
-_RSQRT2 = math.sqrt(0.5)
-_RANGE = 2.46
+SINCOS_RANGE = 1.75
 
 
 @jit
-def sincos(a):
-    """``(sin a, cos a)`` for ``a`` in ``[-pi/2 - 0.07, pi + 0.07]`` by a polynomial, else libm.
+def sincos_poly(x):
+    """``(sin x, cos x)`` by the polynomial alone: valid on ``|x| <= SINCOS_RANGE`` only.
 
-    Each step of the integrator needs six of these; the polynomial costs a quarter of the
-    instructions of libm's ``sincos`` and agrees with it to a few units in the last place.
+    Branch-free, for the integrator's stages, which check the range once per step and redo a
+    step that left it with :func:`sincos` (a branch to libm inside the stage chain makes the
+    compiler pass every sine through memory).
     """
-    x = a - _SHIFT
-    if abs(x) > _RANGE:
-        return math.sin(a), math.cos(a)
     # Estrin's scheme: half the dependency depth of Horner's (the step is latency-bound)
     u = x * x
     u2 = u * u
     u4 = u2 * u2
     s = fma(fma(fma(_S[7], u, _S[6]), u2, fma(_S[5], u, _S[4])), u4,
             fma(fma(_S[3], u, _S[2]), u2, fma(_S[1], u, _S[0])))
-    s = fma(fma(_S[10], u2, fma(_S[9], u, _S[8])), u4 * u4, s) * x
+    s = fma(_S[8] * u4, u4, s) * x
     c = fma(fma(fma(_C[7], u, _C[6]), u2, fma(_C[5], u, _C[4])), u4,
             fma(fma(_C[3], u, _C[2]), u2, fma(_C[1], u, _C[0])))
-    c = fma(fma(_C[10], u2, fma(_C[9], u, _C[8])), u4 * u4, c)
-    return (s + c) * _RSQRT2, (c - s) * _RSQRT2
+    c = fma(_C[8] * u4, u4, c)
+    return s, c
+
+
+@jit
+def sincos(x):
+    """``(sin x, cos x)``: a polynomial on ``|x| <= 1.75``, libm beyond.
+
+    Each step of the integrator needs six of these, one after another on its critical path; the
+    polynomial has a third of the latency of libm's ``sin`` and ``cos`` and agrees with them to
+    a unit or two in the last place.
+    """
+    if abs(x) > SINCOS_RANGE:
+        return math.sin(x), math.cos(x)
+    return sincos_poly(x)
 
 
 @jit
@@ -267,17 +281,45 @@ def forcing_closed(t, omega, phi):
 
 
 @jit
+def corner(f, side, sthc, cthc):
+    """``(P, Q)`` with ``theta'' = P cos(theta) + Q sin(theta) - 3/4 xi theta'`` on corner ``side``.
+
+    SPEC.md §1 on either corner is ``theta'' = 3/4 (f sin(thc + s theta) - s cos(thc + s theta)
+    - xi theta')`` with ``s = side`` (+1 or -1) and ``f`` the forcing acceleration
+    ``alpha omega^2 r``. Expanding the sum angles, ``P = 3/4 (f sin(thc) - s cos(thc))`` and
+    ``Q = 3/4 (f s cos(thc) + sin(thc))``: they depend on time only through ``f``, so the
+    integrator computes them off its critical path and needs the sine and cosine of ``theta``
+    alone. ``sthc, cthc`` are ``sin(thc), cos(thc)``.
+    """
+    a1 = 0.75 * sthc
+    a2 = 0.75 * (side * cthc)
+    return fma(f, a1, -a2), fma(f, a2, a1)
+
+
+@jit
+def accel_pq(P, Q, s, c, dtheta, xi):
+    """``theta''`` from :func:`corner`'s ``P, Q`` and ``s, c = sin(theta), cos(theta)``."""
+    return fma(-0.75 * xi, dtheta, fma(P, c, Q * s))
+
+
+@jit
+def slope_pq(P, Q, s, c):
+    """``d theta'' / d theta`` from :func:`corner`'s ``P, Q`` and ``sin, cos`` of theta."""
+    return fma(Q, c, -(P * s))
+
+
+@jit
 def accel(theta, dtheta, f, side, thc, xi):
     """Angular acceleration ``theta''`` while rocking on corner ``side`` (+1 or -1).
 
-    ``f`` is the forcing acceleration ``alpha omega^2 r``. One formula serves both corners:
-    ``theta'' = 3/4 (f sin(thc + s theta) - s cos(thc + s theta) - xi theta')`` with ``s = side``
-    (SPEC.md §1). On ``side = 0`` (rest) the acceleration is zero.
+    ``f`` is the forcing acceleration ``alpha omega^2 r``; the formula is SPEC.md §1's, arranged
+    by :func:`corner`. On ``side = 0`` (rest) the acceleration is zero.
     """
     if side == 0:
         return 0.0
-    sa, ca = sincos(thc + side * theta)
-    return 0.75 * fma(f, sa, -fma(xi, dtheta, side * ca))
+    P, Q = corner(f, side, math.sin(thc), math.cos(thc))
+    s, c = sincos(theta)
+    return accel_pq(P, Q, s, c, dtheta, xi)
 
 
 @jit
@@ -285,8 +327,12 @@ def accel_jac(theta, dtheta, f, side, thc, xi):
     """Partial derivatives of :func:`accel` with respect to ``theta``, ``theta'`` and ``f``."""
     if side == 0:
         return 0.0, 0.0, 0.0
-    sa, ca = sincos(thc + side * theta)
-    return 0.75 * (side * f * ca + sa), -0.75 * xi, 0.75 * sa
+    sthc = math.sin(thc)
+    cthc = math.cos(thc)
+    P, Q = corner(f, side, sthc, cthc)
+    s, c = sincos(theta)
+    # d/df of P cos + Q sin is 3/4 (sin(thc) cos(theta) + side cos(thc) sin(theta))
+    return slope_pq(P, Q, s, c), -0.75 * xi, 0.75 * fma(sthc, c, side * cthc * s)
 
 
 @jit

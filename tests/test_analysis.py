@@ -82,10 +82,11 @@ def test_multiperiodic_period_and_chaos():
 def test_transient_chaos_is_resolved():
     """At the study's alpha = 0.969 the block wanders chaotically for ~23 periods and overturns.
     Errors grow by ~1e13 over that stretch, so the overturning time is a severe accuracy probe:
-    the compiled path converges in N (1024 and 2048 steps agree to 1e-5), and DOP853 approaches
-    the same time monotonically as its tolerance tightens."""
-    t = {n: rockjit.simulate(1, 0.969, 1.3, periods=30, n_steps=n).t for n in (1024, 2048)}
-    assert t[1024] == pytest.approx(t[2048], abs=1e-5)
+    the compiled path converges in N (1024, 2048 and 4096 steps agree to 5e-5, the level at
+    which rounding errors amplified by the transient differ between grids; N = 512 is still
+    3e-4 away), and DOP853 approaches the same time monotonically as its tolerance tightens."""
+    t = {n: rockjit.simulate(1, 0.969, 1.3, periods=30, n_steps=n).t for n in (1024, 2048, 4096)}
+    assert max(t.values()) - min(t.values()) < 5e-5
     err = []
     for tol in (1e-10, 1e-12, 1e-13):
         ref = rockjit.simulate(1, 0.969, 1.3, periods=30, method="scipy:DOP853", rtol=tol,

@@ -22,6 +22,7 @@ import pytest
 
 import rockjit
 from rockjit import integrate as ig
+from rockjit.simulate import pack
 
 DOP = dict(method="scipy:DOP853", rtol=1e-12, atol=1e-12)
 
@@ -169,6 +170,54 @@ def test_empirical_order_is_five():
     assert 4.7 <= slope <= 5.6, (slope, errs)
     # the embedded estimate is an error indicator of the same size as the step's local error
     assert r.max_error_estimate > 0.0
+
+
+# ---- one step, against a readable reference step ------------------------------------------
+
+def _reference_dp5_step(spec, t, y, h, side, hb, aw2, omega, phi, xi):
+    """One Dormand–Prince step written plainly (tableau from rockjit, field from the SPEC)."""
+    k = []
+    for i in range(7):
+        if i == 0:
+            yi = np.array(y, dtype=float)
+        else:
+            a = ig.A[i] if i < 6 else ig.B
+            yi = np.array(y, dtype=float) + h * sum(a[j] * k[j] for j in range(i))
+        ti = t + (ig.C[i] if i < 6 else 1.0) * h
+        k.append(np.array([yi[1], spec.theta_ddot(ti, yi[0], yi[1], side, hb, aw2, omega, phi,
+                                                  xi)]))
+        if i == 6:
+            return yi
+
+
+@pytest.mark.parametrize("theta0, dtheta0, n", [
+    (0.3, -0.4, 64),    # every stage within the polynomial's range (the fast path)
+    (1.55, 5.0, 8),     # stages beyond |theta| = 1.75: the step is redone with libm's sines
+    (-1.6, -6.0, 8),
+])
+def test_one_step_matches_a_plain_reference_step(spec, theta0, dtheta0, n):
+    hb, alpha, omega, xi = 1.0, 0.6, 1.3, 0.01
+    blk = rockjit.Block(hb=hb, alpha=alpha, omega=omega, xi=xi)
+    phi = 0.4
+    p = pack(blk, phi, n)
+    par = np.zeros(ig.N_PARW)
+    par[:ig.N_PAR] = p
+    par[ig.P_STHC], par[ig.P_CTHC] = math.sin(blk.thc), math.cos(blk.thc)
+    side = 1 if theta0 > 0 else -1
+    h = p[ig.P_H]
+    y = np.array([theta0, dtheta0])
+    K = np.zeros((ig.N_STAGES + 1, 2))
+    tab = np.zeros((ig.N_TAB, ig.N_STAGES + 1))
+    fr, jac = np.zeros(ig.N_STAGES + 1), np.zeros(ig.N_STAGES + 1)
+    ytmp, ynew = np.zeros(2), np.zeros(2)
+    ig.step_table(omega, h, tab)
+    ig.rhs(False, math.sin(phi), y, side, par, K, jac)
+    ig.rk_step(False, False, math.sin(phi), math.cos(phi), y, K, side, par, ytmp, ynew, tab, fr,
+               jac)
+    want = _reference_dp5_step(spec, 0.0, y, h, side, hb, alpha * omega**2, omega, phi, xi)
+    far = max(abs(theta0), abs(ynew[0]))
+    assert (far > 1.75) == (abs(theta0) > 1.5)  # the cases test what they say
+    np.testing.assert_allclose(ynew, want, rtol=1e-13, atol=1e-14)
 
 
 # ---- the flow's Jacobian across impacts: tangent dynamics and saltation ---------------------
