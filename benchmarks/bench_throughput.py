@@ -101,20 +101,22 @@ def _sincos_free(n, x0):
 
 
 @numba.njit(cache=False, _nrt=False)  # as the kernel's loop: no reference counting
-def _dp_steps(n, y, K, par, ytmp, ynew, tab, fr, jac):
+def _dp_steps(n, y, K, par, ytmp, ynew, tab, fr, jac, trig):
     """n bare Dormand-Prince steps chained through the state (no event detection)."""
-    ig.rhs(False, 0.0, y, 1, par, K, jac)
+    ig.rhs(False, 0.0, y, 1, par, K, jac, trig)
     for _ in range(n):
-        ig.rk_step(False, False, 0.0, 1.0, y, K, 1, par, ytmp, ynew, tab, fr, jac)
+        ig.rk_step(False, False, 0.0, 1.0, y, K, 1, par, ytmp, ynew, tab, fr, jac, trig)
         y[0] = ynew[0]
         y[1] = ynew[1]
         K[0, 0] = K[ig.N_STAGES, 0]
         K[0, 1] = K[ig.N_STAGES, 1]
         jac[0] = jac[ig.N_STAGES]
+        trig[0] = trig[2]
+        trig[1] = trig[3]
         if y[0] < -0.3:  # keep the free fall within range (rare)
             y[0] = 0.2
             y[1] = 0.0
-            ig.rhs(False, 0.0, y, 1, par, K, jac)
+            ig.rhs(False, 0.0, y, 1, par, K, jac, trig)
     return y[0]
 
 
@@ -132,14 +134,15 @@ def microbench(n_steps, repeats):
     tab = np.zeros((ig.N_TAB, ig.N_STAGES + 1))
     ig.step_table(par[ig.P_OMEGA], par[ig.P_H], tab)
     fr, jac = np.zeros(ig.N_STAGES + 1), np.zeros(ig.N_STAGES + 1)
+    trig = np.zeros(4)
     _sincos_chain(10, 0.3)
     _sincos_free(10, 0.3)
-    _dp_steps(10, y, K, par, ytmp, ynew, tab, fr, jac)
+    _dp_steps(10, y, K, par, ytmp, ynew, tab, fr, jac, trig)
     n = n_steps
     cases = {
         "sincos, chained": lambda: _sincos_chain(6 * n, 0.3),
         "sincos, independent": lambda: _sincos_free(6 * n, 0.3),
-        "bare DP5 step": lambda: _dp_steps(n, y, K, par, ytmp, ynew, tab, fr, jac),
+        "bare DP5 step": lambda: _dp_steps(n, y, K, par, ytmp, ynew, tab, fr, jac, trig),
     }
     times = C.interleaved(cases, repeats)
     per = {"sincos, chained": 6 * n, "sincos, independent": 6 * n, "bare DP5 step": n}

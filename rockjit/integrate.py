@@ -36,8 +36,9 @@ import math
 import numpy as np
 
 from ._jit import fma, jit
-from .model import (SINCOS_RANGE, accel_pq, corner, forcing_closed, jump, oscillator, saltation,
-                    sincos, sincos_poly, slope_pq, uplift_time)
+from .model import (NEAR_RANGE, SINCOS_RANGE, accel_near, accel_pq, corner, forcing_closed, jump,
+                    near_poly, oscillator, rotate, saltation, sincos, sincos_poly, slope_pq,
+                    uplift_time)
 
 # ---- Dormand–Prince 5(4), scipy's names --------------------------------------------------------
 C = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0])
@@ -190,76 +191,90 @@ def step_table(omega, h, tab):
 
 
 @jit(nrt=False)
-def block_stage(FAST, x, v, f, side, par):
-    """Acceleration and its slope ``d theta''/d theta`` at one stage (:mod:`rockjit.model`).
+def block_stage(FAST, x0, d, v, f, side, par, s0, c0):
+    """Acceleration and its slope ``d theta''/d theta`` at angle ``x0 + d`` (:mod:`rockjit.model`).
 
-    ``FAST``: the sine and cosine by the polynomial alone, valid for ``|x| <= SINCOS_RANGE``
-    (the caller checks)."""
-    if FAST:
-        s, c = sincos_poly(x)
-    else:
-        s, c = sincos(x)
+    ``FAST``: ``s0, c0`` are the sine and cosine of ``x0`` and ``|d| <= NEAR_RANGE`` (the caller
+    checks): the corner's coefficients are rotated to ``x0`` and only ``d`` enters a
+    polynomial, shorter than a sine's over the whole range. Otherwise the sine and cosine of
+    ``x0 + d`` are computed afresh (libm beyond ``SINCOS_RANGE``).
+    """
     P, Q = corner(f, side, par[P_STHC], par[P_CTHC])
+    if FAST:
+        Pr, Qr = rotate(P, Q, s0, c0)
+        sn, cn = near_poly(d)
+        return accel_near(Pr, Qr, d, v, par[P_XI]), slope_pq(Pr, Qr, d * sn, cn)
+    s, c = sincos(x0 + d)
     return accel_pq(P, Q, s, c, v, par[P_XI]), slope_pq(P, Q, s, c)
 
 
 @jit(nrt=False)
-def rhs(EMBED4, r, y, side, par, K, jac):
-    """The field at the step's start into ``K[0]`` (and the slope into ``jac[0]``); ``r`` is the
-    closed-form forcing value (ignored with the embedding, which reads ``r`` from y). The tangent
-    rows of ``K[0]`` are filled by :func:`tangent_step` itself."""
+def rhs(EMBED4, r, y, side, par, K, jac, trig):
+    """The field at the step's start into ``K[0]``, the slope into ``jac[0]``, and the sine and
+    cosine of theta into ``trig[0:2]``; ``r`` is the closed-form forcing value (ignored with the
+    embedding, which reads ``r`` from y). The tangent rows of ``K[0]`` are filled by
+    :func:`tangent_step` itself."""
     if EMBED4:
         r = y[2]
         dr, ds = oscillator(r, y[3], par[P_OMEGA])
         K[0, 2] = dr
         K[0, 3] = ds
+    trig[0], trig[1] = sincos(y[0])
     if side == 0:
         K[0, 0] = 0.0
         K[0, 1] = 0.0
         jac[0] = 0.0
     else:
         K[0, 0] = y[1]
-        K[0, 1], jac[0] = block_stage(False, y[0], y[1], par[P_AW2] * r, side, par)
+        K[0, 1], jac[0] = block_stage(False, y[0], 0.0, y[1], par[P_AW2] * r, side, par, 0.0,
+                                      0.0)
 
 
 @jit(nrt=False, inline=True)
-def block_step(FAST, x0, v0, fr, tab, side, par, K, jac):
+def block_step(FAST, x0, v0, fr, tab, side, par, K, jac, trig):
     """The block's ``(theta, theta')`` over one Dormand–Prince step, written out stage by stage.
 
-    ``K[0, 1]`` holds the acceleration at the start; ``fr[i]`` the forcing acceleration at
-    stage ``i``; ``tab`` the step's table. Fills ``K[1:, :2]`` and ``jac[1:]`` and returns the
-    state at the step's end. This is the integrator's critical path: the stage values stay in
-    registers (a sum reads the newest stage last, so the rest of it is ready early), and only the
-    sine and cosine of each stage's angle lie on the chain (:func:`rockjit.model.corner`).
-    Returns ``(theta, theta', far)``; with ``FAST`` the sines come from the polynomial alone and
-    ``far`` is the largest ``|theta|`` among the stages: beyond ``SINCOS_RANGE`` the caller must
-    redo the step without ``FAST``.
+    ``K[0, 1]`` holds the acceleration at the start, ``trig[0:2]`` the sine and cosine of
+    ``x0``; ``fr[i]`` the forcing acceleration at stage ``i``; ``tab`` the step's table. Fills
+    ``K[1:, :2]``, ``jac[1:]`` and ``trig[2:4]`` (at the step's end) and returns
+    ``(theta, theta', far)`` at the step's end.
+
+    This is the integrator's critical path. The stage values stay in registers; a sum reads the
+    newest stage last, so the rest of it is ready early; the stages' angles are kept as offsets
+    ``d`` from ``x0`` (:func:`block_stage`). With ``FAST``, ``far > 1`` says an offset exceeded
+    ``NEAR_RANGE`` or the end angle ``SINCOS_RANGE``: the caller must redo the step without.
     """
     k0 = K[0, 1]
-    x1 = fma(tab[1, 0], v0, x0)
+    s0 = trig[0]
+    c0 = trig[1]
+    d1 = tab[1, 0] * v0
     v1 = fma(tab[1, 0], k0, v0)
-    k1, j1 = block_stage(FAST, x1, v1, fr[1], side, par)
-    x2 = fma(tab[2, 1], v1, fma(tab[2, 0], v0, x0))
+    k1, j1 = block_stage(FAST, x0, d1, v1, fr[1], side, par, s0, c0)
+    d2 = fma(tab[2, 1], v1, tab[2, 0] * v0)
     v2 = fma(tab[2, 1], k1, fma(tab[2, 0], k0, v0))
-    k2, j2 = block_stage(FAST, x2, v2, fr[2], side, par)
-    x3 = fma(tab[3, 2], v2, fma(tab[3, 1], v1, fma(tab[3, 0], v0, x0)))
+    k2, j2 = block_stage(FAST, x0, d2, v2, fr[2], side, par, s0, c0)
+    d3 = fma(tab[3, 2], v2, fma(tab[3, 1], v1, tab[3, 0] * v0))
     v3 = fma(tab[3, 2], k2, fma(tab[3, 1], k1, fma(tab[3, 0], k0, v0)))
-    k3, j3 = block_stage(FAST, x3, v3, fr[3], side, par)
-    x4 = fma(tab[4, 3], v3, fma(tab[4, 2], v2, fma(tab[4, 1], v1, fma(tab[4, 0], v0, x0))))
+    k3, j3 = block_stage(FAST, x0, d3, v3, fr[3], side, par, s0, c0)
+    d4 = fma(tab[4, 3], v3, fma(tab[4, 2], v2, fma(tab[4, 1], v1, tab[4, 0] * v0)))
     v4 = fma(tab[4, 3], k3, fma(tab[4, 2], k2, fma(tab[4, 1], k1, fma(tab[4, 0], k0, v0))))
-    k4, j4 = block_stage(FAST, x4, v4, fr[4], side, par)
-    x5 = fma(tab[5, 4], v4, fma(tab[5, 3], v3, fma(tab[5, 2], v2,
-             fma(tab[5, 1], v1, fma(tab[5, 0], v0, x0)))))
+    k4, j4 = block_stage(FAST, x0, d4, v4, fr[4], side, par, s0, c0)
+    d5 = fma(tab[5, 4], v4, fma(tab[5, 3], v3, fma(tab[5, 2], v2,
+             fma(tab[5, 1], v1, tab[5, 0] * v0))))
     v5 = fma(tab[5, 4], k4, fma(tab[5, 3], k3, fma(tab[5, 2], k2,
              fma(tab[5, 1], k1, fma(tab[5, 0], k0, v0)))))
-    k5, j5 = block_stage(FAST, x5, v5, fr[5], side, par)
+    k5, j5 = block_stage(FAST, x0, d5, v5, fr[5], side, par, s0, c0)
     # B[1] = 0
-    x6 = fma(tab[T_HB, 5], v5, fma(tab[T_HB, 4], v4, fma(tab[T_HB, 3], v3,
-             fma(tab[T_HB, 2], v2, fma(tab[T_HB, 0], v0, x0)))))
+    d6 = fma(tab[T_HB, 5], v5, fma(tab[T_HB, 4], v4, fma(tab[T_HB, 3], v3,
+             fma(tab[T_HB, 2], v2, tab[T_HB, 0] * v0))))
     v6 = fma(tab[T_HB, 5], k5, fma(tab[T_HB, 4], k4, fma(tab[T_HB, 3], k3,
              fma(tab[T_HB, 2], k2, fma(tab[T_HB, 0], k0, v0)))))
-    k6, j6 = block_stage(FAST, x6, v6, fr[N_STAGES], side, par)
-    far = max(max(max(abs(x1), abs(x2)), max(abs(x3), abs(x4))), max(abs(x5), abs(x6)))
+    k6, j6 = block_stage(FAST, x0, d6, v6, fr[N_STAGES], side, par, s0, c0)
+    x6 = x0 + d6
+    # the next step's base angle, afresh (off the chain: its first use is the next step's rotate)
+    trig[2], trig[3] = sincos_poly(x6) if FAST else sincos(x6)
+    far = max(max(max(abs(d1), abs(d2)), max(abs(d3), abs(d4))), max(abs(d5), abs(d6)))
+    far = max(far * (1.0 / NEAR_RANGE), abs(x6) * (1.0 / SINCOS_RANGE))
     K[1, 0] = v1
     K[2, 0] = v2
     K[3, 0] = v3
@@ -328,7 +343,7 @@ def forcing_at(t, par):
 
 
 @jit(nrt=False, inline=True)
-def rk_step(EMBED4, TANGENT, sp, cp, y, K, side, par, ytmp, ynew, tab, fr, jac):
+def rk_step(EMBED4, TANGENT, sp, cp, y, K, side, par, ytmp, ynew, tab, fr, jac, trig):
     """One Dormand–Prince step from y with the table ``tab`` of its length; ``K[0]`` (and
     ``jac[0]``) must hold the field at the start.
 
@@ -351,9 +366,9 @@ def rk_step(EMBED4, TANGENT, sp, cp, y, K, side, par, ytmp, ynew, tab, fr, jac):
         ynew[0] = y[0]
         ynew[1] = y[1]
     else:
-        x, v, far = block_step(True, y[0], y[1], fr, tab, side, par, K, jac)
-        if far > SINCOS_RANGE:  # rare: a stage beyond the polynomial's range (libm there)
-            x, v, far = block_step(False, y[0], y[1], fr, tab, side, par, K, jac)
+        x, v, far = block_step(True, y[0], y[1], fr, tab, side, par, K, jac, trig)
+        if far > 1.0:  # rare: a stage too far from the start, or beyond the sines' polynomial
+            x, v, far = block_step(False, y[0], y[1], fr, tab, side, par, K, jac, trig)
         ynew[0] = x
         ynew[1] = v
     if TANGENT:
@@ -435,7 +450,7 @@ def dense_event_slope(kind, y0m, h, q0, q1, q2, q3, side, par, x):
 
 @jit(nrt=False)
 def locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, ytmp, yev, counts, tab, fr,
-           jac):
+           jac, trig):
     """Time tau in (lo, hi] of the event, with the state there in yev.
 
     1. A safeguarded Newton iteration on the step's continuous extension (K holds its stages),
@@ -483,7 +498,7 @@ def locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, ytmp, yev, cou
     NY = yev.shape[0]
     for it in range(NEWTON_ITERS):
         step_table(par[P_OMEGA], tau, tab)
-        rk_step(EMBED4, TANGENT, sp, cp, y, K, side, par, ytmp, yev, tab, fr, jac)
+        rk_step(EMBED4, TANGENT, sp, cp, y, K, side, par, ytmp, yev, tab, fr, jac, trig)
         counts[O_RHS] += N_STAGES
         g, dg = event_value(kind, yev, side, par, t + tau)
         if g == 0.0:
@@ -632,17 +647,17 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par_in, ipar, strobe, half, impacts
                  lam_run, per_imp, iout, fout, np.zeros((N_STAGES + 1, NY)), work[0], work[1],
                  work[2], work[3], np.zeros(4), np.zeros((N_TAB, N_STAGES + 1)),
                  np.zeros((N_TAB, N_STAGES + 1)), np.zeros(N_STAGES + 1),
-                 np.zeros(N_STAGES + 1), np.zeros((2, ipar[I_N])))
+                 np.zeros(N_STAGES + 1), np.zeros(4), np.zeros((2, ipar[I_N])))
 
 
 @jit(nrt=False)
 def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, traj, lam_run,
-          per_imp, iout, fout, K, y, ytmp, ynew, yev, lam, tab_h, tab, fr, jac, ptab):
+          per_imp, iout, fout, K, y, ytmp, ynew, yev, lam, tab_h, tab, fr, jac, trig, ptab):
     """The integration itself: ``_run``'s arguments, the parameters with the derived constants
     (``N_PARW``), and work arrays: stages ``K``; states ``y, ytmp, ynew, yev``; ``lam`` (sums of
     the logs of the stretches, overall and in the window); step tables for the grid step and
-    for substeps; the stage forcing ``fr`` and slopes ``jac``; the forcing phase ``ptab`` on
-    the grid."""
+    for substeps; the stage forcing ``fr`` and slopes ``jac``; ``trig``, the sine and cosine of
+    theta at the start and the end of a step; the forcing phase ``ptab`` on the grid."""
     NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
     NY = NS + (4 if TANGENT else 0)  # plus the tangent matrix, column-major
     n_per = ipar[I_N]
@@ -687,7 +702,7 @@ def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, 
         lam_run[0, 1] = 0.0
     if side != 0 and side * y[0] >= par[P_THOVER]:
         status = OVERTURNED
-    rhs(EMBED4, forcing_at(t, par), y, side, par, K, jac)
+    rhs(EMBED4, forcing_at(t, par), y, side, par, K, jac, trig)
     iout[O_RHS] += 1
 
     step = 0
@@ -725,7 +740,7 @@ def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, 
                 y[0] = 0.0
                 y[1] = 0.0
                 side = 1 if forcing_now(EMBED4, t, y, par) > 0.0 else -1
-                rhs(EMBED4, forcing_at(t, par), y, side, par, K, jac)
+                rhs(EMBED4, forcing_at(t, par), y, side, par, K, jac, trig)
                 iout[O_RHS] += 1
                 continue
             if side == 0:
@@ -736,20 +751,20 @@ def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, 
                 if not hold and par[P_AW2] * abs(y[2]) > par[P_COT]:
                     side = 1 if y[2] > 0.0 else -1
                     t_lift = t
-                    rhs(EMBED4, forcing_at(t, par), y, side, par, K, jac)
+                    rhs(EMBED4, forcing_at(t, par), y, side, par, K, jac, trig)
                     iout[O_RHS] += 1
                     continue
             if fresh:
                 # a whole grid step: the forcing phase there is phi + 2 pi j / N exactly
                 hh = h
                 rk_step(EMBED4, TANGENT, ptab[0, j_per], ptab[1, j_per], y, K, side, par,
-                        ytmp, ynew, tab_h, fr, jac)
+                        ytmp, ynew, tab_h, fr, jac, trig)
             else:
                 hh = t_grid - t
                 psi = par[P_OMEGA] * t + par[P_PHI]
                 step_table(par[P_OMEGA], hh, tab)
                 rk_step(EMBED4, TANGENT, math.sin(psi), math.cos(psi), y, K, side, par,
-                        ytmp, ynew, tab, fr, jac)
+                        ytmp, ynew, tab, fr, jac, trig)
             iout[O_RHS] += N_STAGES
             iout[O_SUBSTEPS] += 1
             kind, lo, hi = detect(y, ynew, hh, K, side, par)
@@ -770,11 +785,13 @@ def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, 
                 for m in range(NS):  # first same as last (the tangent rows are redone)
                     K[0, m] = K[N_STAGES, m]
                 jac[0] = jac[N_STAGES]
+                trig[0] = trig[2]
+                trig[1] = trig[3]
                 t = t_grid
                 break
             if hi > lo:
                 tau = locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, ytmp, yev,
-                             iout, tab, fr, jac)
+                             iout, tab, fr, jac, trig)
             else:
                 # an unresolvably small flight: take it as ending at rest where it started
                 tau = 0.0
@@ -793,7 +810,7 @@ def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, 
                 y[1] = 0.0
                 side = 1 if y[2] > 0.0 else -1
                 t_lift = t
-                rhs(EMBED4, forcing_at(t, par), y, side, par, K, jac)
+                rhs(EMBED4, forcing_at(t, par), y, side, par, K, jac, trig)
                 iout[O_RHS] += 1
                 continue
             # impact: jump map, saltation, record
@@ -835,7 +852,7 @@ def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, 
                 iout[O_NREST] += 1
                 if in_window:
                     iout[O_NREST_WIN] += 1
-            rhs(EMBED4, forcing_at(t, par), y, side, par, K, jac)
+            rhs(EMBED4, forcing_at(t, par), y, side, par, K, jac, trig)
             iout[O_RHS] += 1
             if n_imp >= max_imp:
                 status = MAX_IMPACTS

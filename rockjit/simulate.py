@@ -17,9 +17,11 @@ __all__ = ["Result", "simulate", "Z0_STUDY", "DEFAULT_N", "MAX_STEP", "STATUS_ME
 #: Initial state ``(theta, theta', r, s)`` of the study's single runs and sweeps (SPEC.md §7).
 Z0_STUDY = (-0.2254, -0.1597, -0.7778, 0.6284)
 
-#: Default number of steps per forcing period of single runs: the smallest N at which impact
-#: times agree with DOP853 (rtol 1e-12) to 1e-10 on demanding orbits (benchmarks/README.md).
-DEFAULT_N = 256
+#: Default number of steps per forcing period of single runs. Impact times over 20 periods are
+#: within 1e-10 of a converged solution (N = 2048) on the study's orbits from N = 160 on; the
+#: most demanding of them, the asymmetric orbit (hb=1, alpha=0.8), needs it: 2.1e-10 at N = 128,
+#: 6.5e-11 at N = 160 (benchmarks/README.md, "Work against precision").
+DEFAULT_N = 160
 
 #: Largest step (in units of 1/Omega0) a default N may give: at slow forcing, N steps per period
 #: would be coarse against the block's own time scale, so N is raised until h <= MAX_STEP.

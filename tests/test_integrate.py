@@ -191,7 +191,8 @@ def _reference_dp5_step(spec, t, y, h, side, hb, aw2, omega, phi, xi):
 
 
 @pytest.mark.parametrize("theta0, dtheta0, n", [
-    (0.3, -0.4, 64),    # every stage within the polynomial's range (the fast path)
+    (0.3, -0.4, 64),    # every stage within the polynomials' ranges (the fast path)
+    (0.05, 2.5, 16),    # stages more than NEAR_RANGE from the start: redone afresh
     (1.55, 5.0, 8),     # stages beyond |theta| = 1.75: the step is redone with libm's sines
     (-1.6, -6.0, 8),
 ])
@@ -211,12 +212,14 @@ def test_one_step_matches_a_plain_reference_step(spec, theta0, dtheta0, n):
     fr, jac = np.zeros(ig.N_STAGES + 1), np.zeros(ig.N_STAGES + 1)
     ytmp, ynew = np.zeros(2), np.zeros(2)
     ig.step_table(omega, h, tab)
-    ig.rhs(False, math.sin(phi), y, side, par, K, jac)
+    trig = np.zeros(4)
+    ig.rhs(False, math.sin(phi), y, side, par, K, jac, trig)
     ig.rk_step(False, False, math.sin(phi), math.cos(phi), y, K, side, par, ytmp, ynew, tab, fr,
-               jac)
+               jac, trig)
     want = _reference_dp5_step(spec, 0.0, y, h, side, hb, alpha * omega**2, omega, phi, xi)
-    far = max(abs(theta0), abs(ynew[0]))
-    assert (far > 1.75) == (abs(theta0) > 1.5)  # the cases test what they say
+    # the cases test what they say: the fast path, a stage far from the start, beyond 1.75
+    assert (abs(ynew[0] - theta0) > 0.3) == (n <= 16)
+    assert (max(abs(theta0), abs(ynew[0])) > 1.75) == (abs(theta0) > 1.5)
     np.testing.assert_allclose(ynew, want, rtol=1e-13, atol=1e-14)
 
 
@@ -267,7 +270,7 @@ def test_tangent_matches_finite_differences_across_impacts(hb, law, omega, alpha
 def test_free_elastic_rocking_conserves_energy(hb):
     thc = math.atan(hb)
     th0, dth0 = 0.15, 0.0
-    # alpha = 0: omega only sets the grid, h = 2 pi / (5 * 256)
+    # alpha = 0: omega only sets the grid, h = 2 pi / (5 * DEFAULT_N)
     r = rockjit.simulate(hb, 0.0, 5.0, e=1.0, xi=0.0, theta0=th0, dtheta0=dth0, periods=1900,
                          record_stride=5, max_impacts=5000)
     assert r.status == "done" and r.n_impacts >= 1000
@@ -278,7 +281,7 @@ def test_free_elastic_rocking_conserves_energy(hb):
     e0 = energy(th0, dth0)
     assert np.abs(energy(r.strobe[:, 0], r.strobe[:, 1]) / e0 - 1).max() < 1e-10
     traj = r.trajectory
-    assert len(traj) == 1900 * 256 // 5 + 1
+    assert len(traj) == 1900 * rockjit.DEFAULT_N // 5 + 1
     assert np.abs(energy(traj[:, 1], traj[:, 2]) / e0 - 1).max() < 1e-10
     speeds = np.abs(r.impacts[:, 1])
     v0 = math.sqrt(2 * (e0 - 0.75 * math.sin(thc)))  # the impact speed, from the energy
@@ -298,7 +301,7 @@ def test_zeno_cascade_comes_to_rest():
     s = rockjit.simulate(**kw, **DOP)
     assert r.status == s.status == "rest"
     assert r.n_impacts == s.n_impacts < 1000
-    # bounded work: 50 periods on the grid would cost 50 * 256 * 6 = 76800 evaluations
+    # bounded work: 50 periods on the grid would cost 50 * 160 * 6 = 48000 evaluations
     assert r.n_rhs < 20_000
     assert r.t == pytest.approx(s.t, abs=1e-8)
     assert r.t < 50 * r.period

@@ -85,6 +85,32 @@ def test_sincos_falls_back_to_libm_beyond_its_range():
     assert math.isnan(s) and math.isnan(c)
 
 
+def test_near_polynomial_matches_libm_on_its_range():
+    for d in np.concatenate([np.linspace(-model.NEAR_RANGE, model.NEAR_RANGE, 6001),
+                             [0.0, 1e-300, 1e-9]]):
+        sn, cn = model.near_poly(d)
+        assert abs(d * sn - math.sin(d)) <= 2e-16 and abs(cn - math.cos(d)) <= 2e-16, d
+
+
+def test_acceleration_near_a_base_angle_is_the_acceleration_there():
+    """``rotate`` + ``accel_near`` (the integrator's stages) against ``accel`` at the same angle,
+    and the rotated slope against ``accel_jac``."""
+    rng = np.random.default_rng(3)
+    for side in (1, -1):
+        for hb in (1.0, 2.0):
+            thc = math.atan(hb)
+            for _ in range(200):
+                th0, d = rng.uniform(-1.5, 1.5), rng.uniform(-0.3, 0.3)
+                dth, f, xi = rng.uniform(-3, 3), rng.uniform(-2, 2), 0.05
+                P, Q = model.corner(f, side, math.sin(thc), math.cos(thc))
+                Pr, Qr = model.rotate(P, Q, math.sin(th0), math.cos(th0))
+                want = model.accel(th0 + d, dth, f, side, thc, xi)
+                assert model.accel_near(Pr, Qr, d, dth, xi) == pytest.approx(want, abs=2e-15)
+                sn, cn = model.near_poly(d)
+                assert model.slope_pq(Pr, Qr, d * sn, cn) == pytest.approx(
+                    model.accel_jac(th0 + d, dth, f, side, thc, xi)[0], abs=2e-15)
+
+
 # ---- the vector field (SPEC.md §1) ------------------------------------------------------------
 
 @pytest.mark.parametrize("side", [1, -1])
