@@ -105,7 +105,8 @@ def _dp_steps(n, y, K, par, ytmp, ynew, tab, fr, jac, trig):
     """n bare Dormand-Prince steps chained through the state (no event detection)."""
     ig.rhs(False, 0.0, y, 1, par, K, jac, trig)
     for _ in range(n):
-        ig.rk_step(False, False, 0.0, 1.0, y, K, 1, par, ytmp, ynew, tab, fr, jac, trig)
+        ig.rk_step(False, False, False, 0.0, 1.0, y, K, 1, par, ytmp, ynew, tab, fr, jac,
+                   trig)
         y[0] = ynew[0]
         y[1] = ynew[1]
         K[0, 0] = K[ig.N_STAGES, 0]

@@ -191,19 +191,23 @@ def step_table(omega, h, tab):
 
 
 @jit(nrt=False)
-def block_stage(FAST, x0, d, v, f, side, par, s0, c0):
+def block_stage(FAST, SLOPE, x0, d, v, f, side, par, s0, c0):
     """Acceleration and its slope ``d theta''/d theta`` at angle ``x0 + d`` (:mod:`rockjit.model`).
 
     ``FAST``: ``s0, c0`` are the sine and cosine of ``x0`` and ``|d| <= NEAR_RANGE`` (the caller
     checks): the corner's coefficients are rotated to ``x0`` and only ``d`` enters a
     polynomial, shorter than a sine's over the whole range. Otherwise the sine and cosine of
-    ``x0 + d`` are computed afresh (libm beyond ``SINCOS_RANGE``).
+    ``x0 + d`` are computed afresh (libm beyond ``SINCOS_RANGE``). Without ``SLOPE`` (no tangent
+    dynamics) the fast path returns 0 for the slope.
     """
     P, Q = corner(f, side, par[P_STHC], par[P_CTHC])
     if FAST:
         Pr, Qr = rotate(P, Q, s0, c0)
+        a = accel_near(Pr, Qr, d, v, par[P_XI])
+        if not SLOPE:
+            return a, 0.0
         sn, cn = near_poly(d)
-        return accel_near(Pr, Qr, d, v, par[P_XI]), slope_pq(Pr, Qr, d * sn, cn)
+        return a, slope_pq(Pr, Qr, d * sn, cn)
     s, c = sincos(x0 + d)
     return accel_pq(P, Q, s, c, v, par[P_XI]), slope_pq(P, Q, s, c)
 
@@ -226,12 +230,12 @@ def rhs(EMBED4, r, y, side, par, K, jac, trig):
         jac[0] = 0.0
     else:
         K[0, 0] = y[1]
-        K[0, 1], jac[0] = block_stage(False, y[0], 0.0, y[1], par[P_AW2] * r, side, par, 0.0,
-                                      0.0)
+        K[0, 1], jac[0] = block_stage(False, True, y[0], 0.0, y[1], par[P_AW2] * r, side, par,
+                                      0.0, 0.0)
 
 
 @jit(nrt=False, inline=True)
-def block_step(FAST, x0, v0, fr, tab, side, par, K, jac, trig):
+def block_step(FAST, SLOPE, x0, v0, fr, tab, side, par, K, jac, trig):
     """The block's ``(theta, theta')`` over one Dormand–Prince step, written out stage by stage.
 
     ``K[0, 1]`` holds the acceleration at the start, ``trig[0:2]`` the sine and cosine of
@@ -249,27 +253,27 @@ def block_step(FAST, x0, v0, fr, tab, side, par, K, jac, trig):
     c0 = trig[1]
     d1 = tab[1, 0] * v0
     v1 = fma(tab[1, 0], k0, v0)
-    k1, j1 = block_stage(FAST, x0, d1, v1, fr[1], side, par, s0, c0)
+    k1, j1 = block_stage(FAST, SLOPE, x0, d1, v1, fr[1], side, par, s0, c0)
     d2 = fma(tab[2, 1], v1, tab[2, 0] * v0)
     v2 = fma(tab[2, 1], k1, fma(tab[2, 0], k0, v0))
-    k2, j2 = block_stage(FAST, x0, d2, v2, fr[2], side, par, s0, c0)
+    k2, j2 = block_stage(FAST, SLOPE, x0, d2, v2, fr[2], side, par, s0, c0)
     d3 = fma(tab[3, 2], v2, fma(tab[3, 1], v1, tab[3, 0] * v0))
     v3 = fma(tab[3, 2], k2, fma(tab[3, 1], k1, fma(tab[3, 0], k0, v0)))
-    k3, j3 = block_stage(FAST, x0, d3, v3, fr[3], side, par, s0, c0)
+    k3, j3 = block_stage(FAST, SLOPE, x0, d3, v3, fr[3], side, par, s0, c0)
     d4 = fma(tab[4, 3], v3, fma(tab[4, 2], v2, fma(tab[4, 1], v1, tab[4, 0] * v0)))
     v4 = fma(tab[4, 3], k3, fma(tab[4, 2], k2, fma(tab[4, 1], k1, fma(tab[4, 0], k0, v0))))
-    k4, j4 = block_stage(FAST, x0, d4, v4, fr[4], side, par, s0, c0)
+    k4, j4 = block_stage(FAST, SLOPE, x0, d4, v4, fr[4], side, par, s0, c0)
     d5 = fma(tab[5, 4], v4, fma(tab[5, 3], v3, fma(tab[5, 2], v2,
              fma(tab[5, 1], v1, tab[5, 0] * v0))))
     v5 = fma(tab[5, 4], k4, fma(tab[5, 3], k3, fma(tab[5, 2], k2,
              fma(tab[5, 1], k1, fma(tab[5, 0], k0, v0)))))
-    k5, j5 = block_stage(FAST, x0, d5, v5, fr[5], side, par, s0, c0)
+    k5, j5 = block_stage(FAST, SLOPE, x0, d5, v5, fr[5], side, par, s0, c0)
     # B[1] = 0
     d6 = fma(tab[T_HB, 5], v5, fma(tab[T_HB, 4], v4, fma(tab[T_HB, 3], v3,
              fma(tab[T_HB, 2], v2, tab[T_HB, 0] * v0))))
     v6 = fma(tab[T_HB, 5], k5, fma(tab[T_HB, 4], k4, fma(tab[T_HB, 3], k3,
              fma(tab[T_HB, 2], k2, fma(tab[T_HB, 0], k0, v0)))))
-    k6, j6 = block_stage(FAST, x0, d6, v6, fr[N_STAGES], side, par, s0, c0)
+    k6, j6 = block_stage(FAST, SLOPE, x0, d6, v6, fr[N_STAGES], side, par, s0, c0)
     x6 = x0 + d6
     # the next step's base angle, afresh (off the chain: its first use is the next step's rotate)
     trig[2], trig[3] = sincos_poly(x6) if FAST else sincos(x6)
@@ -287,12 +291,13 @@ def block_step(FAST, x0, v0, fr, tab, side, par, K, jac, trig):
     K[4, 1] = k4
     K[5, 1] = k5
     K[6, 1] = k6
-    jac[1] = j1
-    jac[2] = j2
-    jac[3] = j3
-    jac[4] = j4
-    jac[5] = j5
-    jac[6] = j6
+    if SLOPE:
+        jac[1] = j1
+        jac[2] = j2
+        jac[3] = j3
+        jac[4] = j4
+        jac[5] = j5
+        jac[6] = j6
     return x6, v6, far
 
 
@@ -343,18 +348,20 @@ def forcing_at(t, par):
 
 
 @jit(nrt=False, inline=True)
-def rk_step(EMBED4, TANGENT, sp, cp, y, K, side, par, ytmp, ynew, tab, fr, jac, trig):
+def rk_step(EMBED4, TANGENT, tabulated, sp, cp, y, K, side, par, ytmp, ynew, tab, fr, jac,
+            trig):
     """One Dormand–Prince step from y with the table ``tab`` of its length; ``K[0]`` (and
     ``jac[0]``) must hold the field at the start.
 
-    ``sp, cp`` are sin and cos of the forcing phase ``omega t + phi`` at the step's start: the
-    closed-form forcing at each stage is that pair rotated by the table's phase advances, not a
-    fresh ``sin`` (both are ignored with the embedding).
+    ``fr`` receives the forcing acceleration at each stage. With ``tabulated`` (closed form, a
+    whole grid step) it already holds it. Otherwise ``sp, cp`` are sin and cos of the forcing
+    phase ``omega t + phi`` at the step's start, and the closed-form forcing at each stage is
+    that pair rotated by the table's phase advances (both are ignored with the embedding).
     """
     NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
     if EMBED4:
         osc_step(y, K, ytmp, ynew, tab, par, fr)
-    else:
+    elif not tabulated:
         aw2 = par[P_AW2]
         for i in range(N_STAGES + 1):
             fr[i] = aw2 * fma(sp, tab[T_ROTC, i], cp * tab[T_ROTS, i])
@@ -366,9 +373,9 @@ def rk_step(EMBED4, TANGENT, sp, cp, y, K, side, par, ytmp, ynew, tab, fr, jac, 
         ynew[0] = y[0]
         ynew[1] = y[1]
     else:
-        x, v, far = block_step(True, y[0], y[1], fr, tab, side, par, K, jac, trig)
+        x, v, far = block_step(True, TANGENT, y[0], y[1], fr, tab, side, par, K, jac, trig)
         if far > 1.0:  # rare: a stage too far from the start, or beyond the sines' polynomial
-            x, v, far = block_step(False, y[0], y[1], fr, tab, side, par, K, jac, trig)
+            x, v, far = block_step(False, TANGENT, y[0], y[1], fr, tab, side, par, K, jac, trig)
         ynew[0] = x
         ynew[1] = v
     if TANGENT:
@@ -498,7 +505,7 @@ def locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, ytmp, yev, cou
     NY = yev.shape[0]
     for it in range(NEWTON_ITERS):
         step_table(par[P_OMEGA], tau, tab)
-        rk_step(EMBED4, TANGENT, sp, cp, y, K, side, par, ytmp, yev, tab, fr, jac, trig)
+        rk_step(EMBED4, TANGENT, False, sp, cp, y, K, side, par, ytmp, yev, tab, fr, jac, trig)
         counts[O_RHS] += N_STAGES
         g, dg = event_value(kind, yev, side, par, t + tau)
         if g == 0.0:
@@ -647,17 +654,18 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par_in, ipar, strobe, half, impacts
                  lam_run, per_imp, iout, fout, np.zeros((N_STAGES + 1, NY)), work[0], work[1],
                  work[2], work[3], np.zeros(4), np.zeros((N_TAB, N_STAGES + 1)),
                  np.zeros((N_TAB, N_STAGES + 1)), np.zeros(N_STAGES + 1),
-                 np.zeros(N_STAGES + 1), np.zeros(4), np.zeros((2, ipar[I_N])))
+                 np.zeros(N_STAGES + 1), np.zeros(4), np.zeros((ipar[I_N], N_STAGES + 1)))
 
 
 @jit(nrt=False)
 def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, traj, lam_run,
-          per_imp, iout, fout, K, y, ytmp, ynew, yev, lam, tab_h, tab, fr, jac, trig, ptab):
+          per_imp, iout, fout, K, y, ytmp, ynew, yev, lam, tab_h, tab, fr, jac, trig, ftab):
     """The integration itself: ``_run``'s arguments, the parameters with the derived constants
     (``N_PARW``), and work arrays: stages ``K``; states ``y, ytmp, ynew, yev``; ``lam`` (sums of
     the logs of the stretches, overall and in the window); step tables for the grid step and
     for substeps; the stage forcing ``fr`` and slopes ``jac``; ``trig``, the sine and cosine of
-    theta at the start and the end of a step; the forcing phase ``ptab`` on the grid."""
+    theta at the start and the end of a step; ``ftab``, the closed-form forcing acceleration at
+    the stages of each grid step of a period."""
     NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
     NY = NS + (4 if TANGENT else 0)  # plus the tangent matrix, column-major
     n_per = ipar[I_N]
@@ -673,11 +681,13 @@ def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, 
     lam_sum = lam[0:2]
     lam_win = lam[2:4]
     step_table(par[P_OMEGA], h, tab_h)
-    # sin and cos of the forcing phase at the grid points of a period (the grid repeats)
-    for j in range(n_per):
-        psi = par[P_PHI] + 2.0 * math.pi * j / n_per
-        ptab[0, j] = math.sin(psi)
-        ptab[1, j] = math.cos(psi)
+    # The forcing acceleration at the stages of the grid steps of a period (the grid repeats):
+    # phase phi + 2 pi (j + c_i) / N at stage i of step j, sines made once per run.
+    if not EMBED4:
+        for j in range(n_per):
+            for i in range(N_STAGES + 1):
+                c = C[i] if i < N_STAGES else 1.0
+                ftab[j, i] = par[P_AW2] * math.sin(par[P_PHI] + 2.0 * math.pi * (j + c) / n_per)
     for m in range(NS):
         y[m] = y0[m]
     if TANGENT:
@@ -757,13 +767,13 @@ def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, 
             if fresh:
                 # a whole grid step: the forcing phase there is phi + 2 pi j / N exactly
                 hh = h
-                rk_step(EMBED4, TANGENT, ptab[0, j_per], ptab[1, j_per], y, K, side, par,
-                        ytmp, ynew, tab_h, fr, jac, trig)
+                rk_step(EMBED4, TANGENT, not EMBED4, 0.0, 0.0, y, K, side, par, ytmp, ynew,
+                        tab_h, fr if EMBED4 else ftab[j_per], jac, trig)
             else:
                 hh = t_grid - t
                 psi = par[P_OMEGA] * t + par[P_PHI]
                 step_table(par[P_OMEGA], hh, tab)
-                rk_step(EMBED4, TANGENT, math.sin(psi), math.cos(psi), y, K, side, par,
+                rk_step(EMBED4, TANGENT, False, math.sin(psi), math.cos(psi), y, K, side, par,
                         ytmp, ynew, tab, fr, jac, trig)
             iout[O_RHS] += N_STAGES
             iout[O_SUBSTEPS] += 1
