@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import functools
 import math
+from fractions import Fraction
 
 import numpy as np
 
@@ -171,20 +172,49 @@ def settled_period(strobe, half, per_imp, k, reps, pmax, tol):
 
 # ---- layout of the per-step-length table ``tab`` (:func:`step_table`) --------------------------
 # rows 0..5: h A[i, :]; row 6: h B; rows 7 and 8: cos and sin of the forcing's phase advance
-# omega c_i h to stage i (c_6 = 1, the step's end).
-T_HB, T_ROTC, T_ROTS = 6, 7, 8
-N_TAB = 9
+# omega c_i h to stage i (c_6 = 1, the step's end); rows 9..14: h^2 (A A)[i, :]; row 15:
+# h^2 (B A); row 16: h c_i.
+T_HB, T_ROTC, T_ROTS, T_HAA, T_HBA, T_HC = 6, 7, 8, 9, 15, 16
+N_TAB = 17
+
+
+def _nystrom():
+    """``A A`` and ``B A``, exactly (in rationals) and then rounded: a stage's angle straight
+    from the accelerations is ``x_i = x0 + h c_i v0 + h^2 (A A k)_i``, and the step's end
+    ``x0 + h v0 + h^2 (B A k)``."""
+    a = [[Fraction(0)] * N_STAGES for _ in range(N_STAGES)]
+    rows = [(), ((1, 5),), ((3, 40), (9, 40)), ((44, 45), (-56, 15), (32, 9)),
+            ((19372, 6561), (-25360, 2187), (64448, 6561), (-212, 729)),
+            ((9017, 3168), (-355, 33), (46732, 5247), (49, 176), (-5103, 18656))]
+    for i, row in enumerate(rows):
+        for j, (n, d) in enumerate(row):
+            a[i][j] = Fraction(n, d)
+    b = [Fraction(35, 384), Fraction(0), Fraction(500, 1113), Fraction(125, 192),
+         Fraction(-2187, 6784), Fraction(11, 84)]
+    aa = [[sum(a[i][m] * a[m][j] for m in range(N_STAGES)) for j in range(N_STAGES)]
+          for i in range(N_STAGES)]
+    ba = [sum(b[m] * a[m][j] for m in range(N_STAGES)) for j in range(N_STAGES)]
+    assert np.array_equal(np.array(a, dtype=float)[:, :N_STAGES - 1], A)
+    return np.array(aa, dtype=float), np.array(ba, dtype=float)
+
+
+_AA, _BA = _nystrom()
 
 
 @jit(nrt=False)
 def step_table(omega, h, tab):
     """Fill ``tab`` for a step of length ``h`` (layout above)."""
+    h2 = h * h
     for i in range(N_STAGES):
         for j in range(N_STAGES - 1):
             tab[i, j] = h * A[i, j]
+        for j in range(N_STAGES):
+            tab[T_HAA + i, j] = h2 * _AA[i, j]
         tab[T_HB, i] = h * B[i]
+        tab[T_HBA, i] = h2 * _BA[i]
     for i in range(N_STAGES + 1):
         c = C[i] if i < N_STAGES else 1.0
+        tab[T_HC, i] = h * c
         sn, cs = sincos(omega * c * h)
         tab[T_ROTC, i] = cs
         tab[T_ROTS, i] = sn
@@ -251,26 +281,29 @@ def block_step(FAST, SLOPE, x0, v0, fr, tab, side, par, K, jac, trig):
     k0 = K[0, 1]
     s0 = trig[0]
     c0 = trig[1]
-    d1 = tab[1, 0] * v0
+    # offsets of the stages' angles straight from the accelerations (Nystrom's form of the same
+    # tableau), so that each waits for the acceleration two stages back, not for a velocity
+    d1 = tab[T_HC, 1] * v0
     v1 = fma(tab[1, 0], k0, v0)
     k1, j1 = block_stage(FAST, SLOPE, x0, d1, v1, fr[1], side, par, s0, c0)
-    d2 = fma(tab[2, 1], v1, tab[2, 0] * v0)
+    d2 = fma(tab[T_HAA + 2, 0], k0, tab[T_HC, 2] * v0)
     v2 = fma(tab[2, 1], k1, fma(tab[2, 0], k0, v0))
     k2, j2 = block_stage(FAST, SLOPE, x0, d2, v2, fr[2], side, par, s0, c0)
-    d3 = fma(tab[3, 2], v2, fma(tab[3, 1], v1, tab[3, 0] * v0))
+    d3 = fma(tab[T_HAA + 3, 1], k1, fma(tab[T_HAA + 3, 0], k0, tab[T_HC, 3] * v0))
     v3 = fma(tab[3, 2], k2, fma(tab[3, 1], k1, fma(tab[3, 0], k0, v0)))
     k3, j3 = block_stage(FAST, SLOPE, x0, d3, v3, fr[3], side, par, s0, c0)
-    d4 = fma(tab[4, 3], v3, fma(tab[4, 2], v2, fma(tab[4, 1], v1, tab[4, 0] * v0)))
+    d4 = fma(tab[T_HAA + 4, 2], k2, fma(tab[T_HAA + 4, 1], k1,
+             fma(tab[T_HAA + 4, 0], k0, tab[T_HC, 4] * v0)))
     v4 = fma(tab[4, 3], k3, fma(tab[4, 2], k2, fma(tab[4, 1], k1, fma(tab[4, 0], k0, v0))))
     k4, j4 = block_stage(FAST, SLOPE, x0, d4, v4, fr[4], side, par, s0, c0)
-    d5 = fma(tab[5, 4], v4, fma(tab[5, 3], v3, fma(tab[5, 2], v2,
-             fma(tab[5, 1], v1, tab[5, 0] * v0))))
+    d5 = fma(tab[T_HAA + 5, 3], k3, fma(tab[T_HAA + 5, 2], k2, fma(tab[T_HAA + 5, 1], k1,
+             fma(tab[T_HAA + 5, 0], k0, tab[T_HC, 5] * v0))))
     v5 = fma(tab[5, 4], k4, fma(tab[5, 3], k3, fma(tab[5, 2], k2,
              fma(tab[5, 1], k1, fma(tab[5, 0], k0, v0)))))
     k5, j5 = block_stage(FAST, SLOPE, x0, d5, v5, fr[5], side, par, s0, c0)
-    # B[1] = 0
-    d6 = fma(tab[T_HB, 5], v5, fma(tab[T_HB, 4], v4, fma(tab[T_HB, 3], v3,
-             fma(tab[T_HB, 2], v2, tab[T_HB, 0] * v0))))
+    # B[1] = 0, and (B A)[1] = (B A)[5] = 0
+    d6 = fma(tab[T_HBA, 4], k4, fma(tab[T_HBA, 3], k3, fma(tab[T_HBA, 2], k2,
+             fma(tab[T_HBA, 0], k0, tab[T_HC, 6] * v0))))
     v6 = fma(tab[T_HB, 5], k5, fma(tab[T_HB, 4], k4, fma(tab[T_HB, 3], k3,
              fma(tab[T_HB, 2], k2, fma(tab[T_HB, 0], k0, v0)))))
     k6, j6 = block_stage(FAST, SLOPE, x0, d6, v6, fr[N_STAGES], side, par, s0, c0)
