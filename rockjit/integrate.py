@@ -8,11 +8,20 @@ One period of the forcing is cut into ``N`` equal steps ``h = T/N``, so the stro
 2. detect an event: a sign change of ``theta`` (also the grazing case in which ``theta`` dips
    through 0 and comes back within the step, and the case that starts on 0 just after an impact),
    ``|theta|`` reaching the overturning threshold, or, at rest, ``|f|`` reaching ``cot(thc)``;
-3. refine the event time: bisection on the step's continuous extension brackets it, and a
-   safeguarded Newton iteration on re-taken steps from the step's start (each one a genuine
-   5th-order step of length ``tau``) polishes it to rounding level;
+3. refine the event time: a safeguarded Newton iteration on the step's continuous extension
+   estimates it, a genuine 5th-order step of that length from the step's start gives the state
+   there, and one more Newton correction (below 1e-8 h) carries that state along the field;
 4. jump (impact map, saltation of the tangent vectors), refresh the first stage, record the
    event, and finish the step from the event time to the grid point (again with detection).
+
+Where the time goes. A step is six stages in a chain, each waiting for the one before, so its
+cost is the chain's latency more than its arithmetic (benchmarks/README.md, "Throughput"). The
+block's part of a step is written out stage by stage (:func:`block_step`) so that its values
+stay in registers; a stage's angle is kept as an offset from the step's start angle, computed
+straight from the accelerations (Nyström's form of the tableau), and enters only a short
+polynomial (:func:`rockjit.model.accel_near`); the forcing at the stages of a grid step is
+tabulated once per run. The step's pieces are inlined into :func:`_loop`, which is compiled
+without numba's reference counting.
 
 The state lives in one array ``y``: ``theta, theta'``, then ``r, s`` when the oscillator
 embedding is integrated, then the 2×2 tangent matrix (column-major) when Lyapunov exponents are
@@ -203,12 +212,13 @@ _AA, _BA = _nystrom()
 
 @jit(nrt=False)
 def step_table(omega, h, tab):
-    """Fill ``tab`` for a step of length ``h`` (layout above)."""
+    """Fill ``tab`` for a step of length ``h`` (layout above). Only the lower triangles are
+    written (an event costs two of these): the entries above are zero from allocation on."""
     h2 = h * h
     for i in range(N_STAGES):
-        for j in range(N_STAGES - 1):
+        for j in range(i):
             tab[i, j] = h * A[i, j]
-        for j in range(N_STAGES):
+        for j in range(i - 1):
             tab[T_HAA + i, j] = h2 * _AA[i, j]
         tab[T_HB, i] = h * B[i]
         tab[T_HBA, i] = h2 * _BA[i]
