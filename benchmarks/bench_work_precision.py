@@ -46,7 +46,7 @@ import _common as C  # noqa: E402
 import rockjit  # noqa: E402
 
 METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853")
-NS = (16, 32, 64, 128, 256, 512, 1024)
+NS = (16, 32, 64, 128, 160, 256, 512, 1024)
 RTOLS = tuple(10.0 ** -k for k in range(3, 13))
 N_REF = 8192
 #: The independent second reference of each scene: DOP853 where it is cheap and exact enough;

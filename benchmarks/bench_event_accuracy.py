@@ -1,0 +1,138 @@
+"""Issue 2: impact-time accuracy against N, the measurement behind the default N.
+
+The issue asks single runs at the default N for impact times within 1e-10 of a scipy DOP853
+(rtol 1e-12) reference. Measured here, over 20 periods from the study's z0, on the orbits of the
+event-accuracy test (tests/test_reference.py) and two more of the study's (hb=2 Mao):
+
+* the largest impact-time difference of rockjit at N = 64 ... 256 from a converged solution
+  (rockjit at N = 2048), and from DOP853 at rtol 1e-12 with atol 1e-12 and 1e-14;
+* the converged solution's own difference from each DOP853 run (how good that reference is).
+
+A run whose impact count differs from the converged one's is marked, never compared.
+
+    python benchmarks/bench_event_accuracy.py           # full (~1 min)
+    python benchmarks/bench_event_accuracy.py --quick   # smoke (fewer N, 5 periods)
+
+Writes event_accuracy.{md,csv,json,png} to benchmarks/results/ (benchmarks/results/quick/ with
+--quick, or --out DIR).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import _common as C  # noqa: E402
+
+import rockjit  # noqa: E402
+
+ORBITS = {
+    "reference (hb=1 Housner a=0.6)": dict(hb=1.0, alpha=0.6, omega=1.3, law="housner"),
+    "asymmetric (hb=1 Housner a=0.8)": dict(hb=1.0, alpha=0.8, omega=1.3, law="housner"),
+    "hb=1 Mao a=0.3": dict(hb=1.0, alpha=0.3, omega=1.3, law="mao"),
+    "hb=2 Housner a=0.2": dict(hb=2.0, alpha=0.2, omega=1.6, law="housner"),
+    "hb=2 Mao a=0.2": dict(hb=2.0, alpha=0.2, omega=1.6, law="mao"),
+    "hb=2 Mao a=0.3": dict(hb=2.0, alpha=0.3, omega=1.6, law="mao"),
+}
+IN_TEST = 4  # the first four are tests/test_reference.py's EVENT_RUNS
+NS = (64, 96, 128, 144, 160, 192, 256)
+N_CONV = 2048
+TOL = 1e-10
+
+
+def impact_diff(a, b):
+    if a.n_impacts != b.n_impacts:
+        return None
+    return float(np.max(np.abs(a.impacts[:, 0] - b.impacts[:, 0])))
+
+
+def main(argv=None):
+    args = C.parser(__doc__.splitlines()[0]).parse_args(argv)
+    out = C.out_dir(args)
+    quick = args.quick
+    periods = 5 if quick else 20
+    ns = (64, 160) if quick else NS
+    n_def = rockjit.DEFAULT_N
+    ns = tuple(sorted(set(ns) | {n_def}))
+    env = C.environment()
+    print(C.env_line(env))
+
+    rows, records = [], []
+    err = {}
+    for name, kw in ORBITS.items():
+        base = dict(kw, z0=rockjit.Z0_STUDY, periods=periods)
+        conv = rockjit.simulate(**base, n_steps=N_CONV)
+        dops = {atol: rockjit.simulate(**base, method="scipy:DOP853", rtol=1e-12, atol=atol)
+                for atol in (1e-12, 1e-14)}
+        rec = dict(orbit=name, in_test=name in list(ORBITS)[:IN_TEST], run=base,
+                   impacts=conv.n_impacts,
+                   dop853_vs_converged={str(a): impact_diff(d, conv) for a, d in dops.items()},
+                   by_n={})
+        for n in ns:
+            r = rockjit.simulate(**base, n_steps=n)
+            rec["by_n"][n] = dict(converged=impact_diff(r, conv),
+                                  **{f"dop853_atol_{a:g}": impact_diff(r, d)
+                                     for a, d in dops.items()})
+        err[name] = [rec["by_n"][n]["converged"] for n in ns]
+        records.append(rec)
+        mark = "" if rec["in_test"] else " (not in the test)"
+        rows.append([name + mark, conv.n_impacts,
+                     rec["dop853_vs_converged"]["1e-12"], rec["dop853_vs_converged"]["1e-14"]]
+                    + [C.fmt(e) + (" ✗" if e is not None and e > TOL else "")
+                       if e is not None else "count differs" for e in err[name]])
+        print(name, err[name])
+
+    worst = {n: max(e for name in list(ORBITS)[:IN_TEST]
+                    for e in [err[name][ns.index(n)]] if e is not None) for n in ns}
+    smallest = next((n for n in ns if worst[n] <= TOL), None)
+    headers = (["orbit", "impacts", "DOP853 atol 1e-12 vs converged",
+                "DOP853 atol 1e-14 vs converged"]
+               + [f"N={n}" + (" (default)" if n == n_def else "") for n in ns])
+    md = [f"#### Impact times against N: {periods} periods from the study's z0\n",
+          f"Largest impact-time difference from the converged solution (rockjit at N = "
+          f"{N_CONV}); ✗ above {TOL:g}. The DOP853 columns (rtol 1e-12) show how far that "
+          f"reference itself is from the converged one.\n\n",
+          C.md_table(headers, rows),
+          f"\nOn the test's {IN_TEST} orbits the largest difference is "
+          + ", ".join(f"{C.fmt(worst[n])} at N={n}" for n in ns)
+          + f": the smallest N within {TOL:g} is **{smallest}** (default N = {n_def}).\n",
+          f"\n{C.env_line(env)}\n"]
+    md_text = "".join(md)
+    C.write_text(out / "event_accuracy.md", md_text)
+    C.update_readme(args, "event_accuracy", md_text)
+    C.write_csv(out / "event_accuracy.csv", ["orbit", "n_steps", "vs_converged",
+                                             "vs_dop853_atol_1e-12", "vs_dop853_atol_1e-14"],
+                [[rec["orbit"], n, v["converged"], v["dop853_atol_1e-12"],
+                  v["dop853_atol_1e-14"]] for rec in records for n, v in rec["by_n"].items()])
+    C.write_json(out / "event_accuracy.json", dict(periods=periods, n_converged=N_CONV,
+                                                   tolerance=TOL, default_n=n_def,
+                                                   smallest_n_within=smallest, worst=worst,
+                                                   orbits=records, environment=env))
+    C.check_unchanged(env)
+
+    plt = C.pyplot()
+    fig, ax = plt.subplots(figsize=(6.4, 4.4), layout="constrained")
+    for i, (name, e) in enumerate(err.items()):
+        x = [n for n, v in zip(ns, e) if v is not None]
+        y = [max(v, 1e-16) for v in e if v is not None]
+        ax.loglog(x, y, marker="o", ls="-" if i < IN_TEST else ":", label=name)
+    ax.axhline(TOL, color="0.3", ls="--", lw=0.8)
+    ax.axvline(n_def, color="0.5", ls=":", lw=0.8)
+    ax.set_xticks(ns, [str(n) for n in ns])
+    ax.set_xlabel("steps per forcing period N")
+    ax.set_ylabel(f"largest impact-time error over {periods} periods")
+    ax.set_title(f"Impact times against N (vs rockjit N={N_CONV}); dashed: {TOL:g}; "
+                 f"dotted orbits: not in the test", fontsize=8)
+    ax.legend(fontsize=7)
+    ax.grid(True, which="both", alpha=0.3)
+    C.save_figure(fig, out / "event_accuracy.png", dpi=130)
+    plt.close(fig)
+    print(md_text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
