@@ -281,7 +281,8 @@ def main(argv=None):
     an.basin(**BASIN, grid=2, periods=2, lyapunov=True)
 
     # ---- ns per step ---------------------------------------------------------------------
-    ns_list = (64, 256) if quick else (64, 128, 256, 1024)
+    ns_list = tuple(sorted({64, 256, rockjit.DEFAULT_N} if quick
+                           else {64, 128, 256, 1024, rockjit.DEFAULT_N}))
     results = {}
 
     def keep(n):
