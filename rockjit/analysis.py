@@ -44,7 +44,7 @@ from . import integrate as ig
 from ._jit import jit
 from .model import Block
 from .simulate import Z0_STUDY, _int, check_step, steps_per_period, _real, check_settings, forcing_phase
-from .simulate import initial_side, pack
+from .simulate import pack
 
 __all__ = ["BEHAVIOURS", "GRID_N", "BasinResult", "PlaneResult", "SweepResult", "basin",
            "classify_result", "plane",

@@ -565,7 +565,6 @@ def _paper_run(args, kw):
     walls = {}
     results = {}
     n_parts = 6
-    from .analysis import GRID_N
     from .simulate import DEFAULT_N
     n_single = args.n_steps  # None: the library's defaults (DEFAULT_N, GRID_N)
     n_grid = args.n_steps
