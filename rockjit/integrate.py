@@ -364,25 +364,55 @@ def osc_step(y, K, ytmp, ynew, tab, par, fr):
     ynew[3] = ytmp[3]
 
 
-@jit(nrt=False)
-def tangent_step(NS, y, K, ytmp, ynew, tab, par, jac):
+@jit(nrt=False, inline=True)
+def tangent_column(p0, q0, tab, jac, jb):
+    """One column ``(p, q)`` of the tangent matrix over one step, ``p' = q``,
+    ``q' = jac_i p + jb q`` at stage ``i``, written out like :func:`block_step` (its stages are
+    independent of the state's chain, so this is throughput, not latency). Returns the column at
+    the step's end and its derivative there."""
+    k0 = fma(jac[0], p0, jb * q0)
+    p1 = fma(tab[1, 0], q0, p0)
+    q1 = fma(tab[1, 0], k0, q0)
+    k1 = fma(jac[1], p1, jb * q1)
+    p2 = fma(tab[2, 1], q1, fma(tab[2, 0], q0, p0))
+    q2 = fma(tab[2, 1], k1, fma(tab[2, 0], k0, q0))
+    k2 = fma(jac[2], p2, jb * q2)
+    p3 = fma(tab[3, 2], q2, fma(tab[3, 1], q1, fma(tab[3, 0], q0, p0)))
+    q3 = fma(tab[3, 2], k2, fma(tab[3, 1], k1, fma(tab[3, 0], k0, q0)))
+    k3 = fma(jac[3], p3, jb * q3)
+    p4 = fma(tab[4, 3], q3, fma(tab[4, 2], q2, fma(tab[4, 1], q1, fma(tab[4, 0], q0, p0))))
+    q4 = fma(tab[4, 3], k3, fma(tab[4, 2], k2, fma(tab[4, 1], k1, fma(tab[4, 0], k0, q0))))
+    k4 = fma(jac[4], p4, jb * q4)
+    p5 = fma(tab[5, 4], q4, fma(tab[5, 3], q3, fma(tab[5, 2], q2,
+             fma(tab[5, 1], q1, fma(tab[5, 0], q0, p0)))))
+    q5 = fma(tab[5, 4], k4, fma(tab[5, 3], k3, fma(tab[5, 2], k2,
+             fma(tab[5, 1], k1, fma(tab[5, 0], k0, q0)))))
+    k5 = fma(jac[5], p5, jb * q5)
+    # B[1] = 0
+    p6 = fma(tab[T_HB, 5], q5, fma(tab[T_HB, 4], q4, fma(tab[T_HB, 3], q3,
+             fma(tab[T_HB, 2], q2, fma(tab[T_HB, 0], q0, p0)))))
+    q6 = fma(tab[T_HB, 5], k5, fma(tab[T_HB, 4], k4, fma(tab[T_HB, 3], k3,
+             fma(tab[T_HB, 2], k2, fma(tab[T_HB, 0], k0, q0)))))
+    return p6, q6, fma(jac[N_STAGES], p6, jb * q6), k0
+
+
+@jit(nrt=False, inline=True)
+def tangent_step(NS, y, K, ynew, tab, par, jac):
     """The 2×2 tangent matrix (columns at ``y[NS:NS+4]``) over one step: ``V' = J V`` with
     ``J = [[0, 1], [jac, -3/4 xi]]`` at each stage (:func:`block_stage` left the slopes in
-    ``jac``). The tangent never feeds back into the state."""
+    ``jac``). The tangent never feeds back into the state. ``K[0]`` and ``K[-1]`` receive the
+    tangent's derivative at the step's ends (the end's is used to carry an event's state the
+    last Newton correction, :func:`locate`)."""
     jb = -0.75 * par[P_XI]
-    for i in range(N_STAGES + 1):
-        row = i if i < N_STAGES else T_HB
-        for m in range(NS, NS + 4):
-            acc = y[m]
-            for j in range(i):
-                acc = fma(tab[row, j], K[j, m], acc)
-            ytmp[m] = acc
-        for c in range(2):
-            a = NS + 2 * c
-            K[i, a] = ytmp[a + 1]
-            K[i, a + 1] = fma(jac[i], ytmp[a], jb * ytmp[a + 1])
-    for m in range(NS, NS + 4):
-        ynew[m] = ytmp[m]
+    for c in range(2):
+        a = NS + 2 * c
+        p, q, k6, k0 = tangent_column(y[a], y[a + 1], tab, jac, jb)
+        ynew[a] = p
+        ynew[a + 1] = q
+        K[0, a] = y[a + 1]
+        K[0, a + 1] = k0
+        K[N_STAGES, a] = q
+        K[N_STAGES, a + 1] = k6
 
 
 @jit(nrt=False)
@@ -422,7 +452,7 @@ def rk_step(EMBED4, TANGENT, tabulated, sp, cp, y, K, side, par, ytmp, ynew, tab
         ynew[0] = x
         ynew[1] = v
     if TANGENT:
-        tangent_step(NS, y, K, ytmp, ynew, tab, par, jac)
+        tangent_step(NS, y, K, ynew, tab, par, jac)
 
 
 @jit(nrt=False)
