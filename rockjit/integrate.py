@@ -488,12 +488,8 @@ def event_value(kind, y, side, par, t):
 @jit(nrt=False)
 def dense_event(kind, y0m, h, q0, q1, q2, q3, side, par, x):
     """Event function evaluated on the continuous extension at x = tau/h."""
-    v = y0m + h * x * (q0 + x * (q1 + x * (q2 + x * q3)))
-    if kind == EV_IMPACT:
-        return side * v
-    if kind == EV_OVERTURN:
-        return par[P_THOVER] - side * v
-    return par[P_COT] - par[P_AW2] * abs(v)
+    g, _ = dense_event_slope(kind, y0m, h, q0, q1, q2, q3, side, par, x)
+    return g
 
 
 @jit(nrt=False)
