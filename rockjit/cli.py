@@ -246,6 +246,21 @@ def _trajectory_run(args, kw):
 # grids: where chunks run (in-process or Dask) and where finished chunks wait (resumable)
 # ---------------------------------------------------------------------------------------------
 
+def _z0_and_run_checks(args, block):
+    """The grid commands' initial state ``(theta0, theta0', r0, s0)`` (the study's z0 where not
+    given) and their common checks: threads, output path, scheduler."""
+    from .simulate import Z0_STUDY, _real
+    theta0 = _real("theta0", Z0_STUDY[0] if args.theta0 is None else args.theta0)
+    dtheta0 = _real("dtheta0", Z0_STUDY[1] if args.dtheta0 is None else args.dtheta0)
+    if abs(theta0) >= block.theta_over:
+        raise UsageError(f"theta0 must satisfy |theta0| < pi/2 (got {theta0})")
+    _, r0, s0 = _forcing(args, Z0_STUDY[2:])
+    _check_threads(args.threads)
+    _check_out(args.out)
+    _dist_validate(args)
+    return theta0, dtheta0, r0, s0
+
+
 def _dist_validate(args):
     if getattr(args, "scheduler", None):
         try:
@@ -294,20 +309,11 @@ class _Grids:
 
 def _sweep_validate(args):
     from .analysis import alpha_grid
-    from .simulate import Z0_STUDY, _real
     alphas = alpha_grid(args.alpha_range, args.alpha_step)
     block = _block(args.hb, float(alphas[0]), args.omega, args.law, args.e)
     _block(args.hb, float(alphas[-1]), args.omega, args.law, args.e)
     _settings(args.periods, args.n_steps)
-    theta0 = _real("theta0", Z0_STUDY[0] if args.theta0 is None else args.theta0)
-    dtheta0 = _real("dtheta0", Z0_STUDY[1] if args.dtheta0 is None else args.dtheta0)
-    if abs(theta0) >= block.theta_over:
-        raise UsageError(f"theta0 must satisfy |theta0| < pi/2 (got {theta0})")
-    _, r0, s0 = _forcing(args, Z0_STUDY[2:])
-    _check_threads(args.threads)
-    _check_out(args.out)
-    _dist_validate(args)
-    return dict(alphas=alphas, law=block.law, e=block.e, z0=(theta0, dtheta0, r0, s0))
+    return dict(alphas=alphas, law=block.law, e=block.e, z0=_z0_and_run_checks(args, block))
 
 
 def _sweep_arrays(sw):
@@ -434,7 +440,6 @@ def _basin_run(args, kw):
 # ---------------------------------------------------------------------------------------------
 
 def _plane_validate(args):
-    from .simulate import Z0_STUDY, _real
     lo, hi = _range("alpha-range", args.alpha_range)
     if lo < 0:
         raise UsageError(f"alpha-range must satisfy 0 <= start <= end (got {lo}, {hi})")
@@ -445,15 +450,7 @@ def _plane_validate(args):
     for g in args.grid:
         _check_positive_int("grid", g)
     _settings(args.periods, args.n_steps)
-    theta0 = _real("theta0", Z0_STUDY[0] if args.theta0 is None else args.theta0)
-    dtheta0 = _real("dtheta0", Z0_STUDY[1] if args.dtheta0 is None else args.dtheta0)
-    if abs(theta0) >= block.theta_over:
-        raise UsageError(f"theta0 must satisfy |theta0| < pi/2 (got {theta0})")
-    _, r0, s0 = _forcing(args, Z0_STUDY[2:])
-    _check_threads(args.threads)
-    _check_out(args.out)
-    _dist_validate(args)
-    return dict(law=block.law, e=block.e, z0=(theta0, dtheta0, r0, s0))
+    return dict(law=block.law, e=block.e, z0=_z0_and_run_checks(args, block))
 
 
 def _plane_run(args, kw):
