@@ -41,11 +41,14 @@ from __future__ import annotations
 
 import functools
 import math
+from collections import namedtuple
 from fractions import Fraction
 
 import numpy as np
 
 from ._jit import fma, jit
+from .classify import orbit_scale, repeats
+from .result import STATUSES
 from .model import (NEAR_RANGE, SINCOS_RANGE, accel_near, accel_pq, corner, forcing_closed, jump,
                     near_poly, oscillator, rotate, saltation, sincos, sincos_poly, slope_pq,
                     uplift_time)
@@ -84,10 +87,25 @@ MAX_IMPACTS = 3   # the impact bound was reached
 NONFINITE = 4     # a non-finite number appeared (never expected; a guard, not a result)
 SETTLED = 5       # stopped early: the stroboscopic orbit settled (see analysis)
 
-STATUS_NAMES = {
-    DONE: "done", OVERTURNED: "overturned", REST: "rest", MAX_IMPACTS: "max_impacts",
-    NONFINITE: "nonfinite", SETTLED: "settled",
-}
+STATUS_NAMES = dict(enumerate(STATUSES))  # code -> name (rockjit.result.STATUSES)
+
+# ---- the kernel's arguments ---------------------------------------------------------------------
+# rockjit.kernel is the one module that packs these and reads them back; the layouts below are
+# the contract between it and the compiled code.
+
+#: What a run writes: stroboscopic samples at kT and kT + T/2 (rows theta, theta', r, s), the
+#: impacts (rows t, theta'-, theta'+; a ring holding the latest when there are more), the
+#: recorded trajectory (rows t, theta, theta', r, s), the running exponents at kT (columns
+#: lambda1, lambda2 as S(kT)/kT, and the number of collapses of the tangent vectors before kT),
+#: the number of impacts before kT, and the scalar outputs ``iout`` and ``fout`` below.
+Outputs = namedtuple("Outputs", "strobe half impacts traj lam_run per_imp iout fout")
+
+#: The loop's work arrays: stages ``K``; states ``y, ytmp, ynew, yev``; ``lam`` (sums of the
+#: logs of the stretches, overall and in the window); step tables for the grid step (``tab_h``)
+#: and for substeps (``tab``); the stage forcing ``fr`` and slopes ``jac``; ``trig``, the sine
+#: and cosine of theta at the start and the end of a step; ``ftab``, the closed-form forcing
+#: acceleration at the stages of each grid step of a period.
+Work = namedtuple("Work", "K y ytmp ynew yev lam tab_h tab fr jac trig ftab")
 
 # ---- layout of the float parameter vector ``par`` ---------------------------------------------
 P_THC, P_XI, P_E, P_AW2, P_OMEGA, P_PHI, P_COT, P_THOVER, P_REST, P_H, P_SETTLE_TOL = range(11)
@@ -105,8 +123,10 @@ N_IPAR = 8
 
 # ---- layout of the integer outputs ``iout`` ----------------------------------------------------
 O_STATUS, O_STEPS, O_IMPACTS, O_RHS, O_NSTROBE, O_NHALF, O_NTRAJ, O_NREST, O_NREST_WIN, \
-    O_SUBSTEPS, O_NIMP_WIN, O_PERIOD = range(12)
-N_IOUT = 12
+    O_SUBSTEPS, O_NIMP_WIN, O_PERIOD, O_NCOL, O_UNCONVERGED = range(14)
+N_IOUT = 14
+# O_NCOL: collapses of the tangent vectors (rest phases, impacts with e = 0): every perturbation
+# died there. O_UNCONVERGED: events whose Newton polish did not reach its tolerance.
 
 # ---- layout of the float outputs ``fout`` ------------------------------------------------------
 F_T, F_TH, F_DTH, F_R, F_S, F_MAXERR, F_LAM1, F_LAM2, F_WINTIME, F_V = range(10)
@@ -136,8 +156,8 @@ def build(embed4: bool = False, tangent: bool = False, record: bool = False):
     Returns
     -------
     run : numba dispatcher
-        ``run(y0, side0, par, ipar, strobe, half, impacts, traj, lam_run, iout, fout)``,
-        see :func:`run_docs`.
+        ``run(y0, side0, par, ipar, out)`` with ``out`` an :data:`Outputs`; returns the status
+        code (see :func:`_loop`).
     """
     return _build(bool(embed4), bool(tangent), bool(record))
 
@@ -146,35 +166,18 @@ def build(embed4: bool = False, tangent: bool = False, record: bool = False):
 def settled_period(strobe, half, per_imp, k, reps, pmax, tol):
     """Smallest period p <= pmax that the last ``reps * p`` periods repeat, else 0.
 
-    Compares the stroboscopic samples at ``jT`` and ``jT + T/2`` with those ``p`` periods
-    earlier, to ``tol`` times the largest ``|theta|, |theta'|`` among them, and requires the same
-    number of impacts in each compared period (so that a transient which happens to be at rest
-    at the sampling instants is not taken for a periodic orbit).
+    The period test of :func:`rockjit.classify.repeats` on periods ``k - reps p + 1 .. k``,
+    relative to the size of the samples from ``k - (reps + 1) p`` on. It also requires the same
+    number of impacts in each compared period, so that a transient which happens to be at rest
+    at the sampling instants is not taken for a periodic orbit.
     """
     for p in range(1, pmax + 1):
         n = reps * p
-        if k - n - p < 0:
+        k0 = k - n - p
+        if k0 < 0:
             return 0
-        scale = 0.0
-        for j in range(k - n - p, k + 1):
-            for c in range(2):
-                scale = max(scale, abs(strobe[j, c]))
-                if j < k:
-                    scale = max(scale, abs(half[j, c]))
-        lim = tol * scale + 1e-300
-        ok = True
-        for j in range(k - n + 1, k + 1):
-            if per_imp[j] - per_imp[j - 1] != per_imp[j - p] - per_imp[j - p - 1]:
-                ok = False
-                break
-            for c in range(2):
-                if abs(strobe[j, c] - strobe[j - p, c]) > lim:
-                    ok = False
-                if abs(half[j - 1, c] - half[j - 1 - p, c]) > lim:
-                    ok = False
-            if not ok:
-                break
-        if ok:
+        lim = tol * orbit_scale(strobe, half, k0, k) + 1e-300
+        if repeats(strobe, half, per_imp, k - n + 1, k, p, 0, lim):
             return p
     return 0
 
@@ -472,17 +475,26 @@ def dense_coeffs(K, m):
 
 
 @jit(nrt=False)
-def event_value(kind, y, side, par, t):
-    """Event function g (positive before the event) and its time derivative."""
+def event_g(kind, v, dv, side, par):
+    """The event function ``g`` (positive before the event) and its derivative, from the value
+    ``v`` of the component it watches (theta; r for an uplift) and that value's derivative
+    ``dv`` (with respect to time, or to the step fraction: ``g`` is linear in ``dv``)."""
     if kind == EV_IMPACT:
-        return side * y[0], side * y[1]
+        return side * v, side * dv
     if kind == EV_OVERTURN:
-        return par[P_THOVER] - side * y[0], -side * y[1]
-    # EV_UPLIFT, only reached with the embedding
-    r = y[2]
-    dr, _ = oscillator(r, y[3], par[P_OMEGA])
-    sg = 1.0 if r >= 0.0 else -1.0
-    return par[P_COT] - par[P_AW2] * abs(r), -par[P_AW2] * sg * dr
+        return par[P_THOVER] - side * v, -side * dv
+    # EV_UPLIFT, only reached with the embedding: |aw2 r| reaches cot(thc)
+    sg = 1.0 if v >= 0.0 else -1.0
+    return par[P_COT] - par[P_AW2] * abs(v), -par[P_AW2] * sg * dv
+
+
+@jit(nrt=False)
+def event_value(kind, y, side, par):
+    """:func:`event_g` at the state ``y``."""
+    if kind == EV_UPLIFT:
+        dr, _ = oscillator(y[2], y[3], par[P_OMEGA])
+        return event_g(kind, y[2], dr, side, par)
+    return event_g(kind, y[0], y[1], side, par)
 
 
 @jit(nrt=False)
@@ -513,15 +525,10 @@ def turning_point(q0, q1, q2, q3, sgn, want_max):
 
 @jit(nrt=False)
 def dense_event_slope(kind, y0m, h, q0, q1, q2, q3, side, par, x):
-    """``(g, dg/dx)`` of :func:`dense_event` at ``x``."""
+    """``(g, dg/dx)`` of :func:`event_g` on the continuous extension at ``x = tau/h``."""
     v = y0m + h * x * (q0 + x * (q1 + x * (q2 + x * q3)))
     dv = h * (q0 + x * (2.0 * q1 + x * (3.0 * q2 + x * 4.0 * q3)))
-    if kind == EV_IMPACT:
-        return side * v, side * dv
-    if kind == EV_OVERTURN:
-        return par[P_THOVER] - side * v, -side * dv
-    sg = 1.0 if v >= 0.0 else -1.0
-    return par[P_COT] - par[P_AW2] * abs(v), -par[P_AW2] * sg * dv
+    return event_g(kind, v, dv, side, par)
 
 
 @jit(nrt=False)
@@ -576,7 +583,7 @@ def locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, ytmp, yev, cou
         step_table(par[P_OMEGA], tau, tab)
         rk_step(EMBED4, TANGENT, False, sp, cp, y, K, side, par, ytmp, yev, tab, fr, jac, trig)
         counts[O_RHS] += N_STAGES
-        g, dg = event_value(kind, yev, side, par, t + tau)
+        g, dg = event_value(kind, yev, side, par)
         if g == 0.0:
             break
         if g > 0.0:
@@ -593,6 +600,7 @@ def locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, ytmp, yev, cou
         if not (lo_b <= tn <= hi_b):
             tn = 0.5 * (lo_b + hi_b)
         if it == NEWTON_ITERS - 1:
+            counts[O_UNCONVERGED] += 1  # taken at the best bracketed estimate; reported
             break
         tau = tn
     return tau  # yev holds the state at this tau
@@ -707,8 +715,12 @@ def reset_tangent(EMBED4, y):
 
 
 @jit
-def _run(EMBED4, TANGENT, RECORD, y0, side0, par_in, ipar, strobe, half, impacts, traj,
-         lam_run, per_imp, iout, fout):
+def _run(EMBED4, TANGENT, RECORD, y0, side0, par_in, ipar, out):
+    """One run from ``y0`` on corner ``side0``: the parameters ``par_in`` (``N_PAR``) and
+    settings ``ipar`` in, :data:`Outputs` ``out`` filled; returns the status code.
+
+    The work arrays are made here, and the loop itself is compiled without numba's reference
+    counting (its helpers are inlined into it, and each inlined array would be counted)."""
     NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
     NY = NS + (4 if TANGENT else 0)  # plus the tangent matrix, column-major
     par = np.zeros(N_PARW)  # the parameters and constants derived from them
@@ -716,84 +728,279 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par_in, ipar, strobe, half, impacts
         par[m] = par_in[m]
     par[P_STHC] = math.sin(par_in[P_THC])
     par[P_CTHC] = math.cos(par_in[P_THC])
-    # The work arrays are made here, and the loop itself is compiled without numba's reference
-    # counting (its helpers are inlined into it, and each inlined array would be counted).
-    work = np.zeros((4, NY))  # y, ytmp, ynew, yev
-    return _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, traj,
-                 lam_run, per_imp, iout, fout, np.zeros((N_STAGES + 1, NY)), work[0], work[1],
-                 work[2], work[3], np.zeros(4), np.zeros((N_TAB, N_STAGES + 1)),
-                 np.zeros((N_TAB, N_STAGES + 1)), np.zeros(N_STAGES + 1),
-                 np.zeros(N_STAGES + 1), np.zeros(4), np.zeros((ipar[I_N], N_STAGES + 1)))
+    states = np.zeros((4, NY))  # y, ytmp, ynew, yev
+    w = Work(np.zeros((N_STAGES + 1, NY)), states[0], states[1], states[2], states[3],
+             np.zeros(4), np.zeros((N_TAB, N_STAGES + 1)), np.zeros((N_TAB, N_STAGES + 1)),
+             np.zeros(N_STAGES + 1), np.zeros(N_STAGES + 1), np.zeros(4),
+             np.zeros((ipar[I_N], N_STAGES + 1)))
+    return _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, out, w)
 
 
-@jit(nrt=False)
-def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, traj, lam_run,
-          per_imp, iout, fout, K, y, ytmp, ynew, yev, lam, tab_h, tab, fr, jac, trig, ftab):
-    """The integration itself: ``_run``'s arguments, the parameters with the derived constants
-    (``N_PARW``), and work arrays: stages ``K``; states ``y, ytmp, ynew, yev``; ``lam`` (sums of
-    the logs of the stretches, overall and in the window); step tables for the grid step and
-    for substeps; the stage forcing ``fr`` and slopes ``jac``; ``trig``, the sine and cosine of
-    theta at the start and the end of a step; ``ftab``, the closed-form forcing acceleration at
-    the stages of each grid step of a period."""
+@jit(nrt=False, inline=True)
+def start(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, out, w):
+    """Before the first step: the step tables, the initial state and its samples, the field at
+    the start. Returns the status (overturned already, or running)."""
     NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
-    NY = NS + (4 if TANGENT else 0)  # plus the tangent matrix, column-major
     n_per = ipar[I_N]
-    periods = ipar[I_PERIODS]
-    max_imp = ipar[I_MAXIMP]
-    stride = ipar[I_STRIDE]
-    win_step = ipar[I_WINDOW] * n_per
-    h = par[P_H]
-    e = par[P_E]
-    total = n_per * periods
-    half_n = n_per // 2
-    qr_every = ipar[I_QR] if ipar[I_QR] > 0 else total + 1
-    lam_sum = lam[0:2]
-    lam_win = lam[2:4]
-    step_table(par[P_OMEGA], h, tab_h)
+    step_table(par[P_OMEGA], par[P_H], w.tab_h)
     # The forcing acceleration at the stages of the grid steps of a period (the grid repeats):
     # phase phi + 2 pi (j + c_i) / N at stage i of step j, sines made once per run.
     if not EMBED4:
         for j in range(n_per):
             for i in range(N_STAGES + 1):
                 c = C[i] if i < N_STAGES else 1.0
-                ftab[j, i] = par[P_AW2] * math.sin(par[P_PHI] + 2.0 * math.pi * (j + c) / n_per)
+                w.ftab[j, i] = par[P_AW2] * math.sin(par[P_PHI] + 2.0 * math.pi * (j + c)
+                                                     / n_per)
+    y = w.y
     for m in range(NS):
         y[m] = y0[m]
     if TANGENT:
         reset_tangent(EMBED4, y)
     for m in range(N_IOUT):
-        iout[m] = 0
+        out.iout[m] = 0
+    sample(EMBED4, 0.0, y, par, out.strobe[0])
+    out.iout[O_NSTROBE] = 1
+    if RECORD:
+        out.traj[0, 0] = 0.0
+        sample(EMBED4, 0.0, y, par, out.traj[0, 1:])
+        out.iout[O_NTRAJ] = 1
+    if TANGENT:
+        for c in range(3):
+            out.lam_run[0, c] = 0.0
+    out.per_imp[0] = 0
+    status = RUNNING
+    if side0 != 0 and side0 * y[0] >= par[P_THOVER]:
+        status = OVERTURNED
+    if TANGENT and side0 == 0:
+        # at rest from the start: every perturbation small enough dies in a Zeno cascade, and
+        # the block leaves rest when the forcing alone says (see _loop, rest phases)
+        out.iout[O_NCOL] = 1
+    rhs(EMBED4, forcing_at(0.0, par), y, side0, par, w.K, w.jac, w.trig)
+    out.iout[O_RHS] += 1
+    return status
+
+
+@jit(nrt=False, inline=True)
+def leave_rest(EMBED4, t, t_grid, hold, y, side, par, w, iout):
+    """At rest: is the block lifted before the grid point ``t_grid``?
+
+    Returns ``(action, t, side)``: ``REST_END`` (at rest for good), ``REST_HOLD`` (still at
+    rest at ``t_grid``; closed form only, which jumps straight to the uplift instant),
+    ``REST_LIFT`` (lifted at the returned ``t`` onto ``side``, field refreshed), or
+    ``REST_STEP`` (embedding: take a step at rest and watch the forcing).
+    """
+    if not EMBED4:
+        t_up = uplift_time(t, par[P_AW2], par[P_COT], par[P_OMEGA], par[P_PHI])
+        if t_up == math.inf:
+            return REST_END, t, side
+        if t_up >= t_grid or hold:
+            return REST_HOLD, t_grid, side
+        y[0] = 0.0
+        y[1] = 0.0
+        side = 1 if forcing_now(EMBED4, t_up, y, par) > 0.0 else -1
+        rhs(EMBED4, forcing_at(t_up, par), y, side, par, w.K, w.jac, w.trig)
+        iout[O_RHS] += 1
+        return REST_LIFT, t_up, side
+    rad = math.sqrt(y[2] * y[2] + y[3] * y[3])
+    if par[P_AW2] * max(1.0, rad) <= par[P_COT]:
+        return REST_END, t, side
+    if not hold and par[P_AW2] * abs(y[2]) > par[P_COT]:
+        side = 1 if y[2] > 0.0 else -1
+        rhs(EMBED4, forcing_at(t, par), y, side, par, w.K, w.jac, w.trig)
+        iout[O_RHS] += 1
+        return REST_LIFT, t, side
+    return REST_STEP, t, side
+
+
+@jit(nrt=False, inline=True)
+def accept(NS, NY, side, hh, max_err, w):
+    """The step just taken had no event: its error estimate, the state at its end, and its
+    last stage as the next step's first (first same as last). Returns the largest error
+    estimate so far."""
+    K = w.K
+    if side != 0:
+        e0 = 0.0
+        e1 = 0.0
+        for i in range(N_STAGES + 1):
+            e0 += E[i] * K[i, 0]
+            e1 += E[i] * K[i, 1]
+        err = hh * max(abs(e0), abs(e1))
+        if err > max_err:
+            max_err = err
+    for m in range(NY):
+        w.y[m] = w.ynew[m]
+    for m in range(NS):  # first same as last (the tangent rows are redone)
+        K[0, m] = K[N_STAGES, m]
+    w.jac[0] = w.jac[N_STAGES]
+    w.trig[0] = w.trig[2]
+    w.trig[1] = w.trig[3]
+    return max_err
+
+
+@jit(nrt=False)
+def impact(EMBED4, TANGENT, t, t_lift, side, n_imp, in_window, par, out, w):
+    """The jump at an impact (SPEC.md §2), the saltation of the tangent vectors (§5), the
+    impact's record, and the Zeno cut-off (§3).
+
+    Returns ``(side, n_imp, rests, hold)``: the new corner (0 if the block came to rest), the
+    impact count, whether a rest phase began, and whether it began within rounding of the
+    latest uplift (then it is held to the grid point, see :func:`_loop`).
+    """
+    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
+    y = w.y
+    e = par[P_E]
+    dth_m = y[1]
+    dth_p = jump(dth_m, e)
+    if TANGENT:
+        if dth_m != 0.0:
+            s10 = saltation(dth_m, par[P_AW2] * forcing_now(EMBED4, t, y, par), side,
+                            par[P_THC], par[P_XI], e)
+        else:
+            s10 = 0.0
+        for c in range(2):
+            v0 = y[NS + 2 * c]
+            v1 = y[NS + 2 * c + 1]
+            y[NS + 2 * c] = e * v0
+            y[NS + 2 * c + 1] = s10 * v0 + e * v1
+    y[0] = 0.0
+    y[1] = dth_p
+    side = -side
+    impacts = out.impacts
+    q = n_imp % impacts.shape[0]  # a ring: the latest impacts are kept
+    impacts[q, 0] = t
+    impacts[q, 1] = dth_m
+    impacts[q, 2] = dth_p
+    n_imp += 1
+    if in_window:
+        out.iout[O_NIMP_WIN] += 1
+    rests = False
+    hold = False
+    if abs(dth_p) < par[P_REST] or dth_p == 0.0:
+        # Zeno: the impacts would accumulate; the block is at rest from here
+        y[1] = 0.0
+        side = 0
+        rests = True
+        hold = t - t_lift <= 1e-9 * par[P_H]
+        out.iout[O_NREST] += 1
+        if in_window:
+            out.iout[O_NREST_WIN] += 1
+    rhs(EMBED4, forcing_at(t, par), y, side, par, w.K, w.jac, w.trig)
+    out.iout[O_RHS] += 1
+    return side, n_imp, rests, hold
+
+
+@jit(nrt=False, inline=True)
+def grid_point(EMBED4, TANGENT, RECORD, t, step, side, n_imp, n_col, in_window, ipar, par,
+               out, w, j_per, k_per, j_qr, j_rec):
+    """Bookkeeping at the end of grid step ``step`` (1-based count): the tangent vectors'
+    renormalisation, the stroboscopic samples at ``kT`` and ``kT + T/2``, the early stop, the
+    recorded trajectory.
+
+    Returns ``(status, j_per, k_per, j_qr, j_rec, collapsed)``: ``collapsed`` says the tangent
+    vectors collapsed at the renormalisation (counted by the caller).
+    """
+    y = w.y
+    n_per = ipar[I_N]
+    status = RUNNING
+    collapsed = False
+    if TANGENT:
+        j_qr += 1
+        if j_qr == ipar[I_QR]:
+            j_qr = 0
+            if side != 0:
+                collapsed = qr_renormalise(EMBED4, y, w.lam[0:2], in_window, w.lam[2:4])
+                # (the first stage's tangent rows are computed afresh by every step)
+    j_per += 1
+    if j_per == n_per:
+        j_per = 0
+        k_per += 1
+        sample(EMBED4, t, y, par, out.strobe[k_per])
+        out.iout[O_NSTROBE] = k_per + 1
+        out.per_imp[k_per] = n_imp
+        if TANGENT:
+            n_now = n_col + (1 if collapsed else 0)
+            out.lam_run[k_per, 0] = w.lam[0] / t
+            out.lam_run[k_per, 1] = w.lam[1] / t
+            out.lam_run[k_per, 2] = n_now
+        if ipar[I_SETTLE] > 0:
+            p = settled_period(out.strobe, out.half, out.per_imp, k_per, ipar[I_SETTLE],
+                               ipar[I_PMAX], par[P_SETTLE_TOL])
+            if p > 0:
+                out.iout[O_PERIOD] = p
+                status = SETTLED
+    elif j_per == n_per // 2:
+        sample(EMBED4, t, y, par, out.half[k_per])
+        out.iout[O_NHALF] = k_per + 1
+    if RECORD and status == RUNNING:
+        j_rec += 1
+        if j_rec == ipar[I_STRIDE]:
+            j_rec = 0
+            q = step // ipar[I_STRIDE]
+            out.traj[q, 0] = t
+            sample(EMBED4, t, y, par, out.traj[q, 1:])
+            out.iout[O_NTRAJ] = q + 1
+    return status, j_per, k_per, j_qr, j_rec, collapsed
+
+
+@jit(nrt=False, inline=True)
+def finish(EMBED4, TANGENT, status, t, step, n_imp, n_col_win, max_err, ipar, par, out, w):
+    """The scalar outputs at the end of a run (layouts ``O_*`` and ``F_*``)."""
+    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
+    iout = out.iout
+    fout = out.fout
+    iout[O_STATUS] = status
+    iout[O_STEPS] = step
+    iout[O_IMPACTS] = n_imp
+    fout[F_T] = t
+    sample(EMBED4, t, w.y, par, fout[F_TH:F_S + 1])
+    fout[F_MAXERR] = max_err
+    if TANGENT:
+        for m in range(4):
+            fout[F_V + m] = w.y[NS + m]
+        wt = t - ipar[I_WINDOW] * ipar[I_N] * par[P_H]
+        fout[F_WINTIME] = wt
+        if wt > 0.0:
+            fout[F_LAM1] = w.lam[2] / wt if n_col_win == 0 else -math.inf
+            fout[F_LAM2] = w.lam[3] / wt if n_col_win == 0 else -math.inf
+        else:
+            fout[F_LAM1] = math.nan
+            fout[F_LAM2] = math.nan
+
+
+# What leave_rest tells the loop.
+REST_END, REST_HOLD, REST_LIFT, REST_STEP = 0, 1, 2, 3
+
+
+@jit(nrt=False)
+def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, out, w):
+    """The integration: ``_run``'s arguments, the parameters with the derived constants
+    (``N_PARW``), and the :data:`Work` arrays ``w``.
+
+    Grid step by grid step (SPEC.md §4): a step of the current corner, or of rest; an event in
+    it is located, the state taken there (impact: :func:`impact`; uplift; overturning ends the
+    run), and the step finished from the event to the grid point; then :func:`grid_point`.
+    """
+    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
+    NY = NS + (4 if TANGENT else 0)  # plus the tangent matrix, column-major
+    n_per = ipar[I_N]
+    total = n_per * ipar[I_PERIODS]
+    win_step = ipar[I_WINDOW] * n_per
+    h = par[P_H]
+    y = w.y
+    K = w.K
+    status = start(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, out, w)
     side = side0
     t = 0.0
-    status = RUNNING
     max_err = 0.0
     n_imp = 0
-    n_imp_cap = impacts.shape[0]
-
-    sample(EMBED4, t, y, par, strobe[0])
-    iout[O_NSTROBE] = 1
-    if RECORD:
-        traj[0, 0] = t
-        sample(EMBED4, t, y, par, traj[0, 1:])
-        iout[O_NTRAJ] = 1
-    if TANGENT:
-        lam_run[0, 0] = 0.0
-        lam_run[0, 1] = 0.0
-    if side != 0 and side * y[0] >= par[P_THOVER]:
-        status = OVERTURNED
-    rhs(EMBED4, forcing_at(t, par), y, side, par, K, jac, trig)
-    iout[O_RHS] += 1
-
     step = 0
     j_per = 0   # grid steps into the current period
     k_per = 0   # completed periods
     j_qr = 0
     j_rec = 0
-    settle_reps = ipar[I_SETTLE]
-    n_col = 0      # collapses of the tangent vectors (impacts with e = 0)
+    n_col = out.iout[O_NCOL]  # collapses of the tangent vectors (start at rest; see below)
+    n_col_win = n_col if ipar[I_WINDOW] == 0 else 0
     t_lift = -math.inf  # instant of the latest uplift
-    n_col_win = 0
-    per_imp[0] = 0
     while step < total and status == RUNNING:
         t_grid = (step + 1) * h
         in_window = step >= win_step
@@ -804,83 +1011,50 @@ def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, 
         # same instant forever (found by the stress suite).
         hold = False
         while True:
-            if side == 0 and not EMBED4:
-                # at rest, closed-form forcing: jump straight to the uplift instant
-                t_up = uplift_time(t, par[P_AW2], par[P_COT], par[P_OMEGA], par[P_PHI])
-                if t_up == math.inf:
-                    status = REST
-                    break
-                if t_up >= t_grid or hold:
-                    t = t_grid
-                    break
-                t = t_up
-                t_lift = t
-                fresh = False
-                y[0] = 0.0
-                y[1] = 0.0
-                side = 1 if forcing_now(EMBED4, t, y, par) > 0.0 else -1
-                rhs(EMBED4, forcing_at(t, par), y, side, par, K, jac, trig)
-                iout[O_RHS] += 1
-                continue
             if side == 0:
-                rad = math.sqrt(y[2] * y[2] + y[3] * y[3])
-                if par[P_AW2] * max(1.0, rad) <= par[P_COT]:
+                action, t, side = leave_rest(EMBED4, t, t_grid, hold, y, side, par, w, out.iout)
+                if action == REST_END:
                     status = REST
                     break
-                if not hold and par[P_AW2] * abs(y[2]) > par[P_COT]:
-                    side = 1 if y[2] > 0.0 else -1
+                if action == REST_HOLD:
+                    break
+                if action == REST_LIFT:
                     t_lift = t
-                    rhs(EMBED4, forcing_at(t, par), y, side, par, K, jac, trig)
-                    iout[O_RHS] += 1
+                    fresh = EMBED4 and fresh
                     continue
             if fresh:
                 # a whole grid step: the forcing phase there is phi + 2 pi j / N exactly
                 hh = h
-                rk_step(EMBED4, TANGENT, not EMBED4, 0.0, 0.0, y, K, side, par, ytmp, ynew,
-                        tab_h, fr if EMBED4 else ftab[j_per], jac, trig)
+                rk_step(EMBED4, TANGENT, not EMBED4, 0.0, 0.0, y, K, side, par, w.ytmp, w.ynew,
+                        w.tab_h, w.fr if EMBED4 else w.ftab[j_per], w.jac, w.trig)
             else:
                 hh = t_grid - t
                 psi = par[P_OMEGA] * t + par[P_PHI]
-                step_table(par[P_OMEGA], hh, tab)
+                step_table(par[P_OMEGA], hh, w.tab)
                 rk_step(EMBED4, TANGENT, False, math.sin(psi), math.cos(psi), y, K, side, par,
-                        ytmp, ynew, tab, fr, jac, trig)
-            iout[O_RHS] += N_STAGES
-            iout[O_SUBSTEPS] += 1
-            kind, lo, hi = detect(y, ynew, hh, K, side, par)
+                        w.ytmp, w.ynew, w.tab, w.fr, w.jac, w.trig)
+            out.iout[O_RHS] += N_STAGES
+            out.iout[O_SUBSTEPS] += 1
+            kind, lo, hi = detect(y, w.ynew, hh, K, side, par)
             if hold and kind == EV_UPLIFT:
                 kind = EV_NONE
             if kind == EV_NONE:
-                if side != 0:
-                    e0 = 0.0
-                    e1 = 0.0
-                    for i in range(N_STAGES + 1):
-                        e0 += E[i] * K[i, 0]
-                        e1 += E[i] * K[i, 1]
-                    err = hh * max(abs(e0), abs(e1))
-                    if err > max_err:
-                        max_err = err
-                for m in range(NY):
-                    y[m] = ynew[m]
-                for m in range(NS):  # first same as last (the tangent rows are redone)
-                    K[0, m] = K[N_STAGES, m]
-                jac[0] = jac[N_STAGES]
-                trig[0] = trig[2]
-                trig[1] = trig[3]
+                max_err = accept(NS, NY, side, hh, max_err, w)
                 t = t_grid
                 break
             if hi > lo:
-                tau = locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, ytmp, yev,
-                             iout, tab, fr, jac, trig)
+                tau = locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, w.ytmp,
+                             w.yev, out.iout, w.tab, w.fr, w.jac, w.trig)
             else:
                 # an unresolvably small flight: take it as ending at rest where it started
                 tau = 0.0
                 for m in range(NY):
-                    yev[m] = y[m]
-                yev[1] = 0.0
+                    w.yev[m] = y[m]
+                w.yev[1] = 0.0
             t = t + tau
             fresh = False
             for m in range(NY):
-                y[m] = yev[m]
+                y[m] = w.yev[m]
             if kind == EV_OVERTURN:
                 status = OVERTURNED
                 break
@@ -889,51 +1063,25 @@ def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, 
                 y[1] = 0.0
                 side = 1 if y[2] > 0.0 else -1
                 t_lift = t
-                rhs(EMBED4, forcing_at(t, par), y, side, par, K, jac, trig)
-                iout[O_RHS] += 1
+                rhs(EMBED4, forcing_at(t, par), y, side, par, K, w.jac, w.trig)
+                out.iout[O_RHS] += 1
                 continue
-            # impact: jump map, saltation, record
-            dth_m = y[1]
-            dth_p = jump(dth_m, e)
-            if TANGENT:
-                if dth_m != 0.0:
-                    s10 = saltation(dth_m, par[P_AW2] * forcing_now(EMBED4, t, y, par), side,
-                                    par[P_THC], par[P_XI], e)
-                else:
-                    s10 = 0.0
-                for c in range(2):
-                    v0 = y[NS + 2 * c]
-                    v1 = y[NS + 2 * c + 1]
-                    y[NS + 2 * c] = e * v0
-                    y[NS + 2 * c + 1] = s10 * v0 + e * v1
-            y[0] = 0.0
-            y[1] = dth_p
-            side = -side
-            q = n_imp % n_imp_cap  # a ring: the latest impacts are kept
-            impacts[q, 0] = t
-            impacts[q, 1] = dth_m
-            impacts[q, 2] = dth_p
-            n_imp += 1
-            if in_window:
-                iout[O_NIMP_WIN] += 1
-            if abs(dth_p) < par[P_REST] or dth_p == 0.0:
-                # Zeno: the impacts would accumulate; the block is at rest from here
-                y[1] = 0.0
-                side = 0
-                if t - t_lift <= 1e-9 * h:
-                    hold = True
+            side, n_imp, rests, held = impact(EMBED4, TANGENT, t, t_lift, side, n_imp,
+                                              in_window, par, out, w)
+            if rests:
+                hold = hold or held
                 if TANGENT:
-                    # a rest phase leaves the tangent vectors alone; bank their growth
-                    if qr_renormalise(EMBED4, y, lam_sum, in_window, lam_win):
-                        n_col += 1
-                        if in_window:
-                            n_col_win += 1
-                iout[O_NREST] += 1
-                if in_window:
-                    iout[O_NREST_WIN] += 1
-            rhs(EMBED4, forcing_at(t, par), y, side, par, K, jac, trig)
-            iout[O_RHS] += 1
-            if n_imp >= max_imp:
+                    # A rest phase ends every perturbation: a nearby state reaches rest too (its
+                    # Zeno cascade ends a little earlier or later), and the block leaves rest
+                    # when the forcing alone says. The flow's Jacobian across it is zero, and
+                    # the exponents of a stretch holding one are -inf (SPEC.md §5). (Banking the
+                    # vectors' growth instead counted the cascade's saltation entries, ~1/theta'
+                    # at the last impacts, as growth: exponents that depended on rest_speed.)
+                    reset_tangent(EMBED4, y)
+                    n_col += 1
+                    if in_window:
+                        n_col_win += 1
+            if n_imp >= ipar[I_MAXIMP]:
                 status = MAX_IMPACTS
                 break
         if status != RUNNING:
@@ -942,66 +1090,18 @@ def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts, 
         if not (math.isfinite(y[0]) and math.isfinite(y[1])):
             status = NONFINITE
             break
-        if TANGENT:
-            j_qr += 1
-            if j_qr == qr_every:
-                j_qr = 0
-                if side != 0:
-                    if qr_renormalise(EMBED4, y, lam_sum, in_window, lam_win):
-                        n_col += 1
-                        if in_window:
-                            n_col_win += 1
-                    # (the first stage's tangent rows are computed afresh by every step)
-        j_per += 1
-        if j_per == n_per:
-            j_per = 0
-            k_per += 1
-            sample(EMBED4, t, y, par, strobe[k_per])
-            iout[O_NSTROBE] = k_per + 1
-            per_imp[k_per] = n_imp
-            if TANGENT:
-                lam_run[k_per, 0] = lam_sum[0] / t if n_col == 0 else -math.inf
-                lam_run[k_per, 1] = lam_sum[1] / t if n_col == 0 else -math.inf
-            if settle_reps > 0:
-                p = settled_period(strobe, half, per_imp, k_per, settle_reps,
-                                   ipar[I_PMAX], par[P_SETTLE_TOL])
-                if p > 0:
-                    iout[O_PERIOD] = p
-                    status = SETTLED
-                    break
-        elif j_per == half_n:
-            sample(EMBED4, t, y, par, half[k_per])
-            iout[O_NHALF] = k_per + 1
-        if RECORD:
-            j_rec += 1
-            if j_rec == stride:
-                j_rec = 0
-                q = step // stride
-                traj[q, 0] = t
-                sample(EMBED4, t, y, par, traj[q, 1:])
-                iout[O_NTRAJ] = q + 1
-
+        status, j_per, k_per, j_qr, j_rec, collapsed = grid_point(
+            EMBED4, TANGENT, RECORD, t, step, side, n_imp, n_col, in_window, ipar, par, out, w,
+            j_per, k_per, j_qr, j_rec)
+        if collapsed:
+            n_col += 1
+            if in_window:
+                n_col_win += 1
     if status == RUNNING:
         status = DONE
-    iout[O_STATUS] = status
-    iout[O_STEPS] = step
-    iout[O_IMPACTS] = n_imp
-    fout[F_T] = t
-    sample(EMBED4, t, y, par, fout[F_TH:F_S + 1])
-    fout[F_MAXERR] = max_err
-    if TANGENT:
-        for m in range(4):
-            fout[F_V + m] = y[NS + m]
-        wt = t - win_step * h
-        fout[F_WINTIME] = wt
-        if wt > 0.0:
-            fout[F_LAM1] = lam_win[0] / wt if n_col_win == 0 else -math.inf
-            fout[F_LAM2] = lam_win[1] / wt if n_col_win == 0 else -math.inf
-        else:
-            fout[F_LAM1] = math.nan
-            fout[F_LAM2] = math.nan
+    out.iout[O_NCOL] = n_col
+    finish(EMBED4, TANGENT, status, t, step, n_imp, n_col_win, max_err, ipar, par, out, w)
     return status
-
 
 
 @functools.lru_cache(maxsize=None)
@@ -1009,8 +1109,7 @@ def _build(EMBED4, TANGENT, RECORD):
     # The closure only forwards its flags: numba types them as literals, so _run and its helpers
     # are specialised (and cached, being module-level) once per combination of switches.
     @jit
-    def run(y0, side0, par, ipar, strobe, half, impacts, traj, lam_run, per_imp, iout, fout):
-        return _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, strobe, half, impacts,
-                    traj, lam_run, per_imp, iout, fout)
+    def run(y0, side0, par, ipar, out):
+        return _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, out)
 
     return run

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._jit import fma, jit
+from .validate import choice, real
 
 __all__ = [
     "LAWS",
@@ -38,6 +39,7 @@ __all__ = [
     "e_housner",
     "e_mao",
     "forcing_closed",
+    "initial_side",
     "jump",
     "near_poly",
     "oscillator",
@@ -96,14 +98,13 @@ def delta_e_percent(e1, e2):
 # Validated parameters
 # --------------------------------------------------------------------------------------------
 
-def _finite(name, value):
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number (got {value!r})") from None
-    if not math.isfinite(value):
-        raise ValueError(f"{name} must be finite (got {value})")
-    return value
+#: Allowed ranges of the block's parameters. They are wide (the study's values are hb 1-2,
+#: alpha <= 1, omega ~ 1, xi ~ 2e-4) and keep every product the integrator forms finite.
+HB_RANGE = (1e-2, 1e2)
+ALPHA_MAX = 1e3
+OMEGA_RANGE = (1e-4, 1e4)
+XI_MAX = 1e4
+REST_SPEED_MAX = 0.1
 
 
 @dataclass(frozen=True)
@@ -113,22 +114,22 @@ class Block:
     Parameters
     ----------
     hb : float
-        Slenderness ``h/b``, finite and ``> 0`` (``>= 1/sqrt(2)`` for the Housner law).
+        Slenderness ``h/b`` in ``[0.01, 100]`` (``>= 1/sqrt(2)`` for the Housner law).
     alpha : float
-        Forcing amplitude ``A/R``, ``>= 0``.
+        Forcing amplitude ``A/R`` in ``[0, 1000]``.
     omega : float
-        Forcing frequency ``Omega/Omega0``, ``> 0``.
+        Forcing frequency ``Omega/Omega0`` in ``[1e-4, 1e4]``.
     law : {"housner", "mao", "constant"}, optional
         Restitution law; default ``"housner"``, or ``"constant"`` when ``e`` is given.
     e : float, optional
         Coefficient of restitution in ``[0, 1]``, only with the constant law.
     xi : float
-        Viscous damping ``>= 0``; default the study's value (SPEC.md §1).
+        Viscous damping in ``[0, 1e4]``; default the study's value (SPEC.md §1).
     theta_over : float
         Overturning threshold on ``|theta|``, in ``(0, pi/2]``; default ``pi/2``.
     rest_speed : float
         Impact speed ``|theta'|`` after the jump below which the block is put to rest (the Zeno
-        cut-off, SPEC.md §3), ``>= 0``; default ``1e-6``.
+        cut-off, SPEC.md §3), in ``(0, 0.1]``; default ``1e-6``.
     """
 
     hb: float
@@ -141,20 +142,15 @@ class Block:
     rest_speed: float = 1e-6
 
     def __post_init__(self):
-        hb = _finite("hb", self.hb)
-        if hb <= 0:
-            raise ValueError(f"hb must be > 0 (got {hb})")
+        hb = real("hb", self.hb, *HB_RANGE)
         law = self.law
         if law is None:
             law = "housner" if self.e is None else "constant"
-        if law not in LAWS:
-            raise ValueError(f"law must be one of {LAWS} (got {self.law!r})")
+        choice("law", law, LAWS)
         if law == "constant":
             if self.e is None:
                 raise ValueError("e is required for law='constant' (a number in [0, 1])")
-            e = _finite("e", self.e)
-            if not 0.0 <= e <= 1.0:
-                raise ValueError(f"e must be in [0, 1] (got {e})")
+            e = real("e", self.e, 0.0, 1.0)
         elif self.e is not None:
             raise ValueError(f"e is only given with law='constant' (law={law!r}, e={self.e})")
         elif law == "housner" and hb < HB_MIN_HOUSNER:
@@ -162,21 +158,16 @@ class Block:
                 f"hb must be >= 1/sqrt(2) = {HB_MIN_HOUSNER:.6f} for the Housner law "
                 f"(got {hb}); e_H would be negative"
             )
-        alpha = _finite("alpha", self.alpha)
-        if alpha < 0:
-            raise ValueError(f"alpha must be >= 0 (got {alpha})")
-        omega = _finite("omega", self.omega)
-        if omega <= 0:
-            raise ValueError(f"omega must be > 0 (got {omega})")
-        xi = _finite("xi", self.xi)
-        if xi < 0:
-            raise ValueError(f"xi must be >= 0 (got {xi})")
-        theta_over = _finite("theta_over", self.theta_over)
-        if not 0.0 < theta_over <= 0.5 * math.pi:
-            raise ValueError(f"theta_over must be in (0, pi/2] (got {theta_over})")
-        rest_speed = _finite("rest_speed", self.rest_speed)
-        if rest_speed < 0:
-            raise ValueError(f"rest_speed must be >= 0 (got {rest_speed})")
+        alpha = real("alpha", self.alpha, 0.0, ALPHA_MAX)
+        omega = real("omega", self.omega, *OMEGA_RANGE)
+        xi = real("xi", self.xi, 0.0, XI_MAX)
+        theta_over = real("theta_over", self.theta_over, 0.0, 0.5 * math.pi, lo_open=True)
+        if isinstance(self.rest_speed, (int, float)) and self.rest_speed == 0:
+            raise ValueError(
+                "rest_speed must be > 0 (got 0): with e < 1 the impacts of a Zeno cascade "
+                "accumulate in finite time, and without a cut-off a run would pile impacts at "
+                "one instant until max_impacts")
+        rest_speed = real("rest_speed", self.rest_speed, 0.0, REST_SPEED_MAX, lo_open=True)
         for name, value in (("hb", hb), ("alpha", alpha), ("omega", omega), ("xi", xi),
                             ("theta_over", theta_over), ("rest_speed", rest_speed),
                             ("law", law)):
@@ -414,6 +405,17 @@ def oscillator_jac(r, s, omega):
     q = r * r + s * s
     return (1.0 - q - 2.0 * r * r, omega - 2.0 * r * s,
             -omega - 2.0 * r * s, 1.0 - q - 2.0 * s * s)
+
+
+@jit
+def initial_side(theta0, dtheta0):
+    """The corner a run starts on: the sign of ``theta0``, else of ``theta0'``, else 0 (at
+    rest) (SPEC.md §3)."""
+    if theta0 > 0.0 or (theta0 == 0.0 and dtheta0 > 0.0):
+        return 1
+    if theta0 < 0.0 or (theta0 == 0.0 and dtheta0 < 0.0):
+        return -1
+    return 0
 
 
 @jit

@@ -14,7 +14,8 @@ import math
 
 import numpy as np
 
-from .analysis import BEHAVIOURS, classify_result, fractions
+from .analysis import classify_result
+from .result import BEHAVIOURS, fractions
 from .model import delta_e_percent, e_housner, e_mao, thc_from_hb
 
 __all__ = ["BEHAVIOUR_COLOURS", "LAW_COLOURS", "agreement", "fig_basin", "fig_basin_compare",
@@ -438,13 +439,10 @@ def fig_bifurcation(sweeps, alpha_limits=None, title=None):
 
 def _basin_axes(ax, b, show_y=True):
     cmap, norm = _cmap()
-    th, dth = np.asarray(b.theta0), np.asarray(b.dtheta0)
-    dx = (th[-1] - th[0]) / max(len(th) - 1, 1) / 2 if len(th) > 1 else 0.5
-    dy = (dth[-1] - dth[0]) / max(len(dth) - 1, 1) / 2 if len(dth) > 1 else 0.5
     # label[i, j] belongs to theta0[i], dtheta0[j]: rows of the image are dtheta0
     ax.imshow(np.asarray(b.label).T, origin="lower", cmap=cmap, norm=norm,
               interpolation="nearest", aspect="auto",
-              extent=(th[0] - dx, th[-1] + dx, dth[0] - dy, dth[-1] + dy))
+              extent=_extent(np.asarray(b.theta0), np.asarray(b.dtheta0)))
     ax.set_xlabel("\u03b8\u2080")
     if show_y:
         ax.set_ylabel("\u03b8\u2080\u2032")
@@ -489,12 +487,9 @@ def fig_basin_compare(housner_basin, mao_basin, title=None):
         _basin_axes(axes[i], res, show_y=i == 0)
         _basin_legend(axes[i], res)
         axes[i].set_title(_law(res.block), fontsize=11)
-    th, dth = a.theta0, a.dtheta0
-    dx = (th[-1] - th[0]) / max(len(th) - 1, 1) / 2 if len(th) > 1 else 0.5
-    dy = (dth[-1] - dth[0]) / max(len(dth) - 1, 1) / 2 if len(dth) > 1 else 0.5
     axes[2].imshow(agree.T.astype(int), origin="lower", interpolation="nearest",
                    aspect="auto", cmap=ListedColormap(["#7b3294", "#e8e8e8"]), vmin=0, vmax=1,
-                   extent=(th[0] - dx, th[-1] + dx, dth[0] - dy, dth[-1] + dy))
+                   extent=_extent(np.asarray(a.theta0), np.asarray(a.dtheta0)))
     axes[2].set_xlabel("\u03b8\u2080")
     axes[2].set_title(f"agreement: {pct:.1f} % of cells", fontsize=11)
     axes[2].legend(handles=[Patch(color="#e8e8e8", label=f"same behaviour {pct:.1f} %"),
@@ -513,8 +508,11 @@ def fig_basin_compare(housner_basin, mao_basin, title=None):
 # ---------------------------------------------------------------------------------------------
 
 def _extent(x, y):
-    dx = (x[-1] - x[0]) / max(len(x) - 1, 1) / 2 if len(x) > 1 else 0.5
-    dy = (y[-1] - y[0]) / max(len(y) - 1, 1) / 2 if len(y) > 1 else 0.5
+    """``imshow`` extent of a grid over axes ``x, y``: half a cell beyond the end points (half
+    a unit for an axis of one point, or of equal points, so the extent is never empty)."""
+    def half(v):
+        return (v[-1] - v[0]) / (len(v) - 1) / 2 if len(v) > 1 and v[-1] > v[0] else 0.5
+    dx, dy = half(x), half(y)
     return (x[0] - dx, x[-1] + dx, y[0] - dy, y[-1] + dy)
 
 

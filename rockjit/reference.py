@@ -16,8 +16,9 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from .model import Block, accel, accel_jac, forcing_closed, jump, oscillator, oscillator_jac
-from .model import uplift_time
+from .model import (Block, accel, accel_jac, forcing_closed, initial_side, jump, oscillator,
+                    oscillator_jac, uplift_time)
+from .result import Result
 
 # A point just off theta = 0 on the new corner after an impact, so that the impact event of the
 # next segment is not found again at its own starting instant.
@@ -61,12 +62,10 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
                    max_impacts=100_000):
     """Reference run through ``scipy.integrate.solve_ivp``; returns a :class:`Result`.
 
-    Called by :func:`rockjit.simulate` with ``method="scipy[:METHOD]"``, which validates the
-    inputs. Samples are taken at the compiled path's grid points (``T/2`` for the stroboscopic
+    Called by :func:`rockjit.simulate.run` with ``method="scipy[:METHOD]"`` on a validated
+    plan. Samples are taken at the compiled path's grid points (``T/2`` for the stroboscopic
     sections, ``record_stride`` steps for the trajectory) from the solver's own output.
     """
-    from .simulate import Result, initial_side
-
     embed4 = forcing == "embedded"
     fun, jac, forc = _fields(block, phi, embed4)
     T = block.period

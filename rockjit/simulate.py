@@ -1,20 +1,30 @@
-"""``rockjit.simulate``: one run of the forced rocking block, compiled or through scipy."""
+"""``rockjit.simulate``: one run of the forced rocking block, compiled or through scipy.
+
+:func:`plan` validates every input of a run (ranges, the grid's stability, the memory the run
+would allocate) and returns a :class:`RunPlan`; :func:`run` executes it on the compiled path
+(:mod:`rockjit.kernel`) or the scipy reference path (:mod:`rockjit.reference`). The command
+line builds the same plan, so the API and the CLI accept and refuse exactly the same inputs.
+"""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from . import integrate as ig
+from . import kernel
 from .model import Block
-from .model import _finite as _real
+from .result import Result
+from .validate import choice, integer, memory, real
 
-__all__ = ["Result", "simulate", "Z0_STUDY", "DEFAULT_N", "MAX_STEP", "STATUS_MESSAGES",
-           "STEP_LIMIT", "check_step", "steps_per_period"]
+__all__ = ["DAMPING_STEP", "DEFAULT_N", "IVP_METHODS", "MAX_STEP", "RunPlan", "STABLE_DAMPING",
+           "STEP_LIMIT", "Z0_STUDY", "check_step", "default_max_impacts", "forcing_phase",
+           "plan", "run", "simulate", "steps_per_period"]
 
-#: Initial state ``(theta, theta', r, s)`` of the study's single runs and sweeps (SPEC.md §7).
+#: The study's initial state ``(theta, theta', r, s)`` of its single runs and sweeps (SPEC.md
+#: §7), which :func:`simulate` starts from when no initial state is given. (Every other constant
+#: of the study is in :mod:`rockjit.study`, which lists this one too.)
 Z0_STUDY = (-0.2254, -0.1597, -0.7778, 0.6284)
 
 #: Default number of steps per forcing period of single runs. Impact times over 20 periods are
@@ -27,22 +37,48 @@ DEFAULT_N = 160
 #: would be coarse against the block's own time scale, so N is raised until h <= MAX_STEP.
 MAX_STEP = 0.1
 
-
 #: Coarsest step accepted at all: the block's own time scale is ~1, so a longer step is no
 #: integration of it (and a stress case: omega = 0.05 with N = 8 gave h = 16).
 STEP_LIMIT = 1.0
 
+#: Damping: the velocity's own rate is ``c = 3/4 xi``. The Dormand–Prince step is stable on it
+#: for ``h c < 3.307`` (its stability polynomial's real boundary); an explicit N is refused
+#: beyond ``h c = STABLE_DAMPING``, and a default N is raised until ``h c <= DAMPING_STEP``,
+#: where the step also follows the damped mode accurately. (Found by the stress suite: xi = 200
+#: at N = 160, h c = 3.6, overturned at t = 2.2 with an error estimate of 1e2.)
+STABLE_DAMPING = 3.0
+DAMPING_STEP = 1.0
 
-def check_step(period, n_steps, forcing="closed", radius=1.0):
-    """Reject a grid too coarse to integrate: ``ValueError`` naming ``n_steps``.
+#: ``solve_ivp`` methods of the reference path.
+IVP_METHODS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
 
-    Any forcing: ``h = T/N <= STEP_LIMIT``. The embedding also integrates the oscillator's
-    radial contraction, of rate ``3 rho^2 - 1`` from radius ``rho``, which an explicit step
-    only follows stably for ``h (3 rho^2 + 1) <= 1.5`` (found by the stress suite: beyond it
-    r, s overflow).
+#: Largest number of periods, and of steps per period, a run may ask for (the memory check
+#: refuses most large requests earlier, with the memory they would need).
+MAX_PERIODS = 10**9
+MAX_N = 10**9
+
+
+def default_max_impacts(periods):
+    """The default impact bound: 10,000 impacts per period, at least 100,000. A Zeno cascade
+    from ``|theta'| ~ 1`` to the cut-off ``1e-6`` has ``ln(1e-6) / ln(e)`` impacts: ~10 for
+    ``e = 0.25``, ~75 for ``e = 0.83``, ~1,400 for ``e = 0.99``, at most two a period."""
+    return max(100_000, 10_000 * int(periods))
+
+
+def check_step(period, n_steps, forcing="closed", radius=1.0, xi=0.0):
+    """Reject a grid too coarse to integrate: ``ValueError`` naming ``n_steps`` and the N needed.
+
+    Any forcing: ``h = T/N <= STEP_LIMIT``; damping: ``h 3/4 xi <= STABLE_DAMPING``. The
+    embedding also integrates the oscillator's radial contraction, of rate ``3 rho^2 - 1``
+    from radius ``rho``, which an explicit step only follows stably for
+    ``h (3 rho^2 + 1) <= 1.5`` (found by the stress suite: beyond it r, s overflow).
     """
     h_max = STEP_LIMIT
     why = f"the step T/N must be <= {STEP_LIMIT}"
+    if xi > 0 and STABLE_DAMPING / (0.75 * xi) < h_max:
+        h_max = STABLE_DAMPING / (0.75 * xi)
+        why = (f"the damping xi = {xi:g} needs a step T/N <= {h_max:.3g} to stay stable "
+               f"(3/4 xi T/N <= {STABLE_DAMPING})")
     if forcing == "embedded":
         h_emb = 1.5 / (3.0 * max(radius, 1.0) ** 2 + 1.0)
         if h_emb < h_max:
@@ -55,199 +91,199 @@ def check_step(period, n_steps, forcing="closed", radius=1.0):
                          f"T/N = {period / n_steps:.3g})")
 
 
-def steps_per_period(period, default):
-    """``default``, or the smallest even N with ``period / N <= MAX_STEP`` if that is larger."""
+def steps_per_period(period, default, xi=0.0):
+    """``default``, or the smallest even N with ``period / N <= MAX_STEP`` and
+    ``period / N * 3/4 xi <= DAMPING_STEP`` if that is larger."""
     n = int(default)
-    if period / n > MAX_STEP:
-        n = 2 * math.ceil(period / (2 * MAX_STEP))
+    h_max = MAX_STEP
+    if xi > 0:
+        h_max = min(h_max, DAMPING_STEP / (0.75 * xi))
+    if period / n > h_max:
+        n = 2 * math.ceil(period / (2 * h_max))
     return n
 
-STATUS_MESSAGES = {
-    "done": "reached the requested number of periods",
-    "overturned": "the block overturned (|theta| reached theta_over)",
-    "rest": "the block came to rest and the forcing can never lift it again "
-            "(alpha * omega**2 <= cot(thc))",
-    "max_impacts": "stopped at the impact bound max_impacts before the requested end",
-    "nonfinite": "a non-finite number appeared; this is a bug, please report the inputs",
-    "settled": "stopped early: the stroboscopic orbit settled on a periodic one",
-}
 
-
-@dataclass
-class Result:
-    """What one run produced. Arrays are views of exactly what was computed.
-
-    Attributes
-    ----------
-    block : Block
-        The validated parameters.
-    method : str
-        ``"rockjit"`` or ``"scipy:<solve_ivp method>"``.
-    status : str
-        One of ``done, overturned, rest, max_impacts, nonfinite, settled``; ``message`` says it
-        in words.
-    t : float
-        Time reached (the overturning or rest instant for runs that stopped there).
-    state : ndarray, shape (4,)
-        ``(theta, theta', r, s)`` at ``t``.
-    period : float
-        Forcing period ``T``.
-    n_steps : int
-        Steps per period ``N`` (the compiled path's grid; also the scipy path's sampling grid).
-    strobe : ndarray, shape (k, 4)
-        ``(theta, theta', r, s)`` at ``t = 0, T, 2T, ...`` as far as the run went.
-    strobe_half : ndarray, shape (k, 4)
-        The same at ``t = T/2, 3T/2, ...``.
-    impacts : ndarray, shape (m, 3)
-        ``(t, theta'-, theta'+)`` of each impact, in order.
-    n_impacts, n_grid_steps, n_rhs : int
-        Counts of impacts, grid steps completed, right-hand-side evaluations.
-    max_error_estimate : float
-        Largest embedded 4th-order error estimate of ``theta, theta'`` over the run's steps
-        (``nan`` on the scipy path).
-    trajectory : ndarray, shape (p, 5) or None
-        ``(t, theta, theta', r, s)`` every ``record_stride`` grid steps, when asked.
-    lyapunov : ndarray, shape (2,) or None
-        ``(lambda1, lambda2)`` averaged over ``window``, when asked.
-    lyapunov_running : ndarray, shape (k, 2) or None
-        The running estimate ``lambda(t)`` at ``t = 0, T, 2T, ...``.
-    window : tuple of float or None
-        ``(t0, t1)`` over which ``lyapunov`` was averaged.
-    n_rest, n_rest_window : int
-        Rest phases entered (Zeno cut-offs), overall and within ``window``.
-    n_impacts_window : int
-        Impacts within the window (for the exact identity of SPEC.md §5).
-    """
-
-    block: Block
-    method: str
-    status: str
-    t: float
-    state: np.ndarray
-    period: float
-    n_steps: int
-    periods: int
-    strobe: np.ndarray
-    strobe_half: np.ndarray
-    impacts: np.ndarray
-    n_impacts: int
-    n_grid_steps: int
-    n_rhs: int
-    max_error_estimate: float
-    trajectory: np.ndarray | None = None
-    lyapunov: np.ndarray | None = None
-    lyapunov_running: np.ndarray | None = None
-    window: tuple | None = None
-    n_rest: int = 0
-    n_rest_window: int = 0
-    n_impacts_window: int = 0
-    extra: dict = field(default_factory=dict)
-
-    @property
-    def message(self) -> str:
-        return STATUS_MESSAGES[self.status]
-
-    @property
-    def lambda_max(self) -> float:
-        """``lambda1`` over the window (``nan`` when exponents were not asked for)."""
-        return math.nan if self.lyapunov is None else float(self.lyapunov[0])
-
-    def __repr__(self) -> str:
-        b = self.block
-        return (f"Result({self.method}, hb={b.hb}, alpha={b.alpha}, omega={b.omega}, "
-                f"law={b.law}, status={self.status!r}, t={self.t:.6g}, "
-                f"impacts={self.n_impacts})")
-
-
-def _int(name, value, lo, hi=None):
-    try:
-        ok = float(value) == int(value)
-    except (TypeError, ValueError, OverflowError):
-        ok = False
-    if not ok or isinstance(value, bool):
-        raise ValueError(f"{name} must be an integer (got {value!r})")
-    value = int(value)
-    if value < lo or (hi is not None and value > hi):
-        rng = f">= {lo}" if hi is None else f"in [{lo}, {hi}]"
-        raise ValueError(f"{name} must be {rng} (got {value})")
-    return value
-
-
-def forcing_phase(phase=None, r0=None, s0=None, forcing="closed"):
+def forcing_phase(phase=None, r0=None, s0=None, forcing="closed", *, embedded_hint=True):
     """Resolve the forcing's initial condition into ``(phi, r0, s0)``.
 
     Give either ``phase`` (``r = sin(omega t + phase)``) or ``(r0, s0)``; the default is
     ``(r0, s0) = (0, 1)``. With the closed form, ``(r0, s0)`` must lie on the unit circle (to
-    1e-3): off it only the embedding is meaningful (SPEC.md §1).
+    1e-3): off it only the embedding is meaningful (SPEC.md §1); ``embedded_hint`` says so in
+    the message (callers without an embedding turn it off).
     """
-    if forcing not in ("closed", "embedded"):
-        raise ValueError(f"forcing must be 'closed' or 'embedded' (got {forcing!r})")
+    choice("forcing", forcing, ("closed", "embedded"))
     if phase is not None:
         if r0 is not None or s0 is not None:
             raise ValueError("give either phase or (r0, s0), not both")
-        phi = _real("phase", phase)
+        phi = real("phase", phase)
         return phi, math.sin(phi), math.cos(phi)
     if (r0 is None) != (s0 is None):
         raise ValueError("r0 and s0 go together: give both or neither")
     if r0 is None:
         r0, s0 = 0.0, 1.0
-    r0 = _real("r0", r0)
-    s0 = _real("s0", s0)
+    r0 = real("r0", r0, -1e3, 1e3)
+    s0 = real("s0", s0, -1e3, 1e3)
     rad = math.hypot(r0, s0)
     if rad == 0.0:
         raise ValueError("(r0, s0) must not be (0, 0): the forcing oscillator has no phase there")
     if forcing == "closed" and abs(rad - 1.0) > 1e-3:
-        raise ValueError(
-            f"(r0, s0) must lie on the unit circle for forcing='closed' (|(r0, s0)| = {rad:.6g});"
-            " use forcing='embedded' for a start off the circle")
+        hint = "; use forcing='embedded' for a start off the circle" if embedded_hint else \
+            "; give a point on the circle, or a phase"
+        raise ValueError(f"(r0, s0) must lie on the unit circle for the closed-form forcing "
+                         f"(|(r0, s0)| = {rad:.6g}){hint}")
     return math.atan2(r0, s0), r0, s0
 
 
-def initial_side(theta0, dtheta0):
-    """The corner a run starts on: sign of theta0, else of theta0', else 0 (rest)."""
-    if theta0 > 0.0 or (theta0 == 0.0 and dtheta0 > 0.0):
-        return 1
-    if theta0 < 0.0 or (theta0 == 0.0 and dtheta0 < 0.0):
-        return -1
-    return 0
+def initial_state(theta0=None, dtheta0=None, z0=None, r0=None, s0=None, phase=None):
+    """``(theta0, dtheta0, r0, s0)`` from the ways a user may give them: ``z0`` at once, or
+    separately (missing angles are 0), or nothing at all (the study's ``Z0_STUDY``).
+    ``r0, s0`` may be ``None`` (resolved by :func:`forcing_phase`)."""
+    if z0 is not None:
+        if theta0 is not None or dtheta0 is not None or r0 is not None or s0 is not None:
+            raise ValueError("give z0 or (theta0, dtheta0, r0, s0), not both")
+        try:
+            z = np.asarray(z0, dtype=float).ravel()
+        except (TypeError, ValueError):
+            raise ValueError(f"z0 must be 4 numbers (theta, theta', r, s) (got {z0!r})") \
+                from None
+        if z.shape != (4,):
+            raise ValueError(f"z0 must have 4 entries (theta, theta', r, s) (got {z.size})")
+        theta0, dtheta0, r0, s0 = (float(v) for v in z)
+    elif theta0 is None and dtheta0 is None and r0 is None and s0 is None and phase is None:
+        theta0, dtheta0, r0, s0 = Z0_STUDY
+    return (0.0 if theta0 is None else theta0), (0.0 if dtheta0 is None else dtheta0), r0, s0
 
 
-def check_settings(periods, n_steps, max_impacts, window, record_stride):
-    periods = _int("periods", periods, 1)
-    n_steps = _int("n_steps", n_steps, 8)
-    if n_steps % 2:
-        raise ValueError(f"n_steps must be even, so that t = kT + T/2 is on the grid "
-                         f"(got {n_steps})")
-    max_impacts = _int("max_impacts", max_impacts, 1)
-    if window is None:
-        w0 = int(round(0.8 * periods))
+def check_theta0(theta0, block, name="theta0"):
+    """An initial angle inside the bounded region ``|theta0| < theta_over``."""
+    theta0 = real(name, theta0)
+    if abs(theta0) >= block.theta_over:
+        raise ValueError(f"{name} must satisfy |{name}| < theta_over = {block.theta_over:.6g} "
+                         f"(got {theta0:g}): the block would start overturned")
+    return theta0
+
+
+def make_block(hb, alpha, omega, law=None, e=None, xi=None, theta_over=0.5 * math.pi,
+               rest_speed=1e-6):
+    """A :class:`Block` from the API's keyword arguments (``xi=None``: the study's value)."""
+    kw = dict(hb=hb, alpha=alpha, omega=omega, law=law, e=e, theta_over=theta_over,
+              rest_speed=rest_speed)
+    if xi is not None:
+        kw["xi"] = xi
+    return Block(**kw)
+
+
+@dataclass(frozen=True)
+class RunPlan:
+    """A validated single run: everything :func:`run` needs, nothing left to check."""
+
+    block: Block
+    y0: tuple            # (theta0, dtheta0, r0, s0)
+    phi: float
+    forcing: str
+    method: str          # "rockjit" or "scipy:<METHOD>"
+    rtol: float
+    atol: float
+    periods: int
+    n_steps: int
+    window: int
+    max_impacts: int
+    record_stride: int | None
+    lyapunov: bool
+    qr_every: int | None
+    memory_bytes: float
+
+
+def _method(method):
+    if method == "rockjit":
+        return method
+    if isinstance(method, str) and (method == "scipy" or method.startswith("scipy:")):
+        name = method.split(":", 1)[1] if ":" in method else "BDF"
+        if name not in IVP_METHODS:
+            raise ValueError(f"method must be 'rockjit', 'scipy' or 'scipy:<one of "
+                             f"{', '.join(IVP_METHODS)}>' (got {method!r})")
+        return f"scipy:{name}"
+    raise ValueError(f"method must be 'rockjit', 'scipy' or 'scipy:<one of "
+                     f"{', '.join(IVP_METHODS)}>' (got {method!r})")
+
+
+def run_settings(block, periods, n_steps, default_n, max_impacts, window):
+    """The settings every run and grid shares, validated: ``(periods, n_steps, max_impacts,
+    window)``. ``n_steps=None`` gives ``default_n``, raised for slow forcing and strong
+    damping; an explicit one must be even, at least 8, and stable (:func:`check_step`)."""
+    periods = integer("periods", periods, 1, MAX_PERIODS)
+    if n_steps is None:
+        n_steps = steps_per_period(block.period, default_n, block.xi)
     else:
-        w0 = _int("window", window, 0, periods - 1)
+        n_steps = integer("n_steps", n_steps, 8, MAX_N)
+        if n_steps % 2:
+            raise ValueError(f"n_steps must be even, so that t = kT + T/2 is on the grid "
+                             f"(got {n_steps})")
+    max_impacts = default_max_impacts(periods) if max_impacts is None else \
+        integer("max_impacts", max_impacts, 1, 2**62)
+    w0 = int(round(0.8 * periods)) if window is None else \
+        integer("window", window, 0, periods - 1)
+    return periods, n_steps, max_impacts, w0
+
+
+def plan(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta0=None, z0=None,
+         phase=None, r0=None, s0=None, periods=500, n_steps=None, forcing="closed",
+         method="rockjit", rtol=1e-6, atol=1e-9, lyapunov=False, window=None,
+         record_stride=None, max_impacts=None, theta_over=0.5 * math.pi, rest_speed=1e-6,
+         qr_every=None) -> RunPlan:
+    """Validate the inputs of :func:`simulate` (same parameters) into a :class:`RunPlan`.
+
+    Raises ``ValueError`` naming the parameter for anything out of range, for a grid too coarse
+    to integrate stably, and for a run whose arrays would not fit in memory.
+    """
+    theta0, dtheta0, r0, s0 = initial_state(theta0, dtheta0, z0, r0, s0, phase)
+    dtheta0 = real("dtheta0", dtheta0, -1e6, 1e6)
+    block = make_block(hb, alpha, omega, law, e, xi, theta_over, rest_speed)
+    theta0 = check_theta0(theta0, block)
+    phi, r0, s0 = forcing_phase(phase, r0, s0, forcing)
+    method = _method(method)
+    periods, n_steps, max_impacts, w0 = run_settings(block, periods, n_steps, DEFAULT_N,
+                                                     max_impacts, window)
+    check_step(block.period, n_steps, forcing, math.hypot(r0, s0), block.xi)
     if record_stride is not None:
-        record_stride = _int("record_stride", record_stride, 1)
-    return periods, n_steps, max_impacts, w0, record_stride
+        record_stride = integer("record_stride", record_stride, 1, 2**62)
+    if qr_every is not None:
+        qr_every = integer("qr_every", qr_every, 0, 2**62)
+    lyapunov = bool(lyapunov)
+    if method != "rockjit":
+        if lyapunov:
+            raise ValueError("lyapunov=True is only available with method='rockjit'")
+        rtol = real("rtol", rtol, 0.0, 1.0, lo_open=True, hi_open=True)
+        atol = real("atol", atol, 0.0, None, lo_open=True)
+    n_traj = periods * n_steps // record_stride + 1 if record_stride else 1
+    nbytes = kernel.run_bytes(periods, n_steps, max_impacts, n_traj, lyapunov)
+    memory(f"periods = {periods} at n_steps = {n_steps}", nbytes)
+    return RunPlan(block=block, y0=(theta0, dtheta0, r0, s0), phi=phi, forcing=forcing,
+                   method=method, rtol=float(rtol), atol=float(atol), periods=periods,
+                   n_steps=n_steps, window=w0, max_impacts=max_impacts,
+                   record_stride=record_stride, lyapunov=lyapunov, qr_every=qr_every,
+                   memory_bytes=nbytes)
 
 
-def pack(block: Block, phi: float, n_steps: int):
-    """The float parameter vector the compiled kernels read (layout in :mod:`integrate`)."""
-    par = np.zeros(ig.N_PAR)
-    par[ig.P_THC] = block.thc
-    par[ig.P_XI] = block.xi
-    par[ig.P_E] = block.restitution
-    par[ig.P_AW2] = block.alpha * block.omega**2
-    par[ig.P_OMEGA] = block.omega
-    par[ig.P_PHI] = phi
-    par[ig.P_COT] = block.cot
-    par[ig.P_THOVER] = block.theta_over
-    par[ig.P_REST] = block.rest_speed
-    par[ig.P_H] = block.period / n_steps
-    return par
+def run(p: RunPlan) -> Result:
+    """Execute a :class:`RunPlan` on its path (compiled or scipy)."""
+    theta0, dtheta0, r0, s0 = p.y0
+    if p.method != "rockjit":
+        from .reference import simulate_scipy  # scipy.integrate only when asked for
+        return simulate_scipy(p.block, theta0, dtheta0, p.phi, r0, s0, periods=p.periods,
+                              n_steps=p.n_steps, forcing=p.forcing,
+                              ivp_method=p.method.split(":", 1)[1], rtol=p.rtol, atol=p.atol,
+                              record_stride=p.record_stride, max_impacts=p.max_impacts)
+    return kernel.run_single(p.block, (theta0, dtheta0, r0, s0), p.phi, n_steps=p.n_steps,
+                             periods=p.periods, window=p.window, max_impacts=p.max_impacts,
+                             record_stride=p.record_stride, embed4=p.forcing == "embedded",
+                             lyapunov=p.lyapunov, qr_every=p.qr_every)
 
 
 def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta0=None,
              z0=None, phase=None, r0=None, s0=None, periods=500, n_steps=None,
              forcing="closed", method="rockjit", rtol=1e-6, atol=1e-9, lyapunov=False,
-             window=None, record_stride=None, max_impacts=100_000,
+             window=None, record_stride=None, max_impacts=None,
              theta_over=0.5 * math.pi, rest_speed=1e-6, qr_every=None) -> Result:
     """Simulate the harmonically forced rocking block.
 
@@ -260,9 +296,10 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
     e : float, optional
         Constant coefficient of restitution in ``[0, 1]``.
     xi : float, optional
-        Damping; default the study's ``2.208e-4``.
+        Damping in ``[0, 1e4]``; default the study's ``2.208e-4``.
     theta0, dtheta0 : float, optional
-        Initial angle and angular velocity. Default: the study's ``z0`` (SPEC.md §7).
+        Initial angle (``|theta0| < theta_over``) and angular velocity. Default: the study's
+        ``z0`` (SPEC.md §7).
     z0 : sequence of 4 floats, optional
         ``(theta0, dtheta0, r0, s0)`` at once, instead of the four separately.
     phase : float, optional
@@ -273,14 +310,17 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
         Number of forcing periods to integrate (``>= 1``), default 500.
     n_steps : int, optional
         Steps per period ``N`` (even, ``>= 8``); default :data:`DEFAULT_N`, raised for slow
-        forcing so that the step ``T/N`` stays below :data:`MAX_STEP`.
+        forcing so that the step ``T/N`` stays below :data:`MAX_STEP`, and for strong damping
+        so that ``3/4 xi T/N <= DAMPING_STEP``. An explicit N beyond the step's stability
+        (:func:`check_step`) is refused, naming the N needed.
     forcing : {"closed", "embedded"}
         Closed-form forcing, or the 4-D oscillator embedding integrated with the block.
     method : str
         ``"rockjit"`` (compiled, fixed step) or ``"scipy"`` / ``"scipy:<METHOD>"`` for the
         reference path through ``scipy.integrate.solve_ivp`` (default BDF, the study's).
     rtol, atol : float
-        Tolerances of the scipy path (ignored by the compiled one).
+        Tolerances of the scipy path (ignored by the compiled one); ``0 < rtol < 1``,
+        ``atol > 0``.
     lyapunov : bool
         Compute the block's Lyapunov exponents (SPEC.md §5); compiled path only.
     window : int, optional
@@ -288,12 +328,14 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
         (the study's ``[400T, 500T]`` for 500 periods).
     record_stride : int, optional
         Record ``(t, theta, theta', r, s)`` every this many grid steps.
-    max_impacts : int
+    max_impacts : int, optional
         Bound on the number of impacts; reaching it ends the run with status ``max_impacts``.
+        Default :func:`default_max_impacts` (10,000 per period, at least 100,000).
     theta_over : float
         Overturning threshold on ``|theta|``, default ``pi/2``.
     rest_speed : float
-        Zeno cut-off: an impact leaving with ``|theta'| < rest_speed`` puts the block at rest.
+        Zeno cut-off in ``(0, 0.1]``: an impact leaving with ``|theta'| < rest_speed`` puts the
+        block at rest.
     qr_every : int, optional
         Grid steps between Gram–Schmidt renormalisations of the tangent vectors; default
         ``n_steps // 2``; 0 renormalises only on entering rest, so that for a run without rest
@@ -307,91 +349,10 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
     ------
     ValueError
         For any parameter out of its range; the message names the parameter, the allowed range
-        and the value given.
+        and the value given. Also for a run whose arrays would not fit in memory.
     """
-    if z0 is not None:
-        if theta0 is not None or dtheta0 is not None or r0 is not None or s0 is not None:
-            raise ValueError("give z0 or (theta0, dtheta0, r0, s0), not both")
-        z = np.asarray(z0, dtype=float).ravel()
-        if z.shape != (4,):
-            raise ValueError(f"z0 must have 4 entries (theta, theta', r, s) (got {z.size})")
-        theta0, dtheta0, r0, s0 = (float(v) for v in z)
-    elif theta0 is None and dtheta0 is None and r0 is None and s0 is None and phase is None:
-        theta0, dtheta0, r0, s0 = Z0_STUDY
-    theta0 = _real("theta0", 0.0 if theta0 is None else theta0)
-    dtheta0 = _real("dtheta0", 0.0 if dtheta0 is None else dtheta0)
-    kw = dict(hb=hb, alpha=alpha, omega=omega, law=law, e=e, theta_over=theta_over,
-              rest_speed=rest_speed)
-    if xi is not None:
-        kw["xi"] = xi
-    block = Block(**kw)
-    phi, r0, s0 = forcing_phase(phase, r0, s0, forcing)
-    if n_steps is None:
-        n_steps = steps_per_period(block.period, DEFAULT_N)
-    periods, n_steps, max_impacts, w0, record_stride = check_settings(
-        periods, n_steps, max_impacts, window, record_stride)
-    check_step(block.period, n_steps, forcing, math.hypot(r0, s0))
-
-    if isinstance(method, str) and (method == "scipy" or method.startswith("scipy:")):
-        if lyapunov:
-            raise ValueError("lyapunov=True is only available with method='rockjit'")
-        from .reference import simulate_scipy
-        ivp_method = method.split(":", 1)[1] if ":" in method else "BDF"
-        return simulate_scipy(block, theta0, dtheta0, phi, r0, s0, periods=periods,
-                              n_steps=n_steps, forcing=forcing, ivp_method=ivp_method,
-                              rtol=_real("rtol", rtol), atol=_real("atol", atol),
-                              record_stride=record_stride, max_impacts=max_impacts)
-    if method != "rockjit":
-        raise ValueError(f"method must be 'rockjit', 'scipy' or 'scipy:<solve_ivp method>' "
-                         f"(got {method!r})")
-
-    embed4 = forcing == "embedded"
-    run = ig.build(embed4=embed4, tangent=bool(lyapunov), record=record_stride is not None)
-    par = pack(block, phi, n_steps)
-    ipar = np.zeros(ig.N_IPAR, dtype=np.int64)
-    ipar[ig.I_N] = n_steps
-    ipar[ig.I_PERIODS] = periods
-    ipar[ig.I_MAXIMP] = max_impacts
-    ipar[ig.I_STRIDE] = record_stride or 1
-    ipar[ig.I_WINDOW] = w0
-    ipar[ig.I_QR] = n_steps // 2 if qr_every is None else _int("qr_every", qr_every, 0)
-    y0 = np.array([theta0, dtheta0, r0, s0])
-    strobe = np.zeros((periods + 1, 4))
-    half = np.zeros((periods, 4))
-    impacts = np.empty((max_impacts, 3))  # only the rows filled are exposed: no need to zero
-    n_traj = periods * n_steps // record_stride + 1 if record_stride else 1
-    traj = np.zeros((n_traj, 5))
-    lam_run = np.zeros((periods + 1 if lyapunov else 1, 2))
-    per_imp = np.zeros(periods + 1, dtype=np.int64)
-    iout = np.zeros(ig.N_IOUT, dtype=np.int64)
-    fout = np.zeros(ig.N_FOUT)
-    code = run(y0, initial_side(theta0, dtheta0), par, ipar, strobe, half, impacts, traj,
-               lam_run, per_imp, iout, fout)
-    status = ig.STATUS_NAMES[int(code)]
-    n_imp = int(iout[ig.O_IMPACTS])
-    ns = int(iout[ig.O_NSTROBE])
-    res = Result(
-        block=block, method="rockjit", status=status, t=float(fout[ig.F_T]),
-        state=fout[ig.F_TH:ig.F_S + 1].copy(), period=block.period, n_steps=n_steps,
-        periods=periods, strobe=strobe[:ns], strobe_half=half[:int(iout[ig.O_NHALF])],
-        impacts=impacts[:min(n_imp, max_impacts)], n_impacts=n_imp,
-        n_grid_steps=int(iout[ig.O_STEPS]), n_rhs=int(iout[ig.O_RHS]),
-        max_error_estimate=float(fout[ig.F_MAXERR]),
-        trajectory=traj[:int(iout[ig.O_NTRAJ])] if record_stride else None,
-        n_rest=int(iout[ig.O_NREST]), n_rest_window=int(iout[ig.O_NREST_WIN]),
-        n_impacts_window=int(iout[ig.O_NIMP_WIN]),
-    )
-    if lyapunov:
-        # the tangent matrix at the end: the flow's Jacobian since the last renormalisation
-        res.extra["tangent"] = fout[ig.F_V:ig.F_V + 4].reshape(2, 2, order="F").copy()
-        res.window = (w0 * block.period, res.t)
-        res.lyapunov_running = lam_run[:ns]
-        if status == "rest":
-            # at rest for good every perturbation dies out in finite time
-            res.lyapunov = np.array([-math.inf, -math.inf])
-        else:
-            # Gram-Schmidt's first column carries the largest growth only asymptotically; over
-            # a finite window a (near-)degenerate pair may come out in either order
-            res.lyapunov = np.sort(fout[ig.F_LAM1:ig.F_LAM2 + 1])[::-1].copy()
-        res.lyapunov_running = -np.sort(-res.lyapunov_running, axis=1)
-    return res
+    return run(plan(hb, alpha, omega, law, e=e, xi=xi, theta0=theta0, dtheta0=dtheta0, z0=z0,
+                    phase=phase, r0=r0, s0=s0, periods=periods, n_steps=n_steps,
+                    forcing=forcing, method=method, rtol=rtol, atol=atol, lyapunov=lyapunov,
+                    window=window, record_stride=record_stride, max_impacts=max_impacts,
+                    theta_over=theta_over, rest_speed=rest_speed, qr_every=qr_every))

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from rockjit import analysis as an
-from rockjit import chunks
+from rockjit import chunks, kernel
 from rockjit.cli import main
 
 
@@ -78,7 +78,7 @@ def test_losing_a_worker_mid_run_still_completes(client, local_plane, tmp_path):
 
 def test_interrupted_run_resumes(tmp_path, local_plane, monkeypatch):
     store = tmp_path / "store"
-    real = an.run_chunk
+    real = kernel.run_chunk
     calls = []
 
     def interrupt_after_three(*args):
@@ -87,7 +87,7 @@ def test_interrupted_run_resumes(tmp_path, local_plane, monkeypatch):
         calls.append(args[1].shape[0])
         return real(*args)
 
-    monkeypatch.setattr(an, "run_chunk", interrupt_after_three)
+    monkeypatch.setattr(kernel, "run_chunk", interrupt_after_three)
     with pytest.raises(KeyboardInterrupt):
         an.plane(**PLANE, chunk=6, store=store)
     done = sorted(store.glob("cells-*.npz"))
@@ -99,7 +99,7 @@ def test_interrupted_run_resumes(tmp_path, local_plane, monkeypatch):
         counted.append(args[1].shape[0])
         return real(*args)
 
-    monkeypatch.setattr(an, "run_chunk", count)
+    monkeypatch.setattr(kernel, "run_chunk", count)
     resumed = an.plane(**PLANE, chunk=6, store=store)
     assert sum(counted) == 48 - 3 * 6  # only the missing cells were computed
     same(resumed, local_plane)
@@ -127,7 +127,7 @@ def test_plane_command_resumes_and_cleans_up(tmp_path, monkeypatch, capsys):
     out = tmp_path / "plane"
     args = ["plane", "--hb", "1", "--alpha-range", "0.4", "1.0", "--omega-range", "0.9",
             "1.8", "--grid", "8", "6", "--periods", "120", "--out", str(out), "--quiet"]
-    real = an.run_chunk
+    real = kernel.run_chunk
     n = []
 
     def interrupt_once(*a):
@@ -136,12 +136,12 @@ def test_plane_command_resumes_and_cleans_up(tmp_path, monkeypatch, capsys):
         n.append(1)
         return real(*a)
 
-    monkeypatch.setattr(an, "run_chunk", interrupt_once)
-    monkeypatch.setattr(an, "_run_grid", _small_chunks(an._run_grid))
+    monkeypatch.setattr(kernel, "run_chunk", interrupt_once)
+    monkeypatch.setattr(kernel, "run_grid", _small_chunks(kernel.run_grid))
     assert main(args) == 130
     assert not out.exists()  # --out is written only once everything is computed
     assert list((tmp_path / "plane.chunks" / "plane").glob("cells-*.npz"))
-    monkeypatch.setattr(an, "run_chunk", real)
+    monkeypatch.setattr(kernel, "run_chunk", real)
     assert main(args) == 0
     assert not (tmp_path / "plane.chunks").exists()
     z = np.load(out / "plane.npz")

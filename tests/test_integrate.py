@@ -22,7 +22,7 @@ import pytest
 
 import rockjit
 from rockjit import integrate as ig
-from rockjit.simulate import pack
+from rockjit.kernel import pack
 
 DOP = dict(method="scipy:DOP853", rtol=1e-12, atol=1e-12)
 
@@ -413,9 +413,9 @@ def test_impact_bound_is_its_own_status():
 def test_overturn_threshold_is_a_parameter(spec):
     # a tilted slender block falls over the threshold theta_over = 0.3
     kw = dict(hb=2.0, alpha=0.0, omega=1.6, law="housner", theta0=0.5, dtheta0=0.2, periods=2)
-    r = rockjit.simulate(**kw, theta_over=0.3)
-    # theta0 = 0.5 is already past the threshold: overturned at once
-    assert r.status == "overturned" and r.t == 0.0 and r.n_impacts == 0
+    # theta0 = 0.5 is already past the threshold: refused, as on the command line (issue 10)
+    with pytest.raises(ValueError, match=r"theta0 must satisfy \|theta0\| < theta_over = 0\.3"):
+        rockjit.simulate(**kw, theta_over=0.3)
     kw["theta0"] = 0.25
     r = rockjit.simulate(**kw, theta_over=0.3)
     ref = spec.run(2.0, 0.0, 1.6, spec.e_housner(2.0), theta0=0.25, dtheta0=0.2, phi=0.0,

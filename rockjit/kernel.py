@@ -1,0 +1,347 @@
+"""The one owner of the compiled kernels' inputs and outputs: packing, allocating, unpacking.
+
+The kernels (:mod:`rockjit.integrate` for one run, :func:`_grid` here for grids of runs) read a
+float parameter vector ``par`` and integer settings ``ipar`` and fill an
+:data:`rockjit.integrate.Outputs`; their layouts are declared in :mod:`rockjit.integrate`. This
+module is the only one that packs those vectors (:func:`pack`, :func:`settings`), allocates the
+outputs (:func:`outputs`), estimates their memory before anything is allocated
+(:func:`run_bytes`, :func:`grid_bytes`), and reads them back into the result types of
+:mod:`rockjit.result` (:func:`run_single`, :func:`run_grid`).
+
+Grids (three tiers, STYLE.md 1): :func:`_cell`, a serial compiled worker, runs one cell and
+classifies it (:mod:`rockjit.classify`); :func:`_grid`, ``parallel=True``, runs a chunk of cells
+with ``prange``, each iteration with private scratch writing only its own row of the outputs,
+so results do not depend on the number of threads; :func:`run_chunk` is the unit of work of
+:mod:`rockjit.chunks` (in this process or on a Dask worker) and :func:`run_grid` runs all chunks.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from contextlib import contextmanager
+
+import numba
+import numpy as np
+from numba import prange
+
+from . import chunks
+from . import integrate as ig
+from ._jit import jit
+from .classify import classify, lam_between
+from .model import initial_side
+from .result import OVERTURN, REST, UNRESOLVED, Result
+from .validate import integer
+
+__all__ = ["IMPACT_RECORD", "N_RES", "grid_bytes", "outputs", "pack", "run_bytes", "run_chunk",
+           "run_grid", "run_single", "settings"]
+
+#: Rows of the impact record of a single run: beyond this many impacts only the latest are kept
+#: (``Result.n_impacts`` counts all of them).
+IMPACT_RECORD = 1_000_000
+
+# layout of the classification settings ``cpar`` (float)
+C_TOL, C_LAMTOL = range(2)
+# layout of a cell's scalar results ``res`` (float)
+R_LABEL, R_PERIOD, R_LAM1, R_LAM2, R_T, R_NIMP, R_K0, R_K1, R_STATUS = range(9)
+N_RES = 9
+
+
+# ---------------------------------------------------------------------------------------------
+# packing
+# ---------------------------------------------------------------------------------------------
+
+def pack(block, phi, n_steps, settle_tol=0.0):
+    """The float parameter vector ``par`` of a block at forcing phase ``phi`` with ``n_steps``
+    steps per period (layout ``P_*`` in :mod:`rockjit.integrate`)."""
+    par = np.zeros(ig.N_PAR)
+    par[ig.P_THC] = block.thc
+    par[ig.P_XI] = block.xi
+    par[ig.P_E] = block.restitution
+    par[ig.P_AW2] = block.alpha * block.omega**2
+    par[ig.P_OMEGA] = block.omega
+    par[ig.P_PHI] = phi
+    par[ig.P_COT] = block.cot
+    par[ig.P_THOVER] = block.theta_over
+    par[ig.P_REST] = block.rest_speed
+    par[ig.P_H] = block.period / n_steps
+    par[ig.P_SETTLE_TOL] = settle_tol
+    return par
+
+
+def settings(n_steps, periods, max_impacts, window, *, stride=1, settle_reps=0, qr_every=None,
+             pmax=1):
+    """The integer settings ``ipar`` (layout ``I_*`` in :mod:`rockjit.integrate`);
+    ``qr_every`` defaults to twice per period."""
+    ipar = np.zeros(ig.N_IPAR, dtype=np.int64)
+    ipar[ig.I_N] = n_steps
+    ipar[ig.I_PERIODS] = periods
+    ipar[ig.I_MAXIMP] = max_impacts
+    ipar[ig.I_STRIDE] = stride
+    ipar[ig.I_WINDOW] = window
+    ipar[ig.I_SETTLE] = settle_reps
+    ipar[ig.I_QR] = n_steps // 2 if qr_every is None else qr_every
+    ipar[ig.I_PMAX] = pmax
+    return ipar
+
+
+def _impact_rows(max_impacts):
+    return min(max_impacts, IMPACT_RECORD)
+
+
+def outputs(periods, max_impacts, n_traj, tangent):
+    """Fresh :data:`rockjit.integrate.Outputs` for one run."""
+    return ig.Outputs(
+        strobe=np.zeros((periods + 1, 4)), half=np.zeros((periods, 4)),
+        impacts=np.empty((_impact_rows(max_impacts), 3)),  # rows filled are all that is read
+        traj=np.zeros((n_traj, 5)), lam_run=np.zeros((periods + 1 if tangent else 1, 3)),
+        per_imp=np.zeros(periods + 1, dtype=np.int64), iout=np.zeros(ig.N_IOUT, dtype=np.int64),
+        fout=np.zeros(ig.N_FOUT))
+
+
+def run_bytes(periods, n_steps, max_impacts, n_traj, tangent):
+    """Bytes one run allocates (a float: large requests must not overflow)."""
+    p = float(periods)
+    return 8.0 * (4 * (p + 1) + 4 * p + 3 * _impact_rows(max_impacts) + 5 * float(n_traj)
+                  + 3 * (p + 1 if tangent else 1) + (p + 1)
+                  + float(n_steps) * (ig.N_STAGES + 1))
+
+
+def grid_bytes(n_cells, periods, n_steps, n_pts, n_imp_pts, tangent, chunk, threads):
+    """Bytes a grid allocates: its outputs and inputs, plus each thread's scratch."""
+    per_cell = 8.0 * (N_RES + 2 * max(n_pts, 1) + 2 * max(n_imp_pts, 1) + 2 + 4 + ig.N_PAR)
+    scratch = run_bytes(periods, n_steps, max(n_imp_pts, 1), 1, tangent)
+    return float(n_cells) * per_cell * 2 + float(min(chunk, n_cells)) * per_cell \
+        + float(threads) * scratch
+
+
+# ---------------------------------------------------------------------------------------------
+# one run
+# ---------------------------------------------------------------------------------------------
+
+def run_single(block, y0, phi, *, n_steps, periods, window, max_impacts, record_stride,
+               embed4, lyapunov, qr_every):
+    """One compiled run (inputs validated by :func:`rockjit.simulate.plan`); a Result."""
+    run = ig.build(embed4=embed4, tangent=lyapunov, record=record_stride is not None)
+    par = pack(block, phi, n_steps)
+    ipar = settings(n_steps, periods, max_impacts, window, stride=record_stride or 1,
+                    qr_every=qr_every)
+    n_traj = periods * n_steps // record_stride + 1 if record_stride else 1
+    out = outputs(periods, max_impacts, n_traj, lyapunov)
+    y0 = np.asarray(y0, dtype=float)
+    code = run(y0, initial_side(y0[0], y0[1]), par, ipar, out)
+    iout, fout = out.iout, out.fout
+    status = ig.STATUS_NAMES[int(code)]
+    n_imp = int(iout[ig.O_IMPACTS])
+    ns = int(iout[ig.O_NSTROBE])
+    res = Result(
+        block=block, method="rockjit", status=status, t=float(fout[ig.F_T]),
+        state=fout[ig.F_TH:ig.F_S + 1].copy(), period=block.period, n_steps=n_steps,
+        periods=periods, strobe=out.strobe[:ns], strobe_half=out.half[:int(iout[ig.O_NHALF])],
+        impacts=_impacts_in_order(out.impacts, n_imp), n_impacts=n_imp,
+        n_grid_steps=int(iout[ig.O_STEPS]), n_rhs=int(iout[ig.O_RHS]),
+        max_error_estimate=float(fout[ig.F_MAXERR]),
+        trajectory=out.traj[:int(iout[ig.O_NTRAJ])] if record_stride else None,
+        n_rest=int(iout[ig.O_NREST]), n_rest_window=int(iout[ig.O_NREST_WIN]),
+        n_impacts_window=int(iout[ig.O_NIMP_WIN]),
+        n_locate_unconverged=int(iout[ig.O_UNCONVERGED]),
+    )
+    if lyapunov:
+        # the tangent matrix at the end: the flow's Jacobian since the last renormalisation;
+        # with qr_every = 0 that is the whole run's, and zero once a perturbation died (a rest
+        # phase, an impact with e = 0)
+        tangent = fout[ig.F_V:ig.F_V + 4].reshape(2, 2, order="F").copy()
+        res.extra["collapses"] = int(iout[ig.O_NCOL])
+        if qr_every == 0 and iout[ig.O_NCOL] > 0:
+            tangent[:] = 0.0
+        res.extra["tangent"] = tangent
+        res.window = (window * block.period, res.t)
+        lam_run = out.lam_run[:ns]
+        running = np.where(lam_run[:, 2:3] > 0, -math.inf, lam_run[:, :2])
+        if status == "rest":
+            # at rest for good every perturbation dies out in finite time
+            res.lyapunov = np.array([-math.inf, -math.inf])
+        else:
+            # Gram-Schmidt's first column carries the largest growth only asymptotically; over
+            # a finite window a (near-)degenerate pair may come out in either order
+            res.lyapunov = np.sort(fout[ig.F_LAM1:ig.F_LAM2 + 1])[::-1].copy()
+        res.lyapunov_running = -np.sort(-running, axis=1)
+    return res
+
+
+def _impacts_in_order(ring, n_imp):
+    """The impact record in time order: the ring's rows from the oldest kept on."""
+    cap = ring.shape[0]
+    if n_imp <= cap:
+        return ring[:n_imp]
+    q = n_imp % cap
+    return np.concatenate([ring[q:], ring[:q]])
+
+
+# ---------------------------------------------------------------------------------------------
+# grids
+# ---------------------------------------------------------------------------------------------
+
+@jit
+def _cell(TANGENT, y0, side0, par, ipar, cpar, out, res):
+    """Run one cell and classify it; scalar results go to ``res`` (layout ``R_*``)."""
+    status = ig._run(False, TANGENT, False, y0, side0, par, ipar, out)
+    iout = out.iout
+    k1 = iout[ig.O_NSTROBE] - 1
+    if status == ig.SETTLED:
+        p = iout[ig.O_PERIOD]
+        # exactly the samples settled_period compared: (k1 - reps p - p, k1]
+        k0 = max(0, k1 - ipar[ig.I_SETTLE] * p - p + 1)
+    else:
+        k0 = ipar[ig.I_WINDOW]
+    lam1 = math.nan
+    lam2 = math.nan
+    if TANGENT:
+        la, lb = lam_between(out.lam_run, k0, k1)
+        lam1 = max(la, lb)  # sorted: lambda1 >= lambda2 (see run_single)
+        lam2 = min(la, lb)
+    label = UNRESOLVED
+    period = 0
+    if status == ig.OVERTURNED:
+        label = OVERTURN
+    elif status == ig.REST:
+        label = REST
+        lam1 = -math.inf
+        lam2 = -math.inf
+    elif status == ig.DONE or status == ig.SETTLED:
+        label, period = classify(out.strobe, out.half, out.per_imp, k0, k1, lam1, TANGENT,
+                                 cpar[C_TOL], ipar[ig.I_PMAX], cpar[C_LAMTOL])
+    res[R_LABEL] = label
+    res[R_PERIOD] = period
+    res[R_LAM1] = lam1
+    res[R_LAM2] = lam2
+    res[R_T] = out.fout[ig.F_T]
+    res[R_NIMP] = iout[ig.O_IMPACTS]
+    res[R_K0] = k0
+    res[R_K1] = k1
+    res[R_STATUS] = status
+
+
+@jit(parallel=True)
+def _grid(TANGENT, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got,
+          n_imp_got):
+    """Cell i starts from ``y0s[i]`` with the parameter row ``pars[i]`` (integrate's layout).
+
+    Writes ``res[i]`` (scalars), and when ``n_pts > 0`` the last stroboscopic samples
+    ``pts[i, :, :]`` (``theta, theta'`` at kT over the classified stretch) and when
+    ``n_imp_pts > 0`` the impact section ``imp_pts[i, :, :]`` (``t mod T, theta'-``).
+    """
+    n = y0s.shape[0]
+    periods = ipar[ig.I_PERIODS]
+    cap = max(n_imp_pts, 1)
+    for i in prange(n):
+        par = pars[i]
+        T = par[ig.P_H] * ipar[ig.I_N]
+        out = ig.Outputs(np.zeros((periods + 1, 4)), np.zeros((periods + 1, 4)),
+                         np.zeros((cap, 3)), np.zeros((1, 5)),
+                         np.zeros((periods + 1 if TANGENT else 1, 3)),
+                         np.zeros(periods + 1, dtype=np.int64),
+                         np.zeros(ig.N_IOUT, dtype=np.int64), np.zeros(ig.N_FOUT))
+        y0 = y0s[i]
+        _cell(TANGENT, y0, initial_side(y0[0], y0[1]), par, ipar, cpar, out, res[i])
+        k0 = int(res[i, R_K0])
+        k1 = int(res[i, R_K1])
+        lab = int(res[i, R_LABEL])
+        bounded = lab != OVERTURN and lab != REST and lab != UNRESOLVED
+        if n_pts > 0:
+            m = 0
+            if bounded:
+                for k in range(max(k0, k1 - n_pts + 1), k1 + 1):
+                    pts[i, m, 0] = out.strobe[k, 0]
+                    pts[i, m, 1] = out.strobe[k, 1]
+                    m += 1
+            n_got[i] = m
+        if n_imp_pts > 0:
+            m = 0
+            if bounded:
+                nimp = out.iout[ig.O_IMPACTS]
+                t_from = k0 * T
+                first = max(0, nimp - cap)
+                for q in range(first, nimp):
+                    row = q % cap
+                    if out.impacts[row, 0] >= t_from:
+                        tt = out.impacts[row, 0]
+                        imp_pts[i, m, 0] = tt - T * math.floor(tt / T)
+                        imp_pts[i, m, 1] = out.impacts[row, 1]
+                        m += 1
+            n_imp_got[i] = m
+
+
+@functools.lru_cache(maxsize=None)
+def _kernel(tangent):
+    """The grid kernel with or without tangent vectors (a thin closure forwarding the flag as a
+    compile-time literal, so that the module-level kernels are specialised and cached)."""
+    TANGENT = bool(tangent)
+
+    @jit
+    def grid(y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got):
+        _grid(TANGENT, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got,
+              n_imp_got)
+
+    return grid
+
+
+@contextmanager
+def _threads(threads):
+    """Run with ``threads`` numba threads (default: all), small dynamic chunks."""
+    old = numba.get_num_threads()
+    if threads is not None:
+        threads = integer("threads", threads, 1, numba.config.NUMBA_NUM_THREADS)
+        numba.set_num_threads(threads)
+    old_chunk = numba.get_parallel_chunksize()
+    numba.set_parallel_chunksize(1)  # cells differ wildly in cost: balance dynamically
+    try:
+        yield
+    finally:
+        numba.set_parallel_chunksize(old_chunk)
+        numba.set_num_threads(old)
+
+
+def _grid_outputs(n, n_pts, n_imp_pts):
+    return dict(res=np.zeros((n, N_RES)), pts=np.full((n, max(n_pts, 1), 2), np.nan),
+                imp=np.full((n, max(n_imp_pts, 1), 2), np.nan),
+                n_got=np.zeros(n, dtype=np.int64), n_imp_got=np.zeros(n, dtype=np.int64))
+
+
+def run_chunk(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=None):
+    """Run the grid kernel on one chunk of cells; returns its outputs by name.
+
+    The unit of work of :func:`rockjit.chunks.run_chunks`, in this process or on a Dask worker.
+    """
+    out = _grid_outputs(y0s.shape[0], n_pts, n_imp_pts)
+    with _threads(threads):
+        _kernel(tangent)(np.ascontiguousarray(y0s), np.ascontiguousarray(pars), ipar, cpar,
+                         n_pts, n_imp_pts, out["res"], out["pts"], out["imp"], out["n_got"],
+                         out["n_imp_got"])
+    return out
+
+
+def default_chunk(n):
+    """Cells per chunk when none is given: about a twentieth of the grid, at least 64."""
+    return max(64, -(-n // 20))
+
+
+def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, threads, progress, label,
+             chunk=None, client=None, store=None):
+    """All cells through :func:`run_chunk`, chunk by chunk (progress between chunks).
+
+    Returns the outputs by name: ``res`` (rows in the ``R_*`` layout), ``pts``, ``imp``,
+    ``n_got``, ``n_imp_got``.
+    """
+    n = y0s.shape[0]
+    chunk = default_chunk(n) if chunk is None else chunk
+    outputs_ = _grid_outputs(n, n_pts, n_imp_pts)
+    cs = None
+    if store is not None:
+        key = chunks.fingerprint((y0s, pars, ipar, cpar),
+                                 dict(tangent=bool(tangent), n_pts=n_pts, n_imp_pts=n_imp_pts))
+        cs = chunks.ChunkStore(store, key, n, chunk)
+    chunks.run_chunks(run_chunk, (bool(tangent), y0s, pars, ipar, cpar, n_pts, n_imp_pts,
+                                  threads), n, chunk, outputs_, client=client, store=cs,
+                      progress=progress, label=label)
+    return outputs_

@@ -1,0 +1,223 @@
+"""The result types every backend builds: one run, an α sweep, a basin, a parameter plane.
+
+They sit below every backend (the compiled kernels, the scipy path, the grid runners), so that
+any of them can build a result without importing another; they hold labelled arrays and the
+validated parameters, and know nothing of how they were computed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .model import Block
+
+__all__ = ["BEHAVIOURS", "BasinResult", "GridResult", "PlaneResult", "Result", "STATUSES",
+           "STATUS_MESSAGES", "SweepResult", "fractions"]
+
+#: Behaviour names; a label array holds their indices (SPEC.md §6, README "Behaviours").
+BEHAVIOURS = ("overturn", "rest", "symmetric", "asymmetric", "multiperiodic", "chaotic",
+              "aperiodic", "unresolved")
+OVERTURN, REST, SYMMETRIC, ASYMMETRIC, MULTIPERIODIC, CHAOTIC, APERIODIC, UNRESOLVED = range(8)
+
+#: Statuses of a run, in the order of the kernels' status codes (rockjit.integrate).
+STATUSES = ("done", "overturned", "rest", "max_impacts", "nonfinite", "settled")
+
+STATUS_MESSAGES = {
+    "done": "reached the requested number of periods",
+    "overturned": "the block overturned (|theta| reached theta_over)",
+    "rest": "the block came to rest and the forcing can never lift it again "
+            "(alpha * omega**2 <= cot(thc))",
+    "max_impacts": "stopped at the impact bound max_impacts before the requested end",
+    "nonfinite": "a non-finite number appeared; this is a bug, please report the inputs",
+    "settled": "stopped early: the stroboscopic orbit settled on a periodic one",
+}
+
+
+def fractions(label):
+    """Percentage of cells per behaviour name (every name present, zeros included)."""
+    label = np.asarray(label)
+    n = label.size
+    return {name: (100.0 * np.count_nonzero(label == code) / n if n else 0.0)
+            for code, name in enumerate(BEHAVIOURS)}
+
+
+@dataclass
+class Result:
+    """What one run produced. Arrays are views of exactly what was computed.
+
+    Attributes
+    ----------
+    block : Block
+        The validated parameters.
+    method : str
+        ``"rockjit"`` or ``"scipy:<solve_ivp method>"``.
+    status : str
+        One of :data:`STATUSES`; ``message`` says it in words.
+    t : float
+        Time reached (the overturning or rest instant for runs that stopped there).
+    state : ndarray, shape (4,)
+        ``(theta, theta', r, s)`` at ``t``.
+    period : float
+        Forcing period ``T``.
+    n_steps : int
+        Steps per period ``N`` (the compiled path's grid; also the scipy path's sampling grid).
+    periods : int
+        Periods asked for.
+    strobe : ndarray, shape (k, 4)
+        ``(theta, theta', r, s)`` at ``t = 0, T, 2T, ...`` as far as the run went.
+    strobe_half : ndarray, shape (k, 4)
+        The same at ``t = T/2, 3T/2, ...``.
+    impacts : ndarray, shape (m, 3)
+        ``(t, theta'-, theta'+)`` of the impacts, in order: all of them, or the latest
+        :data:`rockjit.kernel.IMPACT_RECORD` when there were more (``n_impacts`` counts all).
+    n_impacts, n_grid_steps, n_rhs : int
+        Counts of impacts, grid steps completed, right-hand-side evaluations.
+    max_error_estimate : float
+        Largest embedded 4th-order error estimate of ``theta, theta'`` over the run's steps
+        (``nan`` on the scipy path).
+    trajectory : ndarray, shape (p, 5) or None
+        ``(t, theta, theta', r, s)`` every ``record_stride`` grid steps, when asked.
+    lyapunov : ndarray, shape (2,) or None
+        ``(lambda1, lambda2)`` averaged over ``window``, when asked; ``-inf`` when every
+        perturbation dies in the window (a rest phase, or an impact with ``e = 0``).
+    lyapunov_running : ndarray, shape (k, 2) or None
+        The running estimate ``lambda(t)`` at ``t = 0, T, 2T, ...``.
+    window : tuple of float or None
+        ``(t0, t1)`` over which ``lyapunov`` was averaged.
+    n_rest, n_rest_window : int
+        Rest phases entered (Zeno cut-offs), overall and within ``window``.
+    n_impacts_window : int
+        Impacts within the window (for the exact identity of SPEC.md §5).
+    n_locate_unconverged : int
+        Events whose time the Newton polish could not bring within its tolerance (taken at the
+        best bracketed estimate; expected 0, counted so that tests can require it).
+    """
+
+    block: Block
+    method: str
+    status: str
+    t: float
+    state: np.ndarray
+    period: float
+    n_steps: int
+    periods: int
+    strobe: np.ndarray
+    strobe_half: np.ndarray
+    impacts: np.ndarray
+    n_impacts: int
+    n_grid_steps: int
+    n_rhs: int
+    max_error_estimate: float
+    trajectory: np.ndarray | None = None
+    lyapunov: np.ndarray | None = None
+    lyapunov_running: np.ndarray | None = None
+    window: tuple | None = None
+    n_rest: int = 0
+    n_rest_window: int = 0
+    n_impacts_window: int = 0
+    n_locate_unconverged: int = 0
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def message(self) -> str:
+        return STATUS_MESSAGES[self.status]
+
+    @property
+    def lambda_max(self) -> float:
+        """``lambda1`` over the window (``nan`` when exponents were not asked for)."""
+        return math.nan if self.lyapunov is None else float(self.lyapunov[0])
+
+    @property
+    def stopped_early(self) -> bool:
+        """True when the run ended before the requested time for a reason other than its
+        physics (the impact bound, a non-finite number)."""
+        return self.status in ("max_impacts", "nonfinite")
+
+    def __repr__(self) -> str:
+        b = self.block
+        return (f"Result({self.method}, hb={b.hb}, alpha={b.alpha}, omega={b.omega}, "
+                f"law={b.law}, status={self.status!r}, t={self.t:.6g}, "
+                f"impacts={self.n_impacts})")
+
+
+def _names_array():
+    return np.array(BEHAVIOURS)
+
+
+@dataclass(kw_only=True)
+class GridResult:
+    """What every grid result has: the block (at the grid's first point), the settings it was
+    computed with, and the behaviour names that its ``label`` codes index."""
+
+    block: Block
+    settings: dict = field(default_factory=dict)
+    names: np.ndarray = field(default_factory=_names_array)
+
+    def fractions(self):
+        """Percentage of cells per behaviour name."""
+        return fractions(self.label)
+
+
+@dataclass(kw_only=True)
+class SweepResult(GridResult):
+    """An α sweep: one run per forcing amplitude, all from the same initial state.
+
+    Attributes
+    ----------
+    alpha : ndarray, shape (n,)
+    label : ndarray of int, shape (n,)
+        Behaviour codes; ``names[label]`` gives the names (:data:`BEHAVIOURS`).
+    period : ndarray of int, shape (n,)
+        Period in forcing periods (0 when none).
+    lambda_max : ndarray, shape (n,)
+        ``lambda1`` over the classified stretch (``nan`` when not computed or overturned,
+        ``-inf`` when every perturbation dies: rest).
+    strobe : ndarray, shape (n, w, 2)
+        ``(theta, theta')`` at ``t = kT`` over the classified stretch (``nan``-padded).
+    impact_section : ndarray, shape (n, m, 2)
+        ``(t mod T, theta'-)`` of the impacts over the classified stretch (``nan``-padded).
+    t_end : ndarray, shape (n,)
+        Time each run stopped (early stop, overturn, rest or the end).
+    """
+
+    alpha: np.ndarray
+    label: np.ndarray
+    period: np.ndarray
+    lambda_max: np.ndarray
+    strobe: np.ndarray
+    impact_section: np.ndarray
+    t_end: np.ndarray
+
+
+@dataclass(kw_only=True)
+class BasinResult(GridResult):
+    """A basin of attraction over ``(theta0, theta0')`` at a fixed forcing phase.
+
+    ``label[i, j]`` belongs to ``theta0[i]``, ``dtheta0[j]``.
+    """
+
+    theta0: np.ndarray
+    dtheta0: np.ndarray
+    label: np.ndarray
+    period: np.ndarray
+    lambda_max: np.ndarray | None
+    t_end: np.ndarray
+
+
+@dataclass(kw_only=True)
+class PlaneResult(GridResult):
+    """Behaviours over the forcing plane ``(alpha, omega)`` from one or more initial states.
+
+    ``label[m, i, j]`` belongs to initial state ``z0[m]``, ``alpha[i]``, ``omega[j]``.
+    """
+
+    alpha: np.ndarray
+    omega: np.ndarray
+    z0: np.ndarray
+    label: np.ndarray
+    period: np.ndarray
+    lambda_max: np.ndarray
+    t_end: np.ndarray

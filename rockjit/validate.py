@@ -1,0 +1,140 @@
+"""One validator per kind of parameter, shared by the API and the command line.
+
+Each function takes the parameter's user-facing ``name`` and its value, and either returns the
+value in canonical form or raises ``ValueError`` naming the parameter, the allowed range and the
+value got (STYLE.md 12): ``ValueError: periods must be in [1, 1e9] (got 0)``. No value a user can
+type reaches numpy, numba or scipy unchecked.
+
+:func:`memory` refuses a computation whose arrays would not fit, before anything is allocated:
+``ValueError: periods = 1e12 would need 29.1 TiB; at most 18.3 GiB fits (memory available)``.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import os
+
+import numpy as np
+
+__all__ = ["available_memory", "choice", "integer", "memory", "pair", "real", "size_text"]
+
+
+def _fmt(v):
+    """A number as a user would type it back (integers without a trailing ``.0``)."""
+    if isinstance(v, float) and v.is_integer() and abs(v) < 1e16:
+        return str(int(v))
+    return f"{v:g}" if isinstance(v, float) else str(v)
+
+
+def _range_text(lo, hi, lo_open, hi_open):
+    if hi is None:
+        return f"{'>' if lo_open else '>='} {_fmt(lo)}"
+    if lo is None:
+        return f"{'<' if hi_open else '<='} {_fmt(hi)}"
+    return f"in {'(' if lo_open else '['}{_fmt(lo)}, {_fmt(hi)}{')' if hi_open else ']'}"
+
+
+def real(name, value, lo=None, hi=None, *, lo_open=False, hi_open=False):
+    """A finite real number in the given range (``None``: unbounded on that side)."""
+    if isinstance(value, (bool, np.bool_)) or isinstance(value, str) and not value.strip():
+        raise ValueError(f"{name} must be a real number (got {value!r})")
+    try:
+        v = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(f"{name} must be a real number (got {value!r})") from None
+    if not math.isfinite(v):
+        raise ValueError(f"{name} must be finite (got {v})")
+    bad = (lo is not None and (v < lo or (lo_open and v == lo))) or \
+          (hi is not None and (v > hi or (hi_open and v == hi)))
+    if bad:
+        raise ValueError(f"{name} must be {_range_text(lo, hi, lo_open, hi_open)} "
+                         f"(got {_fmt(v)})")
+    return v
+
+
+def integer(name, value, lo=None, hi=None):
+    """An integer in ``[lo, hi]``; integral floats (``3.0``) are accepted, ``True`` is not."""
+    if isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be an integer (got {value!r})")
+    if isinstance(value, numbers.Integral):
+        v = int(value)
+    else:
+        try:
+            f = float(value)
+        except (TypeError, ValueError, OverflowError):
+            raise ValueError(f"{name} must be an integer (got {value!r})") from None
+        if not math.isfinite(f) or not f.is_integer():
+            raise ValueError(f"{name} must be an integer (got {value!r})")
+        v = int(f)
+    if (lo is not None and v < lo) or (hi is not None and v > hi):
+        raise ValueError(f"{name} must be {_range_text(lo, hi, False, False)} (got {v})")
+    return v
+
+
+def choice(name, value, options):
+    """One of ``options`` (strings)."""
+    if not isinstance(value, str) or value not in options:
+        raise ValueError(f"{name} must be one of {', '.join(map(repr, options))} "
+                         f"(got {value!r})")
+    return value
+
+
+def pair(name, value, lo=None, hi=None, *, lo_open=False, increasing=True):
+    """Two finite numbers ``(a, b)`` in ``[lo, hi]`` with ``a <= b`` (when ``increasing``)."""
+    try:
+        a, b = value
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be two numbers (got {value!r})") from None
+    a = real(f"{name}[0]", a, lo, hi, lo_open=lo_open)
+    b = real(f"{name}[1]", b, lo, hi, lo_open=lo_open)
+    if increasing and b < a:
+        raise ValueError(f"{name} must satisfy start <= end (got {_fmt(a)}, {_fmt(b)})")
+    return a, b
+
+
+# ---- memory -----------------------------------------------------------------------------------
+
+def available_memory():
+    """Bytes this process may allocate: ``MemAvailable`` (Linux), else physical memory, else
+    ``None`` (unknown: no check)."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
+def size_text(n):
+    """``n`` bytes in binary units: ``'29.1 TiB'``."""
+    n = float(n)
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"):
+        if n < 1024 or unit == "EiB":
+            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
+        n /= 1024
+    return f"{n:.1f} EiB"  # pragma: no cover
+
+
+#: Fraction of the available memory a computation may take.
+MEMORY_SHARE = 0.8
+
+
+def memory(what, nbytes, limit=None):
+    """Refuse a computation needing ``nbytes`` (a float, so no overflow) if it cannot fit.
+
+    ``what`` names the cause in the user's terms (``"periods = 1e+12"``). ``limit`` overrides the
+    machine's available memory (tests).
+    """
+    avail = available_memory() if limit is None else limit
+    if avail is None:
+        return
+    cap = MEMORY_SHARE * avail
+    if not nbytes <= cap:  # also catches inf and nan
+        raise ValueError(f"{what} would need {size_text(nbytes)}; at most {size_text(cap)} fits "
+                         f"(memory available)")
