@@ -1,0 +1,810 @@
+"""Seeded fuzz test of the command line: every bad input is refused cleanly, before any work.
+
+The specification of issue 10 §1 for ``rockjit.cli.main``. For every invalid argument vector:
+exit status 2; exactly one line on stderr, starting with ``rockjit: error:`` and naming the
+offending option or parameter; nothing on stdout, no traceback, no warning; nothing written (the
+command runs with the current directory set to an empty temporary directory and ``--out`` inside
+it; afterwards that directory holds exactly what it held before: no ``--out``, no
+``<out>.chunks``, no stray file); and no large allocation before the refusal.
+
+The cases (``CASES``, printable with ``pytest --collect-only -q``):
+
+- ``issue10 ...``: every item of issue 10 §1, literally, and the numerics items of §3 whose
+  refusal the issue asks for;
+- generated: every subcommand, every option that takes a value, given values outside the range
+  its documentation states (SPEC.md, the docstrings, ``--help``) and malformed values (``nan``,
+  ``inf``, ``1e308``, ``5e-324``, ``abc``, ``""``, ``1,5``, ``0x10``, ...), required options left
+  out, the wrong number of values. Refusal is asserted only where the value is really invalid.
+
+Options the command line does not have today but the issue implies carry ``[guessed --NAME]`` in
+their ids: ``--max-impacts`` (issue 10 §3 asks for it) must exist; ``--xi`` and ``--rest-speed``
+are skipped while the parser does not have them.
+
+Nothing here computes: the entry points of real work (``GUARDED``, the one list to update after a
+refactor) are replaced by a sentinel raising :class:`NotRefused`, so a case that slips past
+validation fails at once ("not refused before work") instead of compiling or allocating. The seed
+(``ROCKJIT_FUZZ_SEED``) chooses the valid values each bad one is embedded in and the order of the
+options; the case ids do not depend on it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import importlib
+import io
+import math
+import os
+import random
+import re
+import shlex
+import stat
+import tempfile
+import tracemalloc
+import warnings
+import zlib
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numba
+import pytest
+
+from rockjit.cli import build_parser, main
+
+# ---------------------------------------------------------------------------------------------
+# The entry points of real work: reaching one means the input was not refused before work.
+# "module:attribute"; the CLI imports some of them lazily inside functions, so the module
+# attributes are what is patched. Update this list after a refactor (test_guards_exist says
+# which entries have gone).
+# ---------------------------------------------------------------------------------------------
+
+GUARDED = (
+    "rockjit.simulate:simulate",
+    "rockjit.analysis:sweep",
+    "rockjit.analysis:basin",
+    "rockjit.analysis:plane",
+    "rockjit.analysis:run_chunk",
+    "rockjit.integrate:build",
+    "rockjit.cli:e_table",          # the work of `cor` (and of `paper`'s first part)
+    "rockjit.io:atomic_open",       # every file the CLI writes goes through these
+    "rockjit.io:write_json",
+    "rockjit.io:write_npz",
+    "rockjit.io:write_csv",
+    "rockjit.io:write_text",
+    "rockjit.io:save_figure",
+)
+#: Patched as well where they exist (names of a refactor in progress); absent ones are ignored.
+GUARDED_IF_PRESENT = (
+    "rockjit.simulate:run",
+    "rockjit.kernel:run_single",
+    "rockjit.kernel:run_grid",
+    "rockjit.kernel:run_chunk",
+    "rockjit.analysis:run",
+)
+
+SEED = int(os.environ.get("ROCKJIT_FUZZ_SEED", "20240610"))
+#: A refusal must come before any large allocation (the whole validation needs well under this).
+ALLOC_LIMIT = 64 * 2**20
+MAX_THREADS = numba.config.NUMBA_NUM_THREADS
+MEMORY_MESSAGE = r"would need .+at most .+fits"
+#: argparse's words when it takes a negative number for an option (issue 10 §1)
+TAKEN_FOR_AN_OPTION = r"expected (one|at least one|\d+) argument"
+
+
+class NotRefused(BaseException):
+    """Raised by a guarded entry point: the case got past validation (BaseException, so that no
+    ``except Exception`` in the CLI can turn it into an error line)."""
+
+
+# ---------------------------------------------------------------------------------------------
+# What a message must contain to name each option or parameter (CLI or library spelling)
+# ---------------------------------------------------------------------------------------------
+
+NAMES = {
+    "--hb": r"\bhb\b", "--hb-values": r"\bhb\b", "--hb-max": r"\bhb\b",
+    "--alpha": r"\balpha\b", "--omega": r"\bomega\b", "--law": r"\blaw\b",
+    "--e": r"(^|[\s'\"(])(--)?e\b",
+    "--theta0": r"(?<!d)theta0", "--dtheta0": r"dtheta0", "--phase": r"\bphase\b",
+    "--r0": r"\br0\b", "--s0": r"\bs0\b",
+    "--method": r"\bmethod\b", "--forcing": r"\bforcing\b", "--rtol": r"\brtol\b",
+    "--atol": r"\batol\b", "--lyapunov": r"lyapunov", "--max-points": r"max[-_ ]points",
+    "--periods": r"\bperiods\b", "--n-steps": r"\bn[-_]steps\b", "--threads": r"\bthreads\b",
+    "--out": r"--out|\bout\b",
+    "--alpha-range": r"\balpha", "--alpha-step": r"alpha[-_]step", "--grid": r"\bgrid\b",
+    "--theta-range": r"(?<!d)theta", "--dtheta-range": r"dtheta", "--omega-range": r"\bomega",
+    "--zoom": r"\bzoom\b(?![-_])", "--zoom-step": r"zoom[-_]step",
+    "--xi": r"\bxi\b", "--rest-speed": r"rest[-_]speed", "--max-impacts": r"max[-_]impacts",
+}
+
+NARGS = {"--alpha-range": 2, "--omega-range": 2, "--theta-range": 2, "--dtheta-range": 2,
+         "--zoom": 2, "--hb-values": "+"}
+FLAGS = {"--quiet", "--lyapunov", "--no-lyapunov", "--full-length"}
+
+NONFINITE = ["nan", "inf", "-inf"]
+#: strings no number parser takes; each option gets two of them, rotating from option to option
+#: (they all end in the same type check: all four on every option would only slow the module)
+MALFORMED = ["abc", "", "1,5", "0x10"]
+#: numbers that are not integers (an integer option must refuse each)
+NOT_INT = ["nan", "inf", "-inf", "1e308", "5e-324", "2.5"]
+HUGE_INT = "99999999999999999999"
+
+
+# ---------------------------------------------------------------------------------------------
+# Cases
+# ---------------------------------------------------------------------------------------------
+
+@dataclass
+class Case:
+    """One invalid command line.
+
+    ``set`` maps an option to its values (a list; ``[]``: the option given last with no value),
+    ``True`` (a flag) or ``None`` (left out), over a valid base drawn for the command.
+    """
+
+    id: str
+    cmd: str
+    set: dict
+    names: str                          # a regular expression the error line must match
+    forbid: tuple = ()                  # regular expressions it must not match
+    setup: str | None = None            # "out-file", "out-in-file", "chunks-file"
+    guessed: str | None = None          # an option the CLI may not have yet
+    guessed_required: bool = False      # ... which it must have (else: skip while absent)
+    memory: bool = False                # must be refused by a memory estimate
+    extra_ok: bool = False              # "unrecognized arguments" is the right answer
+    nargs_ok: bool = False              # "expected N arguments" is the right answer
+    base: bool = True                   # embed in a valid base command line
+    n_at_least: int | None = None       # the message must give a number >= this (the N needed)
+
+
+def _q(values):
+    return " ".join(shlex.quote(v) for v in values)
+
+
+def _id(cmd, opt, vals, note=""):
+    if vals is None:
+        s = f"{cmd} without {opt}"
+    elif vals == []:
+        s = f"{cmd} {opt} (no value)"
+    else:
+        s = f"{cmd} {opt} {_q(vals)}"
+    return s + (f" {note}" if note else "")
+
+
+def _values(cmd, opt, values, extra=None, **kw):
+    """One case per value of a single-valued option (``extra``: options set alongside)."""
+    return [Case(_id(cmd, opt, [v]) + (f" ({_ctx(extra)})" if extra else ""), cmd,
+                 {**(extra or {}), opt: [v]}, NAMES[opt], **kw) for v in values]
+
+
+def _ctx(extra):
+    return ", ".join(opt if val is True else f"{opt} {_q(val)}" for opt, val in extra.items())
+
+
+def _pairs(cmd, opt, pairs, **kw):
+    """One case per value list of a multi-valued option; wrong counts allowed where they are."""
+    out = []
+    for vals in pairs:
+        n = NARGS[opt]
+        wrong_count = (n == "+" and not vals) or (n != "+" and len(vals) != n)
+        extra = n != "+" and len(vals) > n
+        out.append(Case(_id(cmd, opt, vals), cmd, {opt: vals},
+                        NAMES[opt] if not extra else re.escape(vals[-1]),
+                        nargs_ok=wrong_count, extra_ok=extra, **kw))
+    return out
+
+
+def _missing(cmd, opts):
+    return [Case(_id(cmd, o, None), cmd, {o: None}, NAMES[o]) for o in opts]
+
+
+def _out_cases(cmd):
+    return [
+        Case(f"{cmd} --out ''", cmd, {"--out": [""]}, NAMES["--out"]),
+        Case(f"{cmd} --out /proc/x", cmd, {"--out": ["/proc/x"]}, NAMES["--out"]),
+        Case(f"{cmd} --out <an existing file>", cmd, {}, NAMES["--out"], setup="out-file"),
+        Case(f"{cmd} --out <inside a file>", cmd, {}, NAMES["--out"], setup="out-in-file"),
+        Case(f"{cmd} --frobnicate 1", cmd, {"--frobnicate": ["1"]}, "frobnicate",
+             extra_ok=True),
+    ]
+
+
+def _malformed(cmd, opt):
+    """Two of :data:`MALFORMED`, rotating with the option (fixed, not drawn: stable ids)."""
+    k = zlib.crc32(f"{cmd} {opt}".encode())
+    return [MALFORMED[k % 4], MALFORMED[(k + 2) % 4]]
+
+
+def _real_opt(cmd, opt, bad, extra=None):
+    return _values(cmd, opt, NONFINITE + bad + _malformed(cmd, opt), extra)
+
+
+def _int_opt(cmd, opt, bad):
+    cases = _values(cmd, opt, bad + NOT_INT + _malformed(cmd, opt))
+    for c in cases:
+        if c.set[opt] == [HUGE_INT]:  # an integer: too large, not "not an integer" (issue 10)
+            c.forbid = (r"must be an integer",)
+    return cases
+
+
+def _block_cases(cmd, alpha=True, omega=True, laws_ok=("housner", "mao", "constant")):
+    c = _real_opt(cmd, "--hb", ["0", "-1", "-1e308"])
+    # below 1/sqrt(2) the Housner law has e_H < 0 (SPEC.md §2)
+    c += _values(cmd, "--hb", ["0.5", "5e-324"], {"--law": ["housner"]})
+    c += _values(cmd, "--law", [v for v in ("abc", "", "HOUSNER", "0", "both")
+                                if v not in laws_ok])
+    c += _real_opt(cmd, "--e", ["-0.1", "1.5", "-1e308", "1e308", HUGE_INT],
+                   {"--law": ["constant"]})
+    c += _values(cmd, "--e", ["0.5"], {"--law": ["housner"]})       # e only with constant
+    c.append(Case(f"{cmd} --law constant without --e", cmd, {"--law": ["constant"],
+                                                              "--e": None}, NAMES["--e"]))
+    if alpha:
+        c += _real_opt(cmd, "--alpha", ["-1", "-1e-3", "-1e308"])
+    if omega:
+        # 1e308: alpha omega^2 overflows; 5e-324: the period overflows (issue 10 §1)
+        c += _real_opt(cmd, "--omega", ["0", "-1.3", "-1e-3", "-1e308", "1e308", "5e-324"])
+    return c
+
+
+def _state_cases(cmd, theta=True):
+    c = []
+    if theta:
+        c += _real_opt(cmd, "--theta0", ["1.5708", "-2", "1e308", "-1e308", HUGE_INT])
+        c += _real_opt(cmd, "--dtheta0", [])
+    c += _real_opt(cmd, "--phase", [])
+    c += _values(cmd, "--phase", ["0.3"], {"--r0": ["0"], "--s0": ["1"]})
+    # with the closed-form forcing (r0, s0) must lie on the unit circle, not at the origin
+    forcing = [_values(cmd, "--r0", ["0.5", "1e308", "-1e308"], {"--s0": ["1"]}),
+               _values(cmd, "--s0", ["0", "0.5", "-1e308"], {"--r0": ["0"]}),
+               [Case(f"{cmd} --r0 0 without --s0", cmd, {"--r0": ["0"], "--s0": None},
+                     r"\b[rs]0\b"),
+                Case(f"{cmd} --s0 1 without --r0", cmd, {"--s0": ["1"], "--r0": None},
+                     r"\b[rs]0\b")]]
+    for group in forcing:
+        for case in group:
+            if cmd != "trajectory":  # only trajectory takes --forcing (issue 10 §1)
+                case.forbid = (r"embedded",)
+        c += group
+    c += _values(cmd, "--r0", NONFINITE + _malformed(cmd, "--r0"), {"--s0": ["1"]})
+    c += _values(cmd, "--s0", NONFINITE + _malformed(cmd, "--s0"), {"--r0": ["0"]})
+    return c
+
+
+def _run_cases(cmd):
+    c = _int_opt(cmd, "--periods", ["0", "-1", HUGE_INT])
+    c += _int_opt(cmd, "--n-steps", ["0", "-2", "6", "7", "63", HUGE_INT])
+    c += _int_opt(cmd, "--threads", ["0", "-1", str(MAX_THREADS + 1), HUGE_INT])
+    c.append(Case(_id(cmd, "--periods", []), cmd, {"--periods": []}, NAMES["--periods"],
+                  nargs_ok=True))
+    return c
+
+
+def _chunks_case(cmd):
+    # issue 10 §1: a plain file where the chunk store goes ended in NotADirectoryError
+    return [Case(f"{cmd} <out>.chunks is a plain file", cmd, {}, r"chunks", setup="chunks-file")]
+
+
+def _guessed(cmd, required_max_impacts):
+    """Options issue 10 §3 implies and the CLI may not have yet (ids say so)."""
+    c = []
+    mi = "[guessed --max-impacts]"
+    for v in ["0", "-1", HUGE_INT] + NOT_INT + _malformed(cmd, "--max-impacts"):
+        c.append(Case(_id(cmd, "--max-impacts", [v], mi), cmd, {"--max-impacts": [v]},
+                      NAMES["--max-impacts"], guessed="--max-impacts",
+                      guessed_required=required_max_impacts))
+    for v in ["-1", "-1e-3"] + NONFINITE + _malformed(cmd, "--xi"):
+        c.append(Case(_id(cmd, "--xi", [v], "[guessed --xi]"), cmd, {"--xi": [v]},
+                      NAMES["--xi"], guessed="--xi"))
+    for v in ["-1", "-1e-8"] + NONFINITE + _malformed(cmd, "--rest-speed"):
+        c.append(Case(_id(cmd, "--rest-speed", [v], "[guessed --rest-speed]"), cmd,
+                      {"--rest-speed": [v]}, NAMES["--rest-speed"], guessed="--rest-speed"))
+    return c
+
+
+def _trajectory():
+    cmd = "trajectory"
+    c = _block_cases(cmd) + _state_cases(cmd) + _run_cases(cmd)
+    c += _values(cmd, "--method", ["abc", "", "scipy:FOO", "scipy:", "SCIPY", "rockjit:RK45",
+                                   "scipy:rk45"])
+    c += _values(cmd, "--forcing", ["abc", "", "open", "CLOSED"])
+    for tol in ("--rtol", "--atol"):
+        for method in ("scipy", "scipy:RK45"):
+            c += _real_opt(cmd, tol, ["-1", "-1e-6", "-1e308"], {"--method": [method]})
+    c.append(Case(f"{cmd} --method scipy --lyapunov", cmd,
+                  {"--method": ["scipy"], "--lyapunov": True}, NAMES["--lyapunov"]))
+    c += _int_opt(cmd, "--max-points", ["0", "1", "-1"])
+    c += _missing(cmd, ["--hb", "--alpha", "--omega", "--out"])
+    c += _out_cases(cmd) + _guessed(cmd, required_max_impacts=True)
+    return c
+
+
+def _sweep():
+    cmd = "sweep"
+    c = _block_cases(cmd, alpha=False) + _state_cases(cmd) + _run_cases(cmd)
+    c += _pairs(cmd, "--alpha-range", [
+        ["0.5"], ["0.5", "0.6", "0.7"], ["0.6", "0.5"], ["-0.1", "0.5"], ["-1e-3", "0.5"],
+        ["nan", "0.5"], ["0.5", "nan"], ["0.5", "inf"], ["-inf", "0.5"],
+        ["0.5", "1e308"], ["0.5", HUGE_INT],          # 1e23 amplitudes: cannot fit
+        ["abc", "0.5"], ["", "0.5"], ["0.5", "1,5"], ["0x10", "0.5"]])
+    # 5e-324: (end - start) / step overflows
+    c += _real_opt(cmd, "--alpha-step", ["0", "-0.001", "-1e308", "5e-324"])
+    c += _missing(cmd, ["--hb", "--omega", "--alpha-range", "--out"])
+    c += _out_cases(cmd) + _chunks_case(cmd) + _guessed(cmd, required_max_impacts=False)
+    return c
+
+
+def _basin():
+    cmd = "basin"
+    c = _block_cases(cmd, laws_ok=("housner", "mao", "constant", "both"))
+    c.append(Case("basin --law both --e 0.5", cmd, {"--law": ["both"], "--e": ["0.5"]},
+                  NAMES["--e"]))
+    c += _state_cases(cmd, theta=False) + _run_cases(cmd)
+    c += _int_opt(cmd, "--grid", ["0", "-1", HUGE_INT])
+    c += _pairs(cmd, "--theta-range", [
+        ["1"], ["-1", "0", "1"], ["1", "-1"], ["-2", "1"], ["0", "1.6"], ["-1.5708", "0"],
+        ["nan", "1"], ["-inf", "1"], ["0", "inf"], ["-1e308", "1e308"],
+        ["abc", "1"], ["", "1"], ["1,5", "1"]])
+    c += _pairs(cmd, "--dtheta-range", [
+        ["1"], ["-1", "0", "1"], ["1", "-1"], ["nan", "1"], ["-inf", "1"], ["0", "inf"],
+        ["-1e308", "1e308"],                           # hi - lo overflows: no grid spacing
+        ["abc", "1"], ["0x10", "1"], ["1", ""]])
+    c += _missing(cmd, ["--hb", "--alpha", "--omega", "--out"])
+    c += _out_cases(cmd) + _chunks_case(cmd) + _guessed(cmd, required_max_impacts=False)
+    return c
+
+
+def _plane():
+    cmd = "plane"
+    c = _block_cases(cmd, alpha=False, omega=False) + _state_cases(cmd) + _run_cases(cmd)
+    c += _pairs(cmd, "--alpha-range", [
+        ["0.5"], ["0.5", "0.6", "0.7"], ["0.6", "0.5"], ["-0.1", "0.5"], ["-1e-3", "0.5"],
+        ["nan", "0.5"], ["0.5", "inf"], ["-inf", "0.5"], ["-1e308", "0.5"],
+        ["abc", "0.5"], ["", "0.5"], ["0.5", "1,5"]])
+    c += _pairs(cmd, "--omega-range", [
+        ["1"], ["1", "1.5", "2"], ["2", "1"], ["0", "1"], ["-1", "1"], ["-1e-3", "1"],
+        ["nan", "1"], ["1", "inf"], ["-inf", "1"], ["5e-324", "1"], ["1", "1e308"],
+        ["abc", "1"], ["1", ""], ["0x10", "1"]])
+    grid_pairs = [["5"], ["5", "5", "5"], ["0", "5"], ["5", "0"], ["-1", "5"],
+                  [HUGE_INT, "2"], ["abc", "5"], ["5", "2.5"], ["nan", "5"], ["1e308", "5"],
+                  ["", "5"]]
+    for vals in grid_pairs:
+        extra = len(vals) > 2
+        c.append(Case(_id(cmd, "--grid", vals), cmd, {"--grid": vals},
+                      NAMES["--grid"] if not extra else re.escape(vals[-1]),
+                      nargs_ok=len(vals) != 2, extra_ok=extra))
+    c += _missing(cmd, ["--hb", "--alpha-range", "--omega-range", "--out"])
+    c += _out_cases(cmd) + _chunks_case(cmd) + _guessed(cmd, required_max_impacts=False)
+    return c
+
+
+def _cor():
+    cmd = "cor"
+    c = _pairs(cmd, "--hb-values", [
+        [], ["0.5"], ["0"], ["-1"], ["-1e-3"], ["5e-324"], ["-1e308"], ["1", "0.5"],
+        ["nan"], ["inf"], ["-inf"], ["abc"], [""], ["1,5"], ["0x10"], ["2", "nan"]])
+    c += _real_opt(cmd, "--hb-max", ["0.7", "0.5", "0", "-1", "-1e308", "5e-324"])
+    c += _missing(cmd, ["--out"])
+    c += _out_cases(cmd)
+    return c
+
+
+def _paper():
+    cmd = "paper"
+    c = _run_cases(cmd)
+    c += _int_opt(cmd, "--grid", ["0", "-3", HUGE_INT])
+    c += _real_opt(cmd, "--alpha-step", ["0", "-0.1", "-1e308", "5e-324"])
+    # the zoom lies inside the Housner hb=1 range [0.5, 1] (SPEC.md §7), start <= end
+    c += _pairs(cmd, "--zoom", [
+        ["0.9"], ["0.9", "0.95", "0.97"], ["0.2", "0.3"], ["0.9", "1.1"], ["-0.9", "0.95"],
+        ["nan", "0.9"], ["0.9", "inf"], ["-inf", "0.9"], ["abc", "0.9"], ["0.9", ""],
+        ["0.9", "1,5"]])
+    c += _real_opt(cmd, "--zoom-step", ["0", "-0.01", "-1e308", "5e-324"])
+    c += _missing(cmd, ["--out"])
+    c += _out_cases(cmd)
+    return c
+
+
+def _stable_n(omega, xi, stability=3.31):
+    """Fewest steps per period an explicit Dormand-Prince step takes stably against the damping
+    rate 3/4 xi (a lower bound of the N a refusal must name)."""
+    return math.ceil(2.0 * math.pi / omega * 0.75 * xi / stability)
+
+
+def _issue10():
+    """Issue 10 §1 (and the refusals §3 asks for), literally."""
+    traj = {"--hb": ["1"], "--alpha": ["0.6"], "--omega": ["1.3"]}
+    sweep = {"--hb": ["1"], "--omega": ["1.3"], "--alpha-range": ["0.5", "0.6"]}
+    basin = {"--hb": ["1"], "--alpha": ["0.66"], "--omega": ["1.3"]}
+    plane = {"--hb": ["1"], "--alpha-range": ["0.5", "0.6"]}
+
+    def case(text, cmd, opts, names, **kw):
+        return Case(f"issue10: {text}", cmd, opts, names, base=False, **kw)
+
+    out = {"--out": ["{out}"]}
+    return [
+        case("trajectory --omega 1e300 --out o", "trajectory",
+             {**traj, "--omega": ["1e300"], "--out": ["o"]}, NAMES["--omega"]),
+        case("trajectory --omega 1e-300", "trajectory", {**traj, "--omega": ["1e-300"], **out},
+             NAMES["--omega"]),
+        case("trajectory --omega 1e-8 (API: MemoryError)", "trajectory",
+             {**traj, "--omega": ["1e-8"], **out}, r"\bomega\b|\bn[-_]steps\b"),
+        case("trajectory --periods 1000000000000", "trajectory",
+             {**traj, "--periods": ["1000000000000"], **out}, NAMES["--periods"]),
+        case("trajectory --n-steps 4000000000 --periods 1", "trajectory",
+             {**traj, "--n-steps": ["4000000000"], "--periods": ["1"], **out},
+             NAMES["--n-steps"]),
+        case("sweep --alpha-range 0.5 0.6 --alpha-step 1e-12", "sweep",
+             {**sweep, "--alpha-step": ["1e-12"], **out}, NAMES["--alpha-step"]),
+        case("basin --grid 100000", "basin", {**basin, "--grid": ["100000"], **out},
+             NAMES["--grid"], memory=True),
+        case("basin --grid 1000000000", "basin", {**basin, "--grid": ["1000000000"], **out},
+             NAMES["--grid"], memory=True),
+        case("trajectory --method scipy --rtol=-1", "trajectory",
+             {**traj, "--method": ["scipy"], "--rtol=-1": True, **out}, NAMES["--rtol"]),
+        case("plane --omega-range 1 1e300", "plane",
+             {**plane, "--omega-range": ["1", "1e300"], **out}, NAMES["--omega-range"]),
+        case("plane --omega-range 1e-300 1", "plane",
+             {**plane, "--omega-range": ["1e-300", "1"], **out}, NAMES["--omega-range"]),
+        case("trajectory --out /proc/x", "trajectory", {**traj, "--out": ["/proc/x"]},
+             NAMES["--out"]),
+        case("trajectory --out ''", "trajectory", {**traj, "--out": [""]}, NAMES["--out"]),
+        case("basin with <out>.chunks a plain file", "basin", {**basin, **out}, r"chunks",
+             setup="chunks-file"),
+        case("trajectory --periods 99999999999999999999", "trajectory",
+             {**traj, "--periods": [HUGE_INT], **out}, NAMES["--periods"],
+             forbid=(r"must be an integer",)),
+        case("paper --zoom 0.99 0.9", "paper", {"--zoom": ["0.99", "0.9"], **out},
+             NAMES["--zoom"], forbid=(r"alpha[-_]range",)),
+        case("basin --r0 .5 --s0 .5", "basin", {**basin, "--r0": [".5"], "--s0": [".5"], **out},
+             r"\b[rs]0\b", forbid=(r"embedded",)),
+        case("trajectory --dtheta0 -inf", "trajectory", {**traj, "--dtheta0": ["-inf"], **out},
+             NAMES["--dtheta0"]),
+        case("trajectory --theta0 2 (the API runs it, the CLI refuses it)", "trajectory",
+             {**traj, "--theta0": ["2"], **out}, NAMES["--theta0"]),
+        case("trajectory --method scipy:FOO", "trajectory",
+             {**traj, "--method": ["scipy:FOO"], **out}, NAMES["--method"]),
+        # §3 stiff damping: an explicit N below the stability limit in h*3/4*xi is refused,
+        # naming the N needed, at least T * 3/4 xi / 3.31 (Dormand-Prince's stability interval
+        # on the negative real axis is about [-3.31, 0]): 220 for xi = 200, 548 for xi = 500
+        case("trajectory --xi 200 --n-steps 64 [guessed --xi]", "trajectory",
+             {**traj, "--xi": ["200"], "--n-steps": ["64"], **out}, NAMES["--n-steps"],
+             guessed="--xi", n_at_least=_stable_n(1.3, 200)),
+        case("sweep --xi 500 --n-steps 64 [guessed --xi]", "sweep",
+             {**sweep, "--alpha-step": ["0.05"], "--xi": ["500"], "--n-steps": ["64"], **out},
+             NAMES["--n-steps"], guessed="--xi", n_at_least=_stable_n(1.3, 500)),
+        # §3: rest_speed = 0 piles impacts at one instant; refused unless the accumulation
+        # point of SPEC §3 is implemented (then drop this case)
+        case("trajectory --rest-speed 0 [guessed --rest-speed]", "trajectory",
+             {**traj, "--rest-speed": ["0"], **out}, NAMES["--rest-speed"],
+             guessed="--rest-speed"),
+        # §3: expose --max-impacts; a bound whose impact table cannot fit is refused
+        case("trajectory --max-impacts 99999999999999999999 [guessed --max-impacts]",
+             "trajectory", {**traj, "--max-impacts": [HUGE_INT], **out},
+             NAMES["--max-impacts"], guessed="--max-impacts", guessed_required=True),
+    ]
+
+
+def _misc():
+    return [
+        Case("(no command)", "", {}, r"COMMAND|command", base=False),
+        Case("frobnicate --out x", "frobnicate", {"--out": ["{out}"]}, r"frobnicate",
+             base=False),
+    ]
+
+
+CASES = (_issue10() + _trajectory() + _sweep() + _basin() + _plane() + _cor() + _paper()
+         + _misc())
+
+
+# ---------------------------------------------------------------------------------------------
+# Valid command lines the bad values are embedded in (drawn with the seed)
+# ---------------------------------------------------------------------------------------------
+
+BASES = {
+    "trajectory": {"--hb": ["1", "1.5", "2", "3"], "--alpha": ["0", "0.2", "0.6", "0.8"],
+                   "--omega": ["1", "1.3", "1.6", "2.5"], "--law": [None, "housner", "mao"],
+                   "--periods": [None, "1", "5", "20"], "--n-steps": [None, "64", "160"]},
+    "sweep": {"--hb": ["1", "1.5", "2"], "--omega": ["1", "1.3", "1.6"],
+              "--alpha-range": [("0.5", "0.6"), ("0.1", "0.2"), ("0.3", "0.35")],
+              "--alpha-step": [None, "0.01", "0.05"], "--law": [None, "housner", "mao"],
+              "--periods": [None, "5", "20"], "--n-steps": [None, "64"]},
+    "basin": {"--hb": ["1", "2"], "--alpha": ["0.2", "0.66"], "--omega": ["1.3", "1.6"],
+              "--law": [None, "housner", "mao", "both"], "--grid": [None, "4", "10"],
+              "--periods": [None, "5", "20"], "--n-steps": [None, "64"]},
+    "plane": {"--hb": ["1", "2"], "--alpha-range": [("0.1", "0.5"), ("0.5", "1")],
+              "--omega-range": [("0.5", "2"), ("1", "1.6")], "--grid": [None, ("4", "5")],
+              "--law": [None, "housner", "mao"], "--periods": [None, "5", "20"],
+              "--n-steps": [None, "64"]},
+    "cor": {"--hb-values": [None, ("1", "2"), ("1.5",)], "--hb-max": [None, "6", "3"]},
+    "paper": {"--grid": [None, "4", "10"], "--periods": [None, "5", "20"],
+              "--alpha-step": [None, "0.1", "0.05"], "--n-steps": [None, "64"]},
+}
+
+
+def argv_of(case, out):
+    """The case's argument vector, options in a seeded order, ``{out}`` replaced."""
+    rng = random.Random(f"{SEED}:{case.id}")
+    opts = {}
+    if case.base and case.cmd in BASES:
+        for opt, choices in BASES[case.cmd].items():
+            v = rng.choice(choices)
+            if v is not None:
+                opts[opt] = [v] if isinstance(v, str) else list(v)
+        if rng.random() < 0.5:
+            opts["--quiet"] = True
+        opts["--out"] = ["{out}"]
+    for opt, v in case.set.items():
+        opts[opt] = v
+    groups, last = [], []
+    for opt, v in opts.items():
+        if v is None:
+            continue
+        if v is True:
+            groups.append([opt])
+        elif v == []:
+            last.append([opt])
+        else:
+            groups.append([opt] + [out if x == "{out}" else x for x in v])
+    rng.shuffle(groups)
+    argv = [case.cmd] if case.cmd else []
+    for g in groups + last:
+        argv += g
+    return argv
+
+
+# ---------------------------------------------------------------------------------------------
+# Running a case
+# ---------------------------------------------------------------------------------------------
+
+@lru_cache(maxsize=None)
+def _cli_options(cmd):
+    """The option strings the parser knows for subcommand ``cmd``."""
+    sub = next(a for a in build_parser()._actions if a.dest == "command")
+    return frozenset(sub.choices[cmd]._option_string_actions) if cmd in sub.choices else \
+        frozenset()
+
+
+def _resolve(target):
+    mod_name, attr = target.split(":")
+    try:
+        mod = importlib.import_module(mod_name)
+    except ImportError:
+        return None, attr
+    return mod, attr
+
+
+@pytest.fixture(scope="module")
+def reached():
+    """Replace every entry point of real work by a sentinel; the list records what was reached."""
+    calls = []
+    mp = pytest.MonkeyPatch()
+    for target in GUARDED + GUARDED_IF_PRESENT:
+        mod, attr = _resolve(target)
+        if mod is None or not hasattr(mod, attr):
+            continue
+
+        def sentinel(*args, _target=target, **kwargs):
+            calls.append(_target)
+            raise NotRefused(f"{_target} was called")
+
+        mp.setattr(mod, attr, sentinel)
+    yield calls
+    mp.undo()
+
+
+def _snapshot(root):
+    """Everything under ``root``: path -> (kind, mode, size, content hash)."""
+    snap = {}
+    for dirpath, dirnames, filenames in os.walk(root):
+        for name in dirnames + filenames:
+            p = os.path.join(dirpath, name)
+            st = os.lstat(p)
+            digest = None
+            if stat.S_ISREG(st.st_mode):
+                with open(p, "rb") as fh:
+                    digest = hashlib.sha256(fh.read()).hexdigest()
+            snap[os.path.relpath(p, root)] = (stat.S_IFMT(st.st_mode), stat.S_IMODE(st.st_mode),
+                                              st.st_size, digest)
+    return snap
+
+
+def _prepare(case, root):
+    """Files the case needs beforehand; returns the ``--out`` path to use."""
+    out = os.path.join(root, "out")
+    if case.setup == "out-file":
+        with open(out, "w") as fh:
+            fh.write("a user's file, not a directory\n")
+    elif case.setup == "out-in-file":
+        with open(os.path.join(root, "f"), "w") as fh:
+            fh.write("a user's file\n")
+        out = os.path.join(root, "f", "sub")
+    elif case.setup == "chunks-file":
+        with open(out + ".chunks", "w") as fh:
+            fh.write("a user's file named like the chunk store\n")
+    return out
+
+
+def run_main(argv, reached, cwd, trace=False):
+    """``main(argv)`` in ``cwd``; returns (status or None, exception or None, stdout, stderr,
+    warnings, peak bytes allocated or None when not traced)."""
+    reached.clear()
+    out, err = io.StringIO(), io.StringIO()
+    tracing = tracemalloc.is_tracing()
+    old_cwd = os.getcwd()
+    peak = None
+    with warnings.catch_warnings(record=True) as caught, contextlib.redirect_stdout(out), \
+            contextlib.redirect_stderr(err):
+        warnings.simplefilter("always")
+        os.chdir(cwd)
+        if trace:
+            if not tracing:
+                tracemalloc.start()
+            tracemalloc.reset_peak()
+            base = tracemalloc.get_traced_memory()[0]
+        try:
+            rc, exc = main(argv), None
+        except KeyboardInterrupt:
+            raise
+        except BaseException as e:  # noqa: BLE001 - any escape is a finding, reported below
+            rc, exc = None, e
+        finally:
+            os.chdir(old_cwd)
+            if trace:
+                peak = tracemalloc.get_traced_memory()[1] - base
+                if not tracing:
+                    tracemalloc.stop()
+    return rc, exc, out.getvalue(), err.getvalue(), list(caught), peak
+
+
+#: values that ask for something big: allocation is traced on the cases that use them (tracing
+#: every case would triple the module's time)
+BIG = {HUGE_INT, "1e308", "-1e308", "5e-324", "1e300", "1e-300", "1e-8", "1e-12",
+       "1000000000000", "4000000000", "100000", "1000000000"}
+
+
+def _traced(case):
+    return any(isinstance(v, list) and BIG.intersection(v) for v in case.set.values())
+
+
+@pytest.fixture(scope="module")
+def workdir(tmp_path_factory):
+    return tmp_path_factory.mktemp("fuzz")
+
+
+def _param(case):
+    """A case, skipped while it needs a guessed option the parser does not have (optional)."""
+    absent = case.guessed and not case.guessed_required and \
+        case.guessed not in _cli_options(case.cmd)
+    marks = pytest.mark.skip(reason=f"guessed option {case.guessed} is not in `rockjit "
+                                    f"{case.cmd}`: expose it, or adjust this case") \
+        if absent else ()
+    return pytest.param(case, id=case.id, marks=marks)
+
+
+@pytest.mark.parametrize("case", [_param(c) for c in CASES])
+def test_bad_input_is_refused(case, reached, workdir):
+    root = tempfile.mkdtemp(dir=workdir)  # the current directory of the command
+    out = _prepare(case, root)
+    argv = argv_of(case, out)
+    before = _snapshot(root)
+    rc, exc, stdout, stderr, caught, peak = run_main(argv, reached, root, _traced(case))
+    problem = verdict(case, rc, exc, stdout, stderr, caught, peak, reached)
+    if problem is None and _snapshot(root) != before:
+        problem = "wrote: files changed under the current directory"
+    if problem:
+        # pytrace=False: the message says it all (and rendering ~200 tracebacks is slow)
+        pytest.fail(f"{problem}\nargv = {argv!r}\nstderr = {stderr!r}", pytrace=False)
+
+
+def verdict(case, rc, exc, stdout, stderr, caught, peak, reached):
+    """The first way the command failed the specification (a short cause first), or None."""
+    if isinstance(exc, NotRefused):
+        return f"not refused before work: reached {reached[0]}"
+    if exc is not None:
+        return f"traceback: raised {type(exc).__name__}: {exc}"
+    if rc != 2:
+        return f"exit status {rc}, not 2"
+    if "Traceback" in stdout + stderr:
+        return "traceback in the output"
+    if stdout:
+        return f"wrote on stdout: {stdout!r}"
+    if not (stderr.endswith("\n") and stderr.count("\n") == 1):
+        return "not one line on stderr"
+    line = stderr.rstrip("\n")
+    if not line.startswith("rockjit: error:"):
+        return "the line does not start with 'rockjit: error:'"
+    if caught:
+        return f"warned: {[str(w.message) for w in caught]}"
+    msg = line[len("rockjit: error:"):]
+    if not case.extra_ok and "unrecognized arguments" in msg:
+        return "refused as an unknown option"
+    if not case.nargs_ok and re.search(TAKEN_FOR_AN_OPTION, msg):
+        return "a value was taken for an option (argparse and negative numbers)"
+    if not re.search(case.names, msg):
+        return f"the message does not name {case.names!r}"
+    for pattern in case.forbid:
+        if re.search(pattern, msg):
+            return f"the message says {pattern!r}"
+    if case.n_at_least is not None and not any(
+            int(n) >= case.n_at_least for n in re.findall(r"(?<![\d.])\d+(?![\d.])", msg)):
+        return f"the message does not give the N needed (>= {case.n_at_least})"
+    if case.memory and not re.search(MEMORY_MESSAGE, msg):
+        return "no memory estimate ('would need ...; at most ... fits') in the message"
+    if peak is not None and peak >= ALLOC_LIMIT:
+        return f"allocated {peak / 2**20:.0f} MiB before refusing"
+    return None
+
+
+# ---------------------------------------------------------------------------------------------
+# Negative numbers in e-notation are numbers (issue 10 §1)
+# ---------------------------------------------------------------------------------------------
+
+#: (command line up to the value, the value's words, argparse dest, the number expected)
+ACCEPTED = [
+    (["trajectory", "--hb", "1", "--alpha", "0.6", "--omega", "1.3"], ["--theta0", "-1e-3"],
+     "theta0", -1e-3),
+    (["trajectory", "--hb", "1", "--alpha", "0.6", "--omega", "1.3"], ["--dtheta0", "-2.5e-1"],
+     "dtheta0", -0.25),
+    (["basin", "--hb", "1", "--alpha", "0.66", "--omega", "1.3"],
+     ["--dtheta-range", "-1e-2", "1e-2"], "dtheta_range", [-0.01, 0.01]),
+    (["basin", "--hb", "1", "--alpha", "0.66", "--omega", "1.3"],
+     ["--theta-range", "-1E-1", "-1e-2"], "theta_range", [-0.1, -0.01]),
+    (["sweep", "--hb", "1", "--omega", "1.3", "--alpha-range", "0.5", "0.6"],
+     ["--theta0", "-2e-1"], "theta0", -0.2),
+    (["plane", "--hb", "1", "--alpha-range", "0.5", "0.6", "--omega-range", "1", "2"],
+     ["--phase", "-1e-1"], "phase", -0.1),
+    (["basin", "--hb", "1", "--alpha", "0.66", "--omega", "1.3"], ["--r0", "-1e-3", "--s0", "1"],
+     "r0", -1e-3),
+    (["trajectory", "--hb", "1", "--alpha", "0.6", "--omega", "1.3"], ["--dtheta0", "-.5e+0"],
+     "dtheta0", -0.5),
+]
+ACCEPTED_IDS = [f"{base[0]} {' '.join(words)}" for base, words, _, _ in ACCEPTED]
+
+
+@pytest.mark.parametrize("base, words, dest, value", ACCEPTED, ids=ACCEPTED_IDS)
+def test_negative_e_notation_parses(base, words, dest, value):
+    try:
+        args = build_parser().parse_args(base + words + ["--out", "unused"])
+    except Exception as exc:  # noqa: BLE001 - the CLI's parser raises UsageError
+        pytest.fail(f"refused at parsing: {exc}", pytrace=False)
+    got = getattr(args, dest)
+    assert (list(got) if isinstance(value, list) else got) == pytest.approx(value)
+
+
+@pytest.mark.parametrize("base, words", [a[:2] for a in ACCEPTED[:3]], ids=ACCEPTED_IDS[:3])
+def test_negative_e_notation_passes_validation(base, words, reached, tmp_path):
+    # valid input: validation lets it through to the (guarded) work, with no error line
+    rc, exc, _, err, _, _ = run_main(base + words + ["--quiet", "--out", str(tmp_path / "o")],
+                                     reached, tmp_path)
+    if not isinstance(exc, NotRefused):
+        pytest.fail(f"not let through: status {rc}, exception {exc!r}, stderr {err!r}",
+                    pytrace=False)
+    assert err == ""
+
+
+# ---------------------------------------------------------------------------------------------
+# The test's own machinery
+# ---------------------------------------------------------------------------------------------
+
+def test_guards_exist():
+    missing = [t for t in GUARDED if (lambda m, a: m is None or not hasattr(m, a))(*_resolve(t))]
+    assert not missing, f"update GUARDED at the top of this file: {missing} no longer exist"
+
+
+def test_cases_are_distinct_and_many():
+    ids = [c.id for c in CASES]
+    assert len(ids) == len(set(ids)), sorted({i for i in ids if ids.count(i) > 1})
+    assert len({tuple(argv_of(c, "OUT")) + (c.setup,) for c in CASES}) == len(CASES)
+    assert len(CASES) > 150
+    for c in CASES:
+        for opt in c.set:
+            assert opt in NAMES or opt in FLAGS or opt.startswith("--rtol=") or \
+                opt == "--frobnicate", (c.id, opt)
+
+
+def test_guard_stops_a_valid_command(reached, tmp_path):
+    # the sentinel does fire on a valid command line: the refusal test can tell the difference
+    rc, exc, _, err, _, _ = run_main(["basin", "--hb", "1", "--alpha", "0.66", "--omega", "1.3",
+                                      "--grid", "4", "--quiet", "--out", str(tmp_path / "o")],
+                                     reached, tmp_path)
+    assert isinstance(exc, NotRefused) and reached[0] in GUARDED + GUARDED_IF_PRESENT
+    assert err == "" and not (tmp_path / "o").exists()
