@@ -27,6 +27,7 @@ import numpy as np
 
 from . import integrate as ig
 from . import kernel
+from .attractors import floquet, identify, identify_along
 from .classify import classify
 from .model import ALPHA_MAX, OMEGA_RANGE, Block
 from .result import (BEHAVIOURS, BasinResult, PlaneResult, SweepResult, fractions)
@@ -74,6 +75,8 @@ class GridPlan:
     shape: tuple              # the result arrays' shape
     settings: dict = field(default_factory=dict)
     memory_bytes: float = 0.0
+    attractors: bool = False  # identify the attractors (rockjit.attractors)
+    phi: float = 0.0          # the forcing phase (basins: of every cell)
 
 
 def _classification(tol, pmax, lam_tol, settle_tol, settle_reps):
@@ -175,7 +178,7 @@ def plan_sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range
                lyapunov=True, early_stop=True, threads=None, tol=TOL, pmax=PMAX,
                lam_tol=LAM_TOL, max_impacts=None, settle_tol=SETTLE_TOL,
                settle_reps=SETTLE_REPS, n_points=None, n_impact_points=400,
-               chunk=None) -> GridPlan:
+               attractors=True, chunk=None) -> GridPlan:
     """Validate the inputs of :func:`sweep` (same parameters) into a :class:`GridPlan`."""
     alphas = _alphas(alphas, alpha_range, alpha_step)
     block = make_block(hb, float(alphas[0]), omega, law, e, xi)
@@ -203,7 +206,8 @@ def plan_sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range
     return GridPlan(kind="sweep", block=block, y0s=y0s, pars=pars, ipar=ipar, cpar=cpar,
                     tangent=bool(lyapunov), n_pts=n_points, n_imp_pts=n_impact_points,
                     threads=threads, chunk=chunk, axes=dict(alpha=alphas), shape=(n,),
-                    settings=settings, memory_bytes=nbytes)
+                    settings=settings, memory_bytes=nbytes, attractors=bool(attractors),
+                    phi=phi)
 
 
 def plan_basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100,
@@ -211,7 +215,7 @@ def plan_basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100,
                phase=None, periods=500, n_steps=None, window=None, lyapunov=False,
                early_stop=True, threads=None, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL,
                max_impacts=None, settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS,
-               chunk=None) -> GridPlan:
+               attractors=True, chunk=None) -> GridPlan:
     """Validate the inputs of :func:`basin` (same parameters) into a :class:`GridPlan`."""
     block = make_block(hb, alpha, omega, law, e, xi)
     grid = integer("grid", grid, 1, int(math.isqrt(MAX_CELLS)))
@@ -225,7 +229,8 @@ def plan_basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100,
         block, phi, periods=periods, n_steps=n_steps, window=window, early_stop=early_stop,
         tol=tol, pmax=pmax, lam_tol=lam_tol, max_impacts=max_impacts, settle_tol=settle_tol,
         settle_reps=settle_reps, threads=threads, chunk=chunk)
-    nbytes = _grid_memory("basin", float(grid) ** 2, settings, threads, chunk,
+    n_pts = settings["pmax"] if attractors else 0
+    nbytes = _grid_memory("basin", float(grid) ** 2, settings, threads, chunk, n_pts,
                           lyapunov=lyapunov)
     th = np.linspace(*th_rng, grid)
     dth = np.linspace(*dth_rng, grid)
@@ -235,16 +240,17 @@ def plan_basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100,
     settings.update(r0=r0, s0=s0, phase=phi, lyapunov=bool(lyapunov), law=block.law,
                     restitution=block.restitution)
     return GridPlan(kind="basin", block=block, y0s=y0s, pars=pars, ipar=ipar, cpar=cpar,
-                    tangent=bool(lyapunov), n_pts=0, n_imp_pts=0, threads=threads,
+                    tangent=bool(lyapunov), n_pts=n_pts, n_imp_pts=0, threads=threads,
                     chunk=chunk, axes=dict(theta0=th, dtheta0=dth), shape=(grid, grid),
-                    settings=settings, memory_bytes=nbytes)
+                    settings=settings, memory_bytes=nbytes, attractors=bool(attractors),
+                    phi=phi)
 
 
 def plan_plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None, xi=None,
                z0=Z0_STUDY, periods=500, n_steps=None, window=None, lyapunov=True,
                early_stop=True, threads=None, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL,
                max_impacts=None, settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS,
-               chunk=None) -> GridPlan:
+               attractors=True, chunk=None) -> GridPlan:
     """Validate the inputs of :func:`plane` (same parameters) into a :class:`GridPlan`."""
     a0, a1 = pair("alpha_range", alpha_range, 0.0, ALPHA_MAX)
     w0, w1 = pair("omega_range", omega_range, *OMEGA_RANGE)
@@ -268,7 +274,8 @@ def plan_plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None,
         block, phis[0], periods=periods, n_steps=n_steps, window=window,
         early_stop=early_stop, tol=tol, pmax=pmax, lam_tol=lam_tol, max_impacts=max_impacts,
         settle_tol=settle_tol, settle_reps=settle_reps, threads=threads, chunk=chunk)
-    nbytes = _grid_memory("plane", float(M) * na * nw, settings, threads, chunk,
+    n_pts = settings["pmax"] if attractors else 0
+    nbytes = _grid_memory("plane", float(M) * na * nw, settings, threads, chunk, n_pts,
                           lyapunov=lyapunov)
     alphas = np.linspace(a0, a1, na)
     omegas = np.linspace(w0, w1, nw)
@@ -284,9 +291,10 @@ def plan_plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None,
                    1)
     settings.update(lyapunov=bool(lyapunov), law=block.law, restitution=block.restitution)
     return GridPlan(kind="plane", block=block, y0s=y0s, pars=pars, ipar=ipar, cpar=cpar,
-                    tangent=bool(lyapunov), n_pts=0, n_imp_pts=0, threads=threads,
+                    tangent=bool(lyapunov), n_pts=n_pts, n_imp_pts=0, threads=threads,
                     chunk=chunk, axes=dict(alpha=alphas, omega=omegas, z0=z),
-                    shape=(M, na, nw), settings=settings, memory_bytes=nbytes)
+                    shape=(M, na, nw), settings=settings, memory_bytes=nbytes,
+                    attractors=bool(attractors))
 
 
 def run(plan: GridPlan, *, progress=False, client=None, store=None):
@@ -314,6 +322,9 @@ def run(plan: GridPlan, *, progress=False, client=None, store=None):
     t_end = res[:, kernel.R_T].reshape(p.shape)
     common = dict(block=p.block, settings=dict(p.settings), label=label, period=period,
                   t_end=t_end)
+    if p.attractors:
+        common["attractor"], common["attractors"] = _identify(p, res, out["pts"],
+                                                              out["n_got"])
     if p.kind == "sweep":
         return SweepResult(alpha=p.axes["alpha"], lambda_max=lam, strobe=out["pts"],
                            impact_section=out["imp"], **common)
@@ -324,12 +335,51 @@ def run(plan: GridPlan, *, progress=False, client=None, store=None):
                        lambda_max=lam, **common)
 
 
+def _identify(p, res, pts, n_got):
+    """Attractor ids (shaped like the labels) and attractors of a plan's cells, with the
+    Floquet multipliers of the periodic ones (rockjit.attractors)."""
+    label = res[:, kernel.R_LABEL].astype(np.int64)
+    period = res[:, kernel.R_PERIOD].astype(np.int64)
+    lam = res[:, [kernel.R_LAM1, kernel.R_LAM2]] if p.tangent else None
+    n_steps = p.settings["n_steps"]
+    if p.kind == "basin":
+        ids, found = identify(label, period, pts, n_got, lam)
+        blocks = {a.id: p.block for a in found}
+        phis = {a.id: p.phi for a in found}
+    else:
+        shape = p.shape if p.kind == "sweep" else p.shape[1:]
+        per_state = int(np.prod(shape))
+        ids = np.empty(label.size, dtype=np.int64)
+        found, blocks, phis = [], {}, {}
+        for m in range(label.size // per_state):  # a plane's initial states, one by one
+            sl = slice(m * per_state, (m + 1) * per_state)
+            ids_m, found_m = identify_along(label[sl], period[sl], pts[sl], n_got[sl], shape,
+                                            lam=None if lam is None else lam[sl])
+            shift = len(found)
+            ids[sl] = np.where(ids_m >= 0, ids_m + shift, ids_m)
+            for a in found_m:
+                a.id += shift
+                cell = sl.start + a.cell
+                a.cell = cell
+                a.extent = (a.extent[0] + sl.start, a.extent[1] + sl.start)
+                row = p.pars[cell]
+                blocks[a.id] = p.block.replace(alpha=row[ig.P_AW2] / row[ig.P_OMEGA] ** 2,
+                                               omega=row[ig.P_OMEGA])
+                phis[a.id] = row[ig.P_PHI]
+            found += found_m
+    for a in found:
+        if a.period:
+            a.multipliers, a.lam = floquet(blocks[a.id], phis[a.id], n_steps, a.points[0],
+                                           a.period)
+    return ids.reshape(p.shape), found
+
+
 def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None,
           alpha_step=0.001, z0=Z0_STUDY, periods=500, n_steps=None, window=None,
           lyapunov=True, early_stop=True, threads=None, progress=False, tol=TOL, pmax=PMAX,
           lam_tol=LAM_TOL, max_impacts=None, settle_tol=SETTLE_TOL,
-          settle_reps=SETTLE_REPS, n_points=None, n_impact_points=400, client=None,
-          store=None, chunk=None) -> SweepResult:
+          settle_reps=SETTLE_REPS, n_points=None, n_impact_points=400, attractors=True,
+          client=None, store=None, chunk=None) -> SweepResult:
     """Bifurcation sweep over the forcing amplitude ``alpha`` (SPEC.md §7).
 
     Parameters
@@ -359,6 +409,9 @@ def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None
         Stroboscopic samples kept per alpha (default the window length).
     n_impact_points : int
         Impact-section points kept per alpha.
+    attractors : bool
+        Identify the attractors (:mod:`rockjit.attractors`): ``result.attractor`` (ids) and
+        ``result.attractors``; along a sweep or plane by continuation between neighbours.
     client : dask.distributed.Client, optional
         Run the chunks of cells on this cluster (:mod:`rockjit.chunks`).
     store : path, optional
@@ -373,7 +426,7 @@ def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None
                    window=window, lyapunov=lyapunov, early_stop=early_stop, threads=threads,
                    tol=tol, pmax=pmax, lam_tol=lam_tol, max_impacts=max_impacts,
                    settle_tol=settle_tol, settle_reps=settle_reps, n_points=n_points,
-                   n_impact_points=n_impact_points, chunk=chunk)
+                   n_impact_points=n_impact_points, attractors=attractors, chunk=chunk)
     return run(p, progress=progress, client=client, store=store)
 
 
@@ -381,7 +434,7 @@ def basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100, theta_range=
           dtheta_range=(-1.0, 1.0), r0=None, s0=None, phase=None, periods=500,
           n_steps=None, window=None, lyapunov=False, early_stop=True, threads=None,
           progress=False, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL, max_impacts=None,
-          settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS, client=None,
+          settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS, attractors=True, client=None,
           store=None, chunk=None) -> BasinResult:
     """Basin of attraction over ``(theta0, theta0')`` on a ``grid x grid`` lattice.
 
@@ -394,15 +447,15 @@ def basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100, theta_range=
                    n_steps=n_steps, window=window, lyapunov=lyapunov, early_stop=early_stop,
                    threads=threads, tol=tol, pmax=pmax, lam_tol=lam_tol,
                    max_impacts=max_impacts, settle_tol=settle_tol, settle_reps=settle_reps,
-                   chunk=chunk)
+                   attractors=attractors, chunk=chunk)
     return run(p, progress=progress, client=client, store=store)
 
 
 def plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None, xi=None,
           z0=Z0_STUDY, periods=500, n_steps=None, window=None, lyapunov=True,
           early_stop=True, threads=None, progress=False, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL,
-          max_impacts=None, settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS, client=None,
-          store=None, chunk=None) -> PlaneResult:
+          max_impacts=None, settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS,
+          attractors=True, client=None, store=None, chunk=None) -> PlaneResult:
     """Behaviour and ``lambda_max`` at each ``(alpha, omega)`` of a grid (a rocking chart).
 
     Parameters
@@ -421,7 +474,7 @@ def plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None, xi=N
                    periods=periods, n_steps=n_steps, window=window, lyapunov=lyapunov,
                    early_stop=early_stop, threads=threads, tol=tol, pmax=pmax,
                    lam_tol=lam_tol, max_impacts=max_impacts, settle_tol=settle_tol,
-                   settle_reps=settle_reps, chunk=chunk)
+                   settle_reps=settle_reps, attractors=attractors, chunk=chunk)
     return run(p, progress=progress, client=client, store=store)
 
 

@@ -155,10 +155,19 @@ class GridResult:
     block: Block
     settings: dict = field(default_factory=dict)
     names: np.ndarray = field(default_factory=_names_array)
+    #: Outcome id of each cell (same shape as ``label``): ``>= 0`` the attractor it reaches,
+    #: ``-1`` overturn, ``-2`` unresolved (rockjit.attractors); None when not identified.
+    attractor: np.ndarray | None = None
+    #: The attractors (rockjit.attractors.Attractor), by id.
+    attractors: list = field(default_factory=list)
 
     def fractions(self):
         """Percentage of cells per behaviour name."""
         return fractions(self.label)
+
+    def attractor_summary(self):
+        """The attractors as JSON-ready dicts."""
+        return [a.to_dict() for a in self.attractors]
 
 
 @dataclass(kw_only=True)
@@ -205,6 +214,29 @@ class BasinResult(GridResult):
     period: np.ndarray
     lambda_max: np.ndarray | None
     t_end: np.ndarray
+
+    def measures(self, box=5, eps_cells=(1, 2, 3, 4, 6, 8)):
+        """Measures of the attractor map (rockjit.measures): basin entropy ``Sb`` and
+        boundary basin entropy ``Sbb`` on ``box x box`` boxes, the uncertainty exponent of the
+        boundary from the fraction of cells whose outcome differs ``eps`` cells away, and the
+        dynamical integrity (GIM, IF, and LIM of each bounded attractor). JSON-ready."""
+        from . import measures as M
+        ids = self.attractor
+        out = M.basin_entropy(ids, box=min(box, *ids.shape)).to_dict()
+        eps = [e for e in eps_cells if 2 * e < min(ids.shape)]
+        f = M.uncertain_fraction(ids, eps) if eps else []
+        if len(eps) >= 3 and np.all(np.asarray(f) > 0):
+            u = M.uncertainty_exponent(eps, f)
+            out["uncertainty_exponent"] = dict(alpha=u.alpha, stderr=u.stderr,
+                                               dimension=u.dimension, eps_cells=eps,
+                                               fraction=list(map(float, f)))
+        else:  # no boundary the perturbations can find
+            out["uncertainty_exponent"] = dict(alpha=math.nan, stderr=math.nan,
+                                               dimension=math.nan, eps_cells=eps,
+                                               fraction=list(map(float, f)))
+        points = {a.id: a.points for a in self.attractors}
+        out["integrity"] = M.integrity(ids, self.theta0, self.dtheta0, points).to_dict()
+        return out
 
 
 @dataclass(kw_only=True)

@@ -52,10 +52,11 @@ DAMPING_STEP = 1.0
 #: ``solve_ivp`` methods of the reference path.
 IVP_METHODS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
 
-#: Largest number of periods, and of steps per period, a run may ask for (the memory check
-#: refuses most large requests earlier, with the memory they would need).
-MAX_PERIODS = 10**9
-MAX_N = 10**9
+#: Largest number of periods, and of steps per period, a run may ask for: bounds that keep the
+#: kernels' step counter in 64 bits. The memory check refuses most large requests first, with
+#: the memory they would need.
+MAX_PERIODS = 10**15
+MAX_N = 10**12
 
 
 def default_max_impacts(periods):
@@ -258,6 +259,8 @@ def plan(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta0=No
     n_traj = periods * n_steps // record_stride + 1 if record_stride else 1
     nbytes = kernel.run_bytes(periods, n_steps, max_impacts, n_traj, lyapunov)
     memory(f"periods = {periods} at n_steps = {n_steps}", nbytes)
+    if periods * n_steps > 2**62:
+        raise ValueError(f"periods * n_steps must be <= 2**62 (got {periods} * {n_steps})")
     return RunPlan(block=block, y0=(theta0, dtheta0, r0, s0), phi=phi, forcing=forcing,
                    method=method, rtol=float(rtol), atol=float(atol), periods=periods,
                    n_steps=n_steps, window=w0, max_impacts=max_impacts,

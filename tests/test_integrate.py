@@ -458,3 +458,19 @@ def test_dip_through_zero_within_one_step_is_found(spec, th0, dth0):
     # coarse grid: the 3rd impact carries the O(h^5) error of N = 16
     np.testing.assert_allclose(r.impacts[:, 0], ref["impacts"][:, 0], rtol=0, atol=1e-5)
     np.testing.assert_allclose(r.impacts[:2, 0], ref["impacts"][:2, 0], rtol=0, atol=1e-9)
+
+
+def test_default_impact_bound_scales_with_the_periods():
+    # issue 10: 200,000 periods stopped at the old fixed bound of 100,000 impacts (~2 a period)
+    r = rockjit.simulate(1.0, 0.6, 1.3, "housner", periods=60_000, n_steps=64)
+    assert r.status == "done" and r.n_impacts > 100_000
+
+
+def test_impact_record_keeps_the_latest_impacts_in_order(monkeypatch):
+    from rockjit import kernel
+    full = rockjit.simulate(1.0, 0.6, 1.3, "housner", periods=40)
+    assert full.n_impacts > 57
+    monkeypatch.setattr(kernel, "IMPACT_RECORD", 57)  # a ring of 57 rows
+    r = rockjit.simulate(1.0, 0.6, 1.3, "housner", periods=40)
+    assert r.n_impacts == full.n_impacts and r.impacts.shape == (57, 3)
+    np.testing.assert_array_equal(r.impacts, full.impacts[-57:])

@@ -166,3 +166,60 @@ def test_switches_do_not_change_the_trajectory(name, forcing):
     assert np.array_equal(both.trajectory, recorded.trajectory)
     assert np.array_equal(both.lyapunov, tangent.lyapunov)
     assert np.array_equal(both.lyapunov_running, tangent.lyapunov_running)
+
+
+# ---- orbits through rest (issue 10): every perturbation dies, the exponents are -inf ----------
+
+THROUGH_REST = dict(hb=1.0, alpha=0.6, omega=1.3, law="housner", theta0=0.0, dtheta0=0.0,
+                    r0=0.0, s0=1.0)
+
+
+def _scipy_period(x, phase):
+    """One period of the scipy path (DOP853, tight) from (theta, theta') at ``phase``."""
+    kw = {k: v for k, v in THROUGH_REST.items() if k not in ("theta0", "dtheta0", "r0", "s0")}
+    r = rockjit.simulate(**kw, theta0=x[0], dtheta0=x[1], phase=phase, periods=1,
+                         method="scipy:DOP853", rtol=1e-12, atol=1e-12)
+    return r.state[:2]
+
+
+def test_orbit_through_rest_has_exponents_minus_infinity_at_every_cut_off():
+    # Before the fix: lambda1 = +1.954 at rest_speed 1e-6, 0.79 at 1e-3, 0.82 at 1e-8 (the
+    # saltation entries of the cascade's last impacts, ~1/theta', counted as growth).
+    for rest_speed in (1e-3, 1e-4, 1e-6, 1e-8):
+        r = rockjit.simulate(**THROUGH_REST, lyapunov=True, rest_speed=rest_speed)
+        assert r.status == "done" and r.n_rest_window > 0
+        assert np.all(r.lyapunov == -math.inf), (rest_speed, r.lyapunov)
+
+
+def test_orbit_through_rest_has_a_zero_monodromy_like_the_scipy_path():
+    # The stroboscopic map's Jacobian on the settled orbit, by central differences of the
+    # independent scipy path: zero, since both perturbed runs reach rest and leave it when the
+    # forcing alone says.
+    T = 2 * math.pi / THROUGH_REST["omega"]
+    r = rockjit.simulate(**THROUGH_REST, periods=40, qr_every=0, lyapunov=True)
+    k = 30
+    x = r.strobe[k, :2]
+    phase = THROUGH_REST["omega"] * k * T  # phi = atan2(0, 1) = 0 at t = 0
+    eps = 1e-5
+    J = np.empty((2, 2))
+    for j in range(2):
+        d = np.zeros(2)
+        d[j] = eps
+        J[:, j] = (_scipy_period(x + d, phase) - _scipy_period(x - d, phase)) / (2 * eps)
+    assert np.abs(J).max() < 1e-6
+    # the compiled run's flow Jacobian over the run is that zero matrix too
+    assert r.n_rest > 0 and np.array_equal(r.extra["tangent"], np.zeros((2, 2)))
+
+
+def test_rest_only_in_the_transient_leaves_the_window_exponents_finite():
+    # from rest at t = 0 (a collapse at the start), onto the reference orbit, which never rests:
+    # the window's exponents are the orbit's, as from the study's z0 (finite, negative)
+    ref = rockjit.simulate(1.0, 0.6, 1.3, "housner", z0=Z0, lyapunov=True)
+    kw = dict(hb=1.0, alpha=0.6, omega=1.3, law="housner", theta0=0.0, dtheta0=0.0,
+              phase=PHI0, lyapunov=True)
+    r = rockjit.simulate(**kw)
+    assert r.extra["collapses"] >= 1
+    if r.n_rest_window == 0:
+        np.testing.assert_allclose(r.lyapunov, ref.lyapunov, rtol=1e-3)
+    else:
+        assert np.all(r.lyapunov == -math.inf)

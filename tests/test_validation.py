@@ -136,3 +136,54 @@ def test_slow_forcing_raises_the_default_step_count():
     res = rockjit.simulate(hb=2.0, alpha=0.3, omega=0.05, periods=1, theta0=0.1, dtheta0=0.0)
     assert res.period / res.n_steps <= MAX_STEP
     assert res.n_steps > rockjit.DEFAULT_N
+
+
+# ---- issue 10: strong damping, the Zeno cut-off, the start, memory -----------------------------
+
+def test_strong_damping_raises_the_default_step_count_and_stays_bounded():
+    # xi = 200 at N = 160 is past the step's stability (3/4 xi T/N = 3.6 > 3.3): the run used
+    # to overturn at t = 2.17 with an error estimate of 1.4e2. Radau says it stays bounded.
+    r = rockjit.simulate(1.0, 0.6, 1.3, xi=200.0, periods=10)
+    assert 0.75 * 200.0 * r.period / r.n_steps <= 1.0
+    ref = rockjit.simulate(1.0, 0.6, 1.3, xi=200.0, periods=10, method="scipy:Radau",
+                           rtol=1e-10, atol=1e-12)
+    assert r.status == ref.status == "done"
+    np.testing.assert_allclose(r.state[:2], ref.state[:2], atol=1e-7)
+
+
+def test_an_unstable_explicit_step_count_is_refused_naming_the_n_needed():
+    with pytest.raises(ValueError, match=r"n_steps must be >= (\d+).*damping") as err:
+        rockjit.simulate(1.0, 0.6, 1.3, xi=200.0, n_steps=160, periods=1)
+    need = int(err.value.args[0].split(">= ")[1].split()[0])
+    T = 2 * math.pi / 1.3
+    assert 0.75 * 200.0 * T / need <= 3.0 < 0.75 * 200.0 * T / (need - 2)
+    assert rockjit.simulate(1.0, 0.6, 1.3, xi=200.0, n_steps=need, periods=1).status == "done"
+
+
+def test_rest_speed_zero_is_refused():
+    # it piled impacts at one instant until the impact bound
+    with pytest.raises(ValueError, match="rest_speed must be > 0"):
+        rockjit.simulate(1.0, 0.6, 1.3, e=0.5, rest_speed=0.0, periods=1)
+
+
+@pytest.mark.parametrize("kw, match", [
+    (dict(theta0=2.0), "theta0"),                               # the CLI refused it, the API ran
+    (dict(omega=1e300), "omega"), (dict(omega=1e-300), "omega"),  # OverflowError
+    (dict(omega=1e-8), "omega"),                                 # MemoryError
+    (dict(periods=10**12), "would need .* fits"),               # numpy's 29 TiB error
+    (dict(n_steps=4_000_000_000), "would need .* fits"),
+    (dict(periods=99999999999999999999), "periods must be in"),  # was "must be an integer"
+    (dict(periods=10**14), "would need .* fits"),
+    (dict(method="scipy", rtol=-1.0), "rtol"),                   # a TypeError with complex
+    (dict(method="scipy:FOO"), "method"),                        # scipy's own error
+])
+def test_issue_10_inputs_are_refused_by_the_api(kw, match):
+    with pytest.raises(ValueError, match=match):
+        rockjit.simulate(**{**BASE, **kw})
+
+
+def test_memory_estimate_names_the_need_and_the_limit():
+    from rockjit.validate import memory
+    with pytest.raises(ValueError, match=r"x would need 1\.0 GiB; at most 800\.0 MiB fits"):
+        memory("x", 2.0**30, limit=1000 * 2.0**20)
+    memory("x", 2.0**20, limit=1000 * 2.0**20)  # fits: no error
