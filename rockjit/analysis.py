@@ -52,8 +52,9 @@ LAM_TOL = 1e-2
 SETTLE_TOL = 1e-9
 SETTLE_REPS = 10
 
-#: Largest number of cells of one grid (the memory check refuses most large grids earlier).
-MAX_CELLS = 10**9
+#: Largest number of cells of one grid (a bound for the integers; the memory check refuses
+#: large grids first, with the memory they would need).
+MAX_CELLS = 10**18
 
 
 @dataclass(frozen=True)
@@ -113,7 +114,7 @@ def _grid_common(block, phi, *, periods, n_steps, window, early_stop, tol, pmax,
     return par, ipar, cpar, settings, threads, chunk
 
 
-def _grid_memory(kind, n_cells, settings, threads, chunk, n_pts=0, n_imp_pts=0,
+def grid_memory(kind, n_cells, settings, threads, chunk, n_pts=0, n_imp_pts=0,
                  lyapunov=False):
     """Refuse a grid whose arrays would not fit; returns the bytes it needs."""
     nbytes = kernel.grid_bytes(n_cells, settings["periods"], settings["n_steps"], n_pts,
@@ -196,7 +197,7 @@ def plan_sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range
         settle_reps=settle_reps, threads=threads, chunk=chunk)
     n_points = _n_points("n_points", n_points, settings["periods"] - settings["window"] + 1)
     n_impact_points = integer("n_impact_points", n_impact_points, 0, 10**6)
-    nbytes = _grid_memory("sweep", n, settings, threads, chunk, n_points, n_impact_points,
+    nbytes = grid_memory("sweep", n, settings, threads, chunk, n_points, n_impact_points,
                           lyapunov)
     y0s = np.tile(np.array([z[0], z[1], r0, s0]), (n, 1))
     pars = np.tile(par, (n, 1))
@@ -218,7 +219,7 @@ def plan_basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100,
                attractors=True, chunk=None) -> GridPlan:
     """Validate the inputs of :func:`basin` (same parameters) into a :class:`GridPlan`."""
     block = make_block(hb, alpha, omega, law, e, xi)
-    grid = integer("grid", grid, 1, int(math.isqrt(MAX_CELLS)))
+    grid = integer("grid", grid, 1, int(math.isqrt(MAX_CELLS)))  # the memory check refuses first
     th_rng = pair("theta_range", theta_range)
     if max(abs(th_rng[0]), abs(th_rng[1])) >= block.theta_over:
         raise ValueError(f"theta_range must lie inside (-theta_over, theta_over) = "
@@ -230,7 +231,7 @@ def plan_basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100,
         tol=tol, pmax=pmax, lam_tol=lam_tol, max_impacts=max_impacts, settle_tol=settle_tol,
         settle_reps=settle_reps, threads=threads, chunk=chunk)
     n_pts = settings["pmax"] if attractors else 0
-    nbytes = _grid_memory("basin", float(grid) ** 2, settings, threads, chunk, n_pts,
+    nbytes = grid_memory("basin", float(grid) ** 2, settings, threads, chunk, n_pts,
                           lyapunov=lyapunov)
     th = np.linspace(*th_rng, grid)
     dth = np.linspace(*dth_rng, grid)
@@ -275,7 +276,7 @@ def plan_plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None,
         early_stop=early_stop, tol=tol, pmax=pmax, lam_tol=lam_tol, max_impacts=max_impacts,
         settle_tol=settle_tol, settle_reps=settle_reps, threads=threads, chunk=chunk)
     n_pts = settings["pmax"] if attractors else 0
-    nbytes = _grid_memory("plane", float(M) * na * nw, settings, threads, chunk, n_pts,
+    nbytes = grid_memory("plane", float(M) * na * nw, settings, threads, chunk, n_pts,
                           lyapunov=lyapunov)
     alphas = np.linspace(a0, a1, na)
     omegas = np.linspace(w0, w1, nw)

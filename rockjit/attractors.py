@@ -44,7 +44,8 @@ from .result import (APERIODIC, ASYMMETRIC, BEHAVIOURS, CHAOTIC, MULTIPERIODIC, 
                      REST, SYMMETRIC, UNRESOLVED)
 
 __all__ = ["CLOUD_GRID", "CONT_TOL", "MATCH_TOL", "OVERTURN_ID", "UNRESOLVED_ID", "Attractor",
-           "cycle_distance", "floquet", "identify", "identify_along", "match_attractors"]
+           "attractor_agreement", "cycle_distance", "floquet", "identify", "identify_along",
+           "match_attractors"]
 
 #: Outcome ids of the cells that reach no attractor.
 OVERTURN_ID = -1
@@ -366,3 +367,18 @@ def match_attractors(a, b, tol=MATCH_TOL):
                 pairs[x.id] = y.id
                 break
     return pairs
+
+
+def attractor_agreement(a, b, tol=MATCH_TOL):
+    """Agreement of two attractor maps of the same grid (e.g. the two laws' basins): the
+    percent of cells that reach matching attractors (:func:`match_attractors`) or both
+    overturn, and the matched pairs ``{id_a: id_b}``."""
+    pairs = match_attractors(a.attractors, b.attractors, tol)
+    ia, ib = np.asarray(a.attractor), np.asarray(b.attractor)
+    lut = np.full(len(a.attractors), -3)
+    for i, j in pairs.items():
+        lut[i] = j
+    mapped = np.where(ia >= 0, lut[np.maximum(ia, 0)] if lut.size else -3, ia)
+    same = (mapped == ib) & (ia != UNRESOLVED_ID)
+    return dict(percent=100.0 * np.mean(same) if same.size else math.nan,
+                pairs={int(i): int(j) for i, j in pairs.items()})

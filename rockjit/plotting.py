@@ -18,9 +18,9 @@ from .analysis import classify_result
 from .result import BEHAVIOURS, fractions
 from .model import delta_e_percent, e_housner, e_mao, thc_from_hb
 
-__all__ = ["BEHAVIOUR_COLOURS", "LAW_COLOURS", "agreement", "fig_basin", "fig_basin_compare",
-           "fig_bifurcation", "fig_gallery", "fig_laws_timeseries", "fig_restitution",
-           "fig_trajectory"]
+__all__ = ["BEHAVIOUR_COLOURS", "LAW_COLOURS", "agreement", "fig_attractors", "fig_basin",
+           "fig_basin_compare", "fig_bifurcation", "fig_erosion", "fig_gallery",
+           "fig_laws_timeseries", "fig_plane", "fig_restitution", "fig_trajectory"]
 
 #: One colour per behaviour name (analysis.BEHAVIOURS), used by every figure.
 BEHAVIOUR_COLOURS = {
@@ -500,6 +500,120 @@ def fig_basin_compare(housner_basin, mao_basin, title=None):
     fig.suptitle(title or f"Basins of attraction, h/b = {blk.hb:g}, \u03b1 = {blk.alpha:g}, "
                  f"\u03c9 = {blk.omega:g}, (r\u2080, s\u2080) = "
                  f"({a.settings.get('r0', 0):.4g}, {a.settings.get('s0', 1):.4g})")
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# Attractors, integrity, erosion (issue 12)
+# ---------------------------------------------------------------------------------------------
+
+def _attractor_colours(n):
+    """Distinct colours for attractor ids 0..n-1 (tab10, then tab20b/c)."""
+    from matplotlib import colormaps
+    base = list(colormaps["tab10"].colors) + list(colormaps["tab20b"].colors) + \
+        list(colormaps["tab20c"].colors)
+    return [base[i % len(base)] for i in range(n)]
+
+
+def _attractor_panel(ax, ids, theta0, dtheta0, attractors, show_y=True):
+    """The attractor map (``ids[i, j]`` of ``theta0[i], dtheta0[j]``) with each periodic
+    attractor's cycle marked; returns the legend handles."""
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+    n = max(len(attractors), 1)
+    colours = [BEHAVIOUR_COLOURS["unresolved"], BEHAVIOUR_COLOURS["overturn"]] + \
+        _attractor_colours(n)
+    cmap = ListedColormap(colours)
+    norm = BoundaryNorm(np.arange(-2, n + 1) - 0.5, cmap.N)
+    ax.imshow(np.asarray(ids).T, origin="lower", cmap=cmap, norm=norm, interpolation="nearest",
+              aspect="auto", extent=_extent(np.asarray(theta0), np.asarray(dtheta0)))
+    ax.set_xlabel("\u03b8\u2080")
+    if show_y:
+        ax.set_ylabel("\u03b8\u2080\u2032")
+    handles = []
+    for a, c in zip(attractors, colours[2:]):
+        name = f"{a.id}: {a.behaviour}" + (f" p={a.period}" if a.period > 1 else "") + \
+            f", {a.fraction:.1f} %"
+        handles.append(Patch(color=c, label=name))
+        if a.period:
+            ax.plot(a.points[:, 0], a.points[:, 1], ls="", marker="*", ms=11, mfc=c, mec="k",
+                    mew=0.8)
+    over = 100.0 * np.mean(np.asarray(ids) == -1)
+    if over:
+        handles.append(Patch(color=colours[1], label=f"overturn, {over:.1f} %"))
+    unres = 100.0 * np.mean(np.asarray(ids) == -2)
+    if unres:
+        handles.append(Patch(color=colours[0], label=f"unresolved, {unres:.1f} %"))
+    handles.append(Line2D([], [], ls="", marker="*", ms=9, mfc="w", mec="k",
+                          label="cycle points at t = kT"))
+    return handles
+
+
+def fig_attractors(basins, title=None):
+    """Attractor maps of one or two basins (a dict ``law: BasinResult``, or one result), each
+    with its basin entropy and integrity in the panel's title."""
+    if not isinstance(basins, dict):
+        basins = {basins.block.law: basins}
+    fig = _figure(figsize=(6.4 * len(basins), 6.6))
+    axes = np.atleast_1d(fig.subplots(1, len(basins), sharey=True))
+    for i, (ax, b) in enumerate(zip(axes, basins.values())):
+        handles = _attractor_panel(ax, b.attractor, b.theta0, b.dtheta0, b.attractors,
+                                   show_y=i == 0)
+        m = b.measures()
+        ax.set_title(f"{_law(b.block)}: S_b = {m['basin_entropy']:.3f}, "
+                     f"S_bb = {m['boundary_basin_entropy']:.3f}\n"
+                     f"GIM = {m['integrity']['GIM']:.3f}, IF = {m['integrity']['IF']:.3f}",
+                     fontsize=10)
+        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncols=2,
+                  fontsize=7.5, frameon=False)
+    blk = next(iter(basins.values())).block
+    fig.suptitle(title or f"Attractors, h/b = {blk.hb:g}, \u03b1 = {blk.alpha:g}, "
+                 f"\u03c9 = {blk.omega:g}", fontsize=11)
+    return fig
+
+
+def fig_erosion(profiles, title=None):
+    """Erosion profiles (a dict ``law: ErosionResult``, or one): GIM and IF against the
+    amplitude for each law on top (the classic erosion profile), and below, for each law, the
+    stacked basin fractions of its attractor branches (overturn on top, in grey)."""
+    if not isinstance(profiles, dict):
+        profiles = {profiles.block.law: profiles}
+    fig = _figure(figsize=(10.0, 3.6 + 3.0 * len(profiles)))
+    gs = fig.add_gridspec(1 + len(profiles), 1, height_ratios=[1.2] + [1] * len(profiles))
+    ax = fig.add_subplot(gs[0])
+    for law, r in profiles.items():
+        c = LAW_COLOURS.get(law, "k")
+        ax.plot(r.alpha, r.GIM, color=c, lw=1.8, label=f"GIM, {_law(r.block)}")
+        ax.plot(r.alpha, r.IF, color=c, lw=1.4, ls="--", label=f"IF, {_law(r.block)}")
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_ylabel("integrity")
+    ax.legend(fontsize=8, ncols=2)
+    ax.grid(alpha=0.3)
+    for k, (law, r) in enumerate(profiles.items()):
+        axk = fig.add_subplot(gs[1 + k], sharex=ax)
+        fr = r.fractions()
+        colours = _attractor_colours(len(r.branches))
+        labels = [f"{b['id']}: {b['behaviour']}" + (f" p={b['period']}" if b["period"] > 1
+                                                     else "") for b in r.branches]
+        if len(fr):
+            axk.stackplot(r.alpha, fr, colors=colours, labels=labels, lw=0)
+        top = fr.sum(axis=0) if len(fr) else np.zeros_like(r.alpha)
+        axk.fill_between(r.alpha, top, 100.0, color=BEHAVIOUR_COLOURS["overturn"], alpha=0.55,
+                         lw=0, label="overturn / unresolved")
+        axk.set_ylim(0, 100)
+        axk.set_ylabel(f"{_law(r.block)}: % of cells")
+        big = [i for i in np.argsort(-fr.max(axis=1))[:8]] if len(fr) else []
+        handles, labs = axk.get_legend_handles_labels()
+        keep = [j for j, lab in enumerate(labs) if lab == "overturn / unresolved" or
+                any(lab == labels[i] for i in big)]
+        axk.legend([handles[j] for j in keep], [labs[j] for j in keep], fontsize=7,
+                   loc="center left", bbox_to_anchor=(1.0, 0.5), frameon=False)
+    fig.axes[-1].set_xlabel("\u03b1")
+    r0 = next(iter(profiles.values()))
+    fig.suptitle(title or f"Erosion profiles, h/b = {r0.block.hb:g}, "
+                 f"\u03c9 = {r0.block.omega:g}, {r0.attractor.shape[1]}\u00b2 cells per basin",
+                 fontsize=11)
     return fig
 
 

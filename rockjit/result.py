@@ -130,6 +130,29 @@ class Result:
         """``lambda1`` over the window (``nan`` when exponents were not asked for)."""
         return math.nan if self.lyapunov is None else float(self.lyapunov[0])
 
+    def arrays(self):
+        """The run's arrays by name, for an ``.npz``: the recorded trajectory (``t, theta,
+        dtheta, r, s``) when there is one, the samples, the impacts, the running exponents."""
+        out = {}
+        if self.trajectory is not None:
+            tr = self.trajectory
+            out.update(t=tr[:, 0], theta=tr[:, 1], dtheta=tr[:, 2], r=tr[:, 3], s=tr[:, 4])
+        out.update(strobe=self.strobe, strobe_half=self.strobe_half, impacts=self.impacts)
+        if self.lyapunov_running is not None:
+            out["lyapunov_running"] = self.lyapunov_running
+        return out
+
+    def summary(self):
+        """JSON-ready scalars of the run (its exponents when computed)."""
+        out = dict(status=self.status, message=self.message, t_end=self.t,
+                   final_state=self.state, n_impacts=self.n_impacts, n_rest=self.n_rest,
+                   restitution=self.block.restitution, n_steps=self.n_steps,
+                   max_error_estimate=self.max_error_estimate, method=self.method,
+                   n_locate_unconverged=self.n_locate_unconverged)
+        if self.lyapunov is not None:
+            out.update(lambda_max=self.lyapunov[0], lyapunov=self.lyapunov, window=self.window)
+        return out
+
     @property
     def stopped_early(self) -> bool:
         """True when the run ended before the requested time for a reason other than its
@@ -200,6 +223,16 @@ class SweepResult(GridResult):
     impact_section: np.ndarray
     t_end: np.ndarray
 
+    def arrays(self):
+        """The sweep's arrays by name, for an ``.npz``."""
+        out = dict(alpha=self.alpha, label=self.label, period=self.period,
+                   lambda_max=self.lambda_max, strobe=self.strobe,
+                   impact_section=self.impact_section, t_end=self.t_end,
+                   names=np.asarray(self.names, dtype=str))
+        if self.attractor is not None:
+            out["attractor"] = self.attractor
+        return out
+
 
 @dataclass(kw_only=True)
 class BasinResult(GridResult):
@@ -214,6 +247,18 @@ class BasinResult(GridResult):
     period: np.ndarray
     lambda_max: np.ndarray | None
     t_end: np.ndarray
+
+    def summary(self):
+        """JSON-ready: behaviours (percent and counts), settings, attractors and, when they
+        were identified, the attractor map's measures (:meth:`measures`)."""
+        lab = np.asarray(self.label)
+        counts = {str(n): int(np.count_nonzero(lab == c)) for c, n in enumerate(self.names)}
+        out = dict(law=self.block.law, restitution=self.block.restitution,
+                   fractions=self.fractions(), counts=counts, settings=self.settings,
+                   attractors=self.attractor_summary())
+        if self.attractor is not None:
+            out.update(self.measures())
+        return out
 
     def measures(self, box=5, eps_cells=(1, 2, 3, 4, 6, 8)):
         """Measures of the attractor map (rockjit.measures): basin entropy ``Sb`` and

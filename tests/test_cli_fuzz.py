@@ -63,9 +63,11 @@ GUARDED = (
     "rockjit.analysis:sweep",
     "rockjit.analysis:basin",
     "rockjit.analysis:plane",
-    "rockjit.analysis:run_chunk",
+    "rockjit.analysis:run",
+    "rockjit.kernel:run_chunk",
     "rockjit.integrate:build",
-    "rockjit.cli:e_table",          # the work of `cor` (and of `paper`'s first part)
+    "rockjit.study:write_e_table",  # the work of `cor` (and of `paper`'s first part)
+    "rockjit.study:paper",
     "rockjit.io:atomic_open",       # every file the CLI writes goes through these
     "rockjit.io:write_json",
     "rockjit.io:write_npz",

@@ -1,0 +1,250 @@
+"""Erosion profiles: basins along a forcing parameter, their integrity, and their attractors
+continued from one amplitude to the next (global continuation, as in Attractors.jl).
+
+:func:`plan_erosion` makes one grid of every basin's cells (``n_alpha`` stacked basins, each on
+the same ``(theta0, theta0')`` lattice at the same forcing phase), so the whole profile runs as
+one computation: chunk by chunk with progress, resumable from a chunk store, on Dask when asked.
+:func:`run` then, at each amplitude, identifies the attractors (:func:`rockjit.attractors.identify`)
+and measures the basin (:mod:`rockjit.measures`: GIM, IF, basin entropy), and links each
+amplitude's attractors to the previous amplitude's (same behaviour and period, cycles within
+``cont_tol`` of the orbit's size, the nearest one): a *branch* is an attractor followed across
+amplitudes, and its basin fraction against the amplitude is the stacked panel of the profile.
+
+The erosion profile of Lenci and Rega is GIM and IF against the forcing; the study's claim that
+Mao's law "reduces the domain of safe bounded motion" is measured by comparing the two laws'.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import analysis
+from . import integrate as ig
+from . import kernel
+from . import measures as M
+from .attractors import cycle_distance, floquet, identify
+
+__all__ = ["LINK_TOL", "ErosionResult", "erosion", "plan_erosion", "run"]
+
+#: Continuation tolerance from one amplitude to the next, relative to the orbit's size: an
+#: amplitude step of a few hundredths moves a cycle by up to a fifth of its size, while two
+#: distinct attractors of one kind lie about their own size apart; the nearest one is taken.
+LINK_TOL = 0.35
+
+
+@dataclass(frozen=True)
+class ErosionPlan:
+    """The stacked basins of an erosion profile: a :class:`rockjit.analysis.GridPlan` of all
+    cells (amplitude-major) and the amplitudes."""
+
+    grid_plan: analysis.GridPlan
+    alpha: np.ndarray
+    grid: int
+    floquet: bool
+
+
+@dataclass
+class ErosionResult:
+    """An erosion profile: per amplitude, the basin's integrity and each branch's fraction.
+
+    Attributes
+    ----------
+    alpha : ndarray, shape (na,)
+    GIM, IF : ndarray, shape (na,)
+        Global integrity measure and integrity factor of each basin (rockjit.measures).
+    basin_entropy, boundary_basin_entropy : ndarray, shape (na,)
+    overturn : ndarray, shape (na,)
+        Percent of cells that overturn.
+    branches : list of dict
+        Each attractor continued across amplitudes: ``id``, ``behaviour``, ``period``,
+        ``alpha`` (first, last), and ``fraction`` (percent of cells, an array over all
+        amplitudes, 0 where absent).
+    attractor : ndarray of int, shape (na, grid, grid)
+        The attractor map of each basin, in branch ids (-1 overturn, -2 unresolved).
+    label : ndarray of int, shape (na, grid, grid)
+        The behaviour map of each basin.
+    theta0, dtheta0 : ndarray, shape (grid,)
+    block : Block
+        The block at the first amplitude.
+    settings : dict
+    """
+
+    alpha: np.ndarray
+    GIM: np.ndarray
+    IF: np.ndarray
+    basin_entropy: np.ndarray
+    boundary_basin_entropy: np.ndarray
+    overturn: np.ndarray
+    branches: list
+    attractor: np.ndarray
+    label: np.ndarray
+    theta0: np.ndarray
+    dtheta0: np.ndarray
+    block: object
+    settings: dict = field(default_factory=dict)
+
+    def fractions(self):
+        """``(n_branches, na)``: each branch's percent of cells at each amplitude."""
+        return np.array([b["fraction"] for b in self.branches]).reshape(-1, self.alpha.size)
+
+    def to_summary(self):
+        """JSON-ready: the profile's arrays and the branches."""
+        return dict(alpha=self.alpha, GIM=self.GIM, IF=self.IF,
+                    basin_entropy=self.basin_entropy,
+                    boundary_basin_entropy=self.boundary_basin_entropy,
+                    overturn_percent=self.overturn,
+                    branches=[{k: v for k, v in b.items()} for b in self.branches],
+                    law=self.block.law, restitution=self.block.restitution,
+                    settings=self.settings)
+
+
+def plan_erosion(hb, omega, *, law=None, e=None, xi=None, alpha_range, alpha_step=0.01,
+                 grid=100, theta_range=(-1.0, 1.0), dtheta_range=(-1.0, 1.0), r0=None, s0=None,
+                 phase=None, periods=500, n_steps=None, early_stop=True, threads=None,
+                 max_impacts=None, floquet=True, chunk=None) -> ErosionPlan:
+    """Validate an erosion profile: a basin at each amplitude of ``alpha_range`` (ends included,
+    step ``alpha_step``), every basin planned and memory-checked as one grid."""
+    alphas = analysis.alpha_grid(alpha_range, alpha_step)
+    kw = dict(law=law, e=e, xi=xi, grid=grid, theta_range=theta_range,
+              dtheta_range=dtheta_range, r0=r0, s0=s0, phase=phase, periods=periods,
+              n_steps=n_steps, early_stop=early_stop, threads=threads,
+              max_impacts=max_impacts, chunk=chunk)
+    first = analysis.plan_basin(hb, float(alphas[0]), omega, **kw)
+    if alphas.size > 1:  # the largest amplitude's block, and the whole stack's memory
+        analysis.plan_basin(hb, float(alphas[-1]), omega, **kw)
+        analysis.grid_memory("stack of basins", float(first.y0s.shape[0]) * alphas.size,
+                              first.settings, first.threads, first.chunk, first.n_pts)
+    n = first.y0s.shape[0]
+    y0s = np.tile(first.y0s, (alphas.size, 1))
+    pars = np.tile(first.pars, (alphas.size, 1))
+    pars[:, ig.P_AW2] = np.repeat(alphas, n) * first.block.omega ** 2
+    gp = analysis.GridPlan(kind="erosion", block=first.block, y0s=y0s, pars=pars,
+                           ipar=first.ipar, cpar=first.cpar, tangent=False, n_pts=first.n_pts,
+                           n_imp_pts=0, threads=first.threads, chunk=first.chunk,
+                           axes=dict(alpha=alphas, **first.axes),
+                           shape=(alphas.size,) + first.shape, settings=dict(first.settings),
+                           memory_bytes=first.memory_bytes * alphas.size, attractors=True,
+                           phi=first.phi)
+    return ErosionPlan(grid_plan=gp, alpha=alphas, grid=first.shape[0], floquet=bool(floquet))
+
+
+def _link(prev, cur, tol, floor):
+    """``{id_cur: id_prev}``: each current attractor to the nearest previous one of the same
+    behaviour and period whose cycle lies within ``tol`` of the size (rest to rest); the size
+    is at least ``floor`` (a small orbit moves by more than its own size from one amplitude to
+    the next, while staying far from any other)."""
+    links = {}
+    taken = set()
+    for a in sorted(cur, key=lambda x: -x.n_cells):
+        best, dist = None, math.inf
+        for b in prev:
+            if b.id in taken or a.behaviour != b.behaviour or a.period != b.period:
+                continue
+            if a.behaviour == "rest":
+                d = 0.0
+            elif a.period:
+                d = cycle_distance(b.points, a.points) / max(np.abs(a.points).max(),
+                                                             np.abs(b.points).max(), floor)
+            else:  # clouds: their samples' centroids
+                d = np.abs(a.points.mean(axis=0) - b.points.mean(axis=0)).max() / max(
+                    np.abs(a.points).max(), np.abs(b.points).max(), floor)
+            if d <= tol and d < dist:
+                best, dist = b.id, d
+        if best is not None:
+            links[a.id] = best
+            taken.add(best)
+    return links
+
+
+def run(plan: ErosionPlan, *, progress=False, client=None, store=None, cont_tol=LINK_TOL):
+    """Execute an :class:`ErosionPlan`; returns an :class:`ErosionResult`."""
+    gp = plan.grid_plan
+    out = kernel.run_grid(gp.y0s, gp.pars, gp.ipar, gp.cpar, tangent=False, n_pts=gp.n_pts,
+                          n_imp_pts=0, threads=gp.threads, progress=progress, label="erosion",
+                          chunk=gp.chunk, client=client, store=store)
+    res = out["res"]
+    na, g = plan.alpha.size, plan.grid
+    n = g * g
+    label = res[:, kernel.R_LABEL].astype(np.int64)
+    period = res[:, kernel.R_PERIOD].astype(np.int64)
+    th, dth = gp.axes["theta0"], gp.axes["dtheta0"]
+    # the size below which orbits count as small: a tenth of the sampled region's half-width
+    floor = 0.1 * max(th[-1] - th[0], dth[-1] - dth[0]) / 2 or 0.1
+    gim, if_, sb, sbb, over = (np.zeros(na) for _ in range(5))
+    amap = np.empty((na, g, g), dtype=np.int64)
+    branches = []      # dicts, by branch id
+    prev, prev_branch = [], {}
+    for k in range(na):
+        sl = slice(k * n, (k + 1) * n)
+        ids, found = identify(label[sl], period[sl], out["pts"][sl], out["n_got"][sl])
+        block = gp.block.replace(alpha=float(plan.alpha[k]))
+        if plan.floquet:
+            for a in found:
+                if a.period:
+                    a.multipliers, a.lam = floquet(block, gp.phi, gp.settings["n_steps"],
+                                                   a.points[0], a.period)
+        links = _link(prev, found, cont_tol, floor)
+        branch_of = {}
+        for a in found:
+            if a.id in links:
+                bid = prev_branch[links[a.id]]
+            else:
+                bid = len(branches)
+                branches.append(dict(id=bid, behaviour=a.behaviour, period=a.period,
+                                     alpha=[float(plan.alpha[k])] * 2,
+                                     fraction=np.zeros(na), points=a.points.tolist(),
+                                     multipliers=None))
+            branch_of[a.id] = bid
+            br = branches[bid]
+            br["alpha"][1] = float(plan.alpha[k])
+            br["fraction"][k] = a.fraction
+            if a.multipliers is not None and br["multipliers"] is None:
+                br["multipliers"] = [[float(np.real(m)), float(np.imag(m))]
+                                     for m in a.multipliers]
+        ids2 = ids.reshape(g, g)
+        lut = np.array([branch_of[a.id] for a in found] or [-2], dtype=np.int64)
+        amap[k] = np.where(ids2 >= 0, lut[np.maximum(ids2, 0)], ids2)
+        integ = M.integrity(ids2, th, dth)
+        ent = M.basin_entropy(ids2, box=min(5, g))
+        gim[k], if_[k], sb[k], sbb[k] = integ.GIM, integ.IF, ent.Sb, ent.Sbb
+        over[k] = 100.0 * np.mean(ids2 == -1)
+        prev, prev_branch = found, branch_of
+    settings = dict(gp.settings, grid=g, alpha_step=float(plan.alpha[1] - plan.alpha[0])
+                    if na > 1 else 0.0, cont_tol=cont_tol)
+    return ErosionResult(alpha=plan.alpha, GIM=gim, IF=if_, basin_entropy=sb,
+                         boundary_basin_entropy=sbb, overturn=over, branches=branches,
+                         attractor=amap, label=label.reshape(na, g, g), theta0=th, dtheta0=dth,
+                         block=gp.block, settings=settings)
+
+
+def erosion(hb, omega, *, law=None, alpha_range, alpha_step=0.01, grid=100, progress=False,
+            client=None, store=None, cont_tol=LINK_TOL, **kw) -> ErosionResult:
+    """Erosion profile of the basin over ``(theta0, theta0')`` along the forcing amplitude.
+
+    Parameters
+    ----------
+    hb, omega : float
+        Slenderness and forcing frequency.
+    law : str, optional
+        Restitution law (``e``, ``xi`` and the other block parameters as in
+        :func:`rockjit.analysis.basin`).
+    alpha_range : pair of float
+        Amplitudes from start to end (included), every ``alpha_step``.
+    grid : int
+        Cells per side of each basin.
+    progress, client, store :
+        As in :func:`rockjit.analysis.sweep` (the whole stack of basins is one computation).
+    cont_tol : float
+        Continuation tolerance of the attractors from one amplitude to the next, relative to
+        the orbit's size.
+    **kw :
+        Further basin settings: ``theta_range``, ``dtheta_range``, ``r0``, ``s0``, ``phase``,
+        ``periods``, ``n_steps``, ``early_stop``, ``threads``, ``max_impacts``, ``floquet``,
+        ``chunk``, ``e``, ``xi``.
+    """
+    p = plan_erosion(hb, omega, law=law, alpha_range=alpha_range, alpha_step=alpha_step,
+                     grid=grid, **kw)
+    return run(p, progress=progress, client=client, store=store, cont_tol=cont_tol)

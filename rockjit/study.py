@@ -1,0 +1,347 @@
+"""The study rockjit reproduces (SPEC.md §7): every constant of it, and its pipeline, ``paper``.
+
+The constants are the study's parameters: the slenderness ratios with their forcing frequencies
+and amplitude ranges, the sweeps' step, the zoom, the initial states of the single runs, the
+gallery, the basins. :func:`plan_paper` validates a paper's settings (nothing computed) and
+:func:`paper` computes every figure and table and writes them into an output directory object
+(:class:`rockjit.io.OutputDir` on the command line): figures 1-6 of the study, and beyond it
+the attractor maps of its basins with their entropy and integrity (figure 7) and the erosion
+profiles of both laws (figure 8). Its grids run on the chunk store, so an interrupted paper
+resumes, and on a Dask cluster when a client is given.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import analysis
+from . import erosion
+from .analysis import BEHAVIOURS, classify_result
+from .model import delta_e_percent, e_housner, e_mao, thc_from_hb
+from .simulate import DEFAULT_N, Z0_STUDY, simulate
+from .erosion import plan_erosion
+from .simulate import plan as plan_run
+from .validate import integer, pair, real
+
+__all__ = ["ALPHA_STEP", "BASIN_CASES", "BASIN_GRID", "EROSION", "EROSION_STEP", "GALLERY",
+           "LAWS_IC", "LAWS_RUN", "PERIODS", "REFERENCE_RUN", "STUDY", "Z0", "ZOOM", "PaperPlan",
+           "e_table", "paper", "plan_paper"]
+
+#: The initial state of the single runs and sweeps, ``(theta, theta', r, s)``. (Defined in
+#: rockjit.simulate, whose default it is.)
+Z0 = Z0_STUDY
+
+#: Per slenderness ratio: the forcing frequency and the amplitude range of each law's sweep.
+STUDY = {
+    1: dict(omega=1.3, alpha_range={"housner": (0.5, 1.0), "mao": (0.3, 0.8)}),
+    2: dict(omega=1.6, alpha_range={"housner": (0.1, 0.5), "mao": (0.1, 0.5)}),
+}
+#: The sweeps' amplitude step, the number of periods and the asymptotic window's start.
+ALPHA_STEP = 0.001
+PERIODS = 500
+WINDOW = 400
+#: The zoomed Housner hb=1 diagram.
+ZOOM = (0.88, 0.98)
+#: Figure 2: the reference symmetric run.
+REFERENCE_RUN = dict(hb=1.0, alpha=0.6, omega=1.3, law="housner")
+#: Figure 3: the behaviour gallery, ``name: (hb, alpha, omega, initial state)``; the study's
+#: "multiperiodic" example (alpha = 0.969) is transient chaos ending in overturning once
+#: integrated accurately (README, "What the study's settings hide"): both it and a robust
+#: period-2 orbit of the same family are shown.
+GALLERY = {
+    "rest / damped": (1.0, 0.15, 1.0, dict(theta0=0.05, dtheta0=0.0, r0=Z0[2], s0=Z0[3])),
+    "asymmetric": (1.0, 0.8, 1.3, dict(z0=Z0)),
+    "multiperiodic": (1.0, 0.92, 1.3, dict(z0=Z0)),
+    "study's 'multiperiodic'": (1.0, 0.969, 1.3, dict(z0=Z0)),
+    "overturn": (2.0, 0.448, 1.3, dict(z0=Z0)),
+}
+#: Figure 4: Housner vs Mao time series at this block, from these ``(theta0, theta0')`` with
+#: ``(r0, s0) = (0, 1)``.
+LAWS_RUN = dict(hb=2.0, alpha=0.2, omega=1.6)
+LAWS_IC = ((0.8586, -0.8182), (-0.0505, -0.2121), (0.3535, -0.3333))
+#: Figure 6: the basins ``(hb, alpha, omega)``, over ``linspace(-1, 1, BASIN_GRID)^2`` at
+#: ``(r0, s0) = (0, 1)``.
+BASIN_CASES = ((1.0, 0.66, 1.3), (2.0, 0.2, 1.6))
+BASIN_GRID = 100
+#: Erosion profiles (beyond the study): per slenderness ratio, the forcing frequency and the
+#: amplitude range over which both laws' basins are followed (the union of the sweeps'
+#: ranges), every EROSION_STEP.
+EROSION = {1: dict(omega=1.3, alpha_range=(0.3, 1.0)), 2: dict(omega=1.6, alpha_range=(0.1, 0.5))}
+EROSION_STEP = 0.01
+#: The restitution table's slenderness ratios and figure 1's range.
+E_TABLE_HB = (1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0)
+E_FIGURE_HB_MAX = 6.0
+#: Most points recorded of a single run's trajectory.
+MAX_TRAJ_POINTS = 50_000
+
+E_HEADER = ("hb", "thc", "e_H", "e_M", "delta_e_percent")
+ATTRACTOR_HEADER = ("hb", "alpha", "omega", "law", "n_attractors", "basin_entropy",
+                    "boundary_basin_entropy", "uncertainty_exponent", "GIM", "IF",
+                    "attractor_agreement_percent")
+E_FMT = {"hb": "g", "thc": ".4f", "e_H": ".3f", "e_M": ".3f", "delta_e_percent": ".2f"}
+
+
+def e_table(hb_values):
+    """Rows ``(hb, thc, e_H, e_M, delta_e %)`` of the restitution table."""
+    rows = []
+    for hb in hb_values:
+        thc = float(thc_from_hb(hb))
+        eh, em = float(e_housner(thc)), float(e_mao(thc))
+        rows.append((float(hb), thc, eh, em, float(delta_e_percent(em, eh))))
+    return rows
+
+
+def write_e_table(out, hb_values, hb_max, fig_name, table_stem):
+    """Figure 1 and the e-table into ``out``; returns the table as dicts."""
+    from .plotting import fig_restitution
+    rows = e_table(hb_values)
+    out.figure(fig_name, fig_restitution((1 / math.sqrt(2), hb_max)))
+    out.table(table_stem, E_HEADER, rows, E_FMT)
+    return [dict(zip(E_HEADER, r)) for r in rows]
+
+
+@dataclass(frozen=True)
+class PaperPlan:
+    """Validated settings of :func:`paper`, with every grid's plan made."""
+
+    grid: int
+    periods: int
+    n_steps: int | None
+    alpha_step: float
+    zoom: tuple
+    zoom_step: float
+    threads: int | None
+    sweeps: dict            # (hb, law) -> GridPlan
+    zoom_sweep: object      # GridPlan
+    basins: dict            # (hb, law) -> GridPlan
+    erosions: dict          # (hb, law) -> ErosionPlan
+    stride: int
+
+
+def plan_paper(*, grid=BASIN_GRID, periods=PERIODS, n_steps=None, alpha_step=ALPHA_STEP,
+               zoom=ZOOM, zoom_step=None, erosion_step=EROSION_STEP, threads=None) -> PaperPlan:
+    """Validate a paper's settings; every grid is planned here (memory checked), nothing run.
+
+    ``n_steps=None`` takes the library's defaults (``DEFAULT_N`` for single runs, ``GRID_N`` for
+    sweeps and basins). ``zoom`` must lie inside the Housner hb=1 range.
+    """
+    grid = integer("grid", grid, 1, 10**5)
+    periods = integer("periods", periods, 1)
+    alpha_step = real("alpha_step", alpha_step, 0.0, 1.0, lo_open=True)
+    h_rng = STUDY[1]["alpha_range"]["housner"]
+    zoom = pair("zoom", zoom, 0.0, None)
+    if zoom[0] < h_rng[0] or zoom[1] > h_rng[1]:
+        raise ValueError(f"zoom must lie inside the Housner hb=1 range {h_rng} (got {zoom})")
+    zoom_step = alpha_step / 4 if zoom_step is None else \
+        real("zoom_step", zoom_step, 0.0, 1.0, lo_open=True)
+    kw = dict(periods=periods, n_steps=n_steps, threads=threads, lyapunov=True)
+    sweeps = {(hb, law): analysis.plan_sweep(float(hb), st["omega"], law=law, alpha_range=rng,
+                                             alpha_step=alpha_step, **kw)
+              for hb, st in STUDY.items() for law, rng in st["alpha_range"].items()}
+    zoom_sweep = analysis.plan_sweep(1.0, STUDY[1]["omega"], law="housner", alpha_range=zoom,
+                                     alpha_step=zoom_step, **kw)
+    basins = {(hb, law): analysis.plan_basin(hb, alpha, omega, law=law, grid=grid, r0=0.0,
+                                             s0=1.0, periods=periods, n_steps=n_steps,
+                                             threads=threads)
+              for hb, alpha, omega in BASIN_CASES for law in ("housner", "mao")}
+    erosion_step = real("erosion_step", erosion_step, 0.0, 1.0, lo_open=True)
+    erosions = {(hb, law): plan_erosion(float(hb), ev["omega"], law=law,
+                                        alpha_range=ev["alpha_range"], alpha_step=erosion_step,
+                                        grid=grid, r0=0.0, s0=1.0, periods=periods,
+                                        n_steps=n_steps, threads=threads)
+                for hb, ev in EROSION.items() for law in ("housner", "mao")}
+    if n_steps is not None:  # single runs take it too: check it against their blocks
+        for hb, alpha, omega, _ in GALLERY.values():
+            plan_run(hb, alpha, omega, periods=periods, n_steps=n_steps)
+    stride = max(1, math.ceil(periods * (n_steps or DEFAULT_N) / MAX_TRAJ_POINTS))
+    return PaperPlan(grid=grid, periods=periods, n_steps=n_steps, alpha_step=alpha_step,
+                     zoom=zoom, zoom_step=zoom_step, threads=threads, sweeps=sweeps,
+                     zoom_sweep=zoom_sweep, basins=basins, erosions=erosions, stride=stride)
+
+
+def paper(out, plan=None, *, progress=False, client=None, store=None, say=None):
+    """Compute every figure and table of the study into ``out``; returns the summary's results.
+
+    Parameters
+    ----------
+    out : rockjit.io.OutputDir
+        Where the files go (``json``, ``npz``, ``figure``, ``table`` methods); the caller
+        publishes it.
+    plan : PaperPlan, optional
+        From :func:`plan_paper`; default the study's settings.
+    progress : bool
+        Show the grids' progress on stderr.
+    client : dask.distributed.Client, optional
+        Run the sweeps' and basins' chunks on this cluster.
+    store : path, optional
+        Directory of chunk stores, one per grid: an interrupted paper resumes from them.
+    say : callable, optional
+        ``say(message)`` for one line of progress per part.
+    """
+    from pathlib import Path
+
+    from .attractors import attractor_agreement
+    from .plotting import (agreement, fig_attractors, fig_basin_compare, fig_bifurcation,
+                           fig_erosion, fig_gallery, fig_laws_timeseries, fig_trajectory)
+
+    p = plan_paper() if plan is None else plan
+    say = say or (lambda msg: None)
+    walls = {}
+    results = {}
+    n_parts = 8
+    basins_done = {}
+    run_kw = dict(periods=p.periods, n_steps=p.n_steps, record_stride=p.stride, lyapunov=True)
+    t_all = time.perf_counter()
+
+    def grid(gp, name):
+        return analysis.run(gp, progress=progress, client=client,
+                            store=None if store is None else Path(store) / name)
+
+    def part(i, name, what):
+        say(f"paper [{i}/{n_parts}] {name}: {what}")
+        return time.perf_counter()
+
+    def done(name, t0):
+        walls[name] = time.perf_counter() - t0
+        say(f"paper: {name} done in {walls[name]:.1f} s")
+
+    t0 = part(1, "fig1", "restitution laws and the e-table")
+    results["e_table"] = write_e_table(out, E_TABLE_HB, E_FIGURE_HB_MAX, "fig1_restitution.png",
+                                       "e_table")
+    done("fig1", t0)
+
+    t0 = part(2, "fig2", "reference run alpha=0.6, omega=1.3, hb=1, Housner")
+    ref = simulate(**REFERENCE_RUN, z0=Z0, **run_kw)
+    tr = ref.trajectory
+    out.npz("fig2_reference.npz", t=tr[:, 0], theta=tr[:, 1], dtheta=tr[:, 2],
+            strobe=ref.strobe, impacts=ref.impacts, lyapunov_running=ref.lyapunov_running)
+    out.figure("fig2_reference.png", fig_trajectory(ref))
+    name, per = classify_result(ref)
+    results["fig2"] = dict(status=ref.status, behaviour=name, period=per,
+                           lambda_max=ref.lambda_max, lyapunov=ref.lyapunov)
+    done("fig2", t0)
+
+    t0 = part(3, "fig3", "behaviour gallery")
+    gal = {k: simulate(hb, alpha, omega, "housner", **ic, **run_kw)
+           for k, (hb, alpha, omega, ic) in GALLERY.items()}
+    out.figure("fig3_gallery.png", fig_gallery(gal))
+    results["fig3"] = {k: dict(zip(("behaviour", "period"), classify_result(r)),
+                               status=r.status, lambda_max=r.lambda_max)
+                       for k, r in gal.items()}
+    done("fig3", t0)
+
+    t0 = part(4, "fig4", "Housner vs Mao time series, alpha=0.2, omega=1.6, hb=2")
+    rows = [{law: simulate(**LAWS_RUN, law=law, theta0=th0, dtheta0=dth0, r0=0.0, s0=1.0,
+                           **run_kw) for law in ("housner", "mao")} for th0, dth0 in LAWS_IC]
+    out.figure("fig4_laws_timeseries.png", fig_laws_timeseries(rows))
+    results["fig4"] = [{law: dict(zip(("behaviour", "period"), classify_result(r)),
+                                  status=r.status) for law, r in row.items()}
+                       for row in rows]
+    done("fig4", t0)
+
+    t0 = part(5, "fig5", "bifurcation sweeps (4 + zoom)")
+    sweeps = {}
+    sweep_rows = []
+    for (hb, law), gp in p.sweeps.items():
+        alphas = gp.axes["alpha"]
+        say(f"paper: sweep {law} hb={hb:g}, {alphas.size} amplitudes")
+        sw = sweeps[(hb, law)] = grid(gp, f"sweep_hb{hb}_{law}")
+        out.npz(f"fig5_sweep_hb{hb}_{law}.npz", **sw.arrays())
+        fr = sw.fractions()
+        sweep_rows.append([hb, law, STUDY[hb]["omega"], float(alphas[0]), float(alphas[-1]),
+                           int(alphas.size)] + [fr[n] for n in BEHAVIOURS])
+    for hb in STUDY:
+        out.figure(f"fig5_bifurcation_hb{hb}.png", fig_bifurcation(
+            {law: sweeps[(hb, law)] for law in ("housner", "mao")},
+            title=f"Bifurcation diagrams, h/b = {hb}, \u03c9 = {STUDY[hb]['omega']}"))
+    zoom = p.zoom_sweep.axes["alpha"]
+    say(f"paper: zoom sweep Housner hb=1, {zoom.size} amplitudes")
+    zsw = grid(p.zoom_sweep, "sweep_zoom")
+    out.npz("fig5_sweep_zoom_hb1_housner.npz", **zsw.arrays())
+    out.figure("fig5_bifurcation_zoom.png", fig_bifurcation(
+        zsw, alpha_limits=tuple(p.zoom),
+        title=f"Zoom: Housner, h/b = 1, \u03c9 = 1.3, \u03b1 in [{p.zoom[0]:g}, "
+              f"{p.zoom[1]:g}]"))
+    fr = zsw.fractions()
+    sweep_rows.append([1, "housner (zoom)", STUDY[1]["omega"], float(zoom[0]),
+                       float(zoom[-1]), int(zoom.size)] + [fr[n] for n in BEHAVIOURS])
+    sweep_header = ["hb", "law", "omega", "alpha_start", "alpha_end", "n_alpha"] + \
+        [f"{n}_percent" for n in BEHAVIOURS]
+    out.table("sweep_table", sweep_header, sweep_rows,
+              {h: ".1f" for h in sweep_header[6:]} | {"omega": "g", "alpha_start": "g",
+                                                      "alpha_end": "g"})
+    results["fig5"] = [dict(zip(sweep_header, r)) for r in sweep_rows]
+    done("fig5", t0)
+
+    t0 = part(6, "fig6", f"basins, {p.grid}x{p.grid} cells, both laws, two cases")
+    basin_rows = []
+    results["fig6"] = []
+    for hb, alpha, omega in BASIN_CASES:
+        bs = {}
+        for law in ("housner", "mao"):
+            say(f"paper: basin {law} hb={hb:g} alpha={alpha:g} omega={omega:g}")
+            bs[law] = grid(p.basins[(hb, law)], f"basin_hb{hb:g}_{law}")
+        basins_done[(hb, alpha, omega)] = bs
+        agree = agreement(bs["housner"].label, bs["mao"].label)
+        tag = f"hb{hb:g}"
+        out.npz(f"fig6_basin_{tag}.npz", theta0=bs["housner"].theta0,
+                dtheta0=bs["housner"].dtheta0, label_housner=bs["housner"].label,
+                label_mao=bs["mao"].label, names=np.asarray(bs["housner"].names, dtype=str))
+        out.figure(f"fig6_basin_{tag}.png", fig_basin_compare(bs["housner"], bs["mao"]))
+        entry = dict(hb=hb, alpha=alpha, omega=omega, agreement=agree)
+        for law, b in bs.items():
+            fr = b.fractions()
+            entry[law] = dict(fractions=fr)
+            basin_rows.append([hb, alpha, omega, law] + [fr[n] for n in BEHAVIOURS] + [agree])
+        results["fig6"].append(entry)
+    basin_header = ["hb", "alpha", "omega", "law"] + [f"{n}_percent" for n in BEHAVIOURS] + \
+        ["agreement_percent"]
+    out.table("basin_table", basin_header, basin_rows,
+              {h: ".1f" for h in basin_header[4:]} | {"hb": "g", "alpha": "g", "omega": "g"})
+    done("fig6", t0)
+
+    t0 = part(7, "fig7", "attractor maps of the basins, their entropy and integrity")
+    rows = []
+    results["fig7"] = []
+    for hb, alpha, omega in BASIN_CASES:
+        bs = basins_done[(hb, alpha, omega)]
+        out.figure(f"fig7_attractors_hb{hb:g}.png", fig_attractors(bs))
+        agree = attractor_agreement(bs["housner"], bs["mao"])
+        entry = dict(hb=hb, alpha=alpha, omega=omega, attractor_agreement=agree)
+        for law, b in bs.items():
+            m = b.measures()
+            entry[law] = dict(attractors=b.attractor_summary(), **m)
+            rows.append([hb, alpha, omega, law, len(b.attractors), m["basin_entropy"],
+                         m["boundary_basin_entropy"], m["uncertainty_exponent"]["alpha"],
+                         m["integrity"]["GIM"], m["integrity"]["IF"], agree["percent"]])
+        results["fig7"].append(entry)
+    out.table("attractor_table", ATTRACTOR_HEADER, rows,
+              {h: ".3f" for h in ATTRACTOR_HEADER[5:]} | {"hb": "g", "alpha": "g",
+                                                          "omega": "g"})
+    done("fig7", t0)
+
+    t0 = part(8, "fig8", "erosion profiles, both laws, hb = 1 and 2")
+    results["fig8"] = {}
+    for hb in EROSION:
+        prof = {}
+        for law in ("housner", "mao"):
+            say(f"paper: erosion {law} hb={hb:g}, {p.erosions[(hb, law)].alpha.size} "
+                f"amplitudes")
+            prof[law] = erosion.run(p.erosions[(hb, law)], progress=progress, client=client,
+                                    store=None if store is None else
+                                    Path(store) / f"erosion_hb{hb}_{law}")
+        out.figure(f"fig8_erosion_hb{hb}.png", fig_erosion(prof))
+        out.npz(f"fig8_erosion_hb{hb}.npz", alpha=prof["housner"].alpha,
+                **{f"{k}_{law}": v for law, r in prof.items() for k, v in
+                   dict(GIM=r.GIM, IF=r.IF, overturn=r.overturn, fractions=r.fractions(),
+                        basin_entropy=r.basin_entropy).items()})
+        results["fig8"][f"hb{hb}"] = {law: r.to_summary() for law, r in prof.items()}
+    done("fig8", t0)
+
+    results.update(wall_s_parts=walls, zoom_step=p.zoom_step, record_stride=p.stride,
+                   total_s=time.perf_counter() - t_all)
+    return results
