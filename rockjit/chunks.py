@@ -19,7 +19,7 @@ missing or of the wrong shape or type) is discarded and computed again, and the 
 A store is used by one run at a time: a lock file (``lock.json``: the owner's pid and host)
 makes a second run on the same store refuse with a ``ValueError`` naming the owner while it is
 alive; the lock of a process that no longer exists on this host is taken over (and the run
-says so). :func:`run_chunks` releases the lock when it returns or raises; :func:`remove_store`
+says so). :func:`run_chunks` releases the lock when it returns or raises; :func:`remove_stores`
 deletes a store only when it can hold the lock, and only the files rockjit wrote there.
 
 Dask is optional and imported only when a client is given.
@@ -43,7 +43,7 @@ import numpy as np
 
 from .io import atomic_open, create_temp, host_name, pid_alive, write_text
 
-__all__ = ["ChunkStore", "DamagedChunk", "fingerprint", "remove_store", "run_chunks"]
+__all__ = ["ChunkStore", "DamagedChunk", "fingerprint", "remove_stores", "run_chunks"]
 
 
 def fingerprint(arrays, settings):
@@ -324,8 +324,8 @@ class ChunkStore:
         return False
 
     def cleanup(self):
-        """Delete the store (see :func:`remove_store`); returns whether the directory is gone."""
-        return remove_store(self.dir, message=self.message, _lock=self._lock)
+        """Delete the store (see :func:`remove_stores`); returns whether the directory is gone."""
+        return remove_stores(self.dir, message=self.message, _lock=self._lock)
 
     # -- chunks ---------------------------------------------------------------------------------
 
@@ -352,6 +352,12 @@ class ChunkStore:
         """
         path = self._path(a, b)
         try:
+            with open(path, "rb") as fh:
+                if fh.read(4) != b"PK\x03\x04":
+                    raise DamagedChunk(path.name, "not an .npz archive")
+        except OSError as exc:
+            raise DamagedChunk(path.name, f"{type(exc).__name__}: {exc}") from None
+        try:
             with np.load(path, allow_pickle=False) as z:
                 out = {k: z[k] for k in z.files}
         except Exception as exc:  # any way a damaged file fails to read
@@ -376,7 +382,7 @@ class ChunkStore:
         self._path(a, b).unlink(missing_ok=True)
 
 
-def remove_store(directory, *, message=None, _lock=None):
+def remove_stores(directory, *, message=None, _lock=None):
     """Delete a chunk store, or every store directly inside ``directory``, when not in use.
 
     A store (a directory holding ``manifest.json`` or ``lock.json``) is deleted only when this

@@ -341,15 +341,18 @@ class OutputDir:
     Files are written (each atomically, with the user's umask) into a staging directory on the
     same file system as ``path``: a hidden sibling ``.<name>.rockjit-stage-<host>-<pid>-<random>``
     when ``path`` does not exist yet, a hidden ``.rockjit-stage-<host>-<pid>-<random>`` inside it
-    when it does. :meth:`publish` then moves them into place:
+    when it does (so the moves stay on its file system even when it is a mount point, and its
+    parent need not be writable). :meth:`publish` then moves them into place:
 
     - ``path`` absent: one atomic :func:`os.rename` of the staging directory to ``path``;
     - ``path`` present: each file :func:`os.replace`\\ d over its namesake, ``summary.json``
-      last; SIGINT and SIGTERM are deferred (:func:`defer_signals`) for these few moves, so an
-      interrupt cannot split the set. A signal that arrived is recorded in :attr:`interrupted`,
-      not raised: the outputs are published and the run can report success.
+      last.
 
-    On any failure or interrupt before :meth:`publish`, :meth:`abort` (called by the ``with``
+    SIGINT and SIGTERM are deferred (:func:`defer_signals`) for these few moves, so an
+    interrupt cannot split the set. A signal that arrived is recorded in :attr:`interrupted`,
+    not raised: the outputs are published and the run can report success.
+
+    On any failure or interrupt before :meth:`publish`, :meth:`discard` (called by the ``with``
     statement) removes the staging directory and any parent directories it made, and ``path``
     is exactly as before. Only the files the command writes are replaced; other files in
     ``path`` are never touched. Staging directories of runs that died (their pid no longer
@@ -360,7 +363,8 @@ class OutputDir:
     path : str or Path
         The output directory (``--out``).
     command : str, optional
-        The command writing it (``summary.json``'s ``"command"``), for :meth:`stale_warning`.
+        The command writing it, for :meth:`stale_warning`; by default the ``"command"`` of the
+        ``summary.json`` this run stages.
 
     Attributes
     ----------
@@ -373,15 +377,22 @@ class OutputDir:
         The signal (``signal.SIGINT``, ``signal.SIGTERM``) that arrived during :meth:`publish`,
         if one did.
     warning : str or None
-        :meth:`stale_warning` as it stood when :meth:`publish` began.
+        :meth:`stale_warning` as it stood when :meth:`publish` began (what it returned).
 
     Examples
     --------
-    >>> with OutputDir("out", command="basin") as out:     # doctest: +SKIP
-    ...     out.npz("basin.npz", label=label)
-    ...     out.json("summary.json", {"command": "basin", "files": out.written + ["summary.json"]})
-    ...     if out.stale_warning():
-    ...         print(out.stale_warning())
+    The command line's use::
+
+        out = OutputDir(args.out)
+        try:
+            out.npz("basin.npz", label=label)
+            out.json("summary.json", {"command": "basin", "files": out.written + ["summary.json"]})
+            note = out.publish()
+        except BaseException:
+            out.discard()
+            raise
+        if note:
+            print(note, file=sys.stderr)
     """
 
     def __init__(self, path, command=None):
@@ -401,7 +412,8 @@ class OutputDir:
 
     @property
     def staging(self):
-        """The staging directory (``None`` before the first write and after publish/abort)."""
+        """The staging directory (``None`` before the first write, after :meth:`publish` and
+        after :meth:`discard`)."""
         return self._stage
 
     def _stage_dir(self):
@@ -512,9 +524,16 @@ class OutputDir:
             names = ", ".join(kept[:5]) + (f" and {len(kept) - 5} more" if len(kept) > 5 else "")
             return (f"{self.path} also holds {names} from an earlier `rockjit {cmd}` run; "
                     f"this run does not write them and leaves them there")
-        if self.command is not None and cmd != self.command:
+        command = self.command
+        if command is None and self._stage is not None and SUMMARY in self.written:
+            try:  # the command this run's own summary.json names
+                command = json.loads((self._stage / SUMMARY).read_text(encoding="utf-8"))
+                command = command.get("command") if isinstance(command, dict) else None
+            except (OSError, ValueError):
+                command = None
+        if isinstance(command, str) and cmd != command:
             return (f"{self.path} held the outputs of an earlier `rockjit {cmd}` run; this "
-                    f"`rockjit {self.command}` run replaces them")
+                    f"`rockjit {command}` run replaces them")
         return None
 
     def publish(self):
@@ -522,15 +541,17 @@ class OutputDir:
 
         Returns
         -------
-        list of str
-            The names published (:attr:`written`).
+        str or None
+            :meth:`stale_warning` as it stood before the move (also kept in :attr:`warning`):
+            one line for the command line to print, or ``None``. The names published are
+            :attr:`written`.
         """
         if self.published:
-            return list(self.written)
+            return self.warning
         stage = self._stage
         if stage is None:  # nothing was written: nothing to create
             self.published = True
-            return []
+            return None
         missing = [n for n in self.written if not (stage / n).is_file()]
         if missing:
             raise FileNotFoundError(errno.ENOENT, "staged output never written",
@@ -558,7 +579,7 @@ class OutputDir:
             self._made = []
             self.published = True
         self.interrupted = got[0] if got else None
-        return list(self.written)
+        return self.warning
 
     def _check_targets(self, names):
         if not self.path.is_dir():
@@ -568,7 +589,7 @@ class OutputDir:
             if t.is_dir() and not t.is_symlink():
                 raise ValueError(f"cannot write {t}: a directory of that name is in the way")
 
-    def abort(self):
+    def discard(self):
         """Remove the staging directory and any parent directories it made: ``path`` is as
         before."""
         if self._stage is not None:
@@ -585,8 +606,8 @@ class OutputDir:
             try:
                 self.publish()
             except BaseException:
-                self.abort()
+                self.discard()
                 raise
         else:
-            self.abort()
+            self.discard()
         return False

@@ -161,7 +161,8 @@ def test_publish_into_a_new_directory(tmp_path):
     assert not out.exists()  # nothing visible before publish
     stage = o.staging
     assert stage.parent == tmp_path and stage.name.startswith(".out.")
-    assert o.publish() == ["basin.npz", "basin.png", "summary.json"]
+    assert o.publish() is None  # nothing to warn about
+    assert o.written == ["basin.npz", "basin.png", "summary.json"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # the stage was renamed
     assert sorted(p.name for p in out.iterdir()) == ["basin.npz", "basin.png", "summary.json"]
     assert np.load(out / "basin.npz")["label"].tolist() == [0, 1, 2, 3]
@@ -298,7 +299,7 @@ def test_sigterm_in_another_process(tmp_path):
     assert len(left) == 1 and str(p.pid) in left[0].name
     o = rio.OutputDir(out)
     o.text("x.txt", "")  # the first write clears stages of dead runs
-    o.abort()
+    o.discard()
     assert _snapshot(tmp_path) == before
     # terminated while publishing: the set is published whole and the run succeeds
     p = _run_child(CHILD_PUBLISH, out, "publish")
@@ -328,7 +329,7 @@ def test_stale_stages_only_of_dead_runs_on_this_host(tmp_path):
     o.text("a.txt", "a")
     assert not stages["dead"].exists()
     assert all(stages[k].exists() for k in ("alive", "elsewhere", "user"))
-    o.abort()
+    o.discard()
 
 
 def test_stale_warning_names_files_of_another_command(tmp_path):
@@ -343,8 +344,7 @@ def test_stale_warning_names_files_of_another_command(tmp_path):
     o.json("summary.json", {"command": "basin", "files": ["basin.npz", "summary.json"]})
     w = o.stale_warning()
     assert "\n" not in w and "sweep.npz" in w and "bifurcation.png" in w and "sweep" in w
-    o.publish()
-    assert o.warning == w
+    assert o.publish() == w == o.warning
     assert (out / "sweep.npz").read_bytes() == b"s"  # warned about, never deleted
     assert (out / "bifurcation.png").read_bytes() == b"b"
     # the same command again, writing the same files: nothing to say
@@ -352,13 +352,14 @@ def test_stale_warning_names_files_of_another_command(tmp_path):
     o.npz("basin.npz", x=np.arange(2))
     o.json("summary.json", {"command": "basin", "files": ["basin.npz", "summary.json"]})
     assert o.stale_warning() is None
-    o.abort()
-    # another command whose files this run all replaces: still said
-    o = rio.OutputDir(out, command="plane")
+    o.discard()
+    # another command whose files this run all replaces: still said (the command read from
+    # the summary.json this run stages when not given)
+    o = rio.OutputDir(out)
     o.npz("basin.npz", x=np.arange(2))
-    o.json("summary.json", {})
+    o.json("summary.json", {"command": "plane"})
     assert "basin" in o.stale_warning() and "plane" in o.stale_warning()
-    o.abort()
+    o.discard()
 
 
 def test_refusals_leave_everything_as_it_was(tmp_path):
@@ -387,7 +388,7 @@ def test_refusals_leave_everything_as_it_was(tmp_path):
 def test_nothing_written_creates_nothing(tmp_path):
     with rio.OutputDir(tmp_path / "a" / "out") as o:
         pass
-    assert o.publish() == [] and list(tmp_path.iterdir()) == []
+    assert o.publish() is None and o.written == [] and list(tmp_path.iterdir()) == []
 
 
 def test_table_writes_csv_and_markdown(tmp_path):
@@ -487,6 +488,7 @@ def test_damaged_chunks_are_discarded_and_recomputed(tmp_path, capsys):
     for line, path in zip(err, names):
         assert line.startswith(f"rockjit: discarded damaged chunk {path.name} ")
         assert line.endswith("; recomputing")
+    assert "(not an .npz archive)" in err[1] and "'pair'" in err[2]
     calls.clear()
     _same(_run(_open(store), calls), _direct())  # now whole again: loaded, not computed
     assert calls == []
@@ -546,7 +548,7 @@ def test_lock_of_another_host_is_refused(tmp_path):
     (store / "lock.json").write_text(json.dumps({"pid": 1, "host": "elsewhere", "token": "t"}))
     with pytest.raises(ValueError, match="host elsewhere.*pid 1"):
         _open(store)
-    assert not chunks.remove_store(store, message=lambda m: None)
+    assert not chunks.remove_stores(store, message=lambda m: None)
     assert (store / "lock.json").exists()
 
 
@@ -564,7 +566,7 @@ CHILD_RUN = """
     out = {"y": np.zeros(23)}
     store = chunks.ChunkStore(sys.argv[1], chunks.fingerprint((x,), {}), 23, 5)
     chunks.run_chunks(runner, (x,), 23, 5, out, store=store)
-    gone = chunks.remove_store(Path(sys.argv[1]).parent)  # as the command line does
+    gone = chunks.remove_stores(Path(sys.argv[1]).parent)  # as the command line does
     print("removed" if gone else "kept", flush=True)
 """
 
@@ -584,7 +586,7 @@ def test_a_second_run_on_a_store_in_use(tmp_path):
     with pytest.raises(ValueError, match=f"in use by another rockjit run \\(pid {p.pid} "):
         _open_like_child(store)
     msgs = []
-    assert not chunks.remove_store(root, message=msgs.append)
+    assert not chunks.remove_stores(root, message=msgs.append)
     assert len(msgs) == 1 and f"pid {p.pid}" in msgs[0] and "kept" in msgs[0]
     assert (store / "cells-0000000000-0000000005.npz").exists()
     p.stdin.write("\n")
@@ -618,11 +620,11 @@ def test_remove_store_deletes_only_rockjits_files(tmp_path):
     root = tmp_path / "out.chunks"
     for name in ("housner", "mao"):
         _run(_open(root / name))
-    assert chunks.remove_store(root)
+    assert chunks.remove_stores(root)
     assert not root.exists()
     _run(_open(root / "mao"))
     (root / "readme.txt").write_text("mine")
-    assert not chunks.remove_store(root)
+    assert not chunks.remove_stores(root)
     assert sorted(str(p.relative_to(root)) for p in root.rglob("*")) == ["readme.txt"]
 
 
