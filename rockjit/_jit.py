@@ -10,6 +10,7 @@ reference run, contraction bought no speed distinguishable from the noise of thi
 
 import hashlib
 import os
+import re
 from pathlib import Path
 
 import numba
@@ -70,50 +71,122 @@ def fma(typingctx, a, b, c):
 # code from other modules (model.py, _jit.py), and an edit there would leave stale machine code
 # in use. The package's compiled sources are hashed at import, and numba's cache files of this
 # package are dropped whenever the hash differs from the one stamped beside them.
+#
+# Which files are "numba's cache files of this package" follows numba's own cache locators
+# (numba/core/caching.py, numba 0.59-0.68), tried in this order for a function defined in
+# <pkg>/<module>.py:
+#   _UserProvidedCacheLocator  $NUMBA_CACHE_DIR/<subpath>    when NUMBA_CACHE_DIR is set
+#   _InTreeCacheLocator        <pkg>/__pycache__             when writable
+#   _UserWideCacheLocator      <user cache dir>/<subpath>    otherwise (appdirs "numba")
+# where <subpath> = _CacheLocator.get_suitable_cache_subpath(py_file) = "<basename of pkg>_"
+# + sha1(<absolute path of pkg>).hexdigest(), and each function's files are named
+# "<module>.<qualname without < >>-<first line>.py<major><minor><abiflags>" + ".nbi" (the index)
+# or ".<n>.nbc" (the data). Only files of that form whose <module> is a module of the package
+# are deleted, and only in those folders: nothing else under NUMBA_CACHE_DIR is touched.
 
 _SOURCES = ("_jit.py", "model.py", "integrate.py", "analysis.py")
+STAMP = "rockjit-sources.sha256"
+
+
+def _compiled_sources(pkg):
+    """The package's modules whose code numba compiles: those named in ``_SOURCES`` and every
+    module that imports this one (the only way to reach the project's ``jit``)."""
+    names = set(_SOURCES)
+    for f in pkg.glob("*.py"):
+        try:
+            text = f.read_bytes()
+        except OSError:
+            continue
+        if re.search(rb"^\s*from\s+(\.|rockjit)\s*(\._jit\s+)?import\s+.*\b_jit\b"
+                     rb"|^\s*from\s+(\.|rockjit\.)_jit\s+import\b", text, re.M):
+            names.add(f.name)
+    return sorted(names)
+
+
+def _subpath(pkg_dir):
+    """numba's folder name for the functions of files in ``pkg_dir`` (``_CacheLocator.
+    get_suitable_cache_subpath``)."""
+    path = os.path.abspath(pkg_dir)
+    return "_".join([os.path.split(path)[-1], hashlib.sha1(path.encode()).hexdigest()])
+
+
+def _user_wide_dir():
+    """numba's user-wide cache folder (``_UserWideCacheLocator``)."""
+    try:
+        from numba.misc.appdirs import AppDirs
+        return Path(AppDirs(appname="numba", appauthor=False).user_cache_dir)
+    except Exception:  # pragma: no cover - numba's private layout changed
+        return None
 
 
 def _cache_dirs(pkg):
-    """``(stamp folder, folders whose numba files it vouches for)`` pairs."""
-    pairs = [(pkg / "__pycache__", [pkg / "__pycache__"])]
+    """The folders where numba may keep this package's compiled functions, in numba's order
+    of preference (see the comment above)."""
+    variants = {os.path.abspath(pkg), os.path.realpath(pkg)}  # numba uses the path imported
+    dirs = []
     root = os.environ.get("NUMBA_CACHE_DIR")
     if root:
-        # numba makes its per-package folders there only when it first compiles, so the stamp
-        # lives at the root and covers every folder of this package below it
-        subs = [Path(d) for d, _, _ in os.walk(root) if "rockjit" in Path(d).name] \
-            if Path(root).is_dir() else []
-        pairs.append((Path(root), subs))
-    return pairs
+        dirs += [Path(root) / _subpath(v) for v in sorted(variants)]
+    dirs.append(Path(pkg) / "__pycache__")
+    wide = _user_wide_dir()
+    if wide is not None:
+        dirs += [wide / _subpath(v) for v in sorted(variants)]
+    return dirs
+
+
+def _cache_file_pattern(modules):
+    """Names numba gives the cache files of functions defined in ``modules`` (stems)."""
+    alt = "|".join(re.escape(m) for m in sorted(modules))
+    return re.compile(rf"(?:{alt})\.[^/\\]+-\d+\.py\d+[a-z]*(?:\.\d+\.nbc|\.nbi)")
 
 
 def check_cache(pkg=None):
-    """Drop numba's cache files of the package when its compiled sources changed."""
-    pkg = Path(__file__).resolve().parent if pkg is None else Path(pkg)
+    """Drop numba's cache files of the package when its compiled sources changed.
+
+    Parameters
+    ----------
+    pkg : str or Path, optional
+        The package folder (default: this package's).
+
+    Notes
+    -----
+    The sources hashed are the package's modules that numba compiles (``_compiled_sources``).
+    Each cache folder of the package (``_cache_dirs``) holds a stamp, ``rockjit-sources.sha256``,
+    with the hash its files were compiled from. Where the stamp differs or is missing, the
+    folder's cache files of the package's modules are deleted and the stamp rewritten. The first
+    folder numba would use is created if absent (numba would create it when compiling), so the
+    stamp is in place before the first compilation; the others are checked only if they exist.
+    """
+    pkg = Path(__file__).parent if pkg is None else Path(pkg)
     h = hashlib.sha256()
-    for name in _SOURCES:
+    for name in _compiled_sources(pkg):
         try:
-            h.update((pkg / name).read_bytes())
+            h.update(name.encode() + b"\0" + (pkg / name).read_bytes())
         except OSError:
-            return
+            continue  # a module listed in _SOURCES that no longer exists
     digest = h.hexdigest()
-    for home, dirs in _cache_dirs(pkg):
-        stamp = home / "rockjit-sources.sha256"
+    pattern = _cache_file_pattern(f.stem for f in pkg.glob("*.py"))
+    settled = False  # a folder numba will use has been stamped
+    for home in _cache_dirs(pkg):
+        if settled and not home.is_dir():
+            continue
         try:
-            if stamp.read_text() == digest:
+            if (home / STAMP).read_text() == digest:
+                settled = True
                 continue
         except OSError:
             pass
         try:
-            for d in dirs:
-                for f in d.glob("*.nb[ic]"):
-                    f.unlink(missing_ok=True)
             home.mkdir(parents=True, exist_ok=True)
-            tmp = home / f"rockjit-sources.sha256.{os.getpid()}"
+            for f in home.iterdir():
+                if pattern.fullmatch(f.name):
+                    f.unlink(missing_ok=True)
+            tmp = home / f"{STAMP}.{os.getpid()}"
             tmp.write_text(digest)
-            os.replace(tmp, stamp)
+            os.replace(tmp, home / STAMP)
+            settled = True
         except OSError:
-            pass  # a read-only install: numba then caches elsewhere or not at all
+            pass  # read-only: numba then caches in the next folder, or not at all
 
 
 check_cache()

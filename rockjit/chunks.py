@@ -6,30 +6,44 @@ parallel kernel on those cells), in this process or as a task on a ``dask.distri
 whose workers run the same compiled kernels. Results are placed into the full output arrays as
 chunks arrive.
 
-With a store directory, every finished chunk is written there atomically (a temporary file, then
-a rename) beside a manifest holding a fingerprint of the whole computation (inputs, settings,
-chunking, rockjit's version). Running the same computation again with the same directory loads
-the finished chunks and computes only the missing ones, so an interrupted run, or one that lost
-workers, resumes; the result equals an uninterrupted run's bit for bit, because each cell is
-computed independently of the chunking and of where it runs. A directory that holds another
-computation's chunks is refused rather than mixed in.
+With a store directory (:class:`ChunkStore`), every finished chunk is written there atomically
+(:func:`rockjit.io.atomic_open`, with the user's umask) beside a manifest holding a fingerprint
+of the whole computation (inputs, settings, chunking, rockjit's version). Running the same
+computation again with the same directory loads the finished chunks and computes only the
+missing ones, so an interrupted run, or one that lost workers, resumes; the result equals an
+uninterrupted run's bit for bit, because each cell is computed independently of the chunking
+and of where it runs. A directory that holds another computation's chunks is refused rather
+than mixed in. A chunk that cannot be read back whole (truncated, not a zip archive, arrays
+missing or of the wrong shape or type) is discarded and computed again, and the run says so.
+
+A store is used by one run at a time: a lock file (``lock.json``: the owner's pid and host)
+makes a second run on the same store refuse with a ``ValueError`` naming the owner while it is
+alive; the lock of a process that no longer exists on this host is taken over (and the run
+says so). :func:`run_chunks` releases the lock when it returns or raises; :func:`remove_stores`
+deletes a store only when it can hold the lock, and only the files rockjit wrote there.
 
 Dask is optional and imported only when a client is given.
 """
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import hashlib
 import json
 import os
+import re
+import secrets
 import sys
-import tempfile
 import time
+import weakref
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["ChunkStore", "fingerprint", "run_chunks"]
+from .io import atomic_open, create_temp, host_name, pid_alive, write_text
+
+__all__ = ["ChunkStore", "DamagedChunk", "fingerprint", "remove_stores", "run_chunks"]
 
 
 def fingerprint(arrays, settings):
@@ -46,85 +60,435 @@ def fingerprint(arrays, settings):
     return h.hexdigest()
 
 
+class DamagedChunk(ValueError):
+    """A stored chunk that cannot be read back whole.
+
+    Attributes
+    ----------
+    name : str
+        The chunk's file name (``cells-<start>-<end>.npz``).
+    reason : str
+        What is wrong with it, in one line.
+    """
+
+    def __init__(self, name, reason):
+        self.name = name
+        self.reason = " ".join(str(reason).split())
+        super().__init__(f"damaged chunk {name}: {self.reason}")
+
+
+def _say(msg):
+    print(f"rockjit: {msg}", file=sys.stderr, flush=True)
+
+
+# ---- the store's lock --------------------------------------------------------------------------
+
+LOCK = "lock.json"
+_HELD = {}  # absolute lock path -> token, for the locks this process holds
+_CHUNK = re.compile(r"cells-(\d{10})-(\d{10})\.npz")
+_OWN_TEMP = re.compile(r"\.(cells-\d{10}-\d{10}\.npz|manifest\.json)\..+\.tmp"
+                       r"|\.tmp-.+\.(npz|json)")  # (the second: rockjit <= 0.1.0's names)
+_LOCK_TEMP = re.compile(r"\.lock\.json\..+\.tmp")
+
+
+@contextlib.contextmanager
+def _guard(directory):
+    """Serialise lock take-overs in ``directory`` among processes (``flock`` where available)."""
+    try:
+        import fcntl
+        fd = os.open(directory, os.O_RDONLY)
+    except (ImportError, OSError):
+        yield
+        return
+    try:
+        with contextlib.suppress(OSError):
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)
+
+
+def _read_lock(path):
+    """The lock's ``{"pid", "host", "token"}``; ``None`` if absent, ``False`` if unreadable."""
+    try:
+        info = json.loads(Path(path).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError):
+        return False
+    if (not isinstance(info, dict) or not isinstance(info.get("pid"), int)
+            or not isinstance(info.get("host"), str)):
+        return False
+    return info
+
+
+def _release(path, token):
+    with _guard(Path(path).parent):
+        have = _read_lock(path)
+        if have and have.get("token") == token:
+            Path(path).unlink(missing_ok=True)
+    if _HELD.get(str(path)) == token:
+        del _HELD[str(path)]
+
+
+class _Lock:
+    """``<directory>/lock.json``: which process (pid, host) uses a store."""
+
+    def __init__(self, directory, message):
+        self.dir = Path(directory)
+        self.path = Path(os.path.abspath(self.dir / LOCK))
+        self.message = message
+        self.token = None
+        self._finalizer = None
+
+    @property
+    def held(self):
+        return self.token is not None and _HELD.get(str(self.path)) == self.token
+
+    def _create(self, data):
+        fd, tmp = create_temp(self.dir, f".{LOCK}.")
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
+            try:
+                os.link(tmp, self.path)  # atomic: the lock appears complete or not at all
+                return True
+            except FileExistsError:
+                return False
+            except OSError as exc:
+                if exc.errno not in (errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP,
+                                     errno.ENOSYS, errno.EMLINK, errno.EXDEV):
+                    raise
+            try:  # no hard links on this file system: exclusive create
+                fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+            except FileExistsError:
+                return False
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
+            return True
+        finally:
+            tmp.unlink(missing_ok=True)
+
+    def acquire(self):
+        """Take the lock, or raise ``ValueError`` naming the live owner."""
+        if self.held:
+            return
+        token = secrets.token_hex(8)
+        me, host = os.getpid(), host_name()
+        data = json.dumps(dict(pid=me, host=host, token=token,
+                               since=time.strftime("%Y-%m-%dT%H:%M:%S%z"))).encode()
+        for attempt in range(100):
+            if self._create(data):
+                self.token = token
+                _HELD[str(self.path)] = token
+                self._finalizer = weakref.finalize(self, _release, self.path, token)
+                return
+            have = _read_lock(self.path)
+            if have is None:  # released meanwhile
+                continue
+            if have is False:  # being written without hard links, or damaged
+                if attempt < 20:
+                    time.sleep(0.05)
+                    continue
+                raise ValueError(f"{self.dir} has an unreadable lock file; if no other rockjit "
+                                 f"run is using it, delete {self.path}")
+            pid, owner = have["pid"], have["host"]
+            if owner != host:
+                raise ValueError(f"{self.dir} is in use by a rockjit run on host {owner} "
+                                 f"(pid {pid}); wait for it to finish, or, if it has ended, "
+                                 f"delete {self.path}")
+            if pid == me and have.get("token") == _HELD.get(str(self.path)):
+                raise ValueError(f"{self.dir} is in use by another run in this process "
+                                 f"(pid {pid}); one run at a time per store")
+            if pid != me and pid_alive(pid):
+                raise ValueError(f"{self.dir} is in use by another rockjit run (pid {pid} on "
+                                 f"{owner}); wait for it to finish, or use another output "
+                                 f"directory")
+            with _guard(self.dir):  # its owner is gone: take it over, unless another run did
+                if _read_lock(self.path) == have:
+                    self.path.unlink(missing_ok=True)
+                    self.message(f"took over the chunk store {self.dir} from pid {pid} on "
+                                 f"{owner}, which is no longer running")
+        raise ValueError(f"{self.dir}: could not take the lock {self.path}")
+
+    def release(self):
+        """Give the lock back (removes the lock file if it is still this run's)."""
+        if self._finalizer is not None:
+            self._finalizer()  # _release(path, token), once
+            self._finalizer = None
+        self.token = None
+
+
+# ---- the store ---------------------------------------------------------------------------------
+
 class ChunkStore:
-    """Finished chunks of one computation in a directory (see the module docstring)."""
+    """Finished chunks of one computation in a directory (see the module docstring).
+
+    Opening a store takes its lock (``ValueError`` if another live run holds it), removes the
+    temporary files of runs that were killed while writing, and checks or writes the manifest.
+
+    Parameters
+    ----------
+    directory : str or Path
+        The store; created (with its parents) if absent. An existing plain file is refused.
+    key : str
+        The computation's :func:`fingerprint`.
+    n, chunk : int
+        The number of cells and the chunk length.
+    message : callable, optional
+        ``message(text)`` for what the store has to say (a taken-over lock, a discarded chunk);
+        default: a line ``rockjit: <text>`` on stderr.
+    """
 
     MANIFEST = "manifest.json"
+    LOCK = LOCK
 
-    def __init__(self, directory, key, n, chunk):
+    def __init__(self, directory, key, n, chunk, *, message=None):
         self.dir = Path(directory)
         self.key = key
         self.n = int(n)
         self.chunk = int(chunk)
-        self.dir.mkdir(parents=True, exist_ok=True)
+        self.message = _say if message is None else message
+        if os.path.lexists(self.dir) and not self.dir.is_dir():
+            raise ValueError(f"store must be a directory (got {self.dir}, an existing file)")
+        try:
+            self.dir.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise ValueError(f"store {self.dir} cannot be created "
+                             f"({exc.strerror or exc})") from None
+        self._lock = _Lock(self.dir, self.message)
+        try:
+            self._lock.acquire()
+        except OSError as exc:
+            raise ValueError(f"store {self.dir} cannot be written "
+                             f"({exc.strerror or exc})") from None
+        try:
+            self._remove_temporaries()
+            self._check_manifest()
+        except BaseException:
+            self._lock.release()
+            raise
+
+    def _check_manifest(self):
         man = self.dir / self.MANIFEST
-        want = {"key": key, "n": self.n, "chunk": self.chunk}
+        want = {"key": self.key, "n": self.n, "chunk": self.chunk}
         if man.exists():
             try:
-                have = json.loads(man.read_text())
-            except ValueError:
+                have = json.loads(man.read_text(encoding="utf-8"))
+            except (OSError, ValueError):
                 have = None
             if have != want:
                 raise ValueError(
                     f"{self.dir} holds the chunks of a different computation (other inputs or "
                     f"settings); use another output directory or delete {self.dir}")
+        elif any(_CHUNK.fullmatch(p.name) for p in self.dir.iterdir()):
+            raise ValueError(f"{self.dir} holds chunks without a manifest (of a different "
+                             f"computation?); use another output directory or delete {self.dir}")
         else:
-            self._write_bytes(man, json.dumps(want).encode())
+            write_text(man, json.dumps(want))
+
+    def _remove_temporaries(self):
+        now = time.time()
+        for p in self.dir.iterdir():
+            if _OWN_TEMP.fullmatch(p.name):
+                p.unlink(missing_ok=True)
+            elif _LOCK_TEMP.fullmatch(p.name):  # another run's, while it takes a lock
+                with contextlib.suppress(OSError):
+                    if now - p.stat().st_mtime > 60:
+                        p.unlink(missing_ok=True)
+
+    # -- the lock -------------------------------------------------------------------------------
+
+    @property
+    def locked(self):
+        """Whether this store holds its directory's lock."""
+        return self._lock.held
+
+    def acquire(self):
+        """Take the lock again after :meth:`close` (``ValueError`` if another run holds it)."""
+        self._lock.acquire()
+
+    def close(self):
+        """Release the lock (the chunks stay for a later run)."""
+        self._lock.release()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def cleanup(self):
+        """Delete the store (see :func:`remove_stores`); returns whether the directory is gone."""
+        return remove_stores(self.dir, message=self.message, _lock=self._lock)
+
+    # -- chunks ---------------------------------------------------------------------------------
 
     def _path(self, a, b):
         return self.dir / f"cells-{a:010d}-{b:010d}.npz"
 
-    def _write_bytes(self, path, data):
-        fd, tmp = tempfile.mkstemp(dir=self.dir, prefix=".tmp-", suffix=path.suffix)
-        try:
-            with os.fdopen(fd, "wb") as f:
-                f.write(data)
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
-
     def has(self, a, b):
         return self._path(a, b).exists()
 
-    def load(self, a, b):
-        with np.load(self._path(a, b)) as z:
-            return {k: z[k] for k in z.files}
+    def load(self, a, b, like=None):
+        """Chunk ``a:b``'s arrays by name.
+
+        Parameters
+        ----------
+        like : dict name -> ndarray, optional
+            The full output arrays: the chunk must hold exactly these names, each of shape
+            ``(b - a,) + like[name].shape[1:]`` and of the same dtype.
+
+        Raises
+        ------
+        DamagedChunk
+            If the file cannot be read whole (truncated, not an ``.npz``, a bad checksum) or
+            does not match ``like``.
+        """
+        path = self._path(a, b)
+        try:
+            with open(path, "rb") as fh:
+                if fh.read(4) != b"PK\x03\x04":
+                    raise DamagedChunk(path.name, "not an .npz archive")
+        except OSError as exc:
+            raise DamagedChunk(path.name, f"{type(exc).__name__}: {exc}") from None
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                out = {k: z[k] for k in z.files}
+        except Exception as exc:  # any way a damaged file fails to read
+            raise DamagedChunk(path.name, f"{type(exc).__name__}: {exc}") from None
+        if like is not None:
+            if set(out) != set(like):
+                raise DamagedChunk(path.name, f"arrays {sorted(out)}, expected {sorted(like)}")
+            for k, ref in like.items():
+                want = (b - a,) + tuple(ref.shape[1:])
+                if out[k].shape != want or out[k].dtype != ref.dtype:
+                    raise DamagedChunk(path.name, f"array {k!r} is {out[k].dtype}{out[k].shape}"
+                                                  f", expected {ref.dtype}{want}")
+        return out
 
     def save(self, a, b, out):
-        fd, tmp = tempfile.mkstemp(dir=self.dir, prefix=".tmp-", suffix=".npz")
+        """Write chunk ``a:b`` atomically (:func:`rockjit.io.atomic_open`)."""
+        with atomic_open(self._path(a, b), "wb") as fh:
+            np.savez(fh, **out)
+
+    def discard(self, a, b):
+        """Delete chunk ``a:b`` (a damaged one, before computing it again)."""
+        self._path(a, b).unlink(missing_ok=True)
+
+
+def remove_stores(directory, *, message=None, _lock=None):
+    """Delete a chunk store, or every store directly inside ``directory``, when not in use.
+
+    A store (a directory holding ``manifest.json`` or ``lock.json``) is deleted only when this
+    run holds its lock or can take it; a store in use by another live run is kept (and
+    ``message`` says so). Only the files rockjit writes there (chunks, manifest, lock,
+    temporary files) are deleted; a directory is removed only once it is empty, so a file of
+    the user's keeps it and its parents.
+
+    Parameters
+    ----------
+    directory : str or Path
+        A store, or a folder of stores (the command line's ``<out>.chunks``).
+    message : callable, optional
+        As for :class:`ChunkStore`.
+
+    Returns
+    -------
+    bool
+        Whether ``directory`` is gone.
+    """
+    d = Path(directory)
+    say = _say if message is None else message
+    if not d.is_dir() or d.is_symlink():
+        return not os.path.lexists(d)
+
+    def is_store(p):
+        return (p / ChunkStore.MANIFEST).is_file() or (p / LOCK).is_file()
+
+    stores = [d] if is_store(d) else [p for p in sorted(d.iterdir())
+                                      if p.is_dir() and not p.is_symlink() and is_store(p)]
+    for s in stores:
+        lock = _lock if _lock is not None and _lock.path == Path(os.path.abspath(s / LOCK)) \
+            else _Lock(s, say)
         try:
-            with os.fdopen(fd, "wb") as f:
-                np.savez(f, **out)
-            os.replace(tmp, self._path(a, b))
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+            lock.acquire()
+        except ValueError as exc:
+            say(f"kept {s}: {exc}")
+            continue
+        try:
+            for p in s.iterdir():
+                if _CHUNK.fullmatch(p.name) or _OWN_TEMP.fullmatch(p.name) or \
+                        p.name == ChunkStore.MANIFEST:
+                    p.unlink(missing_ok=True)
+        finally:
+            lock.release()
+        with contextlib.suppress(OSError):
+            s.rmdir()
+    if d not in stores:
+        with contextlib.suppress(OSError):
+            d.rmdir()
+    return not os.path.lexists(d)
 
 
 class _Progress:
-    """A one-line progress report on stderr."""
+    """Progress on stderr: one line rewritten with ``\\r`` on a terminal; otherwise plain lines,
+    at most one every :attr:`EVERY` seconds plus the last, so that a log file stays readable."""
 
-    def __init__(self, total, label, enabled, done=0):
+    EVERY = 5.0
+
+    def __init__(self, total, label, enabled, done=0, stream=None):
         self.total, self.label, self.enabled = total, label, enabled
-        self.t0 = time.perf_counter()
+        self.stream = sys.stderr if stream is None else stream
+        try:
+            self.tty = bool(self.stream.isatty())
+        except (AttributeError, ValueError):
+            self.tty = False
+        self.t0 = self.last = time.perf_counter()
         self.done = self.start = done
+        self.shown = False
+        self.pending = False
+
+    def _line(self, width):
+        el = time.perf_counter() - self.t0
+        fresh = self.done - self.start
+        eta = el / fresh * (self.total - self.done) if fresh else float("nan")
+        if width:
+            return (f"{self.label}: {self.done}/{self.total} cells, {el:6.1f} s elapsed, "
+                    f"~{eta:5.1f} s left ")
+        return (f"{self.label}: {self.done}/{self.total} cells, {el:.1f} s elapsed, "
+                f"~{eta:.1f} s left")
 
     def update(self, n):
         self.done += n
         if not self.enabled:
             return
-        el = time.perf_counter() - self.t0
-        fresh = self.done - self.start
-        eta = el / fresh * (self.total - self.done) if fresh else float("nan")
-        sys.stderr.write(f"\r{self.label}: {self.done}/{self.total} cells, {el:6.1f} s"
-                         f" elapsed, ~{eta:5.1f} s left ")
-        sys.stderr.flush()
+        if self.tty:
+            self.stream.write("\r" + self._line(True))
+        elif time.perf_counter() - self.last >= self.EVERY or self.done >= self.total:
+            self.stream.write(self._line(False) + "\n")
+            self.last = time.perf_counter()
+            self.pending = False
+        else:
+            self.pending = True
+            return
+        self.shown = True
+        self.stream.flush()
 
     def close(self):
-        if self.enabled:
-            sys.stderr.write("\n")
-            sys.stderr.flush()
+        if not self.enabled:
+            return
+        if self.tty and self.shown:
+            self.stream.write("\n")
+        elif self.pending:
+            self.stream.write(self._line(False) + "\n")
+            self.pending = False
+        self.stream.flush()
 
 
 def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, progress=False,
@@ -144,13 +508,39 @@ def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, pr
     client : dask.distributed.Client, optional
         Run the chunks as tasks on this cluster (retried if a worker is lost).
     store : ChunkStore, optional
-        Load finished chunks from it and save new ones to it.
+        Load finished chunks from it and save new ones to it. A stored chunk that cannot be
+        read back whole is discarded, reported through ``store.message`` ("discarded damaged
+        chunk cells-...; recomputing") and computed again. The store's lock is taken for the
+        run (if :meth:`ChunkStore.close` gave it back) and released when this function
+        returns or raises.
+    progress : bool
+        Report progress on stderr (a rewritten line on a terminal, else throttled lines).
     """
+    if store is not None:
+        store.acquire()
+    try:
+        return _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, label,
+                           task_prefix)
+    finally:
+        if store is not None:
+            store.close()
+
+
+def _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, label,
+                task_prefix):
     bounds = [(a, min(n, a + chunk)) for a in range(0, n, chunk)]
     todo = []
     for a, b in bounds:
         if store is not None and store.has(a, b):
-            for k, v in store.load(a, b).items():
+            try:
+                loaded = store.load(a, b, like=outputs)
+            except DamagedChunk as exc:
+                store.discard(a, b)
+                store.message(f"discarded damaged chunk {exc.name} ({exc.reason}); "
+                              f"recomputing")
+                todo.append((a, b))
+                continue
+            for k, v in loaded.items():
                 outputs[k][a:b] = v
         else:
             todo.append((a, b))

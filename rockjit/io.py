@@ -1,4 +1,4 @@
-"""Atomic writers: an interrupted run leaves nothing half-written (STYLE.md 11).
+"""Writing files safely: atomic writers and a command's output directory (STYLE.md 11).
 
 Every writer here writes a hidden temporary file next to its target
 (``.<name>.<random>.tmp``, same directory so the rename stays on one file system), flushes and
@@ -6,6 +6,16 @@ Every writer here writes a hidden temporary file next to its target
 and Windows. If anything goes wrong before the rename, including ``KeyboardInterrupt``, the
 temporary file is removed and the target is left as it was (absent, or its previous complete
 version).
+
+Permissions: files are created with mode ``0o666`` and directories with ``0o777``, and the
+operating system applies the process's umask (and a directory's default ACL, where there is
+one), so everything rockjit writes gets the permissions a plain ``open()`` or ``mkdir`` would
+give: ``-rw-r--r--`` and ``drwxr-xr-x`` under umask ``022``. (:func:`tempfile.mkstemp` and
+:func:`tempfile.mkdtemp` would leave ``-rw-------`` and ``drwx------``.)
+
+A command's outputs (:class:`OutputDir`) are staged in a hidden directory and published
+together: a failure or an interrupt before :meth:`OutputDir.publish` leaves ``--out`` exactly as
+it was, and files rockjit did not write are never deleted or replaced.
 
 JSON conventions (:func:`write_json`, :func:`to_jsonable`):
 
@@ -21,19 +31,49 @@ from __future__ import annotations
 import contextlib
 import csv
 import dataclasses
+import errno
 import io as _io
 import json
 import math
 import os
-import tempfile
+import secrets
+import shutil
+import signal
+import socket
+import threading
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["atomic_open", "save_figure", "to_jsonable", "write_csv", "write_json",
+__all__ = ["OutputDir", "atomic_open", "create_temp", "defer_signals", "host_name",
+           "markdown_table", "pid_alive", "save_figure", "to_jsonable", "write_csv", "write_json",
            "write_npz", "write_text"]
 
 TMP_SUFFIX = ".tmp"
+_O_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
+
+
+def create_temp(directory, prefix, suffix=TMP_SUFFIX):
+    """Create a new empty file ``<directory>/<prefix><random><suffix>`` for writing.
+
+    The file is created with mode ``0o666`` less the umask, as :func:`open` would create it.
+
+    Returns
+    -------
+    fd : int
+        An open file descriptor, write-only.
+    path : Path
+        The file's path.
+    """
+    directory = Path(directory) if str(directory) else Path(".")
+    for _ in range(100):
+        path = directory / f"{prefix}{secrets.token_hex(4)}{suffix}"
+        try:
+            fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | _O_CLOEXEC, 0o666)
+        except FileExistsError:
+            continue
+        return fd, path
+    raise FileExistsError(errno.EEXIST, "no unused temporary file name", str(directory))
 
 
 @contextlib.contextmanager
@@ -52,15 +92,14 @@ def atomic_open(path, mode="w", **kwargs):
     Yields
     ------
     file
-        The open temporary file.
+        The open temporary file (permissions: ``0o666`` less the umask).
     """
     path = Path(path)
     if mode not in ("w", "wb"):
         raise ValueError(f"mode must be 'w' or 'wb' (got {mode!r})")
     if "b" not in mode:
         kwargs.setdefault("encoding", "utf-8")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=TMP_SUFFIX,
-                               dir=path.parent if str(path.parent) else ".")
+    fd, tmp = create_temp(path.parent, f".{path.name}.")
     try:
         with os.fdopen(fd, mode, **kwargs) as fh:
             yield fh
@@ -161,3 +200,414 @@ def save_figure(fig, path, *, dpi=150):
     fig.savefig(buf, format=fmt, dpi=dpi)
     with atomic_open(path, "wb") as fh:
         fh.write(buf.getvalue())
+
+
+def markdown_table(header, rows, fmt=None):
+    """A Markdown table; floats formatted with ``fmt[column]`` (default ``".4g"``)."""
+    fmt = fmt or {}
+
+    def cell(i, v):
+        if isinstance(v, (float, np.floating)):
+            return format(float(v), fmt.get(header[i], ".4g"))
+        return str(v)
+
+    lines = ["| " + " | ".join(header) + " |",
+             "|" + "|".join("---" for _ in header) + "|"]
+    lines += ["| " + " | ".join(cell(i, v) for i, v in enumerate(r)) + " |" for r in rows]
+    return "\n".join(lines) + "\n"
+
+
+# ---- owners of hidden directories and lock files -----------------------------------------------
+
+def host_name():
+    """This machine's name, reduced to letters, digits, ``.``, ``-`` and ``_``."""
+    name = "".join(c if c.isalnum() or c in ".-_" else "_" for c in socket.gethostname())
+    return name or "localhost"
+
+
+def pid_alive(pid):
+    """Whether process ``pid`` exists on this machine (a zombie counts as alive)."""
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    except OSError:
+        return True  # cannot tell: assume alive, which never deletes anything
+    return True
+
+
+@contextlib.contextmanager
+def defer_signals(signums=(signal.SIGINT, signal.SIGTERM)):
+    """Hold back ``signums`` for the duration of the block.
+
+    Handlers that only record the signal stand in for the current ones, which are put back on
+    exit. The recorded signals are not raised again: the caller decides what they mean.
+    Outside the main thread, where Python cannot set handlers, nothing is deferred.
+
+    Yields
+    ------
+    list of int
+        The signals that arrived, in order (filled while the block runs).
+    """
+    got = []
+    old = {}
+    if threading.current_thread() is threading.main_thread():
+        for s in signums:
+            try:
+                old[s] = signal.signal(s, lambda signum, frame: got.append(signum))
+            except (ValueError, OSError):
+                pass
+    try:
+        yield got
+    finally:
+        for s, h in old.items():
+            signal.signal(s, signal.SIG_DFL if h is None else h)
+
+
+# ---- a command's output directory ------------------------------------------------------------
+
+_STAGE = "rockjit-stage"
+SUMMARY = "summary.json"
+
+
+def _mkdir_unique(parent, prefix):
+    for _ in range(100):
+        path = parent / f"{prefix}{secrets.token_hex(4)}"
+        try:
+            os.mkdir(path, 0o777)
+        except FileExistsError:
+            continue
+        return path
+    raise FileExistsError(errno.EEXIST, "no unused directory name", str(parent))
+
+
+def _makedirs(path):
+    """Create ``path`` and its missing parents (``0o777`` less the umask); the ones made."""
+    missing = []
+    p = Path(os.path.abspath(path))
+    while not os.path.lexists(p):
+        missing.append(p)
+        p = p.parent
+    made = []
+    try:
+        for d in reversed(missing):
+            os.mkdir(d, 0o777)
+            made.append(d)
+    except BaseException:
+        _rmdirs(made)
+        raise
+    return made
+
+
+def _rmdirs(made):
+    for d in reversed(made):
+        try:
+            os.rmdir(d)
+        except OSError:
+            break
+
+
+def _remove_stale_stages(parent, prefix):
+    """Remove staging directories ``<prefix><host>-<pid>-<random>`` of dead runs on this host."""
+    host = host_name()
+    try:
+        entries = list(os.scandir(parent))
+    except OSError:
+        return
+    for e in entries:
+        if not e.name.startswith(prefix) or not e.is_dir(follow_symlinks=False):
+            continue
+        parts = e.name[len(prefix):].rsplit("-", 2)
+        if len(parts) != 3 or parts[0] != host or not parts[1].isdigit():
+            continue
+        if not pid_alive(int(parts[1])):
+            shutil.rmtree(e.path, ignore_errors=True)
+
+
+def _check_name(name):
+    if (not isinstance(name, str) or name in ("", ".", "..") or "/" in name or os.sep in name
+            or (os.altsep and os.altsep in name) or name.startswith(f".{_STAGE}")):
+        raise ValueError(f"an output file name must be a plain file name (got {name!r})")
+    return name
+
+
+class OutputDir:
+    """The files of one command, staged in a hidden directory and published together.
+
+    Files are written (each atomically, with the user's umask) into a staging directory on the
+    same file system as ``path``: a hidden sibling ``.<name>.rockjit-stage-<host>-<pid>-<random>``
+    when ``path`` does not exist yet, a hidden ``.rockjit-stage-<host>-<pid>-<random>`` inside it
+    when it does (so the moves stay on its file system even when it is a mount point, and its
+    parent need not be writable). :meth:`publish` then moves them into place:
+
+    - ``path`` absent: one atomic :func:`os.rename` of the staging directory to ``path``;
+    - ``path`` present: each file :func:`os.replace`\\ d over its namesake, ``summary.json``
+      last.
+
+    SIGINT and SIGTERM are deferred (:func:`defer_signals`) for these few moves, so an
+    interrupt cannot split the set. A signal that arrived is recorded in :attr:`interrupted`,
+    not raised: the outputs are published and the run can report success.
+
+    On any failure or interrupt before :meth:`publish`, :meth:`discard` (called by the ``with``
+    statement) removes the staging directory and any parent directories it made, and ``path``
+    is exactly as before. Only the files the command writes are replaced; other files in
+    ``path`` are never touched. Staging directories of runs that died (their pid no longer
+    exists on this host) are removed when the next run on the same ``path`` starts writing.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output directory (``--out``).
+    command : str, optional
+        The command writing it, for :meth:`stale_warning`; by default the ``"command"`` of the
+        ``summary.json`` this run stages.
+
+    Attributes
+    ----------
+    path : Path
+    written : list of str
+        The names written so far, in order.
+    published : bool
+        Whether :meth:`publish` has completed.
+    interrupted : int or None
+        The signal (``signal.SIGINT``, ``signal.SIGTERM``) that arrived during :meth:`publish`,
+        if one did.
+    warning : str or None
+        :meth:`stale_warning` as it stood when :meth:`publish` began (what it returned).
+
+    Examples
+    --------
+    The command line's use::
+
+        out = OutputDir(args.out)
+        try:
+            out.npz("basin.npz", label=label)
+            out.json("summary.json", {"command": "basin", "files": out.written + ["summary.json"]})
+            note = out.publish()
+        except BaseException:
+            out.discard()
+            raise
+        if note:
+            print(note, file=sys.stderr)
+    """
+
+    def __init__(self, path, command=None):
+        if not os.fspath(path):
+            raise ValueError("out must name a directory (got '')")
+        self.path = Path(path)
+        self.command = command
+        self.written = []
+        self.published = False
+        self.interrupted = None
+        self.warning = None
+        self._stage = None
+        self._inside = False
+        self._made = []
+
+    # -- staging --------------------------------------------------------------------------------
+
+    @property
+    def staging(self):
+        """The staging directory (``None`` before the first write, after :meth:`publish` and
+        after :meth:`discard`)."""
+        return self._stage
+
+    def _stage_dir(self):
+        if self.published:
+            raise RuntimeError(f"{self.path} was already published")
+        if self._stage is not None:
+            return self._stage
+        out = self.path
+        host, pid = host_name(), os.getpid()
+        sibling = f".{out.name}.{_STAGE}-" if out.name else None
+        if os.path.lexists(out):
+            if not out.is_dir():
+                raise ValueError(f"out must be a directory (got {out}, an existing file)")
+            _remove_stale_stages(out, f".{_STAGE}-")
+            if sibling:
+                _remove_stale_stages(out.parent, sibling)
+            self._inside = True
+            self._stage = _mkdir_unique(out, f".{_STAGE}-{host}-{pid}-")
+            return self._stage
+        try:
+            self._made = _makedirs(out.parent)
+        except OSError as exc:
+            raise ValueError(f"out {out} cannot be created ({exc.strerror or exc})") from None
+        try:
+            _remove_stale_stages(out.parent, sibling)
+            self._inside = False
+            self._stage = _mkdir_unique(out.parent, f"{sibling}{host}-{pid}-")
+        except BaseException:
+            _rmdirs(self._made)
+            self._made = []
+            raise
+        return self._stage
+
+    def file(self, name):
+        """The staged path of ``name``, for a writer of its own; ``name`` is listed as written.
+
+        Write it completely (e.g. with :func:`atomic_open`) before :meth:`publish`.
+        """
+        _check_name(name)
+        path = self._stage_dir() / name
+        self._add(name)
+        return path
+
+    def _target(self, name):
+        _check_name(name)
+        return self._stage_dir() / name
+
+    def _add(self, name):
+        if name not in self.written:
+            self.written.append(name)
+
+    def json(self, name, obj):
+        """Stage ``obj`` as strict JSON (:func:`write_json`)."""
+        write_json(self._target(name), obj)
+        self._add(name)
+
+    def npz(self, name, **arrays):
+        """Stage arrays as an ``.npz`` archive (:func:`write_npz`)."""
+        write_npz(self._target(name), **arrays)
+        self._add(name)
+
+    def figure(self, name, fig, *, dpi=150):
+        """Stage a matplotlib figure (:func:`save_figure`), then clear it to free its memory."""
+        save_figure(fig, self._target(name), dpi=dpi)
+        self._add(name)
+        fig.clear()
+
+    def csv(self, name, header, rows):
+        """Stage a CSV table (:func:`write_csv`)."""
+        write_csv(self._target(name), header, rows)
+        self._add(name)
+
+    def text(self, name, text):
+        """Stage a text file (:func:`write_text`)."""
+        write_text(self._target(name), text)
+        self._add(name)
+
+    def table(self, stem, header, rows, fmt=None):
+        """Stage CSV and Markdown versions of one table: ``<stem>.csv``, ``<stem>.md``."""
+        self.csv(stem + ".csv", header, rows)
+        self.text(stem + ".md", markdown_table(header, rows, fmt))
+
+    # -- publishing -----------------------------------------------------------------------------
+
+    def stale_warning(self):
+        """One line about files of an earlier rockjit run in ``path`` that stay, or ``None``.
+
+        Read from ``path/summary.json``: a warning when it names another command, or lists
+        files that this run has not written (so far) and that still exist. Those files are kept.
+        """
+        try:
+            old = json.loads((self.path / SUMMARY).read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return None
+        if not isinstance(old, dict) or not isinstance(old.get("command"), str):
+            return None
+        cmd = old["command"]
+        files = old.get("files") if isinstance(old.get("files"), list) else []
+        kept = []
+        for f in files:
+            try:
+                f = _check_name(f)
+            except ValueError:
+                continue
+            if f not in self.written and os.path.lexists(self.path / f):
+                kept.append(f)
+        if kept:
+            names = ", ".join(kept[:5]) + (f" and {len(kept) - 5} more" if len(kept) > 5 else "")
+            return (f"{self.path} also holds {names} from an earlier `rockjit {cmd}` run; "
+                    f"this run does not write them and leaves them there")
+        command = self.command
+        if command is None and self._stage is not None and SUMMARY in self.written:
+            try:  # the command this run's own summary.json names
+                command = json.loads((self._stage / SUMMARY).read_text(encoding="utf-8"))
+                command = command.get("command") if isinstance(command, dict) else None
+            except (OSError, ValueError):
+                command = None
+        if isinstance(command, str) and cmd != command:
+            return (f"{self.path} held the outputs of an earlier `rockjit {cmd}` run; this "
+                    f"`rockjit {command}` run replaces them")
+        return None
+
+    def publish(self):
+        """Move the staged files into ``path`` as one unit (see the class docstring).
+
+        Returns
+        -------
+        str or None
+            :meth:`stale_warning` as it stood before the move (also kept in :attr:`warning`):
+            one line for the command line to print, or ``None``. The names published are
+            :attr:`written`.
+        """
+        if self.published:
+            return self.warning
+        stage = self._stage
+        if stage is None:  # nothing was written: nothing to create
+            self.published = True
+            return None
+        missing = [n for n in self.written if not (stage / n).is_file()]
+        if missing:
+            raise FileNotFoundError(errno.ENOENT, "staged output never written",
+                                    str(stage / missing[0]))
+        order = [n for n in self.written if n != SUMMARY] + \
+            [n for n in self.written if n == SUMMARY]
+        self.warning = self.stale_warning()
+        if self._inside:
+            self._check_targets(order)
+        with defer_signals() as got:
+            moved = False
+            if not self._inside:
+                try:
+                    os.rename(stage, self.path)
+                    moved = True
+                except OSError as exc:  # --out appeared meanwhile: publish file by file
+                    if exc.errno not in (errno.EEXIST, errno.ENOTEMPTY):
+                        raise
+                    self._check_targets(order)
+            if not moved:
+                for n in order:
+                    os.replace(stage / n, self.path / n)
+                shutil.rmtree(stage, ignore_errors=True)
+            self._stage = None
+            self._made = []
+            self.published = True
+        self.interrupted = got[0] if got else None
+        return self.warning
+
+    def _check_targets(self, names):
+        if not self.path.is_dir():
+            raise ValueError(f"out must be a directory (got {self.path}, an existing file)")
+        for n in names:
+            t = self.path / n
+            if t.is_dir() and not t.is_symlink():
+                raise ValueError(f"cannot write {t}: a directory of that name is in the way")
+
+    def discard(self):
+        """Remove the staging directory and any parent directories it made: ``path`` is as
+        before."""
+        if self._stage is not None:
+            shutil.rmtree(self._stage, ignore_errors=True)
+            self._stage = None
+        _rmdirs(self._made)
+        self._made = []
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        if exc_type is None:
+            try:
+                self.publish()
+            except BaseException:
+                self.discard()
+                raise
+        else:
+            self.discard()
+        return False

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from numba.core.caching import _CacheLocator
 
 from rockjit import _jit
 from rockjit._jit import fma, jit
@@ -59,8 +60,9 @@ def test_cache_dir_elsewhere_survives_a_cold_start(tmp_path, monkeypatch):
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(root))
     pkg, _ = _fake_package(tmp_path)
     _jit.check_cache(pkg)  # cold: nothing there yet
-    compiled = root / "work_main_rockjit"
-    compiled.mkdir(parents=True)
+    # the folder numba itself picks for functions of pkg/*.py (its own locator code)
+    compiled = root / _CacheLocator.get_suitable_cache_subpath(str(pkg / "integrate.py"))
+    compiled.mkdir(parents=True, exist_ok=True)
     (compiled / "integrate._run-1.py311.nbi").write_text("fresh")
     _jit.check_cache(pkg)  # a second process, sources unchanged
     assert (compiled / "integrate._run-1.py311.nbi").exists()

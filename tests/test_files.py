@@ -1,0 +1,754 @@
+"""Files rockjit writes: the user's umask, outputs published as one unit, chunk stores that
+refuse a second run, survive damage and report progress readably, and a numba cache check that
+deletes only numba's files of this package (issue 10, section 2 and the progress item of 4).
+
+The references are independent of the code under test: the mode a plain ``open``/``mkdir``
+gets under the same umask, byte snapshots of directories taken before an operation, outputs
+computed directly without chunks, and the cache folder numba's own locator names.
+"""
+
+import json
+import os
+import signal
+import stat
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+from numba.core.caching import _CacheLocator
+
+from rockjit import _jit, chunks
+from rockjit import io as rio
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+# ---------------------------------------------------------------------------------------------
+# helpers
+# ---------------------------------------------------------------------------------------------
+
+@pytest.fixture(params=[0o022, 0o077], ids=["umask022", "umask077"])
+def umask(request):
+    old = os.umask(request.param)
+    try:
+        yield request.param
+    finally:
+        os.umask(old)
+
+
+def _mode(path):
+    return stat.S_IMODE(os.lstat(path).st_mode)
+
+
+def _plain_modes(tmp_path):
+    """The modes a plain open() and mkdir() give under the current umask (the kernel's)."""
+    ref = tmp_path / "ref"
+    ref.mkdir()
+    with open(ref / "f", "w") as fh:
+        fh.write("x")
+    os.mkdir(ref / "d")
+    modes = _mode(ref / "f"), _mode(ref / "d")
+    (ref / "f").unlink()
+    (ref / "d").rmdir()
+    ref.rmdir()
+    return modes
+
+
+def _snapshot(root):
+    """Every entry under ``root`` (hidden ones included) with its bytes and mode."""
+    root = Path(root)
+    if not os.path.lexists(root):
+        return None
+    snap = {}
+    for p in sorted(root.rglob("*")):
+        rel = str(p.relative_to(root))
+        snap[rel] = (p.read_bytes() if p.is_file() else "<dir>", _mode(p))
+    return snap
+
+
+class _Fig:
+    """Stands in for a matplotlib figure: ``savefig`` writes bytes, ``during`` runs first."""
+
+    def __init__(self, during=None):
+        self.during = during
+        self.cleared = False
+
+    def savefig(self, buf, format=None, dpi=None):
+        if self.during:
+            self.during()
+        buf.write(b"\x89PNG fake " + str(format).encode())
+
+    def clear(self):
+        self.cleared = True
+
+
+def _run_child(code, *args, **kw):
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    return subprocess.Popen([sys.executable, "-c", textwrap.dedent(code), *map(str, args)],
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env=env, **kw)
+
+
+def _expect_line(proc, want):
+    line = proc.stdout.readline().strip()
+    if line != want:
+        proc.kill()
+        _, err = proc.communicate(timeout=60)
+        pytest.fail(f"child said {line!r}, expected {want!r}; stderr:\n{err}")
+
+
+# ---------------------------------------------------------------------------------------------
+# 1. the user's umask
+# ---------------------------------------------------------------------------------------------
+
+def test_writers_follow_the_umask(tmp_path, umask):
+    f_mode, _ = _plain_modes(tmp_path)
+    assert f_mode == 0o666 & ~umask
+    rio.write_json(tmp_path / "a.json", {"x": 1})
+    rio.write_text(tmp_path / "a.txt", "x")
+    rio.write_npz(tmp_path / "a.npz", x=np.arange(3))
+    rio.write_csv(tmp_path / "a.csv", ["a"], [[1.0]])
+    rio.save_figure(_Fig(), tmp_path / "a.png")
+    with rio.atomic_open(tmp_path / "b.bin", "wb") as fh:
+        fh.write(b"x")
+    for name in ("a.json", "a.txt", "a.npz", "a.csv", "a.png", "b.bin"):
+        assert _mode(tmp_path / name) == f_mode, name
+
+
+def test_output_dir_follows_the_umask(tmp_path, umask):
+    f_mode, d_mode = _plain_modes(tmp_path)
+    fresh = tmp_path / "deep" / "fresh"  # parents made too
+    with rio.OutputDir(fresh, command="cor") as out:
+        out.json("summary.json", {"command": "cor"})
+        out.table("t", ["a"], [[1.0]])
+    assert _mode(tmp_path / "deep") == d_mode and _mode(fresh) == d_mode
+    assert {p.name: _mode(p) for p in fresh.iterdir()} == \
+        {"summary.json": f_mode, "t.csv": f_mode, "t.md": f_mode}
+    existing = tmp_path / "existing"
+    existing.mkdir()
+    with rio.OutputDir(existing) as out:
+        out.npz("x.npz", x=np.arange(2))
+    assert _mode(existing / "x.npz") == f_mode
+
+
+def test_chunk_store_follows_the_umask(tmp_path, umask):
+    f_mode, d_mode = _plain_modes(tmp_path)
+    path = tmp_path / "out.chunks" / "basin"
+    store = chunks.ChunkStore(path, "key", 4, 2)
+    assert _mode(path) == d_mode and _mode(path.parent) == d_mode
+    assert _mode(path / "lock.json") == f_mode
+    assert _mode(path / "manifest.json") == f_mode
+    store.save(0, 2, {"y": np.zeros(2)})
+    assert _mode(path / "cells-0000000000-0000000002.npz") == f_mode
+    store.close()
+
+
+# ---------------------------------------------------------------------------------------------
+# 2. a command's outputs published as one unit
+# ---------------------------------------------------------------------------------------------
+
+def test_publish_into_a_new_directory(tmp_path):
+    out = tmp_path / "out"
+    o = rio.OutputDir(out, command="basin")
+    o.npz("basin.npz", label=np.arange(4))
+    fig = _Fig()
+    o.figure("basin.png", fig)
+    o.json("summary.json", {"command": "basin", "files": o.written + ["summary.json"]})
+    assert fig.cleared
+    assert not out.exists()  # nothing visible before publish
+    stage = o.staging
+    assert stage.parent == tmp_path and stage.name.startswith(".out.")
+    assert o.publish() is None  # nothing to warn about
+    assert o.written == ["basin.npz", "basin.png", "summary.json"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # the stage was renamed
+    assert sorted(p.name for p in out.iterdir()) == ["basin.npz", "basin.png", "summary.json"]
+    assert np.load(out / "basin.npz")["label"].tolist() == [0, 1, 2, 3]
+    assert json.loads((out / "summary.json").read_text())["files"] == \
+        ["basin.npz", "basin.png", "summary.json"]
+    assert o.published and o.interrupted is None and o.warning is None
+
+
+def test_publish_into_an_existing_directory_keeps_the_users_files(tmp_path, monkeypatch):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    (out / "basin.npz").write_bytes(b"old")
+    moved = []
+    real = os.replace
+
+    def record(src, dst):
+        moved.append(Path(dst).name)
+        return real(src, dst)
+
+    with rio.OutputDir(out, command="basin") as o:
+        o.json("summary.json", {"command": "basin", "files": ["basin.npz", "summary.json"]})
+        o.npz("basin.npz", label=np.arange(3))
+        monkeypatch.setattr(os, "replace", record)
+    monkeypatch.setattr(os, "replace", real)
+    assert moved[-2:] == ["basin.npz", "summary.json"]  # summary.json last
+    assert sorted(p.name for p in out.iterdir()) == ["basin.npz", "notes.txt", "summary.json"]
+    assert (out / "notes.txt").read_text() == "mine"
+    assert np.load(out / "basin.npz")["label"].tolist() == [0, 1, 2]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+
+
+@pytest.mark.parametrize("existing", [False, True])
+def test_keyboard_interrupt_inside_a_write_leaves_out_untouched(tmp_path, monkeypatch,
+                                                                existing):
+    out = tmp_path / "sub" / "out"
+    if existing:
+        out.mkdir(parents=True)
+        (out / "summary.json").write_text('{"command": "basin", "files": ["summary.json"]}')
+        (out / "basin.png").write_bytes(b"old figure")
+    before_out, before_root = _snapshot(out), _snapshot(tmp_path)
+
+    def boom(fh, **arrays):
+        fh.write(b"PK\x03\x04 partial")
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        with rio.OutputDir(out, command="basin") as o:
+            o.figure("basin.png", _Fig())
+            o.json("summary.json", {"command": "basin"})
+            monkeypatch.setattr(np, "savez", boom)
+            o.npz("basin.npz", label=np.arange(3))
+    assert _snapshot(out) == before_out
+    assert _snapshot(tmp_path) == before_root  # no stage, no parent left behind
+
+
+@pytest.mark.parametrize("existing", [False, True])
+def test_signal_during_staging_leaves_out_untouched(tmp_path, existing):
+    out = tmp_path / "out"
+    if existing:
+        out.mkdir()
+        (out / "trajectory.png").write_bytes(b"old")
+    before = _snapshot(tmp_path)
+    with pytest.raises(KeyboardInterrupt):
+        with rio.OutputDir(out) as o:
+            o.npz("trajectory.npz", t=np.arange(5.0))
+            o.figure("trajectory.png", _Fig(lambda: os.kill(os.getpid(), signal.SIGINT)))
+            o.json("summary.json", {})
+    assert _snapshot(tmp_path) == before
+
+
+@pytest.mark.parametrize("existing", [False, True])
+def test_signal_during_publish_is_deferred(tmp_path, monkeypatch, existing):
+    out = tmp_path / "out"
+    if existing:
+        out.mkdir()
+        (out / "plane.npz").write_bytes(b"old")
+    handler = signal.getsignal(signal.SIGINT)
+    real = {"rename": os.rename, "replace": os.replace}
+
+    def interrupting(name):
+        def move(src, dst):
+            os.kill(os.getpid(), signal.SIGINT)  # arrives in the middle of the moves
+            return real[name](src, dst)
+        return move
+
+    o = rio.OutputDir(out, command="plane")
+    o.npz("plane.npz", label=np.arange(6))
+    o.json("summary.json", {"command": "plane"})
+    monkeypatch.setattr(os, "rename", interrupting("rename"))
+    monkeypatch.setattr(os, "replace", interrupting("replace"))
+    o.publish()  # no KeyboardInterrupt: the outputs are published, the run can succeed
+    monkeypatch.undo()
+    assert o.published and o.interrupted == signal.SIGINT
+    assert signal.getsignal(signal.SIGINT) is handler
+    assert sorted(p.name for p in out.iterdir()) == ["plane.npz", "summary.json"]
+    assert np.load(out / "plane.npz")["label"].tolist() == list(range(6))
+
+
+CHILD_PUBLISH = """
+    import os, signal, sys, time
+    from rockjit import io as rio
+    out = rio.OutputDir(sys.argv[1], command="basin")
+    out.text("a.txt", "new a")
+    out.text("summary.json", "new summary")
+    if sys.argv[2] == "staging":
+        print("staging", flush=True)
+        time.sleep(60)  # SIGTERM's default action ends the process here
+    real = os.replace
+    def slow(src, dst):
+        print("publishing", flush=True)
+        time.sleep(0.5)  # SIGTERM arrives while the files are being moved
+        real(src, dst)
+    os.replace = slow
+    out.publish()
+    print("published", out.interrupted == signal.SIGTERM, flush=True)
+"""
+
+
+def test_sigterm_in_another_process(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "a.txt").write_text("old a")
+    (out / "summary.json").write_text("old summary")
+    (out / "user.txt").write_text("mine")
+    before = _snapshot(tmp_path)
+    # killed while staging: --out untouched; the next run removes the dead run's stage
+    p = _run_child(CHILD_PUBLISH, out, "staging")
+    _expect_line(p, "staging")
+    assert [d.name for d in out.iterdir() if d.name.startswith(".rockjit-stage-")]
+    p.send_signal(signal.SIGTERM)
+    assert p.wait(timeout=60) == -signal.SIGTERM
+    left = [d for d in out.iterdir() if d.name.startswith(".rockjit-stage-")]
+    assert len(left) == 1 and str(p.pid) in left[0].name
+    o = rio.OutputDir(out)
+    o.text("x.txt", "")  # the first write clears stages of dead runs
+    o.discard()
+    assert _snapshot(tmp_path) == before
+    # terminated while publishing: the set is published whole and the run succeeds
+    p = _run_child(CHILD_PUBLISH, out, "publish")
+    _expect_line(p, "publishing")
+    p.send_signal(signal.SIGTERM)
+    stdout, stderr = p.communicate(timeout=60)
+    assert p.returncode == 0, stderr
+    assert stdout.split("\n")[-2] == "published True"
+    assert {f: (out / f).read_text() for f in ("a.txt", "summary.json", "user.txt")} == \
+        {"a.txt": "new a", "summary.json": "new summary", "user.txt": "mine"}
+    assert sorted(p.name for p in out.iterdir()) == ["a.txt", "summary.json", "user.txt"]
+
+
+def test_stale_stages_only_of_dead_runs_on_this_host(tmp_path):
+    out = tmp_path / "out"
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    host = rio.host_name()
+    stages = {"dead": tmp_path / f".out.rockjit-stage-{host}-{dead.pid}-00000000",
+              "alive": tmp_path / f".out.rockjit-stage-{host}-{os.getppid()}-00000000",
+              "elsewhere": tmp_path / f".out.rockjit-stage-otherhost-{dead.pid}-00000000",
+              "user": tmp_path / ".out.rockjit-stage-notes"}
+    for d in stages.values():
+        d.mkdir()
+        (d / "f").write_text("x")
+    o = rio.OutputDir(out)
+    o.text("a.txt", "a")
+    assert not stages["dead"].exists()
+    assert all(stages[k].exists() for k in ("alive", "elsewhere", "user"))
+    o.discard()
+
+
+def test_stale_warning_names_files_of_another_command(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    old = {"command": "sweep", "files": ["sweep.npz", "bifurcation.png", "summary.json"]}
+    (out / "summary.json").write_text(json.dumps(old))
+    (out / "sweep.npz").write_bytes(b"s")
+    (out / "bifurcation.png").write_bytes(b"b")
+    o = rio.OutputDir(out, command="basin")
+    o.npz("basin.npz", x=np.arange(2))
+    o.json("summary.json", {"command": "basin", "files": ["basin.npz", "summary.json"]})
+    w = o.stale_warning()
+    assert "\n" not in w and "sweep.npz" in w and "bifurcation.png" in w and "sweep" in w
+    assert o.publish() == w == o.warning
+    assert (out / "sweep.npz").read_bytes() == b"s"  # warned about, never deleted
+    assert (out / "bifurcation.png").read_bytes() == b"b"
+    # the same command again, writing the same files: nothing to say
+    o = rio.OutputDir(out, command="basin")
+    o.npz("basin.npz", x=np.arange(2))
+    o.json("summary.json", {"command": "basin", "files": ["basin.npz", "summary.json"]})
+    assert o.stale_warning() is None
+    o.discard()
+    # another command whose files this run all replaces: still said (the command read from
+    # the summary.json this run stages when not given)
+    o = rio.OutputDir(out)
+    o.npz("basin.npz", x=np.arange(2))
+    o.json("summary.json", {"command": "plane"})
+    assert "basin" in o.stale_warning() and "plane" in o.stale_warning()
+    o.discard()
+
+
+def test_refusals_leave_everything_as_it_was(tmp_path):
+    (tmp_path / "file").write_text("mine")
+    with pytest.raises(ValueError, match="existing file"):
+        rio.OutputDir(tmp_path / "file").text("a.txt", "")
+    (tmp_path / "link").symlink_to(tmp_path / "nowhere")
+    with pytest.raises(ValueError, match="existing file"):
+        rio.OutputDir(tmp_path / "link").text("a.txt", "")
+    with pytest.raises(ValueError, match="empty|''"):
+        rio.OutputDir("")
+    out = tmp_path / "out"
+    (out / "summary.json").mkdir(parents=True)  # a directory where a file would go
+    before = _snapshot(tmp_path)
+    with pytest.raises(ValueError, match="in the way"):
+        with rio.OutputDir(out) as o:
+            o.text("a.txt", "a")
+            o.json("summary.json", {})
+    assert _snapshot(tmp_path) == before
+    for bad in ("../x", "a/b", "..", ""):
+        with pytest.raises(ValueError, match="plain file name"):
+            rio.OutputDir(out).text(bad, "")
+    assert _snapshot(tmp_path) == before
+
+
+def test_nothing_written_creates_nothing(tmp_path):
+    with rio.OutputDir(tmp_path / "a" / "out") as o:
+        pass
+    assert o.publish() is None and o.written == [] and list(tmp_path.iterdir()) == []
+
+
+def test_table_writes_csv_and_markdown(tmp_path):
+    with rio.OutputDir(tmp_path / "out") as o:
+        o.table("e_table", ["hb", "e"], [[1, 0.123456], ["x", float("nan")]], fmt={"e": ".3f"})
+    assert (tmp_path / "out" / "e_table.csv").read_text().splitlines() == \
+        ["hb,e", "1,0.123456", "x,nan"]
+    assert (tmp_path / "out" / "e_table.md").read_text() == \
+        "| hb | e |\n|---|---|\n| 1 | 0.123 |\n| x | nan |\n"
+    assert o.written == ["e_table.csv", "e_table.md"]
+
+
+# ---------------------------------------------------------------------------------------------
+# 3. chunk stores
+# ---------------------------------------------------------------------------------------------
+
+N, CHUNK = 23, 5
+BOUNDS = [(a, min(N, a + CHUNK)) for a in range(0, N, CHUNK)]
+
+
+def _runner(x, calls=None):
+    if calls is not None:
+        calls.append((int(x[0]), int(x[-1]) + 1))
+    return {"y": np.sin(x) * 1e3 + x ** 2, "k": (x * 7).astype(np.int64) % 5,
+            "pair": np.stack([np.cos(x), x], axis=1)}
+
+
+def _direct():
+    """The outputs computed in one go, without chunks or a store."""
+    x = np.arange(N, dtype=float)
+    return _runner(x)
+
+
+def _outputs():
+    return {"y": np.zeros(N), "k": np.zeros(N, dtype=np.int64), "pair": np.zeros((N, 2))}
+
+
+def _run(store, calls=None, **kw):
+    x = np.arange(N, dtype=float)
+    out = _outputs()
+    chunks.run_chunks(lambda xs: _runner(xs, calls), (x,), N, CHUNK, out, store=store, **kw)
+    return out
+
+
+def _open(path, message=None):
+    kw = {} if message is None else dict(message=message)
+    return chunks.ChunkStore(path, chunks.fingerprint((np.arange(N, dtype=float),), {}), N,
+                             CHUNK, **kw)
+
+
+def _same(a, b):
+    assert a.keys() == b.keys()
+    for k in a:
+        assert a[k].dtype == b[k].dtype and a[k].tobytes() == b[k].tobytes(), k
+
+
+def test_chunks_are_written_by_the_atomic_writer(tmp_path, monkeypatch):
+    store = tmp_path / "s"
+    _run(_open(store))
+    old = (store / "cells-0000000000-0000000005.npz").read_bytes()
+
+    def boom(fh, **arrays):
+        fh.write(b"PK\x03\x04 partial")
+        raise KeyboardInterrupt
+
+    s = _open(store)
+    monkeypatch.setattr(np, "savez", boom)
+    with pytest.raises(KeyboardInterrupt):
+        s.save(0, 5, _runner(np.arange(5.0)))
+    monkeypatch.undo()
+    s.close()
+    assert (store / "cells-0000000000-0000000005.npz").read_bytes() == old
+    names = sorted(p.name for p in store.iterdir())
+    assert names == sorted(["manifest.json"] + [f"cells-{a:010d}-{b:010d}.npz"
+                                                for a, b in BOUNDS])  # no temporary, no lock
+
+
+def test_damaged_chunks_are_discarded_and_recomputed(tmp_path, capsys):
+    store = tmp_path / "s"
+    _same(_run(_open(store)), _direct())
+    names = [store / f"cells-{a:010d}-{b:010d}.npz" for a, b in BOUNDS]
+    data = names[0].read_bytes()
+    names[0].write_bytes(data[: len(data) // 2])  # truncated
+    names[1].write_bytes(b"not a zip archive at all")
+    good = _runner(np.arange(10.0, 15.0))
+    np.savez(names[2], y=good["y"], k=good["k"])  # an array missing
+    np.savez(names[3], y=good["y"][:3], k=good["k"], pair=good["pair"])  # wrong shape
+    np.savez(names[4], y=good["y"][:3].astype(np.float32), k=good["k"][:3],
+             pair=good["pair"][:3])  # wrong dtype
+    calls = []
+    again = _run(_open(store), calls)
+    _same(again, _direct())
+    assert sorted(calls) == BOUNDS  # exactly the damaged ones, computed again
+    err = capsys.readouterr().err.splitlines()
+    assert [line for line in err if "discarded damaged chunk" in line] == err
+    assert len(err) == len(BOUNDS)
+    for line, path in zip(err, names):
+        assert line.startswith(f"rockjit: discarded damaged chunk {path.name} ")
+        assert line.endswith("; recomputing")
+    assert "(not an .npz archive)" in err[1] and "'pair'" in err[2]
+    calls.clear()
+    _same(_run(_open(store), calls), _direct())  # now whole again: loaded, not computed
+    assert calls == []
+
+
+def test_bit_flip_in_a_chunk_is_caught_by_the_checksum(tmp_path):
+    store = tmp_path / "s"
+    _run(_open(store))
+    path = store / "cells-0000000005-0000000010.npz"
+    raw = bytearray(path.read_bytes())
+    i = raw.index(b"\x93NUMPY") + 128 + 3  # inside the first array's data (header: 128 B)
+    raw[i] ^= 0x01
+    path.write_bytes(bytes(raw))
+    msgs, calls = [], []
+    _same(_run(_open(store, msgs.append), calls), _direct())
+    assert calls == [(5, 10)] and len(msgs) == 1 and path.name in msgs[0]
+
+
+def test_store_path_that_is_a_file(tmp_path):
+    (tmp_path / "f").write_text("mine")
+    with pytest.raises(ValueError, match="existing file"):
+        _open(tmp_path / "f")
+    with pytest.raises(ValueError, match="cannot be created"):
+        _open(tmp_path / "f" / "basin")
+    assert (tmp_path / "f").read_text() == "mine"
+
+
+def test_one_store_one_run_in_this_process(tmp_path):
+    a = _open(tmp_path / "s")
+    with pytest.raises(ValueError, match=f"pid {os.getpid()}"):
+        _open(tmp_path / "s")
+    a.close()
+    assert not (tmp_path / "s" / "lock.json").exists()
+    _open(tmp_path / "s").close()
+
+
+def test_lock_released_when_the_run_raises(tmp_path):
+    store = tmp_path / "s"
+
+    def runner(x):
+        if x[0] >= 10:
+            raise KeyboardInterrupt
+        return _runner(x)
+
+    s = _open(store)
+    with pytest.raises(KeyboardInterrupt):
+        chunks.run_chunks(runner, (np.arange(N, dtype=float),), N, CHUNK, _outputs(), store=s)
+    assert not s.locked and not (store / "lock.json").exists()
+    calls = []
+    _same(_run(_open(store), calls), _direct())  # resumes: only the missing chunks
+    assert sorted(calls) == BOUNDS[2:]
+
+
+def test_lock_of_another_host_is_refused(tmp_path):
+    store = tmp_path / "s"
+    store.mkdir()
+    (store / "lock.json").write_text(json.dumps({"pid": 1, "host": "elsewhere", "token": "t"}))
+    with pytest.raises(ValueError, match="host elsewhere.*pid 1"):
+        _open(store)
+    assert not chunks.remove_stores(store, message=lambda m: None)
+    assert (store / "lock.json").exists()
+
+
+CHILD_RUN = """
+    import sys
+    from pathlib import Path
+    import numpy as np
+    from rockjit import chunks
+    def runner(x):
+        if x[0] == 5:  # the second chunk: wait for the parent
+            print("computing", flush=True)
+            sys.stdin.readline()
+        return {"y": x * 2.0}
+    x = np.arange(23.0)
+    out = {"y": np.zeros(23)}
+    store = chunks.ChunkStore(sys.argv[1], chunks.fingerprint((x,), {}), 23, 5)
+    chunks.run_chunks(runner, (x,), 23, 5, out, store=store)
+    gone = chunks.remove_stores(Path(sys.argv[1]).parent)  # as the command line does
+    print("removed" if gone else "kept", flush=True)
+"""
+
+
+def _open_like_child(path, message=None):
+    x = np.arange(23.0)
+    kw = {} if message is None else dict(message=message)
+    return chunks.ChunkStore(path, chunks.fingerprint((x,), {}), 23, 5, **kw)
+
+
+def test_a_second_run_on_a_store_in_use(tmp_path):
+    root = tmp_path / "out.chunks"
+    store = root / "basin"
+    p = _run_child(CHILD_RUN, store)
+    _expect_line(p, "computing")
+    # the owner is alive: refused, naming it; its store is neither used nor removed
+    with pytest.raises(ValueError, match=f"in use by another rockjit run \\(pid {p.pid} "):
+        _open_like_child(store)
+    msgs = []
+    assert not chunks.remove_stores(root, message=msgs.append)
+    assert len(msgs) == 1 and f"pid {p.pid}" in msgs[0] and "kept" in msgs[0]
+    assert (store / "cells-0000000000-0000000005.npz").exists()
+    p.stdin.write("\n")
+    p.stdin.flush()
+    stdout, stderr = p.communicate(timeout=120)
+    assert p.returncode == 0 and stdout.strip() == "removed", stderr
+    assert not root.exists()  # the owner finished and removed its store
+
+
+def test_a_dead_owners_lock_is_taken_over(tmp_path):
+    store = tmp_path / "s"
+    p = _run_child(CHILD_RUN, store)
+    _expect_line(p, "computing")
+    p.kill()
+    p.wait(timeout=60)
+    lock = json.loads((store / "lock.json").read_text())
+    assert lock["pid"] == p.pid and lock["host"] == rio.host_name()
+    (store / ".cells-0000000005-0000000010.npz.0badc0de.tmp").write_bytes(b"half")
+    msgs = []
+    s = _open_like_child(store, msgs.append)
+    assert s.locked and len(msgs) == 1
+    assert f"pid {p.pid}" in msgs[0] and "no longer running" in msgs[0]
+    assert json.loads((store / "lock.json").read_text())["pid"] == os.getpid()
+    assert not list(store.glob(".*.tmp"))  # the killed run's temporary file is gone
+    (store / "notes.txt").write_text("mine")
+    assert not s.cleanup()  # the user's file keeps the directory
+    assert sorted(p.name for p in store.iterdir()) == ["notes.txt"]
+
+
+def test_remove_store_deletes_only_rockjits_files(tmp_path):
+    root = tmp_path / "out.chunks"
+    for name in ("housner", "mao"):
+        _run(_open(root / name))
+    assert chunks.remove_stores(root)
+    assert not root.exists()
+    _run(_open(root / "mao"))
+    (root / "readme.txt").write_text("mine")
+    assert not chunks.remove_stores(root)
+    assert sorted(str(p.relative_to(root)) for p in root.rglob("*")) == ["readme.txt"]
+
+
+def _fake_clock(monkeypatch):
+    now = [0.0]
+    monkeypatch.setattr(chunks.time, "perf_counter", lambda: now[0])
+    return now
+
+
+def test_progress_in_a_log_file_is_plain_throttled_lines(tmp_path, monkeypatch, capsys):
+    now = _fake_clock(monkeypatch)
+    x = np.arange(N, dtype=float)
+
+    def runner(xs):
+        now[0] += 2.0  # each chunk takes 2 s
+        return _runner(xs)
+
+    chunks.run_chunks(runner, (x,), N, CHUNK, _outputs(), progress=True, label="basin")
+    err = capsys.readouterr().err
+    assert "\r" not in err
+    lines = err.splitlines()
+    # chunks end at 2, 4, 6, 8, 10 s: a line once 5 s have passed since the last (6 s), then
+    # the last one (10 s)
+    assert [line.split(",")[0] for line in lines] == ["basin: 15/23 cells", "basin: 23/23 cells"]
+    assert lines[0] == "basin: 15/23 cells, 6.0 s elapsed, ~3.2 s left"
+
+
+def test_progress_on_a_terminal_rewrites_one_line(monkeypatch):
+    import io
+
+    class Tty(io.StringIO):
+        def isatty(self):
+            return True
+
+    tty = Tty()
+    monkeypatch.setattr(sys, "stderr", tty)
+    chunks.run_chunks(_runner, (np.arange(N, dtype=float),), N, CHUNK, _outputs(),
+                      progress=True)
+    text = tty.getvalue()
+    assert text.count("\r") == len(BOUNDS) and text.count("\n") == 1 and text.endswith("\n")
+
+
+# ---------------------------------------------------------------------------------------------
+# 4. numba's cache: only the package's own files are deleted
+# ---------------------------------------------------------------------------------------------
+
+def _package(tmp_path, extra=()):
+    pkg = tmp_path / "src" / "rockjit"
+    pkg.mkdir(parents=True)
+    for name in _jit._SOURCES + ("cli.py",) + tuple(extra):
+        (pkg / name).write_text(f"# {name}\n")
+    return pkg
+
+
+OURS = ("model.accel_near-341.py311.nbi", "model.accel_near-341.py311.1.nbc",
+        "integrate._build.locals.run-1111.py311.3.nbc", "analysis._grid-88.py311.nbi")
+
+
+def _put(folder, names, text="x"):
+    folder.mkdir(parents=True, exist_ok=True)
+    for n in names:
+        (folder / n).write_text(text)
+
+
+def test_check_cache_deletes_only_numbas_files_of_the_package(tmp_path, monkeypatch):
+    root = tmp_path / "numba-cache"
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(root))
+    monkeypatch.setattr(_jit, "_user_wide_dir", lambda: tmp_path / "user-wide")
+    pkg = _package(tmp_path)
+    numba_dir = root / _CacheLocator.get_suitable_cache_subpath(str(pkg / "model.py"))
+    other_checkout = root / _CacheLocator.get_suitable_cache_subpath(
+        str(tmp_path / "elsewhere" / "rockjit" / "model.py"))
+    decoys = {root / "my-rockjit-notes": ["keep.nbi", "keep.nbc"],
+              numba_dir: ["other.nbc", "other.f-1.py311.nbi", "notes.txt", "model.nbi"],
+              other_checkout: list(OURS),
+              pkg / "__pycache__": ["model.cpython-311.pyc"]}
+    for folder, names in decoys.items():
+        _put(folder, names)
+    _put(numba_dir, OURS)
+    _put(pkg / "__pycache__", OURS)
+
+    def survivors():
+        return {f: sorted(p.name for p in f.iterdir() if p.name != _jit.STAMP)
+                for f in decoys}
+
+    _jit.check_cache(pkg)  # no stamp: nothing there can be trusted
+    assert survivors() == {f: sorted(n) for f, n in decoys.items()}
+    assert (numba_dir / _jit.STAMP).exists() and (pkg / "__pycache__" / _jit.STAMP).exists()
+    assert not (tmp_path / "user-wide").exists()  # a folder numba will not use
+    _put(numba_dir, OURS, "fresh")
+    _jit.check_cache(pkg)  # sources unchanged: kept
+    assert all((numba_dir / n).read_text() == "fresh" for n in OURS)
+    (pkg / "cli.py").write_text("# cli.py, edited\n")  # not compiled: kept
+    _jit.check_cache(pkg)
+    assert all((numba_dir / n).exists() for n in OURS)
+    (pkg / "model.py").write_text("# model.py, edited\n")
+    _jit.check_cache(pkg)
+    assert not any((numba_dir / n).exists() for n in OURS)
+    assert survivors() == {f: sorted(n) for f, n in decoys.items()}
+
+
+def test_check_cache_covers_every_module_that_compiles(tmp_path, monkeypatch):
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.setattr(_jit, "_user_wide_dir", lambda: tmp_path / "user-wide")
+    pkg = _package(tmp_path, extra=("kernel.py",))
+    (pkg / "kernel.py").write_text("from ._jit import jit\n")
+    cache = pkg / "__pycache__"
+    _jit.check_cache(pkg)
+    _put(cache, ["kernel.run_chunk_kernel-12.py311.nbi", "kernel.run_chunk_kernel-12.py311.1.nbc"])
+    (pkg / "kernel.py").write_text("from ._jit import jit\n# edited\n")
+    _jit.check_cache(pkg)
+    assert not list(cache.glob("*.nb[ic]"))
+
+
+def test_check_cache_user_wide_folder_when_pycache_is_unusable(tmp_path, monkeypatch):
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    wide = tmp_path / "user-wide"
+    monkeypatch.setattr(_jit, "_user_wide_dir", lambda: wide)
+    pkg = _package(tmp_path)
+    (pkg / "__pycache__").write_text("a file where numba's folder would be")
+    _jit.check_cache(pkg)
+    folder = wide / _CacheLocator.get_suitable_cache_subpath(str(pkg / "integrate.py"))
+    assert (folder / _jit.STAMP).exists()
+    _put(folder, OURS + ("other.f-1.py311.nbi",))
+    (pkg / "integrate.py").write_text("# edited\n")
+    _jit.check_cache(pkg)
+    assert sorted(p.name for p in folder.iterdir()) == sorted([_jit.STAMP, "other.f-1.py311.nbi"])
