@@ -114,15 +114,25 @@ def _grid_common(block, phi, *, periods, n_steps, window, early_stop, tol, pmax,
     return par, ipar, cpar, settings, threads, chunk
 
 
-def grid_memory(kind, n_cells, settings, threads, chunk, n_pts=0, n_imp_pts=0,
+def grid_memory(what, n_cells, settings, threads, chunk, n_pts=0, n_imp_pts=0,
                  lyapunov=False):
-    """Refuse a grid whose arrays would not fit; returns the bytes it needs."""
+    """Refuse a grid whose arrays would not fit (``what`` names the parameter that sized it, in
+    the message); returns the bytes it needs."""
     nbytes = kernel.grid_bytes(n_cells, settings["periods"], settings["n_steps"], n_pts,
                                n_imp_pts, bool(lyapunov),
                                chunk or kernel.default_chunk(int(min(n_cells, MAX_CELLS))),
                                threads or numba.config.NUMBA_NUM_THREADS)
-    memory(f"a {kind} of {n_cells:.4g} cells", nbytes)
+    memory(f"{what} ({n_cells:.4g} cells)", nbytes)
     return nbytes
+
+
+def _check_state(z, block):
+    """An initial state ``(theta, theta', r, s)`` of a sweep or plane, component by component
+    (the forcing's ``r, s`` are checked by :func:`forcing_phase`)."""
+    check_theta0(z[0], block, "z0[0] (theta0)")
+    real("z0[1] (dtheta0)", z[1], -1e6, 1e6)
+    real("z0[2] (r0)", z[2])
+    real("z0[3] (s0)", z[3])
 
 
 def _n_points(name, value, default):
@@ -134,7 +144,11 @@ def alpha_count(alpha_range, alpha_step):
     made: the count may be too large for memory, and is checked first)."""
     a0, a1 = pair("alpha_range", alpha_range, 0.0, ALPHA_MAX)
     step = real("alpha_step", alpha_step, 0.0, None, lo_open=True)
-    return a0, a1, step, math.floor((a1 - a0) / step + 1e-9) + 1
+    count = (a1 - a0) / step + 1e-9
+    if not count < 2.0**53:  # also inf: a step of 5e-324
+        raise ValueError(f"alpha_step = {step:g} over alpha_range ({a0:g}, {a1:g}) would make "
+                         f"{count:.3g} amplitudes; give a larger alpha_step")
+    return a0, a1, step, math.floor(count) + 1
 
 
 def alpha_grid(alpha_range, alpha_step):
@@ -185,10 +199,9 @@ def plan_sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range
     block = make_block(hb, float(alphas[0]), omega, law, e, xi)
     make_block(hb, float(alphas.max()), omega, law, e, xi)
     z = _z0(z0).ravel()
-    if z.shape != (4,) or not np.all(np.isfinite(z)):
-        raise ValueError("z0 must be 4 finite numbers (theta, theta', r, s)")
-    check_theta0(z[0], block, "z0[0] (theta0)")
-    real("z0[1] (dtheta0)", z[1], -1e6, 1e6)
+    if z.shape != (4,):
+        raise ValueError(f"z0 must be 4 numbers (theta, theta', r, s) (got {z.size})")
+    _check_state(z, block)
     phi, r0, s0 = forcing_phase(None, z[2], z[3], "closed", embedded_hint=False)
     n = alphas.size
     par, ipar, cpar, settings, threads, chunk = _grid_common(
@@ -197,8 +210,8 @@ def plan_sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range
         settle_reps=settle_reps, threads=threads, chunk=chunk)
     n_points = _n_points("n_points", n_points, settings["periods"] - settings["window"] + 1)
     n_impact_points = integer("n_impact_points", n_impact_points, 0, 10**6)
-    nbytes = grid_memory("sweep", n, settings, threads, chunk, n_points, n_impact_points,
-                          lyapunov)
+    nbytes = grid_memory("alphas" if alpha_range is None else "alpha_range and alpha_step", n,
+                         settings, threads, chunk, n_points, n_impact_points, lyapunov)
     y0s = np.tile(np.array([z[0], z[1], r0, s0]), (n, 1))
     pars = np.tile(par, (n, 1))
     pars[:, ig.P_AW2] = alphas * block.omega**2
@@ -231,8 +244,8 @@ def plan_basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100,
         tol=tol, pmax=pmax, lam_tol=lam_tol, max_impacts=max_impacts, settle_tol=settle_tol,
         settle_reps=settle_reps, threads=threads, chunk=chunk)
     n_pts = settings["pmax"] if attractors else 0
-    nbytes = grid_memory("basin", float(grid) ** 2, settings, threads, chunk, n_pts,
-                          lyapunov=lyapunov)
+    nbytes = grid_memory(f"grid = {grid}", float(grid) ** 2, settings, threads, chunk,
+                         n_pts, lyapunov=lyapunov)
     th = np.linspace(*th_rng, grid)
     dth = np.linspace(*dth_rng, grid)
     TH, DTH = np.meshgrid(th, dth, indexing="ij")
@@ -264,11 +277,10 @@ def plan_plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None,
     block = make_block(hb, a0, w0, law, e, xi)
     make_block(hb, a1, w1, law, e, xi)
     z = np.atleast_2d(_z0(z0))
-    if z.ndim != 2 or z.shape[1] != 4 or z.shape[0] == 0 or not np.all(np.isfinite(z)):
-        raise ValueError("z0 must be 4 finite numbers (theta, theta', r, s) or m rows of them")
+    if z.ndim != 2 or z.shape[1] != 4 or z.shape[0] == 0:
+        raise ValueError("z0 must be 4 numbers (theta, theta', r, s) or m rows of them")
     for row in z:
-        check_theta0(row[0], block, "z0[0] (theta0)")
-        real("z0[1] (dtheta0)", row[1], -1e6, 1e6)
+        _check_state(row, block)
     phis = [forcing_phase(None, r, s, "closed", embedded_hint=False)[0] for r, s in z[:, 2:]]
     M = z.shape[0]
     par, ipar, cpar, settings, threads, chunk = _grid_common(
@@ -276,8 +288,8 @@ def plan_plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None,
         early_stop=early_stop, tol=tol, pmax=pmax, lam_tol=lam_tol, max_impacts=max_impacts,
         settle_tol=settle_tol, settle_reps=settle_reps, threads=threads, chunk=chunk)
     n_pts = settings["pmax"] if attractors else 0
-    nbytes = grid_memory("plane", float(M) * na * nw, settings, threads, chunk, n_pts,
-                          lyapunov=lyapunov)
+    nbytes = grid_memory(f"grid = ({na}, {nw})", float(M) * na * nw, settings, threads,
+                         chunk, n_pts, lyapunov=lyapunov)
     alphas = np.linspace(a0, a1, na)
     omegas = np.linspace(w0, w1, nw)
     Z, A, W = np.meshgrid(np.arange(M), alphas, omegas, indexing="ij")
@@ -298,7 +310,7 @@ def plan_plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None,
                     attractors=bool(attractors))
 
 
-def run(plan: GridPlan, *, progress=False, client=None, store=None):
+def run(plan: GridPlan, *, progress=False, client=None, store=None, message=None):
     """Execute a :class:`GridPlan`; returns its :class:`SweepResult`, :class:`BasinResult` or
     :class:`PlaneResult`.
 
@@ -311,11 +323,15 @@ def run(plan: GridPlan, *, progress=False, client=None, store=None):
     store : path, optional
         Directory for finished chunks: a rerun with the same inputs computes only what is
         missing.
+    message : callable, optional
+        ``message(text)`` hears the chunk store's notes (a lock taken over, a damaged chunk
+        recomputed); default a line on stderr.
     """
     p = plan
     out = kernel.run_grid(p.y0s, p.pars, p.ipar, p.cpar, tangent=p.tangent, n_pts=p.n_pts,
                           n_imp_pts=p.n_imp_pts, threads=p.threads, progress=progress,
-                          label=p.kind, chunk=p.chunk, client=client, store=store)
+                          label=p.kind, chunk=p.chunk, client=client, store=store,
+                          message=message)
     res = out["res"]
     label = res[:, kernel.R_LABEL].astype(np.int64).reshape(p.shape)
     period = res[:, kernel.R_PERIOD].astype(np.int64).reshape(p.shape)

@@ -16,6 +16,7 @@ JSON files write non-finite numbers as the strings ``"nan"``, ``"inf"``, ``"-inf
 from __future__ import annotations
 
 import argparse
+import functools
 import math
 import os
 import re
@@ -51,7 +52,7 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
-def _say(args, msg):
+def _say(args, msg):  # progress and notes: silenced by --quiet
     if not args.quiet:
         print(f"{PROG}: {msg}", file=sys.stderr, flush=True)
 
@@ -67,7 +68,11 @@ def _warn(msg):
 def _check_run(args):
     """``--out`` must be a directory or creatable as one, beside a creatable ``<out>.chunks``
     (probed by making and removing a temporary directory where the outputs will be staged);
-    ``--scheduler`` needs dask."""
+    ``--scheduler`` needs dask; ``--threads`` (of every command) fits numba's."""
+    if getattr(args, "threads", None) is not None:
+        import numba
+        from .validate import integer
+        integer("threads", args.threads, 1, numba.config.NUMBA_NUM_THREADS)
     if getattr(args, "scheduler", None):
         try:
             import dask.distributed  # noqa: F401
@@ -105,16 +110,15 @@ def _client(args):
     try:
         return Client(args.scheduler, timeout="15s")
     except (OSError, TimeoutError) as exc:
-        raise UsageError(f"cannot reach the Dask scheduler at {args.scheduler} ({exc})") \
-            from None
+        raise UsageError(f"cannot reach the Dask scheduler at {args.scheduler} ({exc})")
 
 
 def _block_kw(args):
+    """The block's options, and the initial state's, and the grids' settings, by API name."""
     return dict(law=args.law, e=args.e, xi=args.xi)
 
 
 def _state_kw(args):
-    """``theta0, dtheta0, r0, s0, phase`` as given (None where not)."""
     return dict(theta0=args.theta0, dtheta0=args.dtheta0, r0=args.r0, s0=args.s0,
                 phase=args.phase)
 
@@ -125,14 +129,12 @@ def _grid_kw(args):
 
 
 def _z0(args):
-    """The sweep's and plane's initial state: the study's where not given."""
-    from .simulate import Z0_STUDY, forcing_phase
-    th = Z0_STUDY[0] if args.theta0 is None else args.theta0
-    dth = Z0_STUDY[1] if args.dtheta0 is None else args.dtheta0
-    if args.phase is None and args.r0 is None and args.s0 is None:
-        return (th, dth) + Z0_STUDY[2:]
-    _, r0, s0 = forcing_phase(args.phase, args.r0, args.s0, "closed", embedded_hint=False)
-    return (th, dth, r0, s0)
+    """The sweep's and plane's initial state, by simulate's rule: the study's z0 when none is
+    given, else the angles given (0 where not) and the forcing at its phase (default 0)."""
+    from .simulate import forcing_phase, initial_state
+    th, dth, r0, s0 = initial_state(args.theta0, args.dtheta0, None, args.r0, args.s0,
+                                    args.phase)
+    return (th, dth) + forcing_phase(args.phase, r0, s0, "closed", embedded_hint=False)[1:]
 
 
 def _summary(args, wall, out, **results):
@@ -149,8 +151,8 @@ def _summary(args, wall, out, **results):
 
 def _trajectory_plan(args):
     from .simulate import plan
-    if args.max_points < 2:
-        raise UsageError(f"max-points must be >= 2 (got {args.max_points})")
+    from .validate import integer
+    integer("max-points", args.max_points, 2)
     kw = dict(**_block_kw(args), **_state_kw(args), periods=args.periods,
               n_steps=args.n_steps, forcing=args.forcing, method=args.method, rtol=args.rtol,
               atol=args.atol, lyapunov=args.lyapunov, max_impacts=args.max_impacts,
@@ -191,8 +193,7 @@ def _sweep_run(args, p, out):
     from .analysis import run
     from .plotting import fig_bifurcation
     t0 = time.perf_counter()
-    sw = _grids(args, lambda client: run(p, progress=not args.quiet, client=client,
-                                         store=_chunk_root(args) / "sweep"))
+    sw = _grid(args, run, p, "sweep")
     wall = time.perf_counter() - t0
     out.npz("sweep.npz", **sw.arrays())
     out.figure("bifurcation.png", fig_bifurcation(sw))
@@ -227,8 +228,7 @@ def _basin_run(args, plans, out):
     res = {}
     for law, p in plans.items():
         _say(args, f"basin: {law}, {args.grid}x{args.grid} cells, {args.periods} periods")
-        res[law] = _grids(args, lambda client, p=p, law=law: run(
-            p, progress=not args.quiet, client=client, store=_chunk_root(args) / law))
+        res[law] = _grid(args, run, p, law)
     wall = time.perf_counter() - t0
     first = next(iter(res.values()))
     arrays = dict(theta0=first.theta0, dtheta0=first.dtheta0,
@@ -269,8 +269,7 @@ def _plane_run(args, p, out):
     from .analysis import run
     from .plotting import fig_plane
     t0 = time.perf_counter()
-    pl = _grids(args, lambda client: run(p, progress=not args.quiet, client=client,
-                                         store=_chunk_root(args) / "plane"))
+    pl = _grid(args, run, p, "plane")
     wall = time.perf_counter() - t0
     out.npz("plane.npz", alpha=pl.alpha, omega=pl.omega, z0=pl.z0, label=pl.label[0],
             period=pl.period[0], lambda_max=pl.lambda_max[0], t_end=pl.t_end[0],
@@ -300,17 +299,11 @@ def _erosion_run(args, plans, out):
     res = {}
     for law, p in plans.items():
         _say(args, f"erosion: {law}, {p.alpha.size} amplitudes x {p.grid}x{p.grid} cells")
-        res[law] = _grids(args, lambda client, p=p, law=law: run(
-            p, progress=not args.quiet, client=client, store=_chunk_root(args) / law))
+        res[law] = _grid(args, run, p, law)
     wall = time.perf_counter() - t0
-    arrays = {}
-    for law, r in res.items():
-        arrays.update({f"GIM_{law}": r.GIM, f"IF_{law}": r.IF, f"fractions_{law}": r.fractions(),
-                       f"overturn_{law}": r.overturn, f"attractor_{law}": r.attractor,
-                       f"label_{law}": r.label, f"basin_entropy_{law}": r.basin_entropy})
     first = next(iter(res.values()))
     out.npz("erosion.npz", alpha=first.alpha, theta0=first.theta0, dtheta0=first.dtheta0,
-            **arrays)
+            **{k: v for law, r in res.items() for k, v in r.arrays(f"_{law}").items()})
     out.figure("erosion.png", fig_erosion(res))
     _say(args, f"erosion: done in {wall:.1f} s")
     return wall, {law: r.to_summary() for law, r in res.items()}
@@ -342,17 +335,18 @@ def _paper_plan(args):
 def _paper_run(args, p, out):
     from .study import paper
     t0 = time.perf_counter()
-    results = _grids(args, lambda client: paper(
-        out, p, progress=not args.quiet, client=client, store=_chunk_root(args),
-        say=lambda m: _say(args, m)))
+    results = _grid(args, functools.partial(paper, out, say=lambda m: _say(args, m)), p, None)
     return time.perf_counter() - t0, results
 
 
-def _grids(args, work):
-    """``work(client)`` with the Dask client of ``--scheduler`` (or None), closed after."""
+def _grid(args, run, plan, name):
+    """``run(plan, ...)`` with the command line's progress, Dask client (``--scheduler``) and
+    chunk store (``<out>.chunks/name``), the store's notes on stderr unless ``--quiet``."""
     client = _client(args)
     try:
-        return work(client)
+        return run(plan, progress=not args.quiet, client=client,
+                   store=_chunk_root(args) / name if name else _chunk_root(args),
+                   message=lambda m: _say(args, m))
     finally:
         if client is not None:
             client.close()
@@ -453,8 +447,7 @@ def build_parser():
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
                                 parser_class=_Parser)
 
-    p = _command(sub, "trajectory", _trajectory_plan, _trajectory_run,
-                 "one run: trajectory.npz, trajectory.png",
+    p = _command(sub, "trajectory", _trajectory_plan, _trajectory_run, "one run",
                  "Simulate one run; write trajectory.npz (t, theta, dtheta, r, s, strobe, "
                  "strobe_half, impacts, lyapunov_running), trajectory.png and summary.json.")
     _add_block(p)
@@ -471,10 +464,9 @@ def build_parser():
     p.add_argument("--lyapunov", action="store_true", help="compute Lyapunov exponents")
     p.add_argument("--max-points", type=int, default=50_000,
                    help="at most this many recorded points (default 50000)")
-    _add_common(p, threads=False)
+    _add_common(p)
 
-    p = _command(sub, "sweep", _sweep_plan, _sweep_run,
-                 "bifurcation sweep over alpha: sweep.npz, bifurcation.png",
+    p = _command(sub, "sweep", _sweep_plan, _sweep_run, "bifurcation sweep over alpha",
                  "Sweep the forcing amplitude; write sweep.npz, bifurcation.png and "
                  "summary.json (fractions of each behaviour).")
     _add_block(p, alpha=False)
@@ -482,8 +474,7 @@ def build_parser():
     _add_state(p, "default: the study's z0")
     _add_grid_run(p, lyapunov_default=True)
 
-    p = _command(sub, "basin", _basin_plan, _basin_run,
-                 "basin of attraction: basin.npz, basin.png",
+    p = _command(sub, "basin", _basin_plan, _basin_run, "basin of attraction",
                  "Classify a grid of initial states (theta0, dtheta0); write basin.npz "
                  "(label[i, j] belongs to theta0[i], dtheta0[j]), basin.png and summary.json "
                  "(percentages; with --law both, per law and the agreement).")
@@ -496,8 +487,7 @@ def build_parser():
     _add_phase(p, "default (r0, s0) = (0, 1)")
     _add_grid_run(p, lyapunov_default=False)
 
-    p = _command(sub, "plane", _plane_plan, _plane_run,
-                 "behaviours over (alpha, omega): plane.npz, plane.png",
+    p = _command(sub, "plane", _plane_plan, _plane_run, "behaviours over (alpha, omega)",
                  "Classify a grid over the forcing plane (alpha, omega) from one initial state; "
                  "write plane.npz (label[i, j] belongs to alpha[i], omega[j]), plane.png and "
                  "summary.json. Runs in-process or, with --scheduler, on a Dask cluster; an "
@@ -565,7 +555,7 @@ def _error(msg):
 
 def main(argv=None):
     """Run the command line; returns the exit status (0, 2 bad input, 130 interrupted)."""
-    from .io import OutputDir
+    from .io import OutputDir, sigterm_interrupts
     try:
         args = build_parser().parse_args(argv)
     except UsageError as exc:
@@ -579,25 +569,30 @@ def main(argv=None):
         return _error(exc)
     import matplotlib
     matplotlib.use("Agg")
-    out = OutputDir(args.out)
+    out = OutputDir(args.out, command=args.command)
     try:
-        with warnings.catch_warnings():
+        with sigterm_interrupts(), warnings.catch_warnings():
             if args.quiet:
                 warnings.simplefilter("ignore")
             wall, results = args.run(args, plan, out)
             out.json("summary.json", _summary(args, wall, out, **results))
-        note = out.publish()
+            note = out.publish()
     except KeyboardInterrupt:
-        out.discard()
-        print(f"\n{PROG}: interrupted; --out is as it was (finished chunks are kept in "
-              f"{_chunk_root(args)} for a rerun)", file=sys.stderr)
-        return 130
+        if not out.published:
+            out.discard()
+            print(f"\n{PROG}: interrupted; --out is as it was (finished chunks wait in "
+                  f"{_chunk_root(args)} for a rerun)", file=sys.stderr)
+            return 130
+        note = out.warning  # finished and published: a late Ctrl-C changes nothing
     except (UsageError, ValueError) as exc:  # a check made only once running
         out.discard()
         return _error(exc)
-    if note:
-        _warn(note)
-    from .chunks import remove_stores
-    remove_stores(_chunk_root(args))
-    _say(args, f"{args.command}: wrote {args.out}")
+    try:
+        if note:
+            _warn(note)
+        from .chunks import remove_stores
+        remove_stores(_chunk_root(args), message=lambda m: _say(args, m))
+        _say(args, f"{args.command}: wrote {args.out}")
+    except KeyboardInterrupt:
+        pass  # the outputs are published: the command succeeded
     return 0

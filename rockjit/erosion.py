@@ -90,6 +90,12 @@ class ErosionResult:
         """``(n_branches, na)``: each branch's percent of cells at each amplitude."""
         return np.array([b["fraction"] for b in self.branches]).reshape(-1, self.alpha.size)
 
+    def arrays(self, suffix=""):
+        """The profile's arrays by name (each name + ``suffix``), for an ``.npz``."""
+        d = dict(GIM=self.GIM, IF=self.IF, fractions=self.fractions(), overturn=self.overturn,
+                 basin_entropy=self.basin_entropy, attractor=self.attractor, label=self.label)
+        return {k + suffix: v for k, v in d.items()}
+
     def to_summary(self):
         """JSON-ready: the profile's arrays and the branches."""
         return dict(alpha=self.alpha, GIM=self.GIM, IF=self.IF,
@@ -115,8 +121,9 @@ def plan_erosion(hb, omega, *, law=None, e=None, xi=None, alpha_range, alpha_ste
     first = analysis.plan_basin(hb, float(alphas[0]), omega, **kw)
     if alphas.size > 1:  # the largest amplitude's block, and the whole stack's memory
         analysis.plan_basin(hb, float(alphas[-1]), omega, **kw)
-        analysis.grid_memory("stack of basins", float(first.y0s.shape[0]) * alphas.size,
-                              first.settings, first.threads, first.chunk, first.n_pts)
+        analysis.grid_memory(f"grid = {grid} at {alphas.size} amplitudes",
+                             float(first.y0s.shape[0]) * alphas.size, first.settings,
+                             first.threads, first.chunk, first.n_pts)
     n = first.y0s.shape[0]
     y0s = np.tile(first.y0s, (alphas.size, 1))
     pars = np.tile(first.pars, (alphas.size, 1))
@@ -159,12 +166,13 @@ def _link(prev, cur, tol, floor):
     return links
 
 
-def run(plan: ErosionPlan, *, progress=False, client=None, store=None, cont_tol=LINK_TOL):
+def run(plan: ErosionPlan, *, progress=False, client=None, store=None, message=None,
+        cont_tol=LINK_TOL):
     """Execute an :class:`ErosionPlan`; returns an :class:`ErosionResult`."""
     gp = plan.grid_plan
     out = kernel.run_grid(gp.y0s, gp.pars, gp.ipar, gp.cpar, tangent=False, n_pts=gp.n_pts,
                           n_imp_pts=0, threads=gp.threads, progress=progress, label="erosion",
-                          chunk=gp.chunk, client=client, store=store)
+                          chunk=gp.chunk, client=client, store=store, message=message)
     res = out["res"]
     na, g = plan.alpha.size, plan.grid
     n = g * g

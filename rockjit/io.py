@@ -46,8 +46,8 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["OutputDir", "atomic_open", "create_temp", "defer_signals", "host_name",
-           "markdown_table", "pid_alive", "save_figure", "to_jsonable", "write_csv", "write_json",
-           "write_npz", "write_text"]
+           "markdown_table", "pid_alive", "save_figure", "sigterm_interrupts", "to_jsonable",
+           "write_csv", "write_json", "write_npz", "write_text"]
 
 TMP_SUFFIX = ".tmp"
 _O_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
@@ -611,3 +611,22 @@ class OutputDir:
         else:
             self.discard()
         return False
+
+
+@contextlib.contextmanager
+def sigterm_interrupts():
+    """Within the block, SIGTERM interrupts like Ctrl-C (``KeyboardInterrupt``), so that a
+    command's staged outputs are removed on the way out (:meth:`OutputDir.discard`). Only in
+    the main thread, where signals can be handled; elsewhere it does nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    old = signal.signal(signal.SIGTERM, interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, old)

@@ -327,11 +327,12 @@ def default_chunk(n):
 
 
 def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, threads, progress, label,
-             chunk=None, client=None, store=None):
+             chunk=None, client=None, store=None, message=None):
     """All cells through :func:`run_chunk`, chunk by chunk (progress between chunks).
 
     Returns the outputs by name: ``res`` (rows in the ``R_*`` layout), ``pts``, ``imp``,
-    ``n_got``, ``n_imp_got``.
+    ``n_got``, ``n_imp_got``. ``message(text)`` hears what the chunk store has to say (default
+    a line on stderr).
     """
     n = y0s.shape[0]
     chunk = default_chunk(n) if chunk is None else chunk
@@ -340,7 +341,7 @@ def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, threads, progr
     if store is not None:
         key = chunks.fingerprint((y0s, pars, ipar, cpar),
                                  dict(tangent=bool(tangent), n_pts=n_pts, n_imp_pts=n_imp_pts))
-        cs = chunks.ChunkStore(store, key, n, chunk)
+        cs = chunks.ChunkStore(store, key, n, chunk, message=message)
     chunks.run_chunks(run_chunk, (bool(tangent), y0s, pars, ipar, cpar, n_pts, n_imp_pts,
                                   threads), n, chunk, outputs_, client=client, store=cs,
                       progress=progress, label=label)

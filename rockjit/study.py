@@ -136,12 +136,16 @@ def plan_paper(*, grid=BASIN_GRID, periods=PERIODS, n_steps=None, alpha_step=ALP
     zoom = pair("zoom", zoom, 0.0, None)
     if zoom[0] < h_rng[0] or zoom[1] > h_rng[1]:
         raise ValueError(f"zoom must lie inside the Housner hb=1 range {h_rng} (got {zoom})")
-    zoom_step = alpha_step / 4 if zoom_step is None else \
-        real("zoom_step", zoom_step, 0.0, 1.0, lo_open=True)
     kw = dict(periods=periods, n_steps=n_steps, threads=threads, lyapunov=True)
     sweeps = {(hb, law): analysis.plan_sweep(float(hb), st["omega"], law=law, alpha_range=rng,
                                              alpha_step=alpha_step, **kw)
               for hb, st in STUDY.items() for law, rng in st["alpha_range"].items()}
+    zoom_step = alpha_step / 4 if zoom_step is None else \
+        real("zoom_step", zoom_step, 0.0, 1.0, lo_open=True)
+    if not (zoom[1] - zoom[0]) / zoom_step < 1e8:
+        raise ValueError(f"zoom_step = {zoom_step:g} over zoom {zoom} would make "
+                         f"{(zoom[1] - zoom[0]) / zoom_step:.3g} amplitudes; give a larger "
+                         f"zoom_step")
     zoom_sweep = analysis.plan_sweep(1.0, STUDY[1]["omega"], law="housner", alpha_range=zoom,
                                      alpha_step=zoom_step, **kw)
     basins = {(hb, law): analysis.plan_basin(hb, alpha, omega, law=law, grid=grid, r0=0.0,
@@ -163,7 +167,7 @@ def plan_paper(*, grid=BASIN_GRID, periods=PERIODS, n_steps=None, alpha_step=ALP
                      zoom_sweep=zoom_sweep, basins=basins, erosions=erosions, stride=stride)
 
 
-def paper(out, plan=None, *, progress=False, client=None, store=None, say=None):
+def paper(out, plan=None, *, progress=False, client=None, store=None, say=None, message=None):
     """Compute every figure and table of the study into ``out``; returns the summary's results.
 
     Parameters
@@ -181,6 +185,8 @@ def paper(out, plan=None, *, progress=False, client=None, store=None, say=None):
         Directory of chunk stores, one per grid: an interrupted paper resumes from them.
     say : callable, optional
         ``say(message)`` for one line of progress per part.
+    message : callable, optional
+        ``message(text)`` for the chunk stores' notes (default a line on stderr).
     """
     from pathlib import Path
 
@@ -198,7 +204,7 @@ def paper(out, plan=None, *, progress=False, client=None, store=None, say=None):
     t_all = time.perf_counter()
 
     def grid(gp, name):
-        return analysis.run(gp, progress=progress, client=client,
+        return analysis.run(gp, progress=progress, client=client, message=message,
                             store=None if store is None else Path(store) / name)
 
     def part(i, name, what):
@@ -332,13 +338,12 @@ def paper(out, plan=None, *, progress=False, client=None, store=None, say=None):
             say(f"paper: erosion {law} hb={hb:g}, {p.erosions[(hb, law)].alpha.size} "
                 f"amplitudes")
             prof[law] = erosion.run(p.erosions[(hb, law)], progress=progress, client=client,
-                                    store=None if store is None else
+                                    message=message, store=None if store is None else
                                     Path(store) / f"erosion_hb{hb}_{law}")
         out.figure(f"fig8_erosion_hb{hb}.png", fig_erosion(prof))
         out.npz(f"fig8_erosion_hb{hb}.npz", alpha=prof["housner"].alpha,
-                **{f"{k}_{law}": v for law, r in prof.items() for k, v in
-                   dict(GIM=r.GIM, IF=r.IF, overturn=r.overturn, fractions=r.fractions(),
-                        basin_entropy=r.basin_entropy).items()})
+                theta0=prof["housner"].theta0, dtheta0=prof["housner"].dtheta0,
+                **{k: v for law, r in prof.items() for k, v in r.arrays(f"_{law}").items()})
         results["fig8"][f"hb{hb}"] = {law: r.to_summary() for law, r in prof.items()}
     done("fig8", t0)
 

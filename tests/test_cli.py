@@ -145,14 +145,15 @@ def test_paper_quick(tmp_path):
     assert rc == 0
     figs = ["fig1_restitution", "fig2_reference", "fig3_gallery", "fig4_laws_timeseries",
             "fig5_bifurcation_hb1", "fig5_bifurcation_hb2", "fig5_bifurcation_zoom",
-            "fig6_basin_hb1", "fig6_basin_hb2"]
+            "fig6_basin_hb1", "fig6_basin_hb2", "fig7_attractors_hb1", "fig7_attractors_hb2",
+            "fig8_erosion_hb1", "fig8_erosion_hb2"]
     for f in figs:
         assert _is_png(out / f"{f}.png"), f
-    for t in ("e_table", "basin_table", "sweep_table"):
+    for t in ("e_table", "basin_table", "sweep_table", "attractor_table"):
         assert (out / f"{t}.csv").exists() and (out / f"{t}.md").exists()
     s = _summary(out)
     parts = s["wall_s_parts"]
-    assert list(parts) == ["fig1", "fig2", "fig3", "fig4", "fig5", "fig6"]
+    assert list(parts) == ["fig1", "fig2", "fig3", "fig4", "fig5", "fig6", "fig7", "fig8"]
     assert sorted(s["files"]) == sorted(p.name for p in out.iterdir())
     for case, tag in zip(s["fig6"], ("hb1", "hb2")):
         z = np.load(out / f"fig6_basin_{tag}.npz")
@@ -176,11 +177,12 @@ SWEEP = ["sweep", "--hb", "1", "--omega", "1.3", "--alpha-range", "0.5", "0.6"]
 
 
 @pytest.mark.parametrize("argv, word", [
-    (["basin", "--hb", "-1", "--alpha", "0.66", "--omega", "1.3"], "hb must be > 0 (got -1.0)"),
+    (["basin", "--hb", "-1", "--alpha", "0.66", "--omega", "1.3"],
+     "hb must be in [0.01, 100] (got -1)"),
     (BASIN + ["--law", "foo"], "law"),
     (BASIN + ["--grid", "0"], "grid"),
     (BASIN + ["--law", "both", "--e", "0.5"], "--e"),
-    (BASIN + ["--theta-range", "-2", "1"], "theta-range"),
+    (BASIN + ["--theta-range", "-2", "1"], "theta_range"),
     (BASIN + ["--r0", "0.5", "--s0", "0.5"], "(r0, s0)"),
     (BASIN + ["--threads", "0"], "threads"),
     (BASIN + ["--periods", "0"], "periods"),
@@ -189,7 +191,7 @@ SWEEP = ["sweep", "--hb", "1", "--omega", "1.3", "--alpha-range", "0.5", "0.6"]
     (TRAJ + ["--law", "mao", "--e", "0.3"], "e is only given"),
     (TRAJ + ["--alpha", "-0.1"], "alpha"),
     (TRAJ + ["--method", "scipy:FOO"], "method"),
-    (TRAJ + ["--method", "scipy", "--lyapunov"], "--lyapunov"),
+    (TRAJ + ["--method", "scipy", "--lyapunov"], "lyapunov=True is only available"),
     (TRAJ + ["--theta0", "2"], "theta0"),
     (TRAJ + ["--omega", "abc"], "--omega"),
     (TRAJ[:-2], "--omega"),
@@ -199,7 +201,7 @@ SWEEP = ["sweep", "--hb", "1", "--omega", "1.3", "--alpha-range", "0.5", "0.6"]
     (["cor", "--hb-values", "0.5"], "hb"),
     (["cor", "--hb-max", "0.7"], "hb"),
     (["paper", "--grid", "-3"], "grid"),
-    (["paper", "--alpha-step", "-0.1"], "alpha-step"),
+    (["paper", "--alpha-step", "-0.1"], "alpha_step"),
     (["paper", "--zoom", "0.2", "0.3"], "zoom"),
     (["paper", "--periods", "0"], "periods"),
     (["frobnicate"], "invalid choice"),
@@ -246,16 +248,16 @@ def test_python_m_rockjit_help():
 # ---------------------------------------------------------------------------------------------
 
 def test_interrupt_during_computation(tmp_path, monkeypatch, capsys):
-    real = analysis.basin
+    real = analysis.run
     calls = []
 
-    def basin_then_interrupt(*a, **kw):
-        calls.append(kw["law"])
+    def basin_then_interrupt(plan, **kw):
+        calls.append(plan.block.law)
         if len(calls) == 2:  # mid-way: the first law done, the second interrupted
             raise KeyboardInterrupt
-        return real(*a, **kw)
+        return real(plan, **kw)
 
-    monkeypatch.setattr(analysis, "basin", basin_then_interrupt)
+    monkeypatch.setattr(analysis, "run", basin_then_interrupt)
     out = tmp_path / "out"
     assert main(BASIN + ["--law", "both", "--out", str(out)]) == 130
     assert calls == ["housner", "mao"]
@@ -274,9 +276,10 @@ def test_interrupt_during_writing(tmp_path, monkeypatch):
     monkeypatch.setattr(rio, "write_csv", half_then_interrupt)
     out = tmp_path / "out"
     assert main(["cor", "--out", str(out), "--quiet"]) == 130
-    # the figure (written before) is complete; the table and the summary are absent
-    assert sorted(p.name for p in out.iterdir()) == ["restitution.png"]
-    assert _is_png(out / "restitution.png")
+    # a command's outputs are published as one unit: the figure written before the
+    # interruption is not there either, and nothing is left beside --out
+    assert not out.exists()
+    assert list(tmp_path.iterdir()) == []
     monkeypatch.setattr(rio, "write_csv", real)
 
 

@@ -103,7 +103,7 @@ class NotRefused(BaseException):
 # ---------------------------------------------------------------------------------------------
 
 NAMES = {
-    "--hb": r"\bhb\b", "--hb-values": r"\bhb\b", "--hb-max": r"\bhb\b",
+    "--hb": r"\bhb\b", "--hb-values": r"\bhb\b", "--hb-max": r"\bhb\b|\bhb[-_]max\b",
     "--alpha": r"\balpha\b", "--omega": r"\bomega\b", "--law": r"\blaw\b",
     "--e": r"(^|[\s'\"(])(--)?e\b",
     "--theta0": r"(?<!d)theta0", "--dtheta0": r"dtheta0", "--phase": r"\bphase\b",
