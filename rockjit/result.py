@@ -267,7 +267,11 @@ class BasinResult(GridResult):
         dynamical integrity (GIM, IF, and LIM of each bounded attractor). JSON-ready."""
         from . import measures as M
         ids = self.attractor
-        out = M.basin_entropy(ids, box=min(box, *ids.shape)).to_dict()
+        if min(ids.shape) >= 2:
+            out = M.basin_entropy(ids, box=min(box, *ids.shape)).to_dict()
+        else:  # no box of two cells fits
+            out = dict(basin_entropy=math.nan, boundary_basin_entropy=math.nan, n_boxes=0,
+                       n_boundary_boxes=0, box=box)
         eps = [e for e in eps_cells if 2 * e < min(ids.shape)]
         f = M.uncertain_fraction(ids, eps) if eps else []
         if len(eps) >= 3 and np.all(np.asarray(f) > 0):
@@ -280,7 +284,12 @@ class BasinResult(GridResult):
                                                dimension=math.nan, eps_cells=eps,
                                                fraction=list(map(float, f)))
         points = {a.id: a.points for a in self.attractors}
-        out["integrity"] = M.integrity(ids, self.theta0, self.dtheta0, points).to_dict()
+        th, dth = np.asarray(self.theta0), np.asarray(self.dtheta0)
+        if th.size > 1 and dth.size > 1 and th[-1] > th[0] and dth[-1] > dth[0]:
+            out["integrity"] = M.integrity(ids, th, dth, points).to_dict()
+        else:  # a line or a point of initial states holds no disc
+            out["integrity"] = {"GIM": float(np.mean(ids >= 0)), "IF": math.nan,
+                                "LIM": {a.id: math.nan for a in self.attractors}}
         return out
 
 

@@ -158,3 +158,11 @@ def test_two_laws_attractors_are_matched_by_their_cycles():
     moved = [type(x)(**{**x.__dict__, "points": x.points + 0.05}) for x in a.attractors]
     assert all(match_attractors(a.attractors, moved).get(x.id) is None
                for x in a.attractors if x.period)
+
+
+@pytest.mark.parametrize("grid", [1, 2, 3])
+def test_measures_of_tiny_maps_are_defined(grid):
+    m = an.basin(**BASIN, grid=grid, periods=20).measures()
+    assert set(m) >= {"basin_entropy", "boundary_basin_entropy", "integrity",
+                      "uncertainty_exponent"}
+    assert 0.0 <= m["integrity"]["GIM"] <= 1.0

@@ -329,3 +329,33 @@ def test_npz_and_csv_round_trip(tmp_path):
     assert list(z["names"]) == list(BEHAVIOURS) and z["x"].tolist() == [0, 1, 2, 3]
     rio.write_csv(tmp_path / "t.csv", ["a", "b"], [[1, 0.1], ["x", -math.inf]])
     assert (tmp_path / "t.csv").read_text().splitlines() == ["a,b", "1,0.1", "x,-inf"]
+
+
+# ---------------------------------------------------------------------------------------------
+# issue 10: what a user is told
+# ---------------------------------------------------------------------------------------------
+
+def test_quiet_means_quiet_even_for_a_degenerate_grid(tmp_path, capsys):
+    # basin --theta-range 0 0 let a matplotlib UserWarning through --quiet
+    rc = main(BASIN + ["--theta-range", "0", "0", "--out", str(tmp_path / "b")])
+    assert rc == 0
+    assert capsys.readouterr().err == ""
+
+
+def test_a_run_stopped_before_its_end_says_so(tmp_path, capsys):
+    # it exited 0 and printed lambda "nan" without a word
+    rc = main(TRAJ + ["--max-impacts", "5", "--lyapunov", "--out", str(tmp_path / "t")] + TINY)
+    assert rc == 0
+    err = capsys.readouterr().err
+    assert "warning: the run stopped at t = " in err and "--max-impacts" in err
+    assert _summary(tmp_path / "t")["status"] == "max_impacts"
+
+
+def test_a_second_command_into_the_same_folder_warns_of_stale_files(tmp_path, capsys):
+    out = tmp_path / "o"
+    assert main(["cor", "--out", str(out), "--quiet"]) == 0
+    (out / "mine.txt").write_text("a user's file")
+    assert main(BASIN + ["--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "warning:" in err and "rockjit cor" in err
+    assert (out / "mine.txt").read_text() == "a user's file"  # never touched
