@@ -90,7 +90,7 @@ def _classification(tol, pmax, lam_tol, settle_tol, settle_reps):
 
 
 def _grid_common(block, phi, *, periods, n_steps, window, early_stop, tol, pmax, lam_tol,
-                 max_impacts, settle_tol, settle_reps, threads, chunk):
+                 max_impacts, settle_tol, settle_reps, threads, chunk, stop_at_overturn=True):
     """Settings shared by every grid, validated and packed:
     ``(par, ipar, cpar, settings, threads, chunk)``."""
     periods, n_steps, max_impacts, w0 = run_settings(block, periods, n_steps, GRID_N,
@@ -104,13 +104,15 @@ def _grid_common(block, phi, *, periods, n_steps, window, early_stop, tol, pmax,
         chunk = integer("chunk", chunk, 1, MAX_CELLS)
     par = kernel.pack(block, phi, n_steps, settle_tol)
     ipar = kernel.settings(n_steps, periods, max_impacts, w0,
-                           settle_reps=settle_reps if early_stop else 0, pmax=pmax)
+                           settle_reps=settle_reps if early_stop else 0, pmax=pmax,
+                           stop_at_overturn=stop_at_overturn)
     cpar = np.zeros(2)
     cpar[kernel.C_TOL] = tol
     cpar[kernel.C_LAMTOL] = lam_tol
     settings = dict(periods=periods, n_steps=n_steps, window=w0, early_stop=bool(early_stop),
                     tol=tol, pmax=pmax, lam_tol=lam_tol, settle_tol=settle_tol,
-                    settle_reps=settle_reps, max_impacts=max_impacts)
+                    settle_reps=settle_reps, max_impacts=max_impacts,
+                    stop_at_overturn=bool(stop_at_overturn))
     return par, ipar, cpar, settings, threads, chunk
 
 
@@ -193,7 +195,7 @@ def plan_sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range
                lyapunov=True, early_stop=True, threads=None, tol=TOL, pmax=PMAX,
                lam_tol=LAM_TOL, max_impacts=None, settle_tol=SETTLE_TOL,
                settle_reps=SETTLE_REPS, n_points=None, n_impact_points=400,
-               attractors=True, chunk=None) -> GridPlan:
+               attractors=True, stop_at_overturn=True, chunk=None) -> GridPlan:
     """Validate the inputs of :func:`sweep` (same parameters) into a :class:`GridPlan`."""
     alphas = _alphas(alphas, alpha_range, alpha_step)
     block = make_block(hb, float(alphas[0]), omega, law, e, xi)
@@ -207,7 +209,8 @@ def plan_sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range
     par, ipar, cpar, settings, threads, chunk = _grid_common(
         block, phi, periods=periods, n_steps=n_steps, window=window, early_stop=early_stop,
         tol=tol, pmax=pmax, lam_tol=lam_tol, max_impacts=max_impacts, settle_tol=settle_tol,
-        settle_reps=settle_reps, threads=threads, chunk=chunk)
+        settle_reps=settle_reps, threads=threads, chunk=chunk,
+        stop_at_overturn=stop_at_overturn)
     n_points = _n_points("n_points", n_points, settings["periods"] - settings["window"] + 1)
     n_impact_points = integer("n_impact_points", n_impact_points, 0, 10**6)
     nbytes = grid_memory("alphas" if alpha_range is None else "alpha_range and alpha_step", n,
@@ -229,7 +232,7 @@ def plan_basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100,
                phase=None, periods=500, n_steps=None, window=None, lyapunov=False,
                early_stop=True, threads=None, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL,
                max_impacts=None, settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS,
-               attractors=True, chunk=None) -> GridPlan:
+               attractors=True, stop_at_overturn=True, chunk=None) -> GridPlan:
     """Validate the inputs of :func:`basin` (same parameters) into a :class:`GridPlan`."""
     block = make_block(hb, alpha, omega, law, e, xi)
     grid = integer("grid", grid, 1, int(math.isqrt(MAX_CELLS)))  # the memory check refuses first
@@ -242,7 +245,8 @@ def plan_basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100,
     par, ipar, cpar, settings, threads, chunk = _grid_common(
         block, phi, periods=periods, n_steps=n_steps, window=window, early_stop=early_stop,
         tol=tol, pmax=pmax, lam_tol=lam_tol, max_impacts=max_impacts, settle_tol=settle_tol,
-        settle_reps=settle_reps, threads=threads, chunk=chunk)
+        settle_reps=settle_reps, threads=threads, chunk=chunk,
+        stop_at_overturn=stop_at_overturn)
     n_pts = settings["pmax"] if attractors else 0
     nbytes = grid_memory(f"grid = {grid}", float(grid) ** 2, settings, threads, chunk,
                          n_pts, lyapunov=lyapunov)
@@ -264,7 +268,7 @@ def plan_plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None,
                z0=Z0_STUDY, periods=500, n_steps=None, window=None, lyapunov=True,
                early_stop=True, threads=None, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL,
                max_impacts=None, settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS,
-               attractors=True, chunk=None) -> GridPlan:
+               attractors=True, stop_at_overturn=True, chunk=None) -> GridPlan:
     """Validate the inputs of :func:`plane` (same parameters) into a :class:`GridPlan`."""
     a0, a1 = pair("alpha_range", alpha_range, 0.0, ALPHA_MAX)
     w0, w1 = pair("omega_range", omega_range, *OMEGA_RANGE)
@@ -286,7 +290,8 @@ def plan_plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None,
     par, ipar, cpar, settings, threads, chunk = _grid_common(
         block, phis[0], periods=periods, n_steps=n_steps, window=window,
         early_stop=early_stop, tol=tol, pmax=pmax, lam_tol=lam_tol, max_impacts=max_impacts,
-        settle_tol=settle_tol, settle_reps=settle_reps, threads=threads, chunk=chunk)
+        settle_tol=settle_tol, settle_reps=settle_reps, threads=threads, chunk=chunk,
+        stop_at_overturn=stop_at_overturn)
     n_pts = settings["pmax"] if attractors else 0
     nbytes = grid_memory(f"grid = ({na}, {nw})", float(M) * na * nw, settings, threads,
                          chunk, n_pts, lyapunov=lyapunov)
@@ -344,7 +349,8 @@ def run(plan: GridPlan, *, progress=False, client=None, store=None, message=None
                                                               out["n_got"])
     if p.kind == "sweep":
         return SweepResult(alpha=p.axes["alpha"], lambda_max=lam, strobe=out["pts"],
-                           impact_section=out["imp"], **common)
+                           impact_section=out["imp"], t_overturn=res[:, kernel.R_TOVER],
+                           motion=res[:, kernel.R_MOTION].astype(np.int64), **common)
     if p.kind == "basin":
         return BasinResult(theta0=p.axes["theta0"], dtheta0=p.axes["dtheta0"],
                            lambda_max=lam if p.tangent else None, **common)
@@ -396,7 +402,7 @@ def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None
           lyapunov=True, early_stop=True, threads=None, progress=False, tol=TOL, pmax=PMAX,
           lam_tol=LAM_TOL, max_impacts=None, settle_tol=SETTLE_TOL,
           settle_reps=SETTLE_REPS, n_points=None, n_impact_points=400, attractors=True,
-          client=None, store=None, chunk=None) -> SweepResult:
+          stop_at_overturn=True, client=None, store=None, chunk=None) -> SweepResult:
     """Bifurcation sweep over the forcing amplitude ``alpha`` (SPEC.md §7).
 
     Parameters
@@ -426,6 +432,10 @@ def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None
         Stroboscopic samples kept per alpha (default the window length).
     n_impact_points : int
         Impact-section points kept per alpha.
+    stop_at_overturn : bool
+        ``False`` integrates on past the overturning threshold, as the study's code did: such
+        a cell keeps the label overturn (``t_overturn`` its first crossing) and its samples and
+        exponents describe the motion after the fall (``motion``, its behaviour).
     attractors : bool
         Identify the attractors (:mod:`rockjit.attractors`): ``result.attractor`` (ids) and
         ``result.attractors``; along a sweep or plane by continuation between neighbours.
@@ -443,7 +453,8 @@ def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None
                    window=window, lyapunov=lyapunov, early_stop=early_stop, threads=threads,
                    tol=tol, pmax=pmax, lam_tol=lam_tol, max_impacts=max_impacts,
                    settle_tol=settle_tol, settle_reps=settle_reps, n_points=n_points,
-                   n_impact_points=n_impact_points, attractors=attractors, chunk=chunk)
+                   n_impact_points=n_impact_points, attractors=attractors,
+                   stop_at_overturn=stop_at_overturn, chunk=chunk)
     return run(p, progress=progress, client=client, store=store)
 
 
@@ -451,8 +462,8 @@ def basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100, theta_range=
           dtheta_range=(-1.0, 1.0), r0=None, s0=None, phase=None, periods=500,
           n_steps=None, window=None, lyapunov=False, early_stop=True, threads=None,
           progress=False, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL, max_impacts=None,
-          settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS, attractors=True, client=None,
-          store=None, chunk=None) -> BasinResult:
+          settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS, attractors=True,
+          stop_at_overturn=True, client=None, store=None, chunk=None) -> BasinResult:
     """Basin of attraction over ``(theta0, theta0')`` on a ``grid x grid`` lattice.
 
     The forcing phase is fixed (default ``(r0, s0) = (0, 1)``, SPEC.md §7). ``label[i, j]``
@@ -464,7 +475,7 @@ def basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100, theta_range=
                    n_steps=n_steps, window=window, lyapunov=lyapunov, early_stop=early_stop,
                    threads=threads, tol=tol, pmax=pmax, lam_tol=lam_tol,
                    max_impacts=max_impacts, settle_tol=settle_tol, settle_reps=settle_reps,
-                   attractors=attractors, chunk=chunk)
+                   attractors=attractors, stop_at_overturn=stop_at_overturn, chunk=chunk)
     return run(p, progress=progress, client=client, store=store)
 
 
@@ -472,7 +483,8 @@ def plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None, xi=N
           z0=Z0_STUDY, periods=500, n_steps=None, window=None, lyapunov=True,
           early_stop=True, threads=None, progress=False, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL,
           max_impacts=None, settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS,
-          attractors=True, client=None, store=None, chunk=None) -> PlaneResult:
+          attractors=True, stop_at_overturn=True, client=None, store=None,
+          chunk=None) -> PlaneResult:
     """Behaviour and ``lambda_max`` at each ``(alpha, omega)`` of a grid (a rocking chart).
 
     Parameters
@@ -491,7 +503,8 @@ def plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None, xi=N
                    periods=periods, n_steps=n_steps, window=window, lyapunov=lyapunov,
                    early_stop=early_stop, threads=threads, tol=tol, pmax=pmax,
                    lam_tol=lam_tol, max_impacts=max_impacts, settle_tol=settle_tol,
-                   settle_reps=settle_reps, attractors=attractors, chunk=chunk)
+                   settle_reps=settle_reps, attractors=attractors,
+                   stop_at_overturn=stop_at_overturn, chunk=chunk)
     return run(p, progress=progress, client=client, store=store)
 
 
@@ -501,7 +514,7 @@ def classify_result(result, *, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL):
     Uses the same compiled classifier as the sweeps and basins on the result's stroboscopic
     samples from ``window`` on. Returns ``(name, period)``.
     """
-    if result.status == "overturned":
+    if result.status == "overturned" or math.isfinite(result.t_overturn):
         return "overturn", 0
     if result.status == "rest":
         return "rest", 0

@@ -125,7 +125,8 @@ def _state_kw(args):
 
 def _grid_kw(args):
     return dict(periods=args.periods, n_steps=args.n_steps, early_stop=not args.full_length,
-                threads=args.threads, max_impacts=args.max_impacts)
+                threads=args.threads, max_impacts=args.max_impacts,
+                stop_at_overturn=not args.continue_past_overturn)
 
 
 def _z0(args):
@@ -156,7 +157,7 @@ def _trajectory_plan(args):
     kw = dict(**_block_kw(args), **_state_kw(args), periods=args.periods,
               n_steps=args.n_steps, forcing=args.forcing, method=args.method, rtol=args.rtol,
               atol=args.atol, lyapunov=args.lyapunov, max_impacts=args.max_impacts,
-              rest_speed=args.rest_speed)
+              rest_speed=args.rest_speed, stop_at_overturn=not args.continue_past_overturn)
     p = plan(args.hb, args.alpha, args.omega, **kw)  # settles N; then the recording's stride
     stride = max(1, math.ceil(p.periods * p.n_steps / args.max_points))
     return plan(args.hb, args.alpha, args.omega, record_stride=stride, **kw)
@@ -286,9 +287,7 @@ def _erosion_plan(args):
     return {law: plan_erosion(args.hb, args.omega, law=law, e=args.e, xi=args.xi,
                               alpha_range=args.alpha_range, alpha_step=args.alpha_step,
                               grid=args.grid, r0=args.r0, s0=args.s0, phase=args.phase,
-                              periods=args.periods, n_steps=args.n_steps,
-                              early_stop=not args.full_length, threads=args.threads,
-                              max_impacts=args.max_impacts)
+                              **_grid_kw(args))
             for law in _laws(args)}
 
 
@@ -329,7 +328,8 @@ def _paper_plan(args):
     from .study import plan_paper
     return plan_paper(grid=args.grid, periods=args.periods, n_steps=args.n_steps,
                       alpha_step=args.alpha_step, zoom=args.zoom, zoom_step=args.zoom_step,
-                      erosion_step=args.erosion_step, threads=args.threads)
+                      erosion_step=args.erosion_step, as_published=args.as_published,
+                      threads=args.threads)
 
 
 def _paper_run(args, p, out):
@@ -380,6 +380,9 @@ def _add_run(p, periods=500, grid=False):
                         f", raised if T/N > {MAX_STEP} or for strong damping)")
     p.add_argument("--max-impacts", type=int, default=None,
                    help="impact bound (default 10,000 per period, at least 100,000)")
+    p.add_argument("--continue-past-overturn", action="store_true",
+                   help="integrate on past |theta| = pi/2 as the study did (such runs still "
+                        "count as overturned)")
 
 
 def _add_state(p, default_note):
@@ -542,6 +545,8 @@ def build_parser():
                    help="step of the zoom sweep (default alpha-step / 4)")
     p.add_argument("--erosion-step", type=float, default=0.01,
                    help="amplitude step of the erosion profiles (default 0.01)")
+    p.add_argument("--as-published", action="store_true",
+                   help="also draw figure 5 as the study computed it: integrated past overturning")
     _add_common(p)
     _add_scheduler(p)
     return parser

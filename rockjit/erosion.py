@@ -110,14 +110,15 @@ class ErosionResult:
 def plan_erosion(hb, omega, *, law=None, e=None, xi=None, alpha_range, alpha_step=0.01,
                  grid=100, theta_range=(-1.0, 1.0), dtheta_range=(-1.0, 1.0), r0=None, s0=None,
                  phase=None, periods=500, n_steps=None, early_stop=True, threads=None,
-                 max_impacts=None, floquet=True, chunk=None) -> ErosionPlan:
+                 max_impacts=None, floquet=True, stop_at_overturn=True,
+                 chunk=None) -> ErosionPlan:
     """Validate an erosion profile: a basin at each amplitude of ``alpha_range`` (ends included,
     step ``alpha_step``), every basin planned and memory-checked as one grid."""
     alphas = analysis.alpha_grid(alpha_range, alpha_step)
     kw = dict(law=law, e=e, xi=xi, grid=grid, theta_range=theta_range,
               dtheta_range=dtheta_range, r0=r0, s0=s0, phase=phase, periods=periods,
               n_steps=n_steps, early_stop=early_stop, threads=threads,
-              max_impacts=max_impacts, chunk=chunk)
+              max_impacts=max_impacts, stop_at_overturn=stop_at_overturn, chunk=chunk)
     first = analysis.plan_basin(hb, float(alphas[0]), omega, **kw)
     if alphas.size > 1:  # the largest amplitude's block, and the whole stack's memory
         analysis.plan_basin(hb, float(alphas[-1]), omega, **kw)

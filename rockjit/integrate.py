@@ -115,8 +115,10 @@ P_STHC, P_CTHC = range(N_PAR, N_PAR + 2)  # sin(thc), cos(thc)
 N_PARW = N_PAR + 2
 
 # ---- layout of the integer settings ``ipar`` ---------------------------------------------------
-I_N, I_PERIODS, I_MAXIMP, I_STRIDE, I_WINDOW, I_SETTLE, I_QR, I_PMAX = range(8)
-N_IPAR = 8
+I_N, I_PERIODS, I_MAXIMP, I_STRIDE, I_WINDOW, I_SETTLE, I_QR, I_PMAX, I_CONTINUE = range(9)
+N_IPAR = 9
+# I_CONTINUE: 1 to integrate on past the overturning threshold (the study's own runs did; the
+# first crossing is recorded in F_TOVER), 0 to stop there (the physical rule, SPEC.md §3).
 # I_QR: grid steps between renormalisations of the tangent vectors (0: never).
 # I_SETTLE: repetitions of a period that count as settled (0: never stop early); I_PMAX: the
 # longest period looked for.
@@ -130,7 +132,8 @@ N_IOUT = 14
 
 # ---- layout of the float outputs ``fout`` ------------------------------------------------------
 F_T, F_TH, F_DTH, F_R, F_S, F_MAXERR, F_LAM1, F_LAM2, F_WINTIME, F_V = range(10)
-N_FOUT = 14  # F_V..F_V+3: the tangent matrix at the end, column-major
+F_TOVER = F_V + 4  # F_V..F_V+3: the tangent matrix at the end, column-major
+N_FOUT = F_TOVER + 1  # F_TOVER: the first instant |theta| reached theta_over (nan: never)
 
 # Kinds of event.
 EV_NONE, EV_IMPACT, EV_OVERTURN, EV_UPLIFT = 0, 1, 2, 3
@@ -768,6 +771,7 @@ def start(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, out, w):
         for c in range(3):
             out.lam_run[0, c] = 0.0
     out.per_imp[0] = 0
+    out.fout[F_TOVER] = math.nan
     status = RUNNING
     if side0 != 0 and side0 * y[0] >= par[P_THOVER]:
         status = OVERTURNED
@@ -1056,8 +1060,16 @@ def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, out, w):
             for m in range(NY):
                 y[m] = w.yev[m]
             if kind == EV_OVERTURN:
-                status = OVERTURNED
-                break
+                if ipar[I_CONTINUE] == 0:
+                    status = OVERTURNED
+                    break
+                # the study's way: note the first crossing and integrate on (the same field;
+                # the threshold is lifted so that the crossing is not found again)
+                out.fout[F_TOVER] = t
+                par[P_THOVER] = math.inf
+                rhs(EMBED4, forcing_at(t, par), y, side, par, K, w.jac, w.trig)
+                out.iout[O_RHS] += 1
+                continue
             if kind == EV_UPLIFT:
                 y[0] = 0.0
                 y[1] = 0.0

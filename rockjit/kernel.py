@@ -43,8 +43,12 @@ IMPACT_RECORD = 1_000_000
 # layout of the classification settings ``cpar`` (float)
 C_TOL, C_LAMTOL = range(2)
 # layout of a cell's scalar results ``res`` (float)
-R_LABEL, R_PERIOD, R_LAM1, R_LAM2, R_T, R_NIMP, R_K0, R_K1, R_STATUS = range(9)
-N_RES = 9
+R_LABEL, R_PERIOD, R_LAM1, R_LAM2, R_T, R_NIMP, R_K0, R_K1, R_STATUS, R_TOVER, R_MOTION = \
+    range(11)
+N_RES = 11
+# R_TOVER: the first overturning instant (nan: never); R_MOTION: the behaviour of the motion
+# the run settled on, even after the block fell (runs that continue past overturning; the label
+# of such a cell is overturn, the study's rule)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -70,7 +74,7 @@ def pack(block, phi, n_steps, settle_tol=0.0):
 
 
 def settings(n_steps, periods, max_impacts, window, *, stride=1, settle_reps=0, qr_every=None,
-             pmax=1):
+             pmax=1, stop_at_overturn=True):
     """The integer settings ``ipar`` (layout ``I_*`` in :mod:`rockjit.integrate`);
     ``qr_every`` defaults to twice per period."""
     ipar = np.zeros(ig.N_IPAR, dtype=np.int64)
@@ -82,6 +86,7 @@ def settings(n_steps, periods, max_impacts, window, *, stride=1, settle_reps=0, 
     ipar[ig.I_SETTLE] = settle_reps
     ipar[ig.I_QR] = n_steps // 2 if qr_every is None else qr_every
     ipar[ig.I_PMAX] = pmax
+    ipar[ig.I_CONTINUE] = 0 if stop_at_overturn else 1
     return ipar
 
 
@@ -120,12 +125,12 @@ def grid_bytes(n_cells, periods, n_steps, n_pts, n_imp_pts, tangent, chunk, thre
 # ---------------------------------------------------------------------------------------------
 
 def run_single(block, y0, phi, *, n_steps, periods, window, max_impacts, record_stride,
-               embed4, lyapunov, qr_every):
+               embed4, lyapunov, qr_every, stop_at_overturn=True):
     """One compiled run (inputs validated by :func:`rockjit.simulate.plan`); a Result."""
     run = ig.build(embed4=embed4, tangent=lyapunov, record=record_stride is not None)
     par = pack(block, phi, n_steps)
     ipar = settings(n_steps, periods, max_impacts, window, stride=record_stride or 1,
-                    qr_every=qr_every)
+                    qr_every=qr_every, stop_at_overturn=stop_at_overturn)
     n_traj = periods * n_steps // record_stride + 1 if record_stride else 1
     out = outputs(periods, max_impacts, n_traj, lyapunov)
     y0 = np.asarray(y0, dtype=float)
@@ -145,6 +150,7 @@ def run_single(block, y0, phi, *, n_steps, periods, window, max_impacts, record_
         n_rest=int(iout[ig.O_NREST]), n_rest_window=int(iout[ig.O_NREST_WIN]),
         n_impacts_window=int(iout[ig.O_NIMP_WIN]),
         n_locate_unconverged=int(iout[ig.O_UNCONVERGED]),
+        t_overturn=float(fout[ig.F_TOVER]),
     )
     if lyapunov:
         # the tangent matrix at the end: the flow's Jacobian since the last renormalisation;
@@ -211,6 +217,11 @@ def _cell(TANGENT, y0, side0, par, ipar, cpar, out, res):
     elif status == ig.DONE or status == ig.SETTLED:
         label, period = classify(out.strobe, out.half, out.per_imp, k0, k1, lam1, TANGENT,
                                  cpar[C_TOL], ipar[ig.I_PMAX], cpar[C_LAMTOL])
+    res[R_MOTION] = label
+    t_over = out.fout[ig.F_TOVER]
+    if t_over == t_over:  # fell once and went on: overturn, the study's rule
+        label = OVERTURN
+    res[R_TOVER] = t_over
     res[R_LABEL] = label
     res[R_PERIOD] = period
     res[R_LAM1] = lam1
@@ -246,8 +257,8 @@ def _grid(TANGENT, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n
         _cell(TANGENT, y0, initial_side(y0[0], y0[1]), par, ipar, cpar, out, res[i])
         k0 = int(res[i, R_K0])
         k1 = int(res[i, R_K1])
-        lab = int(res[i, R_LABEL])
-        bounded = lab != OVERTURN and lab != REST and lab != UNRESOLVED
+        st = int(res[i, R_STATUS])
+        bounded = st == ig.DONE or st == ig.SETTLED  # it ran to a classified stretch
         if n_pts > 0:
             m = 0
             if bounded:

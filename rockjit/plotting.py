@@ -338,8 +338,10 @@ def _bifurcation_column(fig, gs_col, sw, alpha_limits, show_y):
         ok = np.isfinite(y)
         ax.scatter(a[ok], y[ok], s=0.6, color=BEHAVIOUR_COLOURS[name], lw=0, rasterized=True)
     ax.set_ylabel("\u03b8\u2032(kT)" if show_y else "")
-    ax.set_title(f"{_law(sw.block)}, h/b = {sw.block.hb:g}, \u03c9 = {sw.block.omega:g}",
-                 fontsize=10)
+    published = sw.settings.get("stop_at_overturn") is False
+    ax.set_title(f"{_law(sw.block)}, h/b = {sw.block.hb:g}, \u03c9 = {sw.block.omega:g}"
+                 + (" \u2014 as published: integrated past overturning" if published else ""),
+                 fontsize=9 if published else 10)
     ax.tick_params(labelbottom=False)
 
     # a strip: the behaviour of every alpha, including those without stroboscopic points

@@ -59,7 +59,7 @@ def _fields(block: Block, phi: float, embed4: bool):
 
 def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, forcing,
                    ivp_method="BDF", rtol=1e-6, atol=1e-9, record_stride=None,
-                   max_impacts=100_000):
+                   max_impacts=100_000, stop_at_overturn=True):
     """Reference run through ``scipy.integrate.solve_ivp``; returns a :class:`Result`.
 
     Called by :func:`rockjit.simulate.run` with ``method="scipy[:METHOD]"`` on a validated
@@ -102,6 +102,7 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
     nfev = 0
     nsteps = 0
     n_rest = 0
+    t_overturn = math.nan
     if side != 0 and side * z[0] >= thover:
         status = "overturned"
     take([0.0], z[:, None])
@@ -163,9 +164,9 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
         impact.terminal = True
         impact.direction = -1
 
-        def over(tt, zz, side=side):
+        def over(tt, zz, side=side, thover=thover):
             return thover - side * zz[0]
-        over.terminal = True
+        over.terminal = stop_at_overturn  # else noted and integrated through (the study's way)
         over.direction = -1
 
         def turn(tt, zz, side=side):
@@ -185,8 +186,9 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
             break
         sol_t = np.asarray(sol.t, dtype=float)
         sol_y = np.asarray(sol.y, dtype=float).reshape(len(z), -1)
+        n_term = 2 if stop_at_overturn else 1  # the terminal events
         t_stop = t_end if sol.status == 0 else min(
-            (float(ev[0]) for ev in sol.t_events[:2] if len(ev)), default=t_end)
+            (float(ev[0]) for ev in sol.t_events[:n_term] if len(ev)), default=t_end)
         dip = None
         t_left = t
         for t_turn in sol.t_events[2]:
@@ -198,6 +200,10 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
                 break
             t_left = t_turn
         keep = sol_t <= (dip if dip is not None else t_stop)
+        if not stop_at_overturn and len(sol.t_events[1]) and \
+                sol.t_events[1][0] <= (dip if dip is not None else t_stop):
+            t_overturn = float(sol.t_events[1][0])
+            thover = math.inf  # noted once, as the compiled path does
         nsteps += int(np.count_nonzero(keep))
         take(sol_t[keep], sol_y[:, keep])
         if dip is not None:
@@ -209,8 +215,8 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
             # the last sample point is t_end itself (t_half ends there)
             z = sol_y[:, -1]
             break
-        elif len(sol.t_events[1]) and (not len(sol.t_events[0])
-                                       or sol.t_events[1][0] <= sol.t_events[0][0]):
+        elif stop_at_overturn and len(sol.t_events[1]) and (
+                not len(sol.t_events[0]) or sol.t_events[1][0] <= sol.t_events[0][0]):
             t = float(sol.t_events[1][0])
             z = sol.y_events[1][0].copy()
             status = "overturned"
@@ -278,5 +284,5 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
         strobe=np.array(strobe).reshape(-1, 4), strobe_half=np.array(strobe_half).reshape(-1, 4),
         impacts=np.array(impacts).reshape(-1, 3), n_impacts=len(impacts),
         n_grid_steps=nsteps, n_rhs=nfev, max_error_estimate=math.nan, trajectory=traj,
-        n_rest=n_rest,
+        n_rest=n_rest, t_overturn=t_overturn,
     )

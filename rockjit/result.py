@@ -94,6 +94,9 @@ class Result:
     n_locate_unconverged : int
         Events whose time the Newton polish could not bring within its tolerance (taken at the
         best bracketed estimate; expected 0, counted so that tests can require it).
+    t_overturn : float
+        A run that went on past the overturning threshold (``stop_at_overturn=False``, the
+        study's way): the first instant ``|theta|`` reached it; ``nan`` otherwise.
     """
 
     block: Block
@@ -119,6 +122,7 @@ class Result:
     n_rest_window: int = 0
     n_impacts_window: int = 0
     n_locate_unconverged: int = 0
+    t_overturn: float = math.nan
     extra: dict = field(default_factory=dict)
 
     @property
@@ -148,7 +152,7 @@ class Result:
                    final_state=self.state, n_impacts=self.n_impacts, n_rest=self.n_rest,
                    restitution=self.block.restitution, n_steps=self.n_steps,
                    max_error_estimate=self.max_error_estimate, method=self.method,
-                   n_locate_unconverged=self.n_locate_unconverged)
+                   n_locate_unconverged=self.n_locate_unconverged, t_overturn=self.t_overturn)
         if self.lyapunov is not None:
             out.update(lambda_max=self.lyapunov[0], lyapunov=self.lyapunov, window=self.window)
         return out
@@ -222,6 +226,11 @@ class SweepResult(GridResult):
     strobe: np.ndarray
     impact_section: np.ndarray
     t_end: np.ndarray
+    #: The first overturning instant of each run that went on past it (nan: never, or
+    #: stopped there), and the behaviour code of the motion each run settled on (the label
+    #: before the study's rule made a fallen cell "overturn").
+    t_overturn: np.ndarray | None = None
+    motion: np.ndarray | None = None
 
     def arrays(self):
         """The sweep's arrays by name, for an ``.npz``."""
@@ -231,6 +240,8 @@ class SweepResult(GridResult):
                    names=np.asarray(self.names, dtype=str))
         if self.attractor is not None:
             out["attractor"] = self.attractor
+        if self.settings.get("stop_at_overturn") is False:
+            out.update(t_overturn=self.t_overturn, motion=self.motion)
         return out
 
 

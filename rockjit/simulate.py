@@ -193,6 +193,7 @@ class RunPlan:
     lyapunov: bool
     qr_every: int | None
     memory_bytes: float
+    stop_at_overturn: bool = True
 
 
 def _method(method):
@@ -231,7 +232,7 @@ def plan(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta0=No
          phase=None, r0=None, s0=None, periods=500, n_steps=None, forcing="closed",
          method="rockjit", rtol=1e-6, atol=1e-9, lyapunov=False, window=None,
          record_stride=None, max_impacts=None, theta_over=0.5 * math.pi, rest_speed=1e-6,
-         qr_every=None) -> RunPlan:
+         qr_every=None, stop_at_overturn=True) -> RunPlan:
     """Validate the inputs of :func:`simulate` (same parameters) into a :class:`RunPlan`.
 
     Raises ``ValueError`` naming the parameter for anything out of range, for a grid too coarse
@@ -265,7 +266,7 @@ def plan(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta0=No
                    method=method, rtol=float(rtol), atol=float(atol), periods=periods,
                    n_steps=n_steps, window=w0, max_impacts=max_impacts,
                    record_stride=record_stride, lyapunov=lyapunov, qr_every=qr_every,
-                   memory_bytes=nbytes)
+                   memory_bytes=nbytes, stop_at_overturn=bool(stop_at_overturn))
 
 
 def run(p: RunPlan) -> Result:
@@ -276,18 +277,21 @@ def run(p: RunPlan) -> Result:
         return simulate_scipy(p.block, theta0, dtheta0, p.phi, r0, s0, periods=p.periods,
                               n_steps=p.n_steps, forcing=p.forcing,
                               ivp_method=p.method.split(":", 1)[1], rtol=p.rtol, atol=p.atol,
-                              record_stride=p.record_stride, max_impacts=p.max_impacts)
+                              record_stride=p.record_stride, max_impacts=p.max_impacts,
+                              stop_at_overturn=p.stop_at_overturn)
     return kernel.run_single(p.block, (theta0, dtheta0, r0, s0), p.phi, n_steps=p.n_steps,
                              periods=p.periods, window=p.window, max_impacts=p.max_impacts,
                              record_stride=p.record_stride, embed4=p.forcing == "embedded",
-                             lyapunov=p.lyapunov, qr_every=p.qr_every)
+                             lyapunov=p.lyapunov, qr_every=p.qr_every,
+                             stop_at_overturn=p.stop_at_overturn)
 
 
 def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta0=None,
              z0=None, phase=None, r0=None, s0=None, periods=500, n_steps=None,
              forcing="closed", method="rockjit", rtol=1e-6, atol=1e-9, lyapunov=False,
              window=None, record_stride=None, max_impacts=None,
-             theta_over=0.5 * math.pi, rest_speed=1e-6, qr_every=None) -> Result:
+             theta_over=0.5 * math.pi, rest_speed=1e-6, qr_every=None,
+             stop_at_overturn=True) -> Result:
     """Simulate the harmonically forced rocking block.
 
     Parameters
@@ -343,6 +347,11 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
         Grid steps between Gram–Schmidt renormalisations of the tangent vectors; default
         ``n_steps // 2``; 0 renormalises only on entering rest, so that for a run without rest
         phases ``result.extra["tangent"]`` is the Jacobian of the whole flow (short runs, tests).
+    stop_at_overturn : bool
+        Stop when ``|theta|`` reaches ``theta_over`` (the physical rule, default). ``False``
+        integrates on through the threshold with the same equations, as the study's own code
+        did; ``result.t_overturn`` records the first crossing and the run counts as overturned
+        (:func:`rockjit.analysis.classify_result`).
 
     Returns
     -------
@@ -358,4 +367,5 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
                     phase=phase, r0=r0, s0=s0, periods=periods, n_steps=n_steps,
                     forcing=forcing, method=method, rtol=rtol, atol=atol, lyapunov=lyapunov,
                     window=window, record_stride=record_stride, max_impacts=max_impacts,
-                    theta_over=theta_over, rest_speed=rest_speed, qr_every=qr_every))
+                    theta_over=theta_over, rest_speed=rest_speed, qr_every=qr_every,
+                    stop_at_overturn=stop_at_overturn))

@@ -120,14 +120,17 @@ class PaperPlan:
     basins: dict            # (hb, law) -> GridPlan
     erosions: dict          # (hb, law) -> ErosionPlan
     stride: int
+    published: dict         # (hb, law) -> GridPlan of the sweep as the study computed it, or {}
 
 
 def plan_paper(*, grid=BASIN_GRID, periods=PERIODS, n_steps=None, alpha_step=ALPHA_STEP,
-               zoom=ZOOM, zoom_step=None, erosion_step=EROSION_STEP, threads=None) -> PaperPlan:
+               zoom=ZOOM, zoom_step=None, erosion_step=EROSION_STEP, as_published=False,
+               threads=None) -> PaperPlan:
     """Validate a paper's settings; every grid is planned here (memory checked), nothing run.
 
     ``n_steps=None`` takes the library's defaults (``DEFAULT_N`` for single runs, ``GRID_N`` for
-    sweeps and basins). ``zoom`` must lie inside the Housner hb=1 range.
+    sweeps and basins). ``zoom`` must lie inside the Housner hb=1 range. ``as_published`` adds
+    figure 5 as the study computed it: its sweeps integrated on past overturning.
     """
     grid = integer("grid", grid, 1, 10**5)
     periods = integer("periods", periods, 1)
@@ -140,6 +143,11 @@ def plan_paper(*, grid=BASIN_GRID, periods=PERIODS, n_steps=None, alpha_step=ALP
     sweeps = {(hb, law): analysis.plan_sweep(float(hb), st["omega"], law=law, alpha_range=rng,
                                              alpha_step=alpha_step, **kw)
               for hb, st in STUDY.items() for law, rng in st["alpha_range"].items()}
+    published = {(hb, law): analysis.plan_sweep(float(hb), st["omega"], law=law,
+                                                alpha_range=rng, alpha_step=alpha_step,
+                                                stop_at_overturn=False, **kw)
+                 for hb, st in STUDY.items() for law, rng in st["alpha_range"].items()} \
+        if as_published else {}
     zoom_step = alpha_step / 4 if zoom_step is None else \
         real("zoom_step", zoom_step, 0.0, 1.0, lo_open=True)
     if not (zoom[1] - zoom[0]) / zoom_step < 1e8:
@@ -164,7 +172,34 @@ def plan_paper(*, grid=BASIN_GRID, periods=PERIODS, n_steps=None, alpha_step=ALP
     stride = max(1, math.ceil(periods * (n_steps or DEFAULT_N) / MAX_TRAJ_POINTS))
     return PaperPlan(grid=grid, periods=periods, n_steps=n_steps, alpha_step=alpha_step,
                      zoom=zoom, zoom_step=zoom_step, threads=threads, sweeps=sweeps,
-                     zoom_sweep=zoom_sweep, basins=basins, erosions=erosions, stride=stride)
+                     zoom_sweep=zoom_sweep, basins=basins, erosions=erosions, stride=stride,
+                     published=published)
+
+
+def after_the_fall(sw):
+    """What a sweep integrated past overturning plots where the block fell: the share of its
+    amplitudes whose points and exponent come from motion after the fall, and that motion's
+    behaviours, exponent signs and distinct attractors (continued along the amplitudes)."""
+    from .attractors import identify_along
+    fell = np.isfinite(sw.t_overturn)
+    plotted = fell & np.isin(sw.motion, [BEHAVIOURS.index(b) for b in
+                                         ("symmetric", "asymmetric", "multiperiodic",
+                                          "chaotic", "aperiodic")])
+    n = sw.alpha.size
+    motions = {BEHAVIOURS[c]: int(np.count_nonzero(plotted & (sw.motion == c)))
+               for c in np.unique(sw.motion[plotted])}
+    lam = sw.lambda_max[plotted]
+    n_got = np.count_nonzero(np.isfinite(sw.strobe[..., 0]), axis=1)
+    label = np.where(plotted, sw.motion, BEHAVIOURS.index("overturn"))
+    _, found = identify_along(label, sw.period, sw.strobe, n_got, (n,))
+    return dict(n_alpha=n, fell_percent=100.0 * fell.mean(),
+                plotted_after_fall_percent=100.0 * plotted.mean(), motions=motions,
+                lambda_positive=int(np.count_nonzero(lam > 0)),
+                lambda_negative=int(np.count_nonzero(lam <= 0)),
+                attractors_after_fall=[dict(behaviour=a.behaviour, period=a.period,
+                                            alpha=[float(sw.alpha[a.extent[0]]),
+                                                   float(sw.alpha[a.extent[1]])])
+                                       for a in found])
 
 
 def paper(out, plan=None, *, progress=False, client=None, store=None, say=None, message=None):
@@ -281,6 +316,20 @@ def paper(out, plan=None, *, progress=False, client=None, store=None, say=None, 
               {h: ".1f" for h in sweep_header[6:]} | {"omega": "g", "alpha_start": "g",
                                                       "alpha_end": "g"})
     results["fig5"] = [dict(zip(sweep_header, r)) for r in sweep_rows]
+    if p.published:
+        results["fig5_as_published"] = {}
+        for hb in STUDY:
+            cols = {}
+            for law in ("housner", "mao"):
+                say(f"paper: sweep {law} hb={hb:g} as published (past overturning)")
+                pub = grid(p.published[(hb, law)], f"sweep_hb{hb}_{law}_published")
+                out.npz(f"fig5_sweep_hb{hb}_{law}_as_published.npz", **pub.arrays())
+                cols[law] = sweeps[(hb, law)]
+                cols[f"{law}, as published"] = pub
+                results["fig5_as_published"][f"hb{hb}_{law}"] = after_the_fall(pub)
+            out.figure(f"fig5_bifurcation_hb{hb}_as_published.png", fig_bifurcation(
+                cols, title=f"h/b = {hb}, \u03c9 = {STUDY[hb]['omega']}: the physical diagrams "
+                            f"and the study's (integrated on past |\u03b8| = \u03c0/2)"))
     done("fig5", t0)
 
     t0 = part(6, "fig6", f"basins, {p.grid}x{p.grid} cells, both laws, two cases")

@@ -183,3 +183,20 @@ def test_sweep_bad_input(kwargs, name):
 def test_alpha_grid_includes_end():
     a = an.alpha_grid((0.5, 1.0), 0.001)
     assert a.size == 501 and a[0] == 0.5 and a[-1] == pytest.approx(1.0)
+
+
+def test_a_sweep_past_overturning_keeps_the_label_and_the_motion():
+    # issue 14: the study's Mao hb=1 diagram plotted the motion after the fall
+    kw = dict(law="mao", alpha_range=(0.50, 0.62), alpha_step=0.03, periods=200)
+    phys = an.sweep(1.0, 1.3, **kw)
+    pub = an.sweep(1.0, 1.3, **kw, stop_at_overturn=False)
+    np.testing.assert_array_equal(pub.label, phys.label)  # the same labels, overturn kept
+    fell = np.isfinite(pub.t_overturn)
+    assert fell.any() and not fell.all()
+    over = an.BEHAVIOURS.index("overturn")
+    assert np.all(phys.label[fell] == over) and np.all(np.isnan(phys.strobe[fell]))
+    # ... but the study's way has points and exponents after the fall, of a bounded motion
+    assert np.all(np.isfinite(pub.strobe[fell, 0])) and np.all(np.isfinite(pub.lambda_max[fell]))
+    assert np.all(pub.motion[fell] != over)
+    # where the block never fell, both agree to the bit
+    np.testing.assert_array_equal(pub.strobe[~fell], phys.strobe[~fell])

@@ -474,3 +474,27 @@ def test_impact_record_keeps_the_latest_impacts_in_order(monkeypatch):
     r = rockjit.simulate(1.0, 0.6, 1.3, "housner", periods=40)
     assert r.n_impacts == full.n_impacts and r.impacts.shape == (57, 3)
     np.testing.assert_array_equal(r.impacts, full.impacts[-57:])
+
+
+# ---- issue 14: the study's runs went on past overturning ----------------------------------------
+
+@pytest.mark.parametrize("alpha", [0.59, 0.72])
+def test_continuing_past_overturn_matches_the_scipy_path(alpha):
+    # Mao, hb = 1, omega = 1.3: the block falls within two periods, turns over a few times and
+    # settles on a bounded orbit (non-chaotic at these amplitudes): both paths, tight, agree
+    kw = dict(hb=1.0, alpha=alpha, omega=1.3, law="mao", periods=50, stop_at_overturn=False)
+    r = rockjit.simulate(**kw, n_steps=1024)
+    s = rockjit.simulate(**kw, method="scipy:DOP853", rtol=1e-13, atol=1e-13)
+    assert r.status == s.status == "done"
+    assert np.abs(r.strobe[:, 0]).max() > 0.5 * np.pi  # it did go past the threshold
+    assert r.t_overturn == pytest.approx(s.t_overturn, abs=1e-10)
+    np.testing.assert_allclose(r.strobe[:, :2], s.strobe[:, :2], rtol=0, atol=1e-8)
+    stopped = rockjit.simulate(**{**kw, "stop_at_overturn": True}, n_steps=1024)
+    assert stopped.status == "overturned" and stopped.t == pytest.approx(r.t_overturn, abs=1e-12)
+    assert np.isnan(stopped.t_overturn)
+    assert an_classify(r) == ("overturn", 0)  # the study's rule: the escape happened once
+
+
+def an_classify(result):
+    from rockjit.analysis import classify_result
+    return classify_result(result)
