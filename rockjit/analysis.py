@@ -27,7 +27,8 @@ import numpy as np
 
 from . import integrate as ig
 from . import kernel
-from .attractors import floquet, identify, identify_along
+from .attractors import (cycles_differ, floquet, identify, identify_along,
+                         match_attractors)
 from .classify import classify
 from .model import ALPHA_MAX, OMEGA_RANGE, Block
 from .result import (BEHAVIOURS, BasinResult, PlaneResult, SweepResult, fractions)
@@ -78,6 +79,7 @@ class GridPlan:
     memory_bytes: float = 0.0
     attractors: bool = False  # identify the attractors (rockjit.attractors)
     phi: float = 0.0          # the forcing phase (basins: of every cell)
+    uncertainty: float | None = None  # flag the cells whose outcome moves with eps
 
 
 def _classification(tol, pmax, lam_tol, settle_tol, settle_reps):
@@ -135,6 +137,11 @@ def _check_state(z, block):
     real("z0[1] (dtheta0)", z[1], -1e6, 1e6)
     real("z0[2] (r0)", z[2])
     real("z0[3] (s0)", z[3])
+
+
+def _uncertainty(eps):
+    """The relative perturbation of the uncertain-cell test, or None (no test)."""
+    return None if eps is None else real("uncertainty", eps, 1e-15, 0.5)
 
 
 def _n_points(name, value, default):
@@ -195,7 +202,8 @@ def plan_sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range
                lyapunov=True, early_stop=True, threads=None, tol=TOL, pmax=PMAX,
                lam_tol=LAM_TOL, max_impacts=None, settle_tol=SETTLE_TOL,
                settle_reps=SETTLE_REPS, n_points=None, n_impact_points=400,
-               attractors=True, stop_at_overturn=True, chunk=None) -> GridPlan:
+               attractors=True, stop_at_overturn=True, uncertainty=None,
+               chunk=None) -> GridPlan:
     """Validate the inputs of :func:`sweep` (same parameters) into a :class:`GridPlan`."""
     alphas = _alphas(alphas, alpha_range, alpha_step)
     block = make_block(hb, float(alphas[0]), omega, law, e, xi)
@@ -224,7 +232,8 @@ def plan_sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range
                     tangent=bool(lyapunov), n_pts=n_points, n_imp_pts=n_impact_points,
                     threads=threads, chunk=chunk, axes=dict(alpha=alphas), shape=(n,),
                     settings=settings, memory_bytes=nbytes, attractors=bool(attractors),
-                    phi=phi)
+                    phi=phi,
+                    uncertainty=_uncertainty(uncertainty))
 
 
 def plan_basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100,
@@ -232,7 +241,8 @@ def plan_basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100,
                phase=None, periods=500, n_steps=None, window=None, lyapunov=False,
                early_stop=True, threads=None, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL,
                max_impacts=None, settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS,
-               attractors=True, stop_at_overturn=True, chunk=None) -> GridPlan:
+               attractors=True, stop_at_overturn=True, uncertainty=None,
+               chunk=None) -> GridPlan:
     """Validate the inputs of :func:`basin` (same parameters) into a :class:`GridPlan`."""
     block = make_block(hb, alpha, omega, law, e, xi)
     grid = integer("grid", grid, 1, int(math.isqrt(MAX_CELLS)))  # the memory check refuses first
@@ -261,14 +271,16 @@ def plan_basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100,
                     tangent=bool(lyapunov), n_pts=n_pts, n_imp_pts=0, threads=threads,
                     chunk=chunk, axes=dict(theta0=th, dtheta0=dth), shape=(grid, grid),
                     settings=settings, memory_bytes=nbytes, attractors=bool(attractors),
-                    phi=phi)
+                    phi=phi,
+                    uncertainty=_uncertainty(uncertainty))
 
 
 def plan_plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None, xi=None,
                z0=Z0_STUDY, periods=500, n_steps=None, window=None, lyapunov=True,
                early_stop=True, threads=None, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL,
                max_impacts=None, settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS,
-               attractors=True, stop_at_overturn=True, chunk=None) -> GridPlan:
+               attractors=True, stop_at_overturn=True, uncertainty=None,
+               chunk=None) -> GridPlan:
     """Validate the inputs of :func:`plane` (same parameters) into a :class:`GridPlan`."""
     a0, a1 = pair("alpha_range", alpha_range, 0.0, ALPHA_MAX)
     w0, w1 = pair("omega_range", omega_range, *OMEGA_RANGE)
@@ -312,7 +324,8 @@ def plan_plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None,
                     tangent=bool(lyapunov), n_pts=n_pts, n_imp_pts=0, threads=threads,
                     chunk=chunk, axes=dict(alpha=alphas, omega=omegas, z0=z),
                     shape=(M, na, nw), settings=settings, memory_bytes=nbytes,
-                    attractors=bool(attractors))
+                    attractors=bool(attractors),
+                    uncertainty=_uncertainty(uncertainty))
 
 
 def run(plan: GridPlan, *, progress=False, client=None, store=None, message=None):
@@ -348,14 +361,52 @@ def run(plan: GridPlan, *, progress=False, client=None, store=None, message=None
         common["attractor"], common["attractors"] = _identify(p, res, out["pts"],
                                                               out["n_got"])
     if p.kind == "sweep":
-        return SweepResult(alpha=p.axes["alpha"], lambda_max=lam, strobe=out["pts"],
+        result = SweepResult(alpha=p.axes["alpha"], lambda_max=lam, strobe=out["pts"],
                            impact_section=out["imp"], t_overturn=res[:, kernel.R_TOVER],
                            motion=res[:, kernel.R_MOTION].astype(np.int64), **common)
-    if p.kind == "basin":
-        return BasinResult(theta0=p.axes["theta0"], dtheta0=p.axes["dtheta0"],
-                           lambda_max=lam if p.tangent else None, **common)
-    return PlaneResult(alpha=p.axes["alpha"], omega=p.axes["omega"], z0=p.axes["z0"],
-                       lambda_max=lam, **common)
+    elif p.kind == "basin":
+        result = BasinResult(theta0=p.axes["theta0"], dtheta0=p.axes["dtheta0"],
+                             lambda_max=lam if p.tangent else None, **common)
+    else:
+        result = PlaneResult(alpha=p.axes["alpha"], omega=p.axes["omega"], z0=p.axes["z0"],
+                             lambda_max=lam, **common)
+    if p.uncertainty is not None:
+        result.uncertain = uncertain_cells(p, result, p.uncertainty, progress=progress,
+                                           client=client)
+        result.settings["uncertainty"] = p.uncertainty
+    return result
+
+
+def uncertain_cells(plan, result, eps, *, seed=0, progress=False, client=None):
+    """Which cells of a grid change outcome when their initial state moves by ``eps``
+    (Grebogi, McDonald, Ott & Yorke 1983; rockjit.fate).
+
+    Each cell's ``(theta0, theta0')`` is moved by ``eps`` times its size (absolute where 0) in
+    a seeded random direction and run again with the same plan; a cell is uncertain when the
+    moved run reaches another outcome: another behaviour or period, or another attractor (the
+    two maps' attractors matched by their cycles, rockjit.attractors). Returns a boolean array
+    shaped like the labels.
+    """
+    from dataclasses import replace
+    rng = np.random.default_rng(seed)
+    ang = rng.uniform(0.0, 2.0 * np.pi, plan.y0s.shape[0])
+    y0s = plan.y0s.copy()
+    scale = np.where(np.abs(y0s[:, :2]) > 0, np.abs(y0s[:, :2]), 1.0)
+    y0s[:, 0] += eps * scale[:, 0] * np.cos(ang)
+    y0s[:, 1] += eps * scale[:, 1] * np.sin(ang)
+    moved = run(replace(plan, y0s=y0s, uncertainty=None), progress=progress, client=client)
+    differ = (np.asarray(result.label) != moved.label) | (np.asarray(result.period) !=
+                                                          moved.period)
+    if result.attractor is not None and moved.attractor is not None and plan.kind == "basin":
+        pairs = match_attractors(result.attractors, moved.attractors)
+        lut = np.array([pairs.get(a.id, -3) for a in result.attractors] or [-3])
+        ids = np.asarray(result.attractor)
+        differ |= np.where(ids >= 0, lut[np.maximum(ids, 0)], ids) != moved.attractor
+    elif plan.kind == "sweep":  # each cell its own system: its cycle against its own
+        same = ~differ
+        differ[same] |= cycles_differ(result.strobe[same], moved.strobe[same],
+                                      result.period[same])
+    return differ
 
 
 def _identify(p, res, pts, n_got):
@@ -402,7 +453,8 @@ def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None
           lyapunov=True, early_stop=True, threads=None, progress=False, tol=TOL, pmax=PMAX,
           lam_tol=LAM_TOL, max_impacts=None, settle_tol=SETTLE_TOL,
           settle_reps=SETTLE_REPS, n_points=None, n_impact_points=400, attractors=True,
-          stop_at_overturn=True, client=None, store=None, chunk=None) -> SweepResult:
+          stop_at_overturn=True, uncertainty=None, client=None, store=None,
+          chunk=None) -> SweepResult:
     """Bifurcation sweep over the forcing amplitude ``alpha`` (SPEC.md §7).
 
     Parameters
@@ -432,6 +484,9 @@ def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None
         Stroboscopic samples kept per alpha (default the window length).
     n_impact_points : int
         Impact-section points kept per alpha.
+    uncertainty : float, optional
+        Flag the cells whose outcome changes when their initial state moves by this relative
+        amount (``result.uncertain``, :func:`uncertain_cells`); costs a second run of the grid.
     stop_at_overturn : bool
         ``False`` integrates on past the overturning threshold, as the study's code did: such
         a cell keeps the label overturn (``t_overturn`` its first crossing) and its samples and
@@ -454,7 +509,7 @@ def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None
                    tol=tol, pmax=pmax, lam_tol=lam_tol, max_impacts=max_impacts,
                    settle_tol=settle_tol, settle_reps=settle_reps, n_points=n_points,
                    n_impact_points=n_impact_points, attractors=attractors,
-                   stop_at_overturn=stop_at_overturn, chunk=chunk)
+                   stop_at_overturn=stop_at_overturn, uncertainty=uncertainty, chunk=chunk)
     return run(p, progress=progress, client=client, store=store)
 
 
@@ -463,7 +518,8 @@ def basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100, theta_range=
           n_steps=None, window=None, lyapunov=False, early_stop=True, threads=None,
           progress=False, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL, max_impacts=None,
           settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS, attractors=True,
-          stop_at_overturn=True, client=None, store=None, chunk=None) -> BasinResult:
+          stop_at_overturn=True, uncertainty=None, client=None, store=None,
+          chunk=None) -> BasinResult:
     """Basin of attraction over ``(theta0, theta0')`` on a ``grid x grid`` lattice.
 
     The forcing phase is fixed (default ``(r0, s0) = (0, 1)``, SPEC.md §7). ``label[i, j]``
@@ -475,7 +531,8 @@ def basin(hb, alpha, omega, *, law=None, e=None, xi=None, grid=100, theta_range=
                    n_steps=n_steps, window=window, lyapunov=lyapunov, early_stop=early_stop,
                    threads=threads, tol=tol, pmax=pmax, lam_tol=lam_tol,
                    max_impacts=max_impacts, settle_tol=settle_tol, settle_reps=settle_reps,
-                   attractors=attractors, stop_at_overturn=stop_at_overturn, chunk=chunk)
+                   attractors=attractors, stop_at_overturn=stop_at_overturn,
+                   uncertainty=uncertainty, chunk=chunk)
     return run(p, progress=progress, client=client, store=store)
 
 
@@ -483,7 +540,7 @@ def plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None, xi=N
           z0=Z0_STUDY, periods=500, n_steps=None, window=None, lyapunov=True,
           early_stop=True, threads=None, progress=False, tol=TOL, pmax=PMAX, lam_tol=LAM_TOL,
           max_impacts=None, settle_tol=SETTLE_TOL, settle_reps=SETTLE_REPS,
-          attractors=True, stop_at_overturn=True, client=None, store=None,
+          attractors=True, stop_at_overturn=True, uncertainty=None, client=None, store=None,
           chunk=None) -> PlaneResult:
     """Behaviour and ``lambda_max`` at each ``(alpha, omega)`` of a grid (a rocking chart).
 
@@ -504,7 +561,7 @@ def plane(hb, alpha_range, omega_range, *, grid=(50, 50), law=None, e=None, xi=N
                    early_stop=early_stop, threads=threads, tol=tol, pmax=pmax,
                    lam_tol=lam_tol, max_impacts=max_impacts, settle_tol=settle_tol,
                    settle_reps=settle_reps, attractors=attractors,
-                   stop_at_overturn=stop_at_overturn, chunk=chunk)
+                   stop_at_overturn=stop_at_overturn, uncertainty=uncertainty, chunk=chunk)
     return run(p, progress=progress, client=client, store=store)
 
 

@@ -44,8 +44,8 @@ from .result import (APERIODIC, ASYMMETRIC, BEHAVIOURS, CHAOTIC, MULTIPERIODIC, 
                      REST, SYMMETRIC, UNRESOLVED)
 
 __all__ = ["CLOUD_GRID", "CONT_TOL", "MATCH_TOL", "OVERTURN_ID", "UNRESOLVED_ID", "Attractor",
-           "attractor_agreement", "cycle_distance", "floquet", "identify", "identify_along",
-           "match_attractors"]
+           "attractor_agreement", "cycle_distance", "cycles_differ", "floquet", "identify",
+           "identify_along", "match_attractors"]
 
 #: Outcome ids of the cells that reach no attractor.
 OVERTURN_ID = -1
@@ -382,3 +382,22 @@ def attractor_agreement(a, b, tol=MATCH_TOL):
     same = (mapped == ib) & (ia != UNRESOLVED_ID)
     return dict(percent=100.0 * np.mean(same) if same.size else math.nan,
                 pairs={int(i): int(j) for i, j in pairs.items()})
+
+
+def cycles_differ(pts_a, pts_b, period, tol=MATCH_TOL):
+    """Cell by cell, whether two runs' settled cycles differ (``period > 0`` cells): the last
+    ``p`` finite samples of ``pts_a[i]`` and ``pts_b[i]`` (shape ``(n, m, 2)``, nan-padded)
+    further apart than ``tol`` of the orbit's size under every cyclic shift."""
+    period = np.asarray(period)
+    out = np.zeros(period.size, dtype=bool)
+    ga = np.count_nonzero(np.isfinite(pts_a[..., 0]), axis=1)
+    gb = np.count_nonzero(np.isfinite(pts_b[..., 0]), axis=1)
+    for p in np.unique(period[period > 0]):
+        k = np.flatnonzero((period == p) & (ga >= p) & (gb >= p))
+        ca = _cycles(pts_a[k], ga[k], int(p))
+        cb = _cycles(pts_b[k], gb[k], int(p))
+        d = np.full(k.size, np.inf)
+        for sft in range(int(p)):
+            d = np.minimum(d, np.abs(np.roll(cb, -sft, axis=1) - ca).max(axis=(1, 2)))
+        out[k] = d > tol * np.maximum(np.maximum(_scale(ca), _scale(cb)), 1e-12)
+    return out

@@ -126,7 +126,8 @@ def _state_kw(args):
 def _grid_kw(args):
     return dict(periods=args.periods, n_steps=args.n_steps, early_stop=not args.full_length,
                 threads=args.threads, max_impacts=args.max_impacts,
-                stop_at_overturn=not args.continue_past_overturn)
+                stop_at_overturn=not args.continue_past_overturn,
+                uncertainty=getattr(args, "uncertainty", None))
 
 
 def _z0(args):
@@ -164,8 +165,7 @@ def _trajectory_plan(args):
 
 
 def _trajectory_run(args, p, out):
-    from .analysis import classify_result
-    from .plotting import fig_trajectory
+    from . import outputs
     from .simulate import run
     _say(args, f"trajectory: {p.periods} periods, {p.method}")
     t0 = time.perf_counter()
@@ -176,11 +176,12 @@ def _trajectory_run(args, p, out):
               f"{res.message}" + ("; raise --max-impacts" if res.status == "max_impacts" else ""))
     if p.lyapunov and res.window and res.t <= res.window[0]:
         _warn("the run ended before the averaging window began: lambda is nan")
-    name, period = classify_result(res)
-    out.npz("trajectory.npz", **res.arrays())
-    out.figure("trajectory.png", fig_trajectory(res))
-    return wall, dict(res.summary(), behaviour=name, period=period,
-                      record_stride=p.record_stride)
+    if p.lyapunov and res.beyond_horizon:
+        _warn(f"the run ended at t = {res.t:.4g}, beyond its predictability horizon "
+              f"t* = {res.horizon:.4g} (rounding grown to 1 % at lambda1 = "
+              f"{res.lyapunov_running[-1, 0]:.3g}): its outcome is one sample; "
+              f"`rockjit fate` gives the probabilities")
+    return wall, dict(outputs.trajectory(out, res), record_stride=p.record_stride)
 
 
 def _sweep_plan(args):
@@ -188,20 +189,6 @@ def _sweep_plan(args):
     return plan_sweep(args.hb, args.omega, **_block_kw(args), alpha_range=args.alpha_range,
                       alpha_step=args.alpha_step, z0=_z0(args), lyapunov=not args.no_lyapunov,
                       **_grid_kw(args))
-
-
-def _sweep_run(args, p, out):
-    from .analysis import run
-    from .plotting import fig_bifurcation
-    t0 = time.perf_counter()
-    sw = _grid(args, run, p, "sweep")
-    wall = time.perf_counter() - t0
-    out.npz("sweep.npz", **sw.arrays())
-    out.figure("bifurcation.png", fig_bifurcation(sw))
-    _say(args, f"sweep: {sw.alpha.size} amplitudes in {wall:.1f} s")
-    return wall, dict(n_alpha=int(sw.alpha.size), fractions=sw.fractions(),
-                      settings=sw.settings, restitution=sw.block.restitution,
-                      attractors=sw.attractor_summary())
 
 
 def _laws(args):
@@ -221,44 +208,6 @@ def _basin_plan(args):
             for law in _laws(args)}
 
 
-def _basin_run(args, plans, out):
-    from .analysis import run
-    from .attractors import attractor_agreement
-    from .plotting import agreement, fig_attractors, fig_basin, fig_basin_compare
-    t0 = time.perf_counter()
-    res = {}
-    for law, p in plans.items():
-        _say(args, f"basin: {law}, {args.grid}x{args.grid} cells, {args.periods} periods")
-        res[law] = _grid(args, run, p, law)
-    wall = time.perf_counter() - t0
-    first = next(iter(res.values()))
-    arrays = dict(theta0=first.theta0, dtheta0=first.dtheta0,
-                  names=np.asarray(first.names, dtype=str))
-    if len(res) == 1:
-        arrays.update(label=first.label, period=first.period, t_end=first.t_end,
-                      attractor=first.attractor)
-        if first.lambda_max is not None:
-            arrays["lambda_max"] = first.lambda_max
-        results = first.summary()
-        fig = fig_basin(first)
-    else:
-        for law, b in res.items():
-            arrays.update({f"label_{law}": b.label, f"period_{law}": b.period,
-                           f"t_end_{law}": b.t_end, f"attractor_{law}": b.attractor})
-            if b.lambda_max is not None:
-                arrays[f"lambda_max_{law}"] = b.lambda_max
-        results = {law: b.summary() for law, b in res.items()}
-        results["agreement"] = agreement(res["housner"].label, res["mao"].label)
-        results["attractor_agreement"] = attractor_agreement(res["housner"], res["mao"])
-        fig = fig_basin_compare(res["housner"], res["mao"])
-    out.npz("basin.npz", **arrays)
-    out.figure("basin.png", fig)
-    out.figure("attractors.png", fig_attractors(res))
-    p = next(iter(plans.values()))
-    _say(args, f"basin: done in {wall:.1f} s")
-    return wall, dict(grid=args.grid, r0=p.settings["r0"], s0=p.settings["s0"], **results)
-
-
 def _plane_plan(args):
     from .analysis import plan_plane
     return plan_plane(args.hb, args.alpha_range, args.omega_range, grid=args.grid,
@@ -266,46 +215,50 @@ def _plane_plan(args):
                       **_grid_kw(args))
 
 
-def _plane_run(args, p, out):
-    from .analysis import run
-    from .plotting import fig_plane
-    t0 = time.perf_counter()
-    pl = _grid(args, run, p, "plane")
-    wall = time.perf_counter() - t0
-    out.npz("plane.npz", alpha=pl.alpha, omega=pl.omega, z0=pl.z0, label=pl.label[0],
-            period=pl.period[0], lambda_max=pl.lambda_max[0], t_end=pl.t_end[0],
-            attractor=pl.attractor[0], names=np.asarray(pl.names, dtype=str))
-    out.figure("plane.png", fig_plane(pl))
-    _say(args, f"plane: {pl.label.size} cells in {wall:.1f} s")
-    return wall, dict(grid=list(args.grid), fractions=pl.fractions(), settings=pl.settings,
-                      restitution=pl.block.restitution, scheduler=args.scheduler,
-                      attractors=pl.attractor_summary())
-
-
 def _erosion_plan(args):
     from .erosion import plan_erosion
+    kw = _grid_kw(args)
+    kw.pop("uncertainty")
     return {law: plan_erosion(args.hb, args.omega, law=law, e=args.e, xi=args.xi,
                               alpha_range=args.alpha_range, alpha_step=args.alpha_step,
-                              grid=args.grid, r0=args.r0, s0=args.s0, phase=args.phase,
-                              **_grid_kw(args))
+                              grid=args.grid, r0=args.r0, s0=args.s0, phase=args.phase, **kw)
             for law in _laws(args)}
 
 
-def _erosion_run(args, plans, out):
-    from .erosion import run
-    from .plotting import fig_erosion
+def _grid_run(writer, name):
+    """The run of a grid command: its plan (or one plan per law) computed with the command
+    line's progress, Dask client and chunk store, then written by ``outputs.<writer>``."""
+    def run_it(args, plans, out):
+        from . import analysis, erosion, outputs
+        run = erosion.run if writer == "erosion" else analysis.run
+        t0 = time.perf_counter()
+        if isinstance(plans, dict):
+            res = {law: _grid(args, run, p, law) for law, p in plans.items()}
+        else:
+            res = _grid(args, run, plans, name)
+        wall = time.perf_counter() - t0
+        _say(args, f"{args.command}: computed in {wall:.1f} s")
+        return wall, getattr(outputs, writer)(out, res)
+    return run_it
+
+
+def _fate_plan(args):
+    from .fate import plan_fate
+    return plan_fate(args.hb, args.alpha, args.omega, **_block_kw(args), **_state_kw(args),
+                     ensemble=args.ensemble, spread=args.spread, seed=args.seed,
+                     periods=args.periods, n_steps=args.n_steps, forcing=args.forcing,
+                     max_impacts=args.max_impacts, threads=args.threads,
+                     stop_at_overturn=not args.continue_past_overturn)
+
+
+def _fate_run(args, p, out):
+    from . import outputs
+    from .fate import run
     t0 = time.perf_counter()
-    res = {}
-    for law, p in plans.items():
-        _say(args, f"erosion: {law}, {p.alpha.size} amplitudes x {p.grid}x{p.grid} cells")
-        res[law] = _grid(args, run, p, law)
+    fr = run(p, progress=not args.quiet)
     wall = time.perf_counter() - t0
-    first = next(iter(res.values()))
-    out.npz("erosion.npz", alpha=first.alpha, theta0=first.theta0, dtheta0=first.dtheta0,
-            **{k: v for law, r in res.items() for k, v in r.arrays(f"_{law}").items()})
-    out.figure("erosion.png", fig_erosion(res))
-    _say(args, f"erosion: done in {wall:.1f} s")
-    return wall, {law: r.to_summary() for law, r in res.items()}
+    _say(args, "fate: " + ", ".join(f"{k} {v:.3f}" for k, v in fr.probabilities.items()))
+    return wall, outputs.fate(out, fr)
 
 
 def _cor_plan(args):
@@ -418,6 +371,9 @@ def _add_grid_run(p, lyapunov_default):
         p.add_argument("--lyapunov", action="store_true",
                        help="compute exponents (tells chaotic from aperiodic)")
     p.add_argument("--full-length", action="store_true", help="disable early stopping")
+    p.add_argument("--uncertainty", type=float, default=None, metavar="EPS",
+                   help="flag the cells whose outcome changes when their initial state moves "
+                        "by EPS (relative); runs the grid twice")
     _add_common(p)
     _add_scheduler(p)
 
@@ -469,7 +425,7 @@ def build_parser():
                    help="at most this many recorded points (default 50000)")
     _add_common(p)
 
-    p = _command(sub, "sweep", _sweep_plan, _sweep_run, "bifurcation sweep over alpha",
+    p = _command(sub, "sweep", _sweep_plan, _grid_run("sweep", "sweep"), "bifurcation sweep over alpha",
                  "Sweep the forcing amplitude; write sweep.npz, bifurcation.png and "
                  "summary.json (fractions of each behaviour).")
     _add_block(p, alpha=False)
@@ -477,7 +433,7 @@ def build_parser():
     _add_state(p, "default: the study's z0")
     _add_grid_run(p, lyapunov_default=True)
 
-    p = _command(sub, "basin", _basin_plan, _basin_run, "basin of attraction",
+    p = _command(sub, "basin", _basin_plan, _grid_run("basins", "basin"), "basin of attraction",
                  "Classify a grid of initial states (theta0, dtheta0); write basin.npz "
                  "(label[i, j] belongs to theta0[i], dtheta0[j]), basin.png and summary.json "
                  "(percentages; with --law both, per law and the agreement).")
@@ -490,7 +446,7 @@ def build_parser():
     _add_phase(p, "default (r0, s0) = (0, 1)")
     _add_grid_run(p, lyapunov_default=False)
 
-    p = _command(sub, "plane", _plane_plan, _plane_run, "behaviours over (alpha, omega)",
+    p = _command(sub, "plane", _plane_plan, _grid_run("plane", "plane"), "behaviours over (alpha, omega)",
                  "Classify a grid over the forcing plane (alpha, omega) from one initial state; "
                  "write plane.npz (label[i, j] belongs to alpha[i], omega[j]), plane.png and "
                  "summary.json. Runs in-process or, with --scheduler, on a Dask cluster; an "
@@ -504,7 +460,7 @@ def build_parser():
     _add_state(p, "default: the study's z0")
     _add_grid_run(p, lyapunov_default=True)
 
-    p = _command(sub, "erosion", _erosion_plan, _erosion_run,
+    p = _command(sub, "erosion", _erosion_plan, _grid_run("erosion", "erosion"),
                  "erosion profile: integrity and attractors of the basin along alpha",
                  "A basin at each amplitude; its attractors continued from one amplitude to the "
                  "next; write erosion.npz, erosion.png (GIM and IF against alpha, and each "
@@ -517,6 +473,21 @@ def build_parser():
     p.add_argument("--full-length", action="store_true", help="disable early stopping")
     _add_common(p)
     _add_scheduler(p)
+
+    p = _command(sub, "fate", _fate_plan, _fate_run, "outcome probabilities of nearby runs",
+                 "Run an ensemble from initial states perturbed by a few ulps to 1e-10 "
+                 "(relative): each outcome's probability, the transient's exponent and the "
+                 "predictability horizon; write fate.npz, fate.png and summary.json.")
+    _add_block(p)
+    _add_state(p, "default: the study's z0")
+    _add_run(p)
+    p.add_argument("--forcing", default="closed", choices=("closed", "embedded"),
+                   help="closed-form forcing or the 4-D oscillator embedding")
+    p.add_argument("--ensemble", type=int, default=64, help="members (default 64)")
+    p.add_argument("--spread", type=float, nargs=2, default=None, metavar=("LO", "HI"),
+                   help="relative perturbations, log-uniform (default 8.9e-16 1e-10)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the perturbations")
+    _add_common(p)
 
     p = _command(sub, "cor", _cor_plan, _cor_run, "restitution laws: figure 1 and the e-table",
                  "Figure 1 (e_H, e_M against thc, with delta e %) and a table of e_H, e_M, "

@@ -19,7 +19,7 @@ from .result import BEHAVIOURS, fractions
 from .model import delta_e_percent, e_housner, e_mao, thc_from_hb
 
 __all__ = ["BEHAVIOUR_COLOURS", "LAW_COLOURS", "agreement", "fig_attractors", "fig_basin",
-           "fig_basin_compare", "fig_bifurcation", "fig_erosion", "fig_gallery",
+           "fig_basin_compare", "fig_bifurcation", "fig_erosion", "fig_fate", "fig_gallery",
            "fig_laws_timeseries", "fig_plane", "fig_restitution", "fig_trajectory"]
 
 #: One colour per behaviour name (analysis.BEHAVIOURS), used by every figure.
@@ -616,6 +616,40 @@ def fig_erosion(profiles, title=None):
     fig.suptitle(title or f"Erosion profiles, h/b = {r0.block.hb:g}, "
                  f"\u03c9 = {r0.block.omega:g}, {r0.attractor.shape[1]}\u00b2 cells per basin",
                  fontsize=11)
+    return fig
+
+
+def fig_fate(fate_result, title=None):
+    """An ensemble of nearby runs: each outcome's probability, and when each member stopped
+    against its initial perturbation, with the predictability horizon marked."""
+    fr = fate_result
+    fig = _figure(figsize=(11.0, 4.4))
+    ax, ax_t = fig.subplots(1, 2, width_ratios=(1, 1.5))
+    names = list(fr.probabilities)
+    colours = [BEHAVIOUR_COLOURS.get(n.split()[0], "#7f7f7f") for n in names]
+    ax.barh(range(len(names)), [fr.probabilities[n] for n in names], color=colours)
+    ax.set_yticks(range(len(names)), names, fontsize=8)
+    ax.set_xlim(0, 1)
+    ax.set_xlabel("probability")
+    d = np.abs(fr.initial - fr.initial[0]).max(axis=1)
+    rel = d / max(np.abs(fr.initial[0]).max(), 1e-300)
+    ok = rel > 0
+    for v, c in zip(np.unique(fr.outcome), _attractor_colours(len(np.unique(fr.outcome)))):
+        m = ok & (fr.outcome == v)
+        lab = "overturn" if v == -1 else ("unresolved" if v == -2 else f"attractor {v}")
+        ax_t.scatter(rel[m], fr.t_end[m], s=12, color=BEHAVIOUR_COLOURS["overturn"]
+                     if v == -1 else c, label=lab)
+    ax_t.set_xscale("log")
+    ax_t.set_xlabel("initial perturbation (relative)")
+    ax_t.set_ylabel("t at the end (overturn, rest, or the last period)")
+    if np.isfinite(fr.horizon_rounding):
+        ax_t.axhline(fr.horizon_rounding, color="k", ls="--", lw=0.8,
+                     label=f"horizon of rounding t* = {fr.horizon_rounding:.0f}")
+    ax_t.legend(fontsize=8)
+    b = fr.block
+    fig.suptitle(title or f"Fates of {fr.outcome.size} nearby runs: {_law(b)}, h/b = {b.hb:g}, "
+                 f"\u03b1 = {b.alpha:g}, \u03c9 = {b.omega:g}; \u03bb\u2081 of the "
+                 f"transient {fr.lambda1:.3g}", fontsize=10)
     return fig
 
 

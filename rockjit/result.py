@@ -14,8 +14,9 @@ import numpy as np
 
 from .model import Block
 
-__all__ = ["BEHAVIOURS", "BasinResult", "GridResult", "PlaneResult", "Result", "STATUSES",
-           "STATUS_MESSAGES", "SweepResult", "fractions"]
+__all__ = ["BEHAVIOURS", "HORIZON_TOL", "ROUNDING", "BasinResult", "GridResult",
+           "PlaneResult", "Result", "STATUSES", "STATUS_MESSAGES", "SweepResult", "fractions",
+           "horizon"]
 
 #: Behaviour names; a label array holds their indices (SPEC.md §6, README "Behaviours").
 BEHAVIOURS = ("overturn", "rest", "symmetric", "asymmetric", "multiperiodic", "chaotic",
@@ -34,6 +35,22 @@ STATUS_MESSAGES = {
     "nonfinite": "a non-finite number appeared; this is a bug, please report the inputs",
     "settled": "stopped early: the stroboscopic orbit settled on a periodic one",
 }
+
+
+#: Separation, relative to the orbit's size, at which two runs count as different (the
+#: predictability horizon's tolerance, rockjit.fate).
+HORIZON_TOL = 1e-2
+#: Rounding, relative: the perturbation every run carries.
+ROUNDING = float(np.finfo(float).eps)
+
+
+def horizon(lam1, eps, tol=HORIZON_TOL):
+    """Predictability horizon ``ln(tol / eps) / lam1``: the time two runs ``eps`` apart stay
+    within ``tol`` of each other when they separate at the rate ``lam1`` (``inf`` unless
+    ``lam1 > 0``)."""
+    if not lam1 > 0:
+        return math.inf
+    return math.log(tol / eps) / lam1
 
 
 def fractions(label):
@@ -154,8 +171,24 @@ class Result:
                    max_error_estimate=self.max_error_estimate, method=self.method,
                    n_locate_unconverged=self.n_locate_unconverged, t_overturn=self.t_overturn)
         if self.lyapunov is not None:
-            out.update(lambda_max=self.lyapunov[0], lyapunov=self.lyapunov, window=self.window)
+            out.update(lambda_max=self.lyapunov[0], lyapunov=self.lyapunov, window=self.window,
+                       horizon=self.horizon, beyond_horizon=bool(self.beyond_horizon))
         return out
+
+    @property
+    def horizon(self) -> float:
+        """The run's own predictability horizon: how long rounding (``eps = 2.2e-16``) takes to
+        grow to :data:`HORIZON_TOL` at the finite-time exponent of the whole run, ``lambda1``
+        over ``[0, t]`` (``inf`` when it is not positive, ``nan`` without exponents)."""
+        if self.lyapunov_running is None or len(self.lyapunov_running) < 2:
+            return math.nan
+        return horizon(float(self.lyapunov_running[-1, 0]), ROUNDING)
+
+    @property
+    def beyond_horizon(self) -> bool:
+        """True when the run ended beyond its own horizon: its outcome is one sample of what
+        rounding can make of it, not a result (rockjit.fate gives the probabilities)."""
+        return self.t > self.horizon
 
     @property
     def stopped_early(self) -> bool:
@@ -187,6 +220,9 @@ class GridResult:
     attractor: np.ndarray | None = None
     #: The attractors (rockjit.attractors.Attractor), by id.
     attractors: list = field(default_factory=list)
+    #: Cells whose outcome changes when their initial state moves by ``settings["uncertainty"]``
+    #: (rockjit.analysis.uncertain_cells); None when not asked for.
+    uncertain: np.ndarray | None = None
 
     def fractions(self):
         """Percentage of cells per behaviour name."""

@@ -160,7 +160,7 @@ def plan_paper(*, grid=BASIN_GRID, periods=PERIODS, n_steps=None, alpha_step=ALP
                                              s0=1.0, periods=periods, n_steps=n_steps,
                                              threads=threads)
               for hb, alpha, omega in BASIN_CASES for law in ("housner", "mao")}
-    erosion_step = real("erosion_step", erosion_step, 0.0, 1.0, lo_open=True)
+    erosion_step = real("erosion_step", erosion_step, 1e-6, 1.0)
     erosions = {(hb, law): plan_erosion(float(hb), ev["omega"], law=law,
                                         alpha_range=ev["alpha_range"], alpha_step=erosion_step,
                                         grid=grid, r0=0.0, s0=1.0, periods=periods,

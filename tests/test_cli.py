@@ -359,3 +359,60 @@ def test_a_second_command_into_the_same_folder_warns_of_stale_files(tmp_path, ca
     err = capsys.readouterr().err
     assert "warning:" in err and "rockjit cor" in err
     assert (out / "mine.txt").read_text() == "a user's file"  # never touched
+
+
+# ---------------------------------------------------------------------------------------------
+# beyond the study: attractors, erosion, fates (issues 12 and 14)
+# ---------------------------------------------------------------------------------------------
+
+def test_basin_writes_attractors_and_their_measures(tmp_path):
+    out = tmp_path / "b"
+    assert main(BASIN + ["--law", "both", "--grid", "12", "--uncertainty", "1e-3",
+                         "--out", str(out)]) == 0
+    z = np.load(out / "basin.npz")
+    s = _summary(out)
+    for law in ("housner", "mao"):
+        ids = z[f"attractor_{law}"]
+        assert ids.shape == (12, 12) and z[f"uncertain_{law}"].dtype == bool
+        att = s[law]["attractors"]
+        assert [a["id"] for a in att] == list(range(len(att)))
+        for a in att:  # each attractor's fraction is its share of the map
+            assert a["fraction"] == pytest.approx(100 * np.mean(ids == a["id"]))
+        assert 0 <= s[law]["integrity"]["GIM"] <= 1
+        assert s[law]["integrity"]["GIM"] == pytest.approx(np.mean(ids >= 0))
+        assert s[law]["uncertain_percent"] == pytest.approx(100 * z[f"uncertain_{law}"].mean())
+    assert "percent" in s["attractor_agreement"]
+    assert _is_png(out / "attractors.png")
+
+
+def test_erosion_command(tmp_path):
+    out = tmp_path / "e"
+    assert main(["erosion", "--hb", "1", "--omega", "1.3", "--law", "both", "--alpha-range",
+                 "0.6", "0.7", "--alpha-step", "0.05", "--grid", "8", "--out", str(out)]
+                + TINY) == 0
+    z = np.load(out / "erosion.npz")
+    np.testing.assert_allclose(z["alpha"], [0.6, 0.65, 0.7])
+    s = _summary(out)
+    for law in ("housner", "mao"):
+        assert z[f"GIM_{law}"].shape == (3,) and z[f"attractor_{law}"].shape == (3, 8, 8)
+        np.testing.assert_allclose(z[f"GIM_{law}"], np.mean(z[f"attractor_{law}"] >= 0,
+                                                            axis=(1, 2)))
+        assert len(s[law]["branches"]) == z[f"fractions_{law}"].shape[0]
+    assert _is_png(out / "erosion.png")
+
+
+def test_fate_command_and_a_trajectory_past_overturning(tmp_path):
+    out = tmp_path / "f"
+    assert main(["fate", "--hb", "1", "--alpha", "0.969", "--omega", "1.3", "--ensemble", "16",
+                 "--periods", "200", "--out", str(out), "--quiet"]) == 0
+    s = _summary(out)
+    assert sum(s["probabilities"].values()) == pytest.approx(1.0)
+    z = np.load(out / "fate.npz")
+    assert z["initial"].shape == (16, 2) and z["outcome"].shape == (16,)
+    out = tmp_path / "t"
+    assert main(TRAJ[:2] + ["1", "--alpha", "0.72", "--omega", "1.3", "--law", "mao",
+                            "--continue-past-overturn", "--periods", "20", "--out", str(out),
+                            "--quiet"]) == 0
+    s = _summary(out)
+    assert s["behaviour"] == "overturn" and s["status"] == "done"
+    assert 0 < float(s["t_overturn"]) < 20 * 2 * math.pi / 1.3

@@ -116,10 +116,12 @@ NAMES = {
     "--theta-range": r"(?<!d)theta", "--dtheta-range": r"dtheta", "--omega-range": r"\bomega",
     "--zoom": r"\bzoom\b(?![-_])", "--zoom-step": r"zoom[-_]step",
     "--xi": r"\bxi\b", "--rest-speed": r"rest[-_]speed", "--max-impacts": r"max[-_]impacts",
+    "--uncertainty": r"\buncertainty\b", "--erosion-step": r"erosion[-_]step",
+    "--ensemble": r"\bensemble\b", "--spread": r"\bspread\b", "--seed": r"\bseed\b",
 }
 
 NARGS = {"--alpha-range": 2, "--omega-range": 2, "--theta-range": 2, "--dtheta-range": 2,
-         "--zoom": 2, "--hb-values": "+"}
+         "--zoom": 2, "--hb-values": "+", "--spread": 2}
 FLAGS = {"--quiet", "--lyapunov", "--no-lyapunov", "--full-length"}
 
 NONFINITE = ["nan", "inf", "-inf"]
@@ -263,7 +265,7 @@ def _state_cases(cmd, theta=True):
                      r"\b[rs]0\b")]]
     for group in forcing:
         for case in group:
-            if cmd != "trajectory":  # only trajectory takes --forcing (issue 10 §1)
+            if cmd not in ("trajectory", "fate"):  # only these take --forcing (issue 10 §1)
                 case.forbid = (r"embedded",)
         c += group
     c += _values(cmd, "--r0", NONFINITE + _malformed(cmd, "--r0"), {"--s0": ["1"]})
@@ -485,6 +487,40 @@ def _issue10():
     ]
 
 
+def _grid_extras(cmd):
+    """Options every grid command has beyond the study's (issues 10, 12, 14)."""
+    return _real_opt(cmd, "--uncertainty", ["0", "-1e-6", "0.9", "1e308", "5e-324"])
+
+
+def _erosion():
+    cmd = "erosion"
+    c = _block_cases(cmd, alpha=False, laws_ok=("housner", "mao", "constant", "both"))
+    c += _run_cases(cmd)
+    c += _pairs(cmd, "--alpha-range", [
+        ["0.5"], ["0.6", "0.5"], ["-0.1", "0.5"], ["nan", "0.5"], ["0.5", "inf"],
+        ["0.5", "1e308"], ["abc", "0.5"]])
+    c += _real_opt(cmd, "--alpha-step", ["0", "-0.01", "5e-324"])
+    c += _int_opt(cmd, "--grid", ["0", "-1", HUGE_INT])
+    c += _values(cmd, "--grid", ["100000"])            # the stack of basins cannot fit
+    c += _missing(cmd, ["--hb", "--omega", "--alpha-range", "--out"])
+    c += _out_cases(cmd) + _chunks_case(cmd)
+    return c
+
+
+def _fate():
+    cmd = "fate"
+    c = _block_cases(cmd) + _state_cases(cmd) + _run_cases(cmd)
+    c += _int_opt(cmd, "--ensemble", ["0", "1", "-5", HUGE_INT])
+    c += _int_opt(cmd, "--seed", ["-1", HUGE_INT])
+    c += _pairs(cmd, "--spread", [
+        ["1e-10"], ["1e-8", "1e-10"], ["0", "1e-10"], ["-1e-12", "1e-10"], ["1e-3", "0.5"],
+        ["nan", "1e-10"], ["1e-12", "inf"], ["abc", "1e-10"]])
+    c += _values(cmd, "--forcing", ["abc", "open"])
+    c += _missing(cmd, ["--hb", "--alpha", "--omega", "--out"])
+    c += _out_cases(cmd)
+    return c
+
+
 def _misc():
     return [
         Case("(no command)", "", {}, r"COMMAND|command", base=False),
@@ -494,6 +530,8 @@ def _misc():
 
 
 CASES = (_issue10() + _trajectory() + _sweep() + _basin() + _plane() + _cor() + _paper()
+         + _erosion() + _fate() + _grid_extras("sweep") + _grid_extras("basin")
+         + _grid_extras("plane") + _real_opt("paper", "--erosion-step", ["0", "-0.01", "5e-324"])
          + _misc())
 
 
@@ -519,6 +557,12 @@ BASES = {
     "cor": {"--hb-values": [None, ("1", "2"), ("1.5",)], "--hb-max": [None, "6", "3"]},
     "paper": {"--grid": [None, "4", "10"], "--periods": [None, "5", "20"],
               "--alpha-step": [None, "0.1", "0.05"], "--n-steps": [None, "64"]},
+    "erosion": {"--hb": ["1", "2"], "--omega": ["1.3", "1.6"],
+                "--alpha-range": [("0.5", "0.6"), ("0.1", "0.2")],
+                "--alpha-step": [None, "0.05"], "--law": [None, "housner", "both"],
+                "--grid": [None, "4"], "--periods": [None, "5"], "--n-steps": [None, "64"]},
+    "fate": {"--hb": ["1", "2"], "--alpha": ["0.6", "0.969"], "--omega": ["1.3", "1.6"],
+             "--ensemble": [None, "8"], "--periods": [None, "5"], "--n-steps": [None, "64"]},
 }
 
 

@@ -1,0 +1,223 @@
+"""Fates decided by round-off: ensembles of nearby runs, outcome probabilities, horizons.
+
+A chaotic transient amplifies any difference at a rate ``lambda1``: two runs ``eps`` apart
+(rounding is ``eps ~ 1e-16``) become unrelated after about the *predictability horizon*
+``t* = ln(tol / eps) / lambda1`` (``tol`` the separation at which they count as different, here
+:data:`HORIZON_TOL` of the orbit's size). Past ``t*`` a single run's outcome is one sample of a
+distribution, not a result. :func:`fate` runs ``K`` copies from initial states perturbed at
+relative sizes spread log-uniformly over ``spread`` (default: from a few units in the last place
+to ``1e-10``) and reports each outcome's probability, the finite-time exponent of the transient,
+and the horizon. The ensemble is one grid of the compiled kernels (closed-form forcing) or
+``K`` single runs (the embedding), so it is independent of the number of threads.
+
+Grids can flag their *uncertain* cells (:func:`rockjit.analysis.uncertain_cells`, the
+``uncertainty`` setting of the grids): those whose outcome changes when the initial state is
+perturbed by ``eps``; the fraction of uncertain cells against ``eps`` gives the boundary's
+uncertainty exponent (Grebogi, McDonald, Ott & Yorke 1983,
+:func:`rockjit.measures.uncertainty_exponent`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import analysis, kernel
+from .attractors import identify
+from .result import BEHAVIOURS, HORIZON_TOL, ROUNDING, horizon
+from .simulate import plan as plan_run
+from .simulate import run as run_one
+from .validate import integer, memory, pair
+
+__all__ = ["DEFAULT_SPREAD", "HORIZON_TOL", "FatePlan", "FateResult", "fate", "horizon",
+           "perturb", "plan_fate", "run"]
+
+#: Relative perturbations of the ensemble's initial states: four units in the last place to
+#: 1e-10 (log-uniform).
+DEFAULT_SPREAD = (4 * np.finfo(float).eps, 1e-10)
+
+
+def perturb(x, k, spread, seed):
+    """``k`` copies of the state ``x`` (theta, theta'), each component moved by a relative
+    amount ``+-10^u`` with ``u`` uniform over ``log10(spread)`` (absolute where the component is
+    0); seeded, so an ensemble is the same on every machine. Copy 0 is ``x`` itself."""
+    rng = np.random.default_rng(seed)
+    lo, hi = np.log10(spread[0]), np.log10(spread[1])
+    mag = 10.0 ** rng.uniform(lo, hi, size=(k, 2))
+    sign = rng.choice([-1.0, 1.0], size=(k, 2))
+    x = np.asarray(x, dtype=float)
+    scale = np.where(x != 0.0, np.abs(x), 1.0)
+    out = x[None, :] + sign * mag * scale[None, :]
+    out[0] = x
+    return out
+
+
+@dataclass
+class FateResult:
+    """The outcomes of an ensemble of nearby runs.
+
+    Attributes
+    ----------
+    probabilities : dict of str to float
+        Each outcome's share of the members: ``"overturn"``, ``"rest"``, ``"unresolved"``, or
+        an attractor ``"<behaviour> p=<period> #<id>"`` (sums to 1).
+    outcome : ndarray of int, shape (K,)
+        Each member's outcome id (``>= 0`` attractors, ``-1`` overturn, ``-2`` unresolved).
+    t_end : ndarray, shape (K,)
+        When each member stopped (overturned, came to rest for good, or the end).
+    initial : ndarray, shape (K, 2)
+        The members' initial ``(theta, theta')``; member 0 is the nominal run.
+    lambda1 : float
+        The nominal run's finite-time largest exponent over the transient ``[0, t_end]``.
+    horizon : float
+        ``ln(HORIZON_TOL / spread[1]) / lambda1``: beyond it the members are unrelated.
+    horizon_rounding : float
+        The same for rounding alone (``eps = 2.2e-16``): the horizon of a single run.
+    nominal : Result
+        The unperturbed run (with exponents).
+    """
+
+    probabilities: dict
+    outcome: np.ndarray
+    t_end: np.ndarray
+    initial: np.ndarray
+    lambda1: float
+    horizon: float
+    horizon_rounding: float
+    nominal: object
+    block: object
+    settings: dict = field(default_factory=dict)
+
+    def to_summary(self):
+        """JSON-ready."""
+        return dict(probabilities=self.probabilities, lambda1=self.lambda1,
+                    horizon=self.horizon, horizon_rounding=self.horizon_rounding,
+                    t_end_median=float(np.median(self.t_end)),
+                    nominal=self.nominal.summary(), settings=self.settings)
+
+
+@dataclass(frozen=True)
+class FatePlan:
+    """A validated ensemble: the nominal run's plan, the members' initial states."""
+
+    run_plan: object
+    starts: np.ndarray
+    ensemble: int
+    spread: tuple
+    seed: int
+    threads: int | None
+
+
+def plan_fate(hb, alpha, omega, law=None, *, ensemble=64, spread=None, seed=0, threads=None,
+              **run_kw) -> FatePlan:
+    """Validate an ensemble (the parameters of :func:`fate`); nothing is run."""
+    import numba
+    ensemble = integer("ensemble", ensemble, 2, 10**6)
+    spread = DEFAULT_SPREAD if spread is None else pair("spread", spread, 0.0, 1e-2,
+                                                          lo_open=True)
+    seed = integer("seed", seed, 0, 2**63 - 1)
+    if threads is not None:
+        threads = integer("threads", threads, 1, numba.config.NUMBA_NUM_THREADS)
+    run_kw.pop("lyapunov", None)
+    p = plan_run(hb, alpha, omega, law, lyapunov=True, **run_kw)
+    memory(f"ensemble = {ensemble}", kernel.grid_bytes(ensemble, p.periods, p.n_steps,
+                                                       analysis.PMAX, 0, False, ensemble, 1))
+    starts = perturb(p.y0[:2], ensemble, spread, seed)
+    if np.abs(starts[:, 0]).max() >= p.block.theta_over:
+        raise ValueError(f"spread = {spread} moves theta0 past theta_over; give a smaller "
+                         f"spread")
+    return FatePlan(run_plan=p, starts=starts, ensemble=ensemble, spread=tuple(spread),
+                    seed=seed, threads=threads)
+
+
+def run(plan: FatePlan, *, progress=False) -> FateResult:
+    """Execute a :class:`FatePlan`."""
+    p, starts = plan.run_plan, plan.starts
+    nominal = run_one(p)
+    if p.forcing == "closed":
+        label, period, pts, n_got, t_end = _members_on_a_grid(p, starts, plan.threads,
+                                                              progress)
+    else:  # the embedding: one compiled run per member (the grid kernels use the closed form)
+        label, period, pts, n_got, t_end = _members_one_by_one(p, starts)
+    ids, found = identify(label, period, pts, n_got)
+    names = {-1: "overturn", -2: "unresolved"}
+    names.update({a.id: a.behaviour if a.behaviour == "rest" else
+                  f"{a.behaviour} p={a.period} #{a.id}" for a in found})
+    probs = {names[int(v)]: float(np.mean(ids == v)) for v in np.unique(ids)}
+    lam_run = nominal.lyapunov_running
+    lam1 = float(lam_run[-1, 0]) if lam_run is not None and len(lam_run) > 1 else math.nan
+    return FateResult(probabilities=probs, outcome=ids, t_end=t_end, initial=starts,
+                      lambda1=lam1, horizon=horizon(lam1, plan.spread[1]),
+                      horizon_rounding=horizon(lam1, ROUNDING), nominal=nominal,
+                      block=p.block, settings=dict(ensemble=plan.ensemble,
+                                                   spread=list(plan.spread), seed=plan.seed,
+                                                   forcing=p.forcing, periods=p.periods,
+                                                   n_steps=p.n_steps, horizon_tol=HORIZON_TOL))
+
+
+def fate(hb, alpha, omega, law=None, *, ensemble=64, spread=None, seed=0, threads=None,
+         progress=False, **run_kw) -> FateResult:
+    """Outcome probabilities of ``ensemble`` runs from initial states perturbed at relative
+    sizes over ``spread`` (see the module docstring).
+
+    Parameters
+    ----------
+    hb, alpha, omega, law :
+        The block, as in :func:`rockjit.simulate`.
+    ensemble : int
+        Members, at least 2 (member 0 is the unperturbed run).
+    spread : pair of float, optional
+        Smallest and largest relative perturbation, ``0 < lo <= hi <= 1e-2``; default
+        :data:`DEFAULT_SPREAD`.
+    seed : int
+        Seed of the perturbations.
+    threads, progress :
+        As for the grids (closed-form forcing).
+    **run_kw :
+        The run's other settings, as in :func:`rockjit.simulate` (initial state, ``periods``,
+        ``n_steps``, ``forcing``, ``e``, ``xi``, ...). ``lyapunov`` is always on for the
+        nominal run.
+    """
+    return run(plan_fate(hb, alpha, omega, law, ensemble=ensemble, spread=spread, seed=seed,
+                         threads=threads, **run_kw), progress=progress)
+
+
+def _members_on_a_grid(p, starts, threads, progress):
+    """The members as the cells of one grid (closed-form forcing): full length, no early stop,
+    so that each member's fate is its own run's, as far as the nominal run went."""
+    n = starts.shape[0]
+    par = kernel.pack(p.block, p.phi, p.n_steps, analysis.SETTLE_TOL)
+    ipar = kernel.settings(p.n_steps, p.periods, p.max_impacts, p.window,
+                           pmax=analysis.PMAX, stop_at_overturn=p.stop_at_overturn)
+    cpar = np.array([analysis.TOL, analysis.LAM_TOL])
+    y0s = np.column_stack([starts, np.full(n, p.y0[2]), np.full(n, p.y0[3])])
+    out = kernel.run_grid(y0s, np.tile(par, (n, 1)), ipar, cpar, tangent=False,
+                          n_pts=analysis.PMAX, n_imp_pts=0, threads=threads,
+                          progress=progress, label="fate")
+    res = out["res"]
+    return (res[:, kernel.R_LABEL].astype(np.int64), res[:, kernel.R_PERIOD].astype(np.int64),
+            out["pts"], out["n_got"], res[:, kernel.R_T])
+
+
+def _members_one_by_one(p, starts):
+    from dataclasses import replace
+
+    from .analysis import classify_result
+    n = starts.shape[0]
+    m = analysis.PMAX
+    label = np.zeros(n, dtype=np.int64)
+    period = np.zeros(n, dtype=np.int64)
+    pts = np.full((n, m, 2), np.nan)
+    n_got = np.zeros(n, dtype=np.int64)
+    t_end = np.zeros(n)
+    for i, (th, dth) in enumerate(starts):
+        r = run_one(replace(p, y0=(float(th), float(dth)) + tuple(p.y0[2:]), lyapunov=False))
+        name, per = classify_result(r)
+        label[i], period[i], t_end[i] = BEHAVIOURS.index(name), per, r.t
+        if name not in ("overturn", "rest", "unresolved"):
+            s = r.strobe[-m:, :2]
+            pts[i, :len(s)] = s
+            n_got[i] = len(s)
+    return label, period, pts, n_got, t_end

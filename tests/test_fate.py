@@ -1,0 +1,84 @@
+"""Fates decided by round-off (issue 14): ensembles, horizons, uncertain cells.
+
+- an ensemble's probabilities sum to 1 and do not depend on the number of threads;
+- the predictability horizon of a chaotic run against the time two runs ``eps`` apart take to
+  separate, measured here with plain runs;
+- the cells inside a periodic attractor's basin are never uncertain; those flagged lie on the
+  basin's boundary;
+- a single run's own horizon is reported, and refused inputs name their parameter.
+"""
+
+import math
+
+import numba
+import numpy as np
+import pytest
+
+import rockjit
+from rockjit import analysis as an
+from rockjit import fate as F
+
+CHAOTIC = dict(hb=1.0, alpha=0.955, omega=1.3, law="housner")  # tests/test_lyapunov.py
+
+
+def test_probabilities_sum_to_one_and_ignore_the_thread_count():
+    kw = dict(hb=1.0, alpha=0.969, omega=1.3, law="housner", ensemble=40, periods=300)
+    one = F.fate(**kw, threads=1)
+    two = F.fate(**kw, threads=min(2, numba.config.NUMBA_NUM_THREADS))
+    assert sum(one.probabilities.values()) == pytest.approx(1.0)
+    assert one.probabilities == two.probabilities
+    np.testing.assert_array_equal(one.t_end, two.t_end)
+    # member 0 is the nominal run itself
+    assert one.t_end[0] == pytest.approx(one.nominal.t, abs=1e-9)
+
+
+def test_horizon_matches_the_separation_time_of_two_runs():
+    # lambda1 of the chaotic orbit, over a long run
+    lam1 = rockjit.simulate(**CHAOTIC, periods=300, lyapunov=True).lyapunov[0]
+    assert lam1 > 0.05
+    eps = 1e-10
+    T = 2 * math.pi / CHAOTIC["omega"]
+    a = rockjit.simulate(**CHAOTIC, periods=300, record_stride=8)
+    z0 = rockjit.Z0_STUDY
+    b = rockjit.simulate(**CHAOTIC, periods=300, record_stride=8,
+                         z0=(z0[0] * (1 + eps), *z0[1:]))
+    n = min(len(a.trajectory), len(b.trajectory))
+    d = np.abs(a.trajectory[:n, 1:3] - b.trajectory[:n, 1:3]).max(axis=1)
+    size = np.abs(a.trajectory[:n, 1:3]).max()
+    t_sep = a.trajectory[np.argmax(d > F.HORIZON_TOL * size), 0]
+    predicted = F.horizon(lam1, eps * abs(z0[0]) / size)
+    assert predicted / 2 <= t_sep <= 2 * predicted, (t_sep, predicted, T)
+
+
+def test_no_uncertain_cell_inside_a_periodic_basin():
+    b = an.basin(1.0, 0.66, 1.3, law="housner", grid=40, periods=300, uncertainty=1e-3)
+    ids = b.attractor
+    # a cell is interior when it and its eight neighbours reach the same attractor
+    inner = np.zeros_like(ids, dtype=bool)
+    core = ids[1:-1, 1:-1]
+    same = np.ones_like(core, dtype=bool)
+    for di in (-1, 0, 1):
+        for dj in (-1, 0, 1):
+            same &= ids[1 + di:ids.shape[0] - 1 + di, 1 + dj:ids.shape[1] - 1 + dj] == core
+    inner[1:-1, 1:-1] = same & (core >= 0)
+    assert inner.sum() > 100
+    assert not np.any(b.uncertain & inner)
+    assert b.uncertain.any()  # a perturbation of 1e-3 does move some boundary cells
+
+
+def test_a_single_run_reports_its_own_horizon():
+    r = rockjit.simulate(**CHAOTIC, periods=300, lyapunov=True)
+    lam = r.lyapunov_running[-1, 0]
+    assert r.horizon == pytest.approx(math.log(F.HORIZON_TOL / np.finfo(float).eps) / lam)
+    assert r.beyond_horizon  # 300 chaotic periods: far beyond what rounding allows
+    s = rockjit.simulate(1.0, 0.6, 1.3, "housner", periods=100, lyapunov=True)
+    assert s.horizon == math.inf and not s.beyond_horizon  # a stable orbit forgets errors
+
+
+@pytest.mark.parametrize("kw, match", [
+    (dict(ensemble=1), "ensemble"), (dict(spread=(1e-3, 1e-1)), "spread"),
+    (dict(spread=(0.0, 1e-10)), "spread"), (dict(seed=-1), "seed"),
+])
+def test_fate_refuses_bad_input(kw, match):
+    with pytest.raises(ValueError, match=match):
+        F.fate(1.0, 0.969, 1.3, "housner", periods=10, **kw)
