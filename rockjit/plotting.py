@@ -229,13 +229,16 @@ def fig_trajectory(result, title=None):
 # Figure 3: behaviour gallery
 # ---------------------------------------------------------------------------------------------
 
-def fig_gallery(results):
+def fig_gallery(results, notes=None):
     """Figure 3: ``θ(t)`` and phase portrait of each run, titled with its behaviour.
 
     Parameters
     ----------
     results : dict of str -> Result
         Caption -> run (each with a trajectory), one column each.
+    notes : dict of str -> str, optional
+        Caption -> a note printed under that run's time series (e.g. an ensemble's outcome
+        probabilities, for a run whose fate is decided by round-off).
     """
     if not results:
         raise ValueError("results must hold at least one run")
@@ -259,6 +262,10 @@ def fig_gallery(results):
                      bbox=dict(boxstyle="round,pad=0.3", fc=colour, alpha=0.25, lw=0))
         if res.status == "overturned":
             ax.axhline(np.sign(tr[-1, 1]) * b.theta_over, color="0.5", ls=":", lw=0.8)
+        if notes and caption in notes:
+            ax.text(0.02, 0.03, notes[caption], transform=ax.transAxes, fontsize=7,
+                    va="bottom", bbox=dict(boxstyle="round,pad=0.3", fc="w", alpha=0.85,
+                                           lw=0.5))
         in_window = _phase(axes[1, c], res, colour=colour)
         axes[1, c].set_title("window" if in_window else "whole run", fontsize=8)
     fig.suptitle(f"Behaviour gallery ({_law(next(iter(results.values())).block)})")
