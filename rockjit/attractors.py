@@ -352,28 +352,48 @@ def floquet(block, phi, n_steps, point, period):
     return mu, lam
 
 
-def match_attractors(a, b, tol=MATCH_TOL):
-    """Pairs ``{id_a: id_b}`` of two lists of attractors (e.g. two laws' basins) whose cycles
-    coincide (same behaviour and period, :func:`cycle_distance` within ``tol`` of the size);
-    rest matches rest."""
-    pairs = {}
+def match_attractors(a, b, tol=MATCH_TOL, floor=1e-12):
+    """Pairs ``{id_a: id_b}`` of two lists of attractors whose cycles coincide: same behaviour
+    and period, :func:`cycle_distance` within ``tol`` of the size (the larger orbit's, at least
+    ``floor``); rest matches rest. Nearest pairs first, each attractor in one pair at most.
+
+    Within one system (two maps of one basin) ``tol`` is :data:`MATCH_TOL`; across systems
+    (the two laws' basins, :func:`attractor_agreement`) the cycles differ and the nearest
+    attractor of the same kind is taken (``tol`` of order 1).
+    """
+    cand = []
     for x in a:
         for y in b:
-            if x.behaviour != y.behaviour or x.period != y.period or y.id in pairs.values():
+            if x.behaviour != y.behaviour or x.period != y.period:
                 continue
-            if x.behaviour == "rest" or (x.period and x.points.shape == y.points.shape and
-                                         cycle_distance(x.points, y.points) <= tol * max(
-                                             _scale(x.points), _scale(y.points), 1e-12)):
-                pairs[x.id] = y.id
-                break
+            if x.behaviour == "rest":
+                cand.append((0.0, x.id, y.id))
+            elif x.period and x.points.shape == y.points.shape:
+                size = max(_scale(x.points), _scale(y.points), floor)
+                d = cycle_distance(x.points, y.points) / size
+                if d <= tol:
+                    cand.append((d, x.id, y.id))
+    pairs, used = {}, set()
+    for d, i, j in sorted(cand):
+        if i not in pairs and j not in used:
+            pairs[i] = j
+            used.add(j)
     return pairs
 
 
-def attractor_agreement(a, b, tol=MATCH_TOL):
-    """Agreement of two attractor maps of the same grid (e.g. the two laws' basins): the
-    percent of cells that reach matching attractors (:func:`match_attractors`) or both
-    overturn, and the matched pairs ``{id_a: id_b}``."""
-    pairs = match_attractors(a.attractors, b.attractors, tol)
+#: Across laws, the nearest attractor of the same kind within this many times the orbit's size
+#: (at least LAW_FLOOR), see :func:`attractor_agreement`.
+LAW_TOL = 1.0
+LAW_FLOOR = 0.1
+
+
+def attractor_agreement(a, b, tol=LAW_TOL, floor=LAW_FLOOR):
+    """Agreement of two attractor maps of the same grid (the two laws' basins): the percent of
+    cells that reach matching attractors or both overturn, and the matched pairs
+    ``{id_a: id_b}``. Two laws are two systems, so their attractors match when they are of the
+    same kind (behaviour and period) and nearest to each other, within ``tol`` of the orbit's
+    size or ``floor``, whichever is larger (:func:`match_attractors`)."""
+    pairs = match_attractors(a.attractors, b.attractors, tol, floor)
     ia, ib = np.asarray(a.attractor), np.asarray(b.attractor)
     lut = np.full(len(a.attractors), -3)
     for i, j in pairs.items():

@@ -281,7 +281,8 @@ def _paper_plan(args):
     from .study import plan_paper
     return plan_paper(grid=args.grid, periods=args.periods, n_steps=args.n_steps,
                       alpha_step=args.alpha_step, zoom=args.zoom, zoom_step=args.zoom_step,
-                      erosion_step=args.erosion_step, as_published=args.as_published,
+                      erosion_step=args.erosion_step, erosion_grid=args.erosion_grid,
+                      as_published=args.as_published,
                       threads=args.threads)
 
 
@@ -514,8 +515,10 @@ def build_parser():
                         f"{ZOOM[1]})")
     p.add_argument("--zoom-step", type=float, default=None,
                    help="step of the zoom sweep (default alpha-step / 4)")
-    p.add_argument("--erosion-step", type=float, default=0.01,
-                   help="amplitude step of the erosion profiles (default 0.01)")
+    p.add_argument("--erosion-step", type=float, default=0.02,
+                   help="amplitude step of the erosion profiles (default 0.02)")
+    p.add_argument("--erosion-grid", type=int, default=40,
+                   help="cells per side of the erosion profiles' basins (default 40)")
     p.add_argument("--as-published", action="store_true",
                    help="also draw figure 5 as the study computed it: integrated past overturning")
     _add_common(p)

@@ -28,9 +28,9 @@ from .fate import fate
 from .simulate import plan as plan_run
 from .validate import integer, pair, real
 
-__all__ = ["ALPHA_STEP", "BASIN_CASES", "BASIN_GRID", "EROSION", "EROSION_STEP", "GALLERY",
-           "LAWS_IC", "LAWS_RUN", "PERIODS", "REFERENCE_RUN", "STUDY", "Z0", "ZOOM", "PaperPlan",
-           "e_table", "paper", "plan_paper"]
+__all__ = ["ALPHA_STEP", "BASIN_CASES", "BASIN_GRID", "EROSION", "EROSION_GRID", "EROSION_STEP",
+           "GALLERY", "LAWS_IC", "LAWS_RUN", "PERIODS", "REFERENCE_RUN", "STUDY", "Z0", "ZOOM",
+           "PaperPlan", "after_the_fall", "e_table", "paper", "plan_paper"]
 
 #: The initial state of the single runs and sweeps, ``(theta, theta', r, s)``. (Defined in
 #: rockjit.simulate, whose default it is.)
@@ -75,7 +75,10 @@ BASIN_GRID = 100
 #: amplitude range over which both laws' basins are followed (the union of the sweeps'
 #: ranges), every EROSION_STEP.
 EROSION = {1: dict(omega=1.3, alpha_range=(0.3, 1.0)), 2: dict(omega=1.6, alpha_range=(0.1, 0.5))}
-EROSION_STEP = 0.01
+#: The paper's erosion profiles are a survey (a 40 x 40 basin every 0.02: 36 and 21 basins per
+#: law, ~1/12 of the cells of a 100 x 100 profile every 0.01, which `rockjit erosion` computes).
+EROSION_STEP = 0.02
+EROSION_GRID = 40
 #: The restitution table's slenderness ratios and figure 1's range.
 E_TABLE_HB = (1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0)
 E_FIGURE_HB_MAX = 6.0
@@ -128,8 +131,8 @@ class PaperPlan:
 
 
 def plan_paper(*, grid=BASIN_GRID, periods=PERIODS, n_steps=None, alpha_step=ALPHA_STEP,
-               zoom=ZOOM, zoom_step=None, erosion_step=EROSION_STEP, as_published=False,
-               threads=None) -> PaperPlan:
+               zoom=ZOOM, zoom_step=None, erosion_step=EROSION_STEP,
+               erosion_grid=EROSION_GRID, as_published=False, threads=None) -> PaperPlan:
     """Validate a paper's settings; every grid is planned here (memory checked), nothing run.
 
     ``n_steps=None`` takes the library's defaults (``DEFAULT_N`` for single runs, ``GRID_N`` for
@@ -167,8 +170,9 @@ def plan_paper(*, grid=BASIN_GRID, periods=PERIODS, n_steps=None, alpha_step=ALP
     erosion_step = real("erosion_step", erosion_step, 1e-6, 1.0)
     erosions = {(hb, law): plan_erosion(float(hb), ev["omega"], law=law,
                                         alpha_range=ev["alpha_range"], alpha_step=erosion_step,
-                                        grid=grid, r0=0.0, s0=1.0, periods=periods,
-                                        n_steps=n_steps, threads=threads)
+                                        grid=integer("erosion_grid", erosion_grid, 1, 10**4),
+                                        r0=0.0, s0=1.0, periods=periods, n_steps=n_steps,
+                                        threads=threads)
                 for hb, ev in EROSION.items() for law in ("housner", "mao")}
     if n_steps is not None:  # single runs take it too: check it against their blocks
         for hb, alpha, omega, _ in GALLERY.values():

@@ -118,6 +118,7 @@ NAMES = {
     "--xi": r"\bxi\b", "--rest-speed": r"rest[-_]speed", "--max-impacts": r"max[-_]impacts",
     "--uncertainty": r"\buncertainty\b", "--erosion-step": r"erosion[-_]step",
     "--ensemble": r"\bensemble\b", "--spread": r"\bspread\b", "--seed": r"\bseed\b",
+    "--erosion-grid": r"erosion[-_]grid",
 }
 
 NARGS = {"--alpha-range": 2, "--omega-range": 2, "--theta-range": 2, "--dtheta-range": 2,
@@ -532,6 +533,7 @@ def _misc():
 CASES = (_issue10() + _trajectory() + _sweep() + _basin() + _plane() + _cor() + _paper()
          + _erosion() + _fate() + _grid_extras("sweep") + _grid_extras("basin")
          + _grid_extras("plane") + _real_opt("paper", "--erosion-step", ["0", "-0.01", "5e-324"])
+         + _int_opt("paper", "--erosion-grid", ["0", "-1", HUGE_INT])
          + _misc())
 
 
