@@ -82,6 +82,11 @@ class Bench:
     args : argparse.Namespace
     quick : bool
         ``--quick`` was given.
+    out_path : Path
+        Where the outputs go: ``--out``, else benchmarks/results/ (benchmarks/results/quick/
+        with ``--quick``). :attr:`out` makes it on first use.
+    publishes : bool
+        A full run into benchmarks/results/: its report also refreshes its README block.
     env : dict
         What the numbers are measured on (:func:`environment`), taken when the run starts.
     """
@@ -96,10 +101,8 @@ class Bench:
             p.error("--quick never writes to benchmarks/results/ (it holds the committed "
                     "results); give another --out")
         a = self.args
-        #: where the outputs go: ``--out``, else benchmarks/results (quick/ with ``--quick``)
         self.out_path = Path(a.out if a.out is not None else
                              QUICK_RESULTS if self.quick else RESULTS)
-        #: a full run into benchmarks/results/ refreshes its block of benchmarks/README.md
         self.publishes = not self.quick and _same_path(self.out_path, RESULTS)
         self.env = environment()
         print(env_line(self.env), flush=True)

@@ -427,12 +427,11 @@ def csv_rows(m):
 def json_data(m, bkw, skw):
     t1, t2, t5 = m["t1"], m["t2"], m["t5"]
     sw = t5["sweep"].result
-    cpu = {k: v for k, v in t1.cpu.items()}
     return dict(
         quick=m["quick"], environment=m["env"], total_s=m["total"], basin_settings=bkw,
         sweep_settings=dict(skw, z0=list(skw["z0"])), grid_n=GRID_N,
         n_threads=m["n_threads"], first_call_in_process_s=m["first"], load_average=m["loads"],
-        cpu_s=dict(item1=cpu, item2=dict(t2.cpu),
+        cpu_s=dict(item1=dict(t1.cpu), item2=dict(t2.cpu),
                    item5={tag: dict(t.cpu) for tag, t in t5.items()}),
         item1=dict(wall_s=t1.wall, median_s=t1.medians(),
                    threads_identical=m["threads_identical"],

@@ -50,10 +50,10 @@ were); their horizon is cut so that no run is given more than ``MAX_GRID_STEPS``
     omega = 1e-3, and such runs get few periods;
 ``through_rest``
     orbits that pass through rest: under forcing above the uplift threshold
-    (``alpha omega^2 = m cot(thc)``, ``m`` in [1.02, 4]), from rest (``theta0 = theta0' = 0``)
-    or rocking, mostly with a low restitution (``e`` in [0.02, 0.3]) so that impacts accumulate
-    into a Zeno rest and the forcing lifts the block again; mostly with exponents, and with
-    ``rest_speed`` from 1e-8 to 1e-3.
+    (``alpha omega^2 = m cot(thc)``, ``m`` in [1.02, 4], mostly below 1.5), from rest
+    (``theta0 = theta0' = 0``) or rocking, mostly with a low restitution (``e`` in [0.02, 0.3])
+    so that impacts accumulate into a Zeno rest and the forcing lifts the block again; mostly
+    with exponents, and with ``rest_speed`` from 1e-8 to 1e-3.
 
 Checks of every run (:func:`check_run`; each returns a list of problems, empty when it passes):
 
@@ -414,8 +414,9 @@ def case_through_rest(rng, max_periods):
     kw = _params(rng)
     cot = 1.0 / kw["hb"]
     a_max = RANGES["alpha"][1]
-    # forcing above the uplift threshold, so that a block at rest is lifted again
-    m = _logu(rng, 1.02, 4.0)
+    # forcing above the uplift threshold, so that a block at rest is lifted again; mostly a
+    # little above it, where a lifted block comes back to rest within the period
+    m = _logu(rng, 1.02, 1.5) if rng.random() < 0.75 else _logu(rng, 1.5, 4.0)
     om_lo = max(RANGES["omega"][0], math.sqrt(cot * m / a_max) * 1.0001)
     kw["omega"] = _logu(rng, om_lo, RANGES["omega"][1])
     kw["alpha"] = cot * m / kw["omega"] ** 2
