@@ -253,8 +253,21 @@ def item5_rows(t5):
 
 # --------------------------------------------------------------------------- the report
 
-def _pct_row(fr):
-    return [fr[n] for n in BEHAVIOURS]
+def _threads_table(t):
+    """Items 1 and 2: each case's wall and CPU time, against early stopping on all threads."""
+    base = t.median("early, all threads")
+    return H.md_table(["case", "wall median (s)", "runs", "time / early all threads",
+                       "CPU median (s)", "CPU / wall"],
+                      [[k, t.median(k), len(t.wall[k]), t.median(k) / base, t.cpu_median(k),
+                        t.cpu_median(k) / t.median(k)] for k in THREADS_CASES])
+
+
+def _fractions_table(t):
+    """Items 1 and 2: the percentage of each behaviour, early stop and full length."""
+    return H.md_table(["run"] + [f"{n} %" for n in BEHAVIOURS],
+                      [[run, *[t.result[k].fractions()[n] for n in BEHAVIOURS]]
+                       for run, k in (("early stop", "early, all threads"),
+                                      ("full length", "full length, all threads"))])
 
 
 def _with_period(label, period):
@@ -278,30 +291,19 @@ def markdown(m):
     md.append(f"**1. Basin hb=1, alpha=0.66, omega=1.3, Housner** (target <= "
               f"{TARGET_BASIN_S:g} s)\n\n")
     base = t1.median("early, all threads")
-    md.append(H.md_table(["case", "wall median (s)", "runs", "time / early all threads",
-                          "CPU median (s)", "CPU / wall"],
-                         [[k, t1.median(k), len(t1.wall[k]), t1.median(k) / base,
-                           t1.cpu_median(k), t1.cpu_median(k) / t1.median(k)]
-                          for k in THREADS_CASES]))
+    md.append(_threads_table(t1))
     md.append(f"\nThread speed-up (early stop): {t1.median('early, 1 thread') / base:.2f}x on "
               f"{n_threads} threads; early stopping saves "
               f"{t1.median('full length, all threads') / base:.0f}x over full length. Labels "
               f"and t_end identical on 1 and {n_threads} threads: {m['threads_identical']}. "
               f"Target {'**met**' if base <= TARGET_BASIN_S else '**not met**'} "
               f"({base:.2f} s).\n\n")
-    md.append(H.md_table(["run"] + [f"{n} %" for n in BEHAVIOURS],
-                         [["early stop", *_pct_row(t1.result["early, all threads"].fractions())],
-                          ["full length",
-                           *_pct_row(t1.result["full length, all threads"].fractions())]]))
+    md.append(_fractions_table(t1))
 
     md.append(f"\n**2. Sweep hb=1, Housner, {s_early.alpha.size} alphas, lambda_max on** "
               f"(target <= {TARGET_SWEEP_S:g} s)\n\n")
     base2 = t2.median("early, all threads")
-    md.append(H.md_table(["case", "wall median (s)", "runs", "time / early all threads",
-                          "CPU median (s)", "CPU / wall"],
-                         [[k, t2.median(k), len(t2.wall[k]), t2.median(k) / base2,
-                           t2.cpu_median(k), t2.cpu_median(k) / t2.median(k)]
-                          for k in THREADS_CASES]))
+    md.append(_threads_table(t2))
     es = m["sweep_es"]
     md.append(f"\nThread speed-up: {t2.median('early, 1 thread') / base2:.2f}x; early stopping "
               f"saves {t2.median('full length, all threads') / base2:.1f}x. Results identical "
@@ -309,10 +311,7 @@ def markdown(m):
               f"{es['agreement']:.2f} % of alphas with the same label "
               f"({len(es['differing'])} differ). Target "
               f"{'**met**' if base2 <= TARGET_SWEEP_S else '**not met**'} ({base2:.2f} s).\n\n")
-    md.append(H.md_table(["run"] + [f"{n} %" for n in BEHAVIOURS],
-                         [["early stop", *_pct_row(s_early.fractions())],
-                          ["full length",
-                           *_pct_row(t2.result["full length, all threads"].fractions())]]))
+    md.append(_fractions_table(t2))
 
     md.append(f"\n**4. Early stopping vs full length, the study's four basins** (N = {GRID_N}; "
               f"requirement >= {TARGET_AGREEMENT:g} % on each)\n\n")
