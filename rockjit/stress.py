@@ -86,9 +86,10 @@ Checks of every run (:func:`check_run`; each returns a list of problems, empty w
     (SPEC.md §5; issue 10 found lambda1 = +1.95 on such an orbit).
 
 Hitting the impact bound is not a failure; it is counted and reported as such. Neither is the
-refusal of a grid too coarse to integrate (``T/N`` above rockjit's step limit, or an embedded
-step beyond the oscillator's stability): it must be a ``ValueError`` naming ``n_steps`` (any
-other exception fails the ``status`` check), and it is counted as ``refused``.
+refusal of a grid too coarse to integrate (``T/N`` above rockjit's step limit, an embedded step
+beyond the oscillator's stability, or, issue 10, a step beyond the explicit stability of a large
+damping): it must be a ``ValueError`` naming ``n_steps`` first (any other exception fails the
+``status`` check), and it is counted as ``refused``.
 
 Exact checks that ride along:
 
@@ -659,15 +660,17 @@ def check_run(kw, res):
 
 
 def refused(exc):
-    """Is ``exc`` rockjit's documented refusal of a grid too coarse to integrate?"""
-    return isinstance(exc, ValueError) and str(exc).startswith("n_steps must be")
+    """Is ``exc`` rockjit's documented refusal of a grid too coarse to integrate (a
+    ``ValueError`` whose message opens with the parameter's name, ``n_steps``)?"""
+    return isinstance(exc, ValueError) and str(exc).startswith("n_steps")
 
 
 def run_case(case):
     """``(result, problems, refusal)``.
 
-    A grid too coarse to integrate (``T/N`` beyond rockjit's step limit, or an embedded step
-    beyond the oscillator's stability) must be refused with a ``ValueError`` naming ``n_steps``:
+    A grid too coarse to integrate (``T/N`` beyond rockjit's step limit, an embedded step beyond
+    the oscillator's stability, or a step beyond the explicit stability of a large damping) must
+    be refused with a ``ValueError`` naming ``n_steps``:
     that is ``(None, {no problems}, message)``. Any other exception is a failure of the
     ``status`` check.
     """
