@@ -1,16 +1,28 @@
-"""Shared helpers of the benchmark scripts: timing, compile-time probes, tables, atomic writes.
+"""The benchmark harness: options, side-by-side timing, compile probes and the one report writer.
 
-House rules (benchmarks/README.md): every quoted time is a median of repeats taken side by side in
-one run; compile time is measured apart from run time; every output file is written atomically
-(temporary file in the same folder, then ``os.replace``), so an interrupted run leaves nothing
-half-made.
+Every script in this folder is a list of *experiments* (small functions that measure one thing
+and return rows) and a ``main()`` that runs them and hands the rows to :meth:`Bench.report`. This
+module is all they share:
+
+- :class:`Bench` parses the common options (``--quick``, ``--out DIR``), records what the numbers
+  were measured on, and writes the report: the Markdown table (``.md``, also pasted into its block
+  of benchmarks/README.md by a full run), the ``.csv``, the ``.json`` and the plots, every file
+  through :mod:`rockjit.io`'s atomic writers (so the JSON is strict, with non-finite floats
+  written as the strings ``"nan"``, ``"inf"``, ``"-inf"``, rockjit's one convention);
+- :func:`side_by_side` times cases interleaved in rotating order (medians of repeats, every ratio
+  taken within one process: the machine is shared and noisy);
+- :func:`compile_times` measures compile time apart from run time, in fresh processes sharing one
+  new ``NUMBA_CACHE_DIR``;
+- :func:`impact_time_error` compares the impact times of two runs.
+
+House rules (benchmarks/README.md): every quoted time is a median of repeats taken side by side;
+compile time is reported apart; a ``--quick`` run is a smoke test that never writes to
+benchmarks/results/ and never touches the README.
 """
 
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 import json
 import math
 import os
@@ -21,39 +33,150 @@ import sys
 import tempfile
 import textwrap
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 RESULTS = HERE / "results"
 QUICK_RESULTS = RESULTS / "quick"
+README = HERE / "README.md"
 
 #: The study's reference run (SPEC.md §7, figure 2).
 REFERENCE_RUN = dict(hb=1.0, alpha=0.6, omega=1.3, law="housner")
 
 
-# --------------------------------------------------------------------------- command line
+# --------------------------------------------------------------------------- one benchmark run
 
 def parser(description: str) -> argparse.ArgumentParser:
+    """The options every script takes: ``--quick`` and ``--out DIR``."""
     p = argparse.ArgumentParser(description=description)
     p.add_argument("--quick", action="store_true",
-                   help="fast smoke mode: fewer periods and repeats, no cold-compile "
-                        "subprocesses; writes to benchmarks/results/quick/ unless --out is given")
+                   help="smoke mode: tiny sizes, few repeats, no cold-compile processes; writes "
+                        "to benchmarks/results/quick/ unless --out is given, never to "
+                        "benchmarks/results/")
     p.add_argument("--out", type=Path, default=None,
                    help="output folder (default benchmarks/results, or benchmarks/results/quick "
                         "with --quick)")
     return p
 
 
-def out_dir(args) -> Path:
-    out = args.out if args.out is not None else (QUICK_RESULTS if args.quick else RESULTS)
-    out.mkdir(parents=True, exist_ok=True)
-    if out.resolve() == QUICK_RESULTS.resolve():
-        # smoke-mode outputs are never meant to be committed
-        gi = out / ".gitignore"
-        if not gi.exists():
-            write_text(gi, "*\n")
-    return out
+def _same_path(a, b) -> bool:
+    return Path(a).resolve() == Path(b).resolve()
+
+
+class Bench:
+    """One run of a benchmark script: its options, output folder, environment and report.
+
+    Parameters
+    ----------
+    doc : str
+        The script's module docstring; its first line is the ``--help`` description.
+    argv : list of str, optional
+        The command line (default ``sys.argv[1:]``).
+    options : callable, optional
+        ``options(parser)`` adds the script's own options.
+
+    Attributes
+    ----------
+    args : argparse.Namespace
+    quick : bool
+        ``--quick`` was given.
+    out_path : Path
+        Where the outputs go: ``--out``, else benchmarks/results/ (benchmarks/results/quick/
+        with ``--quick``). :attr:`out` makes it on first use.
+    publishes : bool
+        A full run into benchmarks/results/: its report also refreshes its README block.
+    env : dict
+        What the numbers are measured on (:func:`environment`), taken when the run starts.
+    """
+
+    def __init__(self, doc: str, argv=None, *, options=None):
+        p = parser(doc.strip().splitlines()[0])
+        if options is not None:
+            options(p)
+        self.args = p.parse_args(argv)
+        self.quick = bool(self.args.quick)
+        if self.quick and self.args.out is not None and _same_path(self.args.out, RESULTS):
+            p.error("--quick never writes to benchmarks/results/ (it holds the committed "
+                    "results); give another --out")
+        a = self.args
+        self.out_path = Path(a.out if a.out is not None else
+                             QUICK_RESULTS if self.quick else RESULTS)
+        self.publishes = not self.quick and _same_path(self.out_path, RESULTS)
+        self.env = environment()
+        print(env_line(self.env), flush=True)
+
+    @property
+    def out(self) -> Path:
+        """The output folder, made on first use."""
+        out = self.out_path
+        if not out.is_dir():
+            out.mkdir(parents=True, exist_ok=True)
+        if _same_path(out, QUICK_RESULTS) and not (out / ".gitignore").exists():
+            _io().write_text(out / ".gitignore", "*\n")  # smoke outputs are never committed
+        return out
+
+    def report(self, name: str, *, markdown: str, csv=None, data=None, figures=(),
+               block: str | None = None, also=()):
+        """Write the run's outputs and, for a full run into benchmarks/results/, its prose.
+
+        Parameters
+        ----------
+        name : str
+            Base name of the files: ``name.md``, ``name.csv``, ``name.json``.
+        markdown : str
+            The tables and prose, written to ``name.md`` and, when :attr:`publishes`, between
+            the ``<!-- block:begin -->`` and ``<!-- block:end -->`` markers of the README.
+        csv : (headers, rows), optional
+        data : dict, optional
+            Everything measured, raw times included, for ``name.json``.
+        figures : iterable of (filename, figure, dpi)
+            Saved into the output folder and closed.
+        block : str, optional
+            The README block's key (default ``name``).
+        also : iterable of Path
+            More files whose ``block`` is refreshed along with the README.
+        """
+        rio = _io()
+        out = self.out
+        rio.write_text(out / f"{name}.md", markdown)
+        if csv is not None:
+            headers, rows = csv
+            rio.write_csv(out / f"{name}.csv", headers, rows)
+        if data is not None:
+            rio.write_json(out / f"{name}.json", data)
+        for fname, fig, dpi in figures:
+            rio.save_figure(fig, out / fname, dpi=dpi)
+            pyplot().close(fig)
+        if self.publishes:
+            for path in (*also, README):
+                update_block(path, block or name, markdown)
+        check_unchanged(self.env)
+        print(markdown)
+
+
+def _io():
+    import rockjit.io
+    return rockjit.io
+
+
+def update_block(path, key: str, text: str) -> bool:
+    """Replace the block between ``<!-- key:begin -->`` and ``<!-- key:end -->`` in ``path``.
+
+    Written atomically; a missing file, or one without the markers, is left alone.
+    """
+    path = Path(path)
+    if not path.exists():
+        return False
+    old = path.read_text()
+    begin, end = f"<!-- {key}:begin -->", f"<!-- {key}:end -->"
+    i, j = old.find(begin), old.find(end)
+    if i < 0 or j < i:
+        print(f"note: no {begin} ... {end} block in {path}; not updated", file=sys.stderr)
+        return False
+    _io().write_text(path, old[:i + len(begin)] + "\n" + text.rstrip("\n") + "\n" + old[j:])
+    return True
 
 
 # --------------------------------------------------------------------------- timing
@@ -65,24 +188,58 @@ def timed(fn, *args, **kwargs):
     return time.perf_counter() - t0, out
 
 
+def timed_cpu(fn, *args, **kwargs):
+    """``(wall seconds, process CPU seconds of all threads, fn(*args, **kwargs))``."""
+    c0 = time.process_time()
+    t0 = time.perf_counter()
+    out = fn(*args, **kwargs)
+    wall = time.perf_counter() - t0
+    return wall, time.process_time() - c0, out
+
+
 def median(xs) -> float:
     return float(statistics.median(xs))
 
 
-def interleaved(cases: dict, repeats: int, *, counts: dict | None = None) -> dict:
-    """Time every case round-robin, so that all are measured side by side in one run.
+@dataclass
+class Timings:
+    """What :func:`side_by_side` measured, by case key.
+
+    Attributes
+    ----------
+    wall, cpu : dict
+        ``{key: [seconds, ...]}``: wall time and process CPU time (all threads) of every call.
+    result : dict
+        ``{key: value}``: what the case's last call returned.
+    """
+
+    wall: dict = field(default_factory=dict)
+    cpu: dict = field(default_factory=dict)
+    result: dict = field(default_factory=dict)
+
+    def median(self, key) -> float:
+        return median(self.wall[key])
+
+    def medians(self) -> dict:
+        return {k: median(v) for k, v in self.wall.items()}
+
+    def cpu_median(self, key) -> float:
+        return median(self.cpu[key])
+
+
+def side_by_side(cases: dict, repeats: int, *, counts: dict | None = None) -> Timings:
+    """Time every case round-robin, so that all are measured side by side in one process.
 
     ``cases`` maps a key to a zero-argument callable. There are ``repeats`` rounds; each calls
     every case once, in an order rotated (and reversed every other round) from round to round so
     that no case always runs first or always after the same one. ``counts`` lets an expensive
     case run in only ``counts[key]`` of the rounds, spread evenly over them.
-    Returns ``{key: [seconds, ...]}``.
     """
     keys = list(cases)
     counts = counts or {}
     rounds = {k: {int(i * repeats / counts[k]) for i in range(counts[k])} if k in counts
               else set(range(repeats)) for k in keys}
-    times = {k: [] for k in keys}
+    t = Timings(wall={k: [] for k in keys}, cpu={k: [] for k in keys})
     for rep in range(repeats):
         i = rep % len(keys)
         order = keys[i:] + keys[:i]
@@ -90,51 +247,95 @@ def interleaved(cases: dict, repeats: int, *, counts: dict | None = None) -> dic
             order = order[::-1]
         for k in order:
             if rep in rounds[k]:
-                dt, _ = timed(cases[k])
-                times[k].append(dt)
-    return times
+                wall, cpu, t.result[k] = timed_cpu(cases[k])
+                t.wall[k].append(wall)
+                t.cpu[k].append(cpu)
+    return t
 
+
+# --------------------------------------------------------------------------- compile probes
 
 _PROBE = textwrap.dedent("""
     import json, statistics, sys, time
+    spec = json.loads(sys.argv[1])
     t0 = time.perf_counter()
     import rockjit
+    from rockjit import analysis
     t1 = time.perf_counter()
-    kw = json.loads(sys.argv[1])
-    rockjit.simulate(**kw)
+    fn = dict(simulate=rockjit.simulate, basin=analysis.basin, sweep=analysis.sweep,
+              plane=analysis.plane)[spec["kind"]]
+    fn(**spec["kw"])
     t2 = time.perf_counter()
     warm = []
-    for _ in range(int(sys.argv[2])):
+    for _ in range(spec["repeats"]):
         a = time.perf_counter()
-        rockjit.simulate(**kw)
+        fn(**spec["kw"])
         warm.append(time.perf_counter() - a)
     print(json.dumps(dict(import_s=t1 - t0, first_s=t2 - t1, warm_s=statistics.median(warm))))
 """)
 
 
-def _probe(kwargs: dict, cache_dir: str, warm_repeats: int) -> dict:
-    env = dict(os.environ, NUMBA_CACHE_DIR=cache_dir)
-    proc = subprocess.run([sys.executable, "-c", _PROBE, json.dumps(kwargs), str(warm_repeats)],
-                          env=env, capture_output=True, text=True, check=True,
-                          cwd=cache_dir)  # not the repo root: '' on sys.path must not shadow
-    d = json.loads(proc.stdout.strip().splitlines()[-1])
-    d["compile_s"] = d["first_s"] - d["warm_s"]
-    return d
+def child_env(**extra) -> dict:
+    """The environment for a child Python process that imports the same rockjit as this one."""
+    import rockjit
+    src = str(Path(rockjit.__file__).resolve().parent.parent)
+    path = os.environ.get("PYTHONPATH", "")
+    env = dict(os.environ, PYTHONPATH=src + (os.pathsep + path if path else ""))
+    env.update(extra)
+    return env
 
 
-def compile_times(kwargs: dict, *, warm_repeats: int = 5) -> dict:
-    """Compile time of ``rockjit.simulate(**kwargs)``, measured in fresh processes.
+def compile_times(kind: str, kwargs: dict, *, sessions=("cold", "cached"),
+                  warm_repeats: int = 5) -> dict:
+    """Compile time of one call, measured in fresh processes: the one compile probe.
 
-    Two fresh Python processes share one new, empty ``NUMBA_CACHE_DIR``. In each, ``compile_s``
-    is the first call's wall time minus the median of ``warm_repeats`` later calls (the run time
-    itself). The first process compiles from nothing (``cold``); the second starts with the cache
-    the first one wrote (``cached``), which is what a user sees in every session after the first.
-    ``import_s`` (``import rockjit``) is reported apart.
+    One fresh Python process per name in ``sessions``, one after the other, all sharing one new,
+    empty ``NUMBA_CACHE_DIR``: the first compiles from nothing (``cold``), the later ones start
+    with what the earlier ones wrote (what a user sees in every session after the first). In
+    each, ``compile_s`` is the first call's wall time minus the median of ``warm_repeats`` later
+    calls (the run time itself); ``import_s`` (``import rockjit``) is reported apart.
+
+    Parameters
+    ----------
+    kind : {"simulate", "basin", "sweep", "plane"}
+        ``rockjit.simulate`` or the ``rockjit.analysis`` function called.
+    kwargs : dict
+        Its keyword arguments (JSON-serialisable).
+
+    Returns
+    -------
+    dict
+        ``{session: dict(import_s, first_s, warm_s, compile_s)}``.
     """
+    spec = json.dumps(dict(kind=kind, kw=kwargs, repeats=warm_repeats))
+    out = {}
     with tempfile.TemporaryDirectory(prefix="rockjit-numba-cache-") as d:
-        cold = _probe(kwargs, d, warm_repeats)
-        cached = _probe(kwargs, d, warm_repeats)
-    return dict(cold=cold, cached=cached)
+        env = child_env(NUMBA_CACHE_DIR=d)
+        for name in sessions:
+            proc = subprocess.run([sys.executable, "-c", _PROBE, spec], env=env, cwd=d,
+                                  capture_output=True, text=True, check=True)
+            r = json.loads(proc.stdout.strip().splitlines()[-1])
+            r["compile_s"] = r["first_s"] - r["warm_s"]
+            out[name] = r
+            print(f"compile {kind} {name}: {r['compile_s']:.1f} s (first call "
+                  f"{r['first_s']:.1f} s, warm {r['warm_s']:.3g} s)", flush=True)
+    return out
+
+
+# --------------------------------------------------------------------------- comparing runs
+
+def impact_time_error(res, ref):
+    """Largest impact-time difference of two runs.
+
+    Returns a float; ``None`` when neither run has an impact; the string ``"counts differ (a vs
+    b)"`` when their impact counts differ (then nothing can be compared).
+    """
+    if res.n_impacts != ref.n_impacts:
+        return f"counts differ ({res.n_impacts} vs {ref.n_impacts})"
+    if res.n_impacts == 0:
+        return None
+    import numpy as np
+    return float(np.max(np.abs(res.impacts[:, 0] - ref.impacts[:, 0])))
 
 
 # --------------------------------------------------------------------------- formatting
@@ -145,7 +346,7 @@ def fmt(x, digits: int = 3) -> str:
         return "—"
     if isinstance(x, str):
         return x
-    if isinstance(x, (int,)) and not isinstance(x, bool):
+    if isinstance(x, int) and not isinstance(x, bool):
         return f"{x:,}".replace(",", " ")
     if not math.isfinite(x):
         return "—" if math.isnan(x) else str(x)
@@ -161,6 +362,13 @@ def md_table(headers, rows) -> str:
     lines += ["| " + " | ".join(fmt(v) for v in row) + " |" for row in rows]
     return "\n".join(lines) + "\n"
 
+
+def quick_note(quick: bool, what: str = "") -> str:
+    """The heading's mark of a smoke run."""
+    return f" (QUICK MODE{': ' + what if what else ''})" if quick else ""
+
+
+# --------------------------------------------------------------------------- the machine
 
 def environment() -> dict:
     """What the numbers were measured on."""
@@ -206,94 +414,17 @@ def env_line(env: dict) -> str:
             f"{env['rockjit']} at commit {env['commit']}, {env['date']}.")
 
 
-# --------------------------------------------------------------------------- atomic writes
-
-def _atomic(path: Path, write, mode: str = "w"):
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}-", suffix=path.suffix)
+def loadavg() -> tuple:
+    """The 1-, 5- and 15-minute load averages (nan where the system has none)."""
     try:
-        with os.fdopen(fd, mode) as f:
-            write(f)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the file the usual mode
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
+        return tuple(os.getloadavg())
+    except OSError:
+        return (math.nan,) * 3
 
 
-def update_readme(args, key: str, text: str):
-    """Replace the block between ``<!-- key:begin -->`` and ``<!-- key:end -->`` in README.md.
-
-    Only full runs written to the default folder update it, so the README always quotes the
-    committed results and never a smoke run's.
-    """
-    if args.quick or (args.out is not None and Path(args.out).resolve() != RESULTS.resolve()):
-        return
-    readme = HERE / "README.md"
-    if not readme.exists():
-        return
-    old = readme.read_text()
-    begin, end = f"<!-- {key}:begin -->", f"<!-- {key}:end -->"
-    i, j = old.find(begin), old.find(end)
-    if i < 0 or j < i:
-        print(f"note: no {begin} ... {end} block in {readme}; not updated", file=sys.stderr)
-        return
-    write_text(readme, old[:i + len(begin)] + "\n" + text.rstrip("\n") + "\n" + old[j:])
-
-
-def write_text(path, text: str):
-    _atomic(path, lambda f: f.write(text))
-
-
-def write_json(path, obj):
-    """JSON with non-finite floats written as ``null`` (strict JSON has no NaN)."""
-    text = json.dumps(_finite(obj), indent=2, default=_jsonable, allow_nan=False) + "\n"
-    write_text(path, text)
-
-
-def _finite(x):
-    import numpy as np
-    if isinstance(x, dict):
-        return {k: _finite(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_finite(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return _finite(x.tolist())
-    if isinstance(x, (float, np.floating)):
-        return float(x) if math.isfinite(x) else None
-    return x
-
-
-def write_csv(path, headers, rows):
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(headers)
-    w.writerows([["" if v is None else v for v in row] for row in rows])
-    write_text(path, buf.getvalue())
-
-
-def save_figure(fig, path, **kwargs):
-    """``fig.savefig`` through a temporary file in the same folder, then a rename."""
-    path = Path(path)
-    fmt_ = path.suffix.lstrip(".")
-    _atomic(path, lambda f: fig.savefig(f, format=fmt_, **kwargs), mode="wb")
-
-
-def _jsonable(x):
-    import numpy as np
-    if isinstance(x, np.generic):
-        return x.item()
-    if isinstance(x, np.ndarray):
-        return x.tolist()
-    if isinstance(x, Path):
-        return str(x)
-    raise TypeError(f"not JSON serialisable: {type(x)}")
+def load_text() -> str:
+    """:func:`loadavg` as ``"1.08 / 1.10 / 0.97"``."""
+    return " / ".join(f"{x:.2f}" for x in loadavg())
 
 
 def pyplot():

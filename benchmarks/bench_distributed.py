@@ -10,86 +10,108 @@ with a tiny plane first, and compile time is reported apart.
 
     python benchmarks/bench_distributed.py            # full: 60 x 60 plane, 500 periods
     python benchmarks/bench_distributed.py --quick    # smoke: 16 x 16, 100 periods
+
+Writes distributed.{md,csv,json,png} to benchmarks/results/ (benchmarks/results/quick/ with
+--quick, or --out DIR).
 """
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
-import _common as C
+import _common as H
 
 from rockjit import analysis as an
 
+FULL = dict(grid=(60, 60), periods=500, repeats=3, chunk_divisors=(4, 16, 64))
+QUICK = dict(grid=(16, 16), periods=100, repeats=1, chunk_divisors=(4, 16))
+HEADERS = ("run", "chunks", "wall median s", "ratio to in-process", "overhead per chunk s",
+           "identical to in-process")
 
-def main():
-    args = C.parser(__doc__.splitlines()[0]).parse_args()
-    out = C.out_dir(args)
+
+def plane_kwargs(cfg):
+    return dict(hb=1, alpha_range=(0.3, 1.0), omega_range=(0.8, 2.0), grid=cfg["grid"],
+                periods=cfg["periods"])
+
+
+# --------------------------------------------------------------------------- the experiment
+
+def in_process_and_cluster(kw, chunk_sizes, repeats):
+    """The plane in this process and on the cluster at each chunk size, interleaved.
+
+    Returns ``(wall times by case, identical to the in-process result by case, compile s,
+    workers' warm-up s)``.
+    """
     from dask.distributed import Client, LocalCluster
 
-    grid = (16, 16) if args.quick else (60, 60)
-    periods = 100 if args.quick else 500
-    repeats = 1 if args.quick else 3
-    kw = dict(hb=1, alpha_range=(0.3, 1.0), omega_range=(0.8, 2.0), grid=grid, periods=periods)
-    n = grid[0] * grid[1]
-    chunk_sizes = [n // 4, n // 16, n // 64] if not args.quick else [n // 4, n // 16]
-
-    t_compile, _ = C.timed(an.plane, **dict(kw, grid=(2, 2), periods=5))
+    tiny = dict(kw, grid=(2, 2), periods=5)
+    t_compile, _ = H.timed(an.plane, **tiny)
     ref = an.plane(**kw)  # warm, and the reference result
     cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                            dashboard_address=None)
     client = Client(cluster)
     try:
-        t_warm_workers, _ = C.timed(an.plane, **dict(kw, grid=(2, 2), periods=5),
-                                    client=client, chunk=2)
+        t_workers, _ = H.timed(an.plane, **tiny, client=client, chunk=2)
         cases = {"in-process": lambda: an.plane(**kw)}
         for c in chunk_sizes:
             cases[f"cluster, {c} cells/chunk"] = (lambda c=c: an.plane(**kw, chunk=c,
                                                                       client=client))
-        times = {k: [] for k in cases}
-        identical = {}
-        for _ in range(repeats):
-            for k, fn in cases.items():
-                dt, res = C.timed(fn)
-                times[k].append(dt)
-                identical[k] = bool(np.array_equal(res.label, ref.label) and np.array_equal(
-                    res.lambda_max, ref.lambda_max, equal_nan=True))
+        t = H.side_by_side(cases, repeats)
     finally:
         client.close()
         cluster.close()
+    identical = {k: bool(np.array_equal(res.label, ref.label)
+                         and np.array_equal(res.lambda_max, ref.lambda_max, equal_nan=True))
+                 for k, res in t.result.items()}
+    return t.wall, identical, t_compile, t_workers
 
-    base = C.median(times["in-process"])
-    rows = []
-    for k in cases:
-        med = C.median(times[k])
+
+def rows(times, identical, n):
+    base = H.median(times["in-process"])
+    out = []
+    for k in times:
+        med = H.median(times[k])
         size = max(64, -(-n // 20)) if k == "in-process" else int(k.split(", ")[1].split()[0])
         n_chunks = -(-n // size)  # in-process runs the default chunking (progress between)
         per_chunk = None if k == "in-process" else (med - base) / n_chunks
-        rows.append((k, n_chunks, med, med / base, per_chunk, "yes" if identical[k] else "NO"))
-    headers = ("run", "chunks", "wall median s", "ratio to in-process",
-               "overhead per chunk s", "identical to in-process")
-    table = C.md_table(headers, rows)
-    env = C.environment()
-    note = (f"Plane {grid[0]} x {grid[1]} = {n} cells, {periods} periods, lambda_max on; "
-            f"median of {repeats}, cases interleaved. Compile (first call, this process): "
-            f"{t_compile:.1f} s; workers' first chunk (cache load): {t_warm_workers:.1f} s. "
-            f"{C.env_line(env)}\n")
-    C.write_text(out / "distributed.md", table + "\n" + note)
-    C.write_csv(out / "distributed.csv", headers, rows)
-    C.write_json(out / "distributed.json", dict(rows=[dict(zip(headers, r)) for r in rows],
-                                                compile_s=t_compile, env=env,
-                                                worker_warmup_s=t_warm_workers))
-    plt = C.pyplot()
+        out.append((k, n_chunks, med, med / base, per_chunk, "yes" if identical[k] else "NO"))
+    return out
+
+
+# --------------------------------------------------------------------------- the report
+
+def plot(table, cfg):
+    plt = H.pyplot()
     fig, ax = plt.subplots(figsize=(7, 3.6))
-    ax.barh([r[0] for r in rows][::-1], [r[2] for r in rows][::-1], color="#4c72b0")
+    ax.barh([r[0] for r in table][::-1], [r[2] for r in table][::-1], color="#4c72b0")
     ax.set_xlabel("wall time [s] (median)")
-    ax.set_title(f"{grid[0]}x{grid[1]} plane, {periods} periods: in-process vs 2-worker "
-                 "LocalCluster", fontsize=9)
+    ax.set_title(f"{cfg['grid'][0]}x{cfg['grid'][1]} plane, {cfg['periods']} periods: "
+                 "in-process vs 2-worker LocalCluster", fontsize=9)
     fig.tight_layout()
-    C.save_figure(fig, out / "distributed.png", dpi=120)
-    C.update_readme(args, "distributed", table + "\n" + note)
-    print(table)
-    print(note)
+    return fig
+
+
+def main(argv=None):
+    b = H.Bench(__doc__, argv)
+    cfg = QUICK if b.quick else FULL
+    g = cfg["grid"]
+    n = g[0] * g[1]
+    times, identical, t_compile, t_workers = in_process_and_cluster(
+        plane_kwargs(cfg), [n // d for d in cfg["chunk_divisors"]], cfg["repeats"])
+    table = rows(times, identical, n)
+    md = (H.md_table(HEADERS, table) + "\n"
+          + f"Plane {g[0]} x {g[1]} = {n} cells, {cfg['periods']} periods, lambda_max on; "
+            f"median of {cfg['repeats']}, cases interleaved. Compile (first call, this process): "
+            f"{t_compile:.1f} s; workers' first chunk (cache load): {t_workers:.1f} s. "
+            f"{H.env_line(b.env)}\n")
+    b.report("distributed", markdown=md, csv=(HEADERS, table),
+             data=dict(rows=[dict(zip(HEADERS, r)) for r in table], compile_s=t_compile,
+                       env=b.env, worker_warmup_s=t_workers, raw_wall_s=times),
+             figures=[("distributed.png", plot(table, cfg), 120)])
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -20,14 +20,10 @@ Writes event_accuracy.{md,csv,json,png} to benchmarks/results/ (benchmarks/resul
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
-import numpy as np
+import _common as H
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import _common as C  # noqa: E402
-
-import rockjit  # noqa: E402
+import rockjit
 
 ORBITS = {
     "reference (hb=1 Housner a=0.6)": dict(hb=1.0, alpha=0.6, omega=1.3, law="housner"),
@@ -41,84 +37,79 @@ IN_TEST = 4  # the first four are tests/test_reference.py's EVENT_RUNS
 NS = (64, 96, 128, 144, 160, 192, 256)
 N_CONV = 2048
 TOL = 1e-10
+DOP_ATOLS = (1e-12, 1e-14)
+FULL = dict(periods=20, ns=NS)
+QUICK = dict(periods=5, ns=(64, 160))
 
 
-def impact_diff(a, b):
-    if a.n_impacts != b.n_impacts:
-        return None
-    return float(np.max(np.abs(a.impacts[:, 0] - b.impacts[:, 0])))
+def _num(x):
+    """An impact-time error as a number, or None when the runs cannot be compared."""
+    return x if isinstance(x, float) else None
 
 
-def main(argv=None):
-    args = C.parser(__doc__.splitlines()[0]).parse_args(argv)
-    out = C.out_dir(args)
-    quick = args.quick
-    periods = 5 if quick else 20
-    ns = (64, 160) if quick else NS
-    n_def = rockjit.DEFAULT_N
-    ns = tuple(sorted(set(ns) | {n_def}))
-    env = C.environment()
-    print(C.env_line(env))
+# --------------------------------------------------------------------------- the experiment
 
-    rows, records = [], []
-    err = {}
-    for name, kw in ORBITS.items():
-        base = dict(kw, z0=rockjit.Z0_STUDY, periods=periods)
-        conv = rockjit.simulate(**base, n_steps=N_CONV)
-        dops = {atol: rockjit.simulate(**base, method="scipy:DOP853", rtol=1e-12, atol=atol)
-                for atol in (1e-12, 1e-14)}
-        rec = dict(orbit=name, in_test=name in list(ORBITS)[:IN_TEST], run=base,
-                   impacts=conv.n_impacts,
-                   dop853_vs_converged={str(a): impact_diff(d, conv) for a, d in dops.items()},
-                   by_n={})
-        for n in ns:
-            r = rockjit.simulate(**base, n_steps=n)
-            rec["by_n"][n] = dict(converged=impact_diff(r, conv),
-                                  **{f"dop853_atol_{a:g}": impact_diff(r, d)
-                                     for a, d in dops.items()})
-        err[name] = [rec["by_n"][n]["converged"] for n in ns]
-        records.append(rec)
-        mark = "" if rec["in_test"] else " (not in the test)"
-        rows.append([name + mark, conv.n_impacts,
-                     rec["dop853_vs_converged"]["1e-12"], rec["dop853_vs_converged"]["1e-14"]]
-                    + [C.fmt(e) + (" ✗" if e is not None and e > TOL else "")
-                       if e is not None else "count differs" for e in err[name]])
-        print(name, err[name])
+def orbit(name, kw, periods, ns):
+    """One orbit: the converged solution, DOP853 at two atols, and rockjit at each N."""
+    base = dict(kw, z0=rockjit.Z0_STUDY, periods=periods)
+    conv = rockjit.simulate(**base, n_steps=N_CONV)
+    dops = {atol: rockjit.simulate(**base, method="scipy:DOP853", rtol=1e-12, atol=atol)
+            for atol in DOP_ATOLS}
+    rec = dict(orbit=name, in_test=name in list(ORBITS)[:IN_TEST], run=base,
+               impacts=conv.n_impacts,
+               dop853_vs_converged={str(a): _num(H.impact_time_error(d, conv))
+                                    for a, d in dops.items()},
+               by_n={})
+    for n in ns:
+        r = rockjit.simulate(**base, n_steps=n)
+        rec["by_n"][n] = dict(converged=_num(H.impact_time_error(r, conv)),
+                              **{f"dop853_atol_{a:g}": _num(H.impact_time_error(r, d))
+                                 for a, d in dops.items()})
+    print(name, [rec["by_n"][n]["converged"] for n in ns])
+    return rec
 
-    worst = {n: max(e for name in list(ORBITS)[:IN_TEST]
-                    for e in [err[name][ns.index(n)]] if e is not None) for n in ns}
-    smallest = next((n for n in ns if worst[n] <= TOL), None)
+
+def worst_of_test(records, ns):
+    """The largest difference at each N over the test's orbits, and the smallest N within TOL."""
+    worst = {n: max(e for rec in records[:IN_TEST]
+                    for e in [rec["by_n"][n]["converged"]] if e is not None) for n in ns}
+    return worst, next((n for n in ns if worst[n] <= TOL), None)
+
+
+# --------------------------------------------------------------------------- the report
+
+def markdown(records, ns, n_def, worst, smallest, periods, env):
+    rows = []
+    for rec in records:
+        errs = [rec["by_n"][n]["converged"] for n in ns]
+        rows.append([rec["orbit"] + ("" if rec["in_test"] else " (not in the test)"),
+                     rec["impacts"], rec["dop853_vs_converged"]["1e-12"],
+                     rec["dop853_vs_converged"]["1e-14"]]
+                    + [H.fmt(e) + (" ✗" if e > TOL else "") if e is not None
+                       else "count differs" for e in errs])
     headers = (["orbit", "impacts", "DOP853 atol 1e-12 vs converged",
                 "DOP853 atol 1e-14 vs converged"]
                + [f"N={n}" + (" (default)" if n == n_def else "") for n in ns])
-    md = [f"#### Impact times against N: {periods} periods from the study's z0\n",
-          f"Largest impact-time difference from the converged solution (rockjit at N = "
-          f"{N_CONV}); ✗ above {TOL:g}. The DOP853 columns (rtol 1e-12) show how far that "
-          f"reference itself is from the converged one.\n\n",
-          C.md_table(headers, rows),
-          f"\nOn the test's {IN_TEST} orbits the largest difference is "
-          + ", ".join(f"{C.fmt(worst[n])} at N={n}" for n in ns)
-          + f": the smallest N within {TOL:g} is **{smallest}** (default N = {n_def}).\n",
-          f"\n{C.env_line(env)}\n"]
-    md_text = "".join(md)
-    C.write_text(out / "event_accuracy.md", md_text)
-    C.update_readme(args, "event_accuracy", md_text)
-    C.write_csv(out / "event_accuracy.csv", ["orbit", "n_steps", "vs_converged",
-                                             "vs_dop853_atol_1e-12", "vs_dop853_atol_1e-14"],
-                [[rec["orbit"], n, v["converged"], v["dop853_atol_1e-12"],
-                  v["dop853_atol_1e-14"]] for rec in records for n, v in rec["by_n"].items()])
-    C.write_json(out / "event_accuracy.json", dict(periods=periods, n_converged=N_CONV,
-                                                   tolerance=TOL, default_n=n_def,
-                                                   smallest_n_within=smallest, worst=worst,
-                                                   orbits=records, environment=env))
-    C.check_unchanged(env)
+    return "".join([
+        f"#### Impact times against N: {periods} periods from the study's z0\n",
+        f"Largest impact-time difference from the converged solution (rockjit at N = "
+        f"{N_CONV}); ✗ above {TOL:g}. The DOP853 columns (rtol 1e-12) show how far that "
+        f"reference itself is from the converged one.\n\n",
+        H.md_table(headers, rows),
+        f"\nOn the test's {IN_TEST} orbits the largest difference is "
+        + ", ".join(f"{H.fmt(worst[n])} at N={n}" for n in ns)
+        + f": the smallest N within {TOL:g} is **{smallest}** (default N = {n_def}).\n",
+        f"\n{H.env_line(env)}\n"])
 
-    plt = C.pyplot()
+
+def plot(records, ns, n_def, periods):
+    plt = H.pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.4), layout="constrained")
-    for i, (name, e) in enumerate(err.items()):
+    for i, rec in enumerate(records):
+        e = [rec["by_n"][n]["converged"] for n in ns]
         x = [n for n, v in zip(ns, e) if v is not None]
         y = [max(v, 1e-16) for v in e if v is not None]
-        ax.loglog(x, y, marker="o", ls="-" if i < IN_TEST else ":", label=name)
+        ax.loglog(x, y, marker="o", ls="-" if i < IN_TEST else ":", label=rec["orbit"])
     ax.axhline(TOL, color="0.3", ls="--", lw=0.8)
     ax.axvline(n_def, color="0.5", ls=":", lw=0.8)
     ax.set_xticks(ns, [str(n) for n in ns])
@@ -128,9 +119,31 @@ def main(argv=None):
                  f"dotted orbits: not in the test", fontsize=8)
     ax.legend(fontsize=7)
     ax.grid(True, which="both", alpha=0.3)
-    C.save_figure(fig, out / "event_accuracy.png", dpi=130)
-    plt.close(fig)
-    print(md_text)
+    return fig
+
+
+# --------------------------------------------------------------------------- main
+
+def main(argv=None):
+    b = H.Bench(__doc__, argv)
+    cfg = QUICK if b.quick else FULL
+    periods = cfg["periods"]
+    n_def = rockjit.DEFAULT_N
+    ns = tuple(sorted(set(cfg["ns"]) | {n_def}))
+
+    records = [orbit(name, kw, periods, ns) for name, kw in ORBITS.items()]
+    worst, smallest = worst_of_test(records, ns)
+
+    b.report("event_accuracy",
+             markdown=markdown(records, ns, n_def, worst, smallest, periods, b.env),
+             csv=(["orbit", "n_steps", "vs_converged", "vs_dop853_atol_1e-12",
+                   "vs_dop853_atol_1e-14"],
+                  [[rec["orbit"], n, v["converged"], v["dop853_atol_1e-12"],
+                    v["dop853_atol_1e-14"]] for rec in records for n, v in rec["by_n"].items()]),
+             data=dict(periods=periods, n_converged=N_CONV, tolerance=TOL, default_n=n_def,
+                       smallest_n_within=smallest, worst=worst, orbits=records,
+                       environment=b.env),
+             figures=[("event_accuracy.png", plot(records, ns, n_def, periods), 130)])
     return 0
 
 

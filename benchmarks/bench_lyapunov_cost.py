@@ -21,14 +21,48 @@ from __future__ import annotations
 
 import math
 import sys
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import _common as C  # noqa: E402
+import _common as H
 
-import rockjit  # noqa: E402
+import rockjit
+
+FULL = dict(periods=500, repeats=21)
+QUICK = dict(periods=20, repeats=3)
+
+
+# --------------------------------------------------------------------------- experiments
+
+def first_calls(run, n_def):
+    """The first call of each kernel in this process (compile, or load from numba's cache)."""
+    out = {}
+    for lyap in (False, True):
+        out[lyap], _ = H.timed(run, n_def, lyap)
+        print(f"first call in process, lyapunov={lyap}: {out[lyap]:.3f} s")
+    return out
+
+
+def cost(run, ns, repeats):
+    """``lyapunov=False`` against ``True`` at each N, the four cases interleaved.
+
+    (N, False) and (N, True) are adjacent: the rotation of the rounds alternates which goes first.
+    """
+    return H.side_by_side({(n, lyap): (lambda n=n, lyap=lyap: run(n, lyap))
+                           for n in ns for lyap in (False, True)}, repeats)
+
+
+def compile_cost(base, n_def, warm, first, quick):
+    """Compile time of each kernel: fresh processes (full), or the in-process first call."""
+    out = {}
+    for lyap in (False, True):
+        inproc = first[lyap] - warm[(n_def, lyap)]
+        if quick:
+            out[lyap] = dict(cold=None, cached=None, inproc_s=inproc)
+        else:
+            out[lyap] = dict(inproc_s=inproc, **H.compile_times(
+                "simulate", dict(base, z0=list(base["z0"]), n_steps=n_def, lyapunov=lyap)))
+    return out
 
 
 def identity(res):
@@ -39,80 +73,38 @@ def identity(res):
     return float(np.sum(res.lyapunov)), -0.75 * b.xi + 2.0 * nu * math.log(b.restitution), nu
 
 
-def main(argv=None):
-    args = C.parser(__doc__.splitlines()[0]).parse_args(argv)
-    out = C.out_dir(args)
-    quick = args.quick
-    periods = 20 if quick else 500
-    repeats = 3 if quick else 21
-    n_def = rockjit.DEFAULT_N
-    ns = [n_def] + [n for n in (64,) if n != n_def]
-    base = dict(C.REFERENCE_RUN, z0=rockjit.Z0_STUDY, periods=periods)
-
-    def run(n, lyap):
-        return rockjit.simulate(**base, n_steps=n, lyapunov=lyap)
-
-    env = C.environment()
-    print(C.env_line(env))
-
-    first_inproc = {}
-    for lyap in (False, True):
-        first_inproc[lyap], _ = C.timed(run, n_def, lyap)
-        print(f"first call in process, lyapunov={lyap}: {first_inproc[lyap]:.3f} s")
-
-    results = {}
-
-    def keep(key):
-        def call():
-            results[key] = run(*key)
-        return call
-
-    # (N, False), (N, True) adjacent: the rotation of C.interleaved alternates which goes first
-    cases = {(n, lyap): keep((n, lyap)) for n in ns for lyap in (False, True)}
-    times = C.interleaved(cases, repeats)
-    med = {k: C.median(v) for k, v in times.items()}
-
-    compile_info = {}
-    for lyap in (False, True):
-        warm = med[(n_def, lyap)]
-        if quick:
-            compile_info[lyap] = dict(cold=None, cached=None, inproc_s=first_inproc[lyap] - warm)
-        else:
-            ct = C.compile_times(dict(base, n_steps=n_def, lyapunov=lyap))
-            compile_info[lyap] = dict(inproc_s=first_inproc[lyap] - warm, **ct)
-            print(f"compile lyapunov={lyap}: cold {ct['cold']['compile_s']:.2f} s, "
-                  f"cached {ct['cached']['compile_s']:.2f} s")
-
-    # ---- cost table
-    cost_headers = ["N", "lyapunov=False (s)", "lyapunov=True (s)", "cost ratio", "n_rhs",
-                    "impacts"]
-    cost_rows, records = [], []
+def records(ns, n_def, t):
+    """One record per N: the cost and the exponents with their identity."""
+    out = []
     for n in ns:
-        r0, r1 = results[(n, False)], results[(n, True)]
+        r0, r1 = t.result[(n, False)], t.result[(n, True)]
+        m0, m1 = t.median((n, False)), t.median((n, True))
         # the tangent kernel is a separate compilation: its trajectory may round differently
         same_path = dict(n_rhs_equal=r0.n_rhs == r1.n_rhs,
                          state_difference=float(np.max(np.abs(r0.state - r1.state))))
-        ratio = med[(n, True)] / med[(n, False)]
-        cost_rows.append([f"{n}" + (" (default)" if n == n_def else ""), med[(n, False)],
-                          med[(n, True)], ratio, r1.n_rhs, r1.n_impacts])
         s, rhs, nu = identity(r1)
-        records.append(dict(n_steps=n, wall_median_off_s=med[(n, False)],
-                            wall_median_on_s=med[(n, True)], cost_ratio=ratio,
-                            wall_all_off_s=times[(n, False)], wall_all_on_s=times[(n, True)],
-                            n_rhs=r1.n_rhs, n_impacts=r1.n_impacts,
-                            lambda1=float(r1.lyapunov[0]), lambda2=float(r1.lyapunov[1]),
-                            lambda_sum=s, identity_rhs=rhs, identity_error=abs(s - rhs), nu=nu,
-                            n_impacts_window=r1.n_impacts_window, n_rest_window=r1.n_rest_window,
-                            window=list(r1.window), status=r1.status,
-                            on_vs_off=same_path))
+        out.append(dict(n_steps=n, wall_median_off_s=m0, wall_median_on_s=m1, cost_ratio=m1 / m0,
+                        wall_all_off_s=t.wall[(n, False)], wall_all_on_s=t.wall[(n, True)],
+                        n_rhs=r1.n_rhs, n_impacts=r1.n_impacts,
+                        lambda1=float(r1.lyapunov[0]), lambda2=float(r1.lyapunov[1]),
+                        lambda_sum=s, identity_rhs=rhs, identity_error=abs(s - rhs), nu=nu,
+                        n_impacts_window=r1.n_impacts_window, n_rest_window=r1.n_rest_window,
+                        window=list(r1.window), status=r1.status, on_vs_off=same_path))
+    return out
 
-    # ---- exponents table
-    lam_headers = ["N", "lambda1", "lambda2", "lambda1 + lambda2", "-3/4 xi + 2 nu ln e",
-                   "identity error", "nu (impacts / unit time)", "rest phases in window"]
+
+# --------------------------------------------------------------------------- the report
+
+CSV_COLUMNS = ("n_steps", "wall_median_off_s", "wall_median_on_s", "cost_ratio", "n_rhs",
+               "lambda1", "lambda2", "lambda_sum", "identity_rhs", "identity_error")
+
+
+def markdown(recs, compile_info, r_def, n_def, cfg, quick, env):
+    cost_rows = [[f"{r['n_steps']}" + (" (default)" if r["n_steps"] == n_def else ""),
+                  r["wall_median_off_s"], r["wall_median_on_s"], r["cost_ratio"], r["n_rhs"],
+                  r["n_impacts"]] for r in recs]
     lam_rows = [[r["n_steps"], r["lambda1"], r["lambda2"], r["lambda_sum"], r["identity_rhs"],
-                 r["identity_error"], r["nu"], r["n_rest_window"]] for r in records]
-
-    comp_headers = ["kernel", "compile, cold (s)", "compile, cached (s)"]
+                 r["identity_error"], r["nu"], r["n_rest_window"]] for r in recs]
     comp_rows = []
     for lyap in (False, True):
         ci = compile_info[lyap]
@@ -121,46 +113,29 @@ def main(argv=None):
             comp_rows.append([name + " [in-process first call]", ci["inproc_s"], None])
         else:
             comp_rows.append([name, ci["cold"]["compile_s"], ci["cached"]["compile_s"]])
-
-    r_def = results[(n_def, True)]
     w0, w1 = r_def.window
-    md_text = "".join([
-        f"### Lyapunov cost: reference run, {periods} periods, window "
-        f"[{w0 / r_def.period:.0f}T, {w1 / r_def.period:.0f}T]"
-        f"{' (QUICK MODE)' if quick else ''}\n",
-        C.md_table(cost_headers, cost_rows),
-        f"\nMedians of {repeats} warm runs each, the four cases interleaved in one process in "
-        f"rotating order. Ratio = with / without exponents. There is no scipy variational path "
-        f"(exponents are computed only by the compiled integrator), so no reference timing.\n\n",
-        C.md_table(lam_headers, lam_rows),
+    return "".join([
+        f"### Lyapunov cost: reference run, {cfg['periods']} periods, window "
+        f"[{w0 / r_def.period:.0f}T, {w1 / r_def.period:.0f}T]{H.quick_note(quick)}\n",
+        H.md_table(["N", "lyapunov=False (s)", "lyapunov=True (s)", "cost ratio", "n_rhs",
+                    "impacts"], cost_rows),
+        f"\nMedians of {cfg['repeats']} warm runs each, the four cases interleaved in one "
+        f"process in rotating order. Ratio = with / without exponents. There is no scipy "
+        f"variational path (exponents are computed only by the compiled integrator), so no "
+        f"reference timing.\n\n",
+        H.md_table(["N", "lambda1", "lambda2", "lambda1 + lambda2", "-3/4 xi + 2 nu ln e",
+                    "identity error", "nu (impacts / unit time)", "rest phases in window"],
+                   lam_rows),
         "\nIdentity (SPEC.md §5): lambda1 + lambda2 = -3/4 xi + 2 nu ln e over the window, "
         f"xi = {r_def.block.xi:.6g}, e = {r_def.block.restitution:.6g}.\n\n",
-        C.md_table(comp_headers, comp_rows),
+        H.md_table(["kernel", "compile, cold (s)", "compile, cached (s)"], comp_rows),
         "\nCompile: first call in a fresh process minus the warm median; cold = empty numba "
         "cache, cached = the cache the cold process wrote.\n",
-        f"\n{C.env_line(env)}\n"])
-    C.write_text(out / "lyapunov_cost.md", md_text)
-    C.update_readme(args, "lyapunov_cost", md_text)
-    C.write_csv(out / "lyapunov_cost.csv",
-                ["n_steps", "wall_median_off_s", "wall_median_on_s", "cost_ratio", "n_rhs",
-                 "lambda1", "lambda2", "lambda_sum", "identity_rhs", "identity_error"],
-                [[r[k] for k in ("n_steps", "wall_median_off_s", "wall_median_on_s",
-                                 "cost_ratio", "n_rhs", "lambda1", "lambda2", "lambda_sum",
-                                 "identity_rhs", "identity_error")] for r in records])
-    C.write_json(out / "lyapunov_cost.json", dict(
-        run=dict(base, z0=list(rockjit.Z0_STUDY)), quick=quick, repeats=repeats,
-        default_n=n_def, environment=env, rows=records,
-        compile={str(k): v for k, v in compile_info.items()},
-        first_call_in_process_s={str(k): v for k, v in first_inproc.items()},
-        lyapunov_running={str(n): results[(n, True)].lyapunov_running for n in ns}))
-    C.check_unchanged(env)
-    plot(out / "lyapunov_cost.png", ns, results, n_def)
-    print(md_text)
-    return 0
+        f"\n{H.env_line(env)}\n"])
 
 
-def plot(path, ns, results, n_def):
-    plt = C.pyplot()
+def plot(ns, results, n_def):
+    plt = H.pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
     r = results[(n_def, True)]
     k = np.arange(r.lyapunov_running.shape[0])
@@ -183,8 +158,38 @@ def plot(path, ns, results, n_def):
                  fontsize=9)
     ax.legend(fontsize=7)
     ax.grid(True, alpha=0.3)
-    C.save_figure(fig, path, dpi=130)
-    plt.close(fig)
+    return fig
+
+
+# --------------------------------------------------------------------------- main
+
+def main(argv=None):
+    b = H.Bench(__doc__, argv)
+    cfg = QUICK if b.quick else FULL
+    n_def = rockjit.DEFAULT_N
+    ns = [n_def] + [n for n in (64,) if n != n_def]
+    base = dict(H.REFERENCE_RUN, z0=rockjit.Z0_STUDY, periods=cfg["periods"])
+
+    def run(n, lyap):
+        return rockjit.simulate(**base, n_steps=n, lyapunov=lyap)
+
+    first = first_calls(run, n_def)
+    t = cost(run, ns, cfg["repeats"])
+    compile_info = compile_cost(base, n_def, t.medians(), first, b.quick)
+    recs = records(ns, n_def, t)
+
+    b.report("lyapunov_cost",
+             markdown=markdown(recs, compile_info, t.result[(n_def, True)], n_def, cfg, b.quick,
+                               b.env),
+             csv=(CSV_COLUMNS, [[r[k] for k in CSV_COLUMNS] for r in recs]),
+             data=dict(run=dict(base, z0=list(rockjit.Z0_STUDY)), quick=b.quick,
+                       repeats=cfg["repeats"], default_n=n_def, environment=b.env, rows=recs,
+                       compile={str(k): v for k, v in compile_info.items()},
+                       first_call_in_process_s={str(k): v for k, v in first.items()},
+                       lyapunov_running={str(n): t.result[(n, True)].lyapunov_running
+                                         for n in ns}),
+             figures=[("lyapunov_cost.png", plot(ns, t.result, n_def), 130)])
+    return 0
 
 
 if __name__ == "__main__":

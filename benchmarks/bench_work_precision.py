@@ -36,14 +36,12 @@ from __future__ import annotations
 
 import math
 import sys
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import _common as C  # noqa: E402
+import _common as H
 
-import rockjit  # noqa: E402
+import rockjit
 
 METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853")
 NS = (16, 32, 64, 128, 160, 256, 512, 1024)
@@ -89,92 +87,98 @@ def error(measure, res, ref):
     else:
         err = float(np.max(np.abs(res.state[:2] - ref.state[:2]))) if res.status == ref.status \
             else math.nan
-    t_err = math.nan
-    if res.n_impacts == ref.n_impacts and res.n_impacts:
-        t_err = float(np.max(np.abs(res.impacts[:, 0] - ref.impacts[:, 0])))
-    return err, t_err, flag
+    t_err = H.impact_time_error(res, ref)
+    return err, t_err if isinstance(t_err, float) else math.nan, flag
 
 
 def time_scipy(kw, method, rtol, repeats):
     """Run once; when cheap (< 1 s), ``repeats - 1`` more; median wall and the result."""
     call = dict(kw, method=f"scipy:{method}", rtol=rtol, atol=ATOL_RATIO * rtol)
-    dt, res = C.timed(rockjit.simulate, **call)
+    dt, res = H.timed(rockjit.simulate, **call)
     walls = [dt]
     if dt < 1.0:
         for _ in range(repeats - 1):
-            walls.append(C.timed(rockjit.simulate, **call)[0])
+            walls.append(H.timed(rockjit.simulate, **call)[0])
     return walls, res
 
 
-def run_scene(name, scene, quick, cap):
-    kw = dict(scene["kw"])
-    if quick and name == "periodic":
-        kw["periods"] = 10
-    measure = scene["measure"]
+def references(name, kw, measure, quick):
+    """The scene's reference (rockjit at N_REF), its independent second reference and the
+    floor below which an error is not resolved."""
     ref = rockjit.simulate(**kw, n_steps=N_REF)
     half = rockjit.simulate(**kw, n_steps=N_REF // 2)
     m2, tol2 = REF2[name] if not quick else ("DOP853", REF_DOP)
-    ref2_wall, ref2 = C.timed(rockjit.simulate, **kw, method=f"scipy:{m2}", **tol2)
+    ref2_wall, ref2 = H.timed(rockjit.simulate, **kw, method=f"scipy:{m2}", **tol2)
     d2, _, flag2 = error(measure, ref2, ref)
     dop = ref2 if m2 == "DOP853" else rockjit.simulate(**kw, method="scipy:DOP853", **REF_DOP)
     d_dop, _, flag_dop = error(measure, dop, ref)
     d_half, _, _ = error(measure, half, ref)
-    floor = max(d2, d_half)
     print(f"[{name}] reference rockjit N={N_REF}: {ref.status} t={ref.t:.15g} "
           f"impacts={ref.n_impacts}; {m2} {tol2}: {ref2.status} t={ref2.t:.15g} "
           f"impacts={ref2.n_impacts}; difference {d2:.3g} {flag2}; DOP853 {d_dop:.3g}; "
           f"N={N_REF // 2} {d_half:.3g}")
+    return ref, dict(
+        ref=dict(status=ref.status, t=ref.t, state=ref.state, n_impacts=ref.n_impacts,
+                 n_rhs=ref.n_rhs),
+        ref2=dict(method=m2, tol=tol2, status=ref2.status, t=ref2.t, state=ref2.state,
+                  n_impacts=ref2.n_impacts, wall_s=ref2_wall, difference=d2, flag=flag2),
+        dop853=dict(tol=REF_DOP, difference=d_dop, flag=flag_dop),
+        half=dict(n=N_REF // 2, difference=d_half),
+        floor=max(d2, d_half), floor_flag=flag2)
 
-    ns = (16, 64, 256) if quick else NS
-    repeats = 3 if quick else 21
-    results = {}
 
-    def keep(n):
-        def call():
-            results[n] = rockjit.simulate(**kw, n_steps=n)
-        return call
-
-    times = C.interleaved({n: keep(n) for n in ns}, repeats)
+def rockjit_rows(kw, measure, ref, ns, repeats):
+    """rockjit at each N, interleaved: one row per N."""
+    t = H.side_by_side({n: (lambda n=n: rockjit.simulate(**kw, n_steps=n)) for n in ns},
+                       repeats)
     rows = []
     for n in ns:
-        r = results[n]
+        r = t.result[n]
         err, t_err, flag = error(measure, r, ref)
         rows.append(dict(method="rockjit", setting=f"N={n}", n=n, rtol=None,
-                         wall_s=C.median(times[n]), wall_all_s=times[n], n_rhs=r.n_rhs,
+                         wall_s=t.median(n), wall_all_s=t.wall[n], n_rhs=r.n_rhs,
                          error=err, impact_time_error=t_err, flag=flag, status=r.status,
                          n_impacts=r.n_impacts, error_estimate=r.max_error_estimate))
         print(f"  rockjit N={n}: {rows[-1]['wall_s']:.3g} s, error {err:.3g} {flag}")
+    return rows
 
-    rtols = (1e-3, 1e-6, 1e-9) if quick else RTOLS
-    srepeats = 2 if quick else 3
+
+def scipy_rows(kw, measure, ref, method, rtols, repeats, cap):
+    """One scipy method at each rtol, until a run takes longer than ``cap``: one row per rtol."""
+    rows = []
+    skipped_from = None
+    for rtol in rtols:
+        if skipped_from is not None:
+            rows.append(dict(method=method, setting=f"rtol={rtol:.0e}", n=None, rtol=rtol,
+                             wall_s=math.nan, wall_all_s=[], n_rhs=None, error=math.nan,
+                             impact_time_error=math.nan,
+                             flag=f"skipped (rtol={skipped_from:.0e} took > {cap:g} s)",
+                             status=None, n_impacts=None, error_estimate=math.nan))
+            continue
+        walls, r = time_scipy(kw, method, rtol, repeats)
+        err, t_err, flag = error(measure, r, ref)
+        rows.append(dict(method=method, setting=f"rtol={rtol:.0e}", n=None, rtol=rtol,
+                         wall_s=H.median(walls), wall_all_s=walls, n_rhs=r.n_rhs, error=err,
+                         impact_time_error=t_err, flag=flag, status=r.status,
+                         n_impacts=r.n_impacts, error_estimate=math.nan))
+        print(f"  {method} rtol={rtol:.0e}: {rows[-1]['wall_s']:.3g} s, error {err:.3g} {flag}")
+        if max(walls) > cap:
+            skipped_from = rtol
+    return rows
+
+
+def run_scene(name, scene, quick, cap):
+    """One scene: its references, rockjit at every N, each scipy method at every rtol."""
+    kw = dict(scene["kw"])
+    if quick and name == "periodic":
+        kw["periods"] = 10
+    measure = scene["measure"]
+    ref, refs = references(name, kw, measure, quick)
+    rows = rockjit_rows(kw, measure, ref, (16, 64, 256) if quick else NS, 3 if quick else 21)
     for m in METHODS:
-        skipped_from = None
-        for rtol in rtols:
-            if skipped_from is not None:
-                rows.append(dict(method=m, setting=f"rtol={rtol:.0e}", n=None, rtol=rtol,
-                                 wall_s=math.nan, wall_all_s=[], n_rhs=None, error=math.nan,
-                                 impact_time_error=math.nan,
-                                 flag=f"skipped (rtol={skipped_from:.0e} took > {cap:g} s)",
-                                 status=None, n_impacts=None, error_estimate=math.nan))
-                continue
-            walls, r = time_scipy(kw, m, rtol, srepeats)
-            err, t_err, flag = error(measure, r, ref)
-            rows.append(dict(method=m, setting=f"rtol={rtol:.0e}", n=None, rtol=rtol,
-                             wall_s=C.median(walls), wall_all_s=walls, n_rhs=r.n_rhs, error=err,
-                             impact_time_error=t_err, flag=flag, status=r.status,
-                             n_impacts=r.n_impacts, error_estimate=math.nan))
-            print(f"  {m} rtol={rtol:.0e}: {rows[-1]['wall_s']:.3g} s, error {err:.3g} {flag}")
-            if max(walls) > cap:
-                skipped_from = rtol
-    return dict(name=name, kw=kw, measure=measure, title=scene["title"], rows=rows,
-                ref=dict(status=ref.status, t=ref.t, state=ref.state, n_impacts=ref.n_impacts,
-                         n_rhs=ref.n_rhs),
-                ref2=dict(method=m2, tol=tol2, status=ref2.status, t=ref2.t, state=ref2.state,
-                          n_impacts=ref2.n_impacts, wall_s=ref2_wall, difference=d2,
-                          flag=flag2),
-                dop853=dict(tol=REF_DOP, difference=d_dop, flag=flag_dop),
-                half=dict(n=N_REF // 2, difference=d_half),
-                floor=floor, floor_flag=flag2)
+        rows += scipy_rows(kw, measure, ref, m, (1e-3, 1e-6, 1e-9) if quick else RTOLS,
+                           2 if quick else 3, cap)
+    return dict(name=name, kw=kw, measure=measure, title=scene["title"], rows=rows, **refs)
 
 
 def hard_table(quick):
@@ -198,26 +202,9 @@ def cheapest(rows, target):
     return r["wall_s"], r["setting"]
 
 
-def main(argv=None):
-    p = C.parser(__doc__.splitlines()[0])
-    p.add_argument("--cap", type=float, default=None,
-                   help="skip a method's tighter rtols once a run takes longer than this "
-                        "(seconds; default 8, 2 with --quick)")
-    args = p.parse_args(argv)
-    out = C.out_dir(args)
-    quick = args.quick
-    cap = args.cap if args.cap is not None else (2.0 if quick else 8.0)
-    env = C.environment()
-    print(C.env_line(env))
-    rockjit.simulate(hb=1.0, alpha=0.6, omega=1.3, periods=2)  # load the kernel
-
-    scenes = {name: run_scene(name, sc, quick, cap) for name, sc in SCENES.items()}
-    hard = hard_table(quick)
-    C.check_unchanged(env)
-
-    # ---- tables
+def markdown(scenes, hard, cap, quick, env):
     n_def = rockjit.DEFAULT_N
-    md = [f"#### Work–precision: results{' (QUICK MODE)' if quick else ''}\n"]
+    md = [f"#### Work–precision: results{H.quick_note(quick)}\n"]
     md.append(f"References: errors are measured against rockjit at N = {N_REF}; the "
               "independent second reference is a scipy solver at its tightest tolerances. "
               f"The floor is the larger of their difference and the change of rockjit's from "
@@ -233,7 +220,7 @@ def main(argv=None):
                          f"{r2['tol']['atol']:.0e}",
                          r2["difference"], r2["flag"] or "agree", s["dop853"]["difference"],
                          s["half"]["difference"], s["floor"]])
-    md.append(C.md_table(["scene", "error of", "status", "impacts", "t end", "second reference",
+    md.append(H.md_table(["scene", "error of", "status", "impacts", "t end", "second reference",
                           "difference", "status, impacts", "DOP853 1e-13 difference",
                           f"N={N_REF // 2} difference", "floor"], ref_rows))
 
@@ -251,11 +238,11 @@ def main(argv=None):
                 if c is None:
                     row.append("—")
                 elif m == "rockjit" or base is None:
-                    row.append(f"{C.fmt(c[0])} s ({c[1]})")
+                    row.append(f"{H.fmt(c[0])} s ({c[1]})")
                 else:
-                    row.append(f"{C.fmt(c[0])} s ({c[1]}), {C.fmt(c[0] / base[0])}x")
+                    row.append(f"{H.fmt(c[0])} s ({c[1]}), {H.fmt(c[0] / base[0])}x")
             sum_rows.append(row)
-    md.append(C.md_table(["target", "scene", "rockjit", *METHODS], sum_rows))
+    md.append(H.md_table(["target", "scene", "rockjit", *METHODS], sum_rows))
     md.append("\nscipy cells: wall time, setting, and how many times rockjit's cheapest run at "
               "the same target it costs.\n")
 
@@ -267,7 +254,7 @@ def main(argv=None):
         row = [f"{n}" + (" (default)" if n == n_def else "")]
         for s in scenes.values():
             r = next(r for r in s["rows"] if r["n"] == n)
-            e = C.fmt(r["error"]) + (" †" if r["error"] < s["floor"] else "")
+            e = H.fmt(r["error"]) + (" †" if r["error"] < s["floor"] else "")
             row += [e if not r["flag"] else f"{e} [{r['flag']}]", r["impact_time_error"],
                     r["error_estimate"], r["wall_s"]]
         n_rows.append(row)
@@ -275,7 +262,7 @@ def main(argv=None):
     for s in scenes.values():
         q = "t_over err" if s["measure"] == "overturn" else "state err"
         hdr += [f"{s['name']}: {q}", "impact t err", "estimate", "wall (s)"]
-    md.append(C.md_table(hdr, n_rows))
+    md.append(H.md_table(hdr, n_rows))
     md.append("\n† below the floor (the two references' difference): not resolved.\n")
 
     md.append("\nEvery run, per scene: error (median wall time in s); flags in brackets:\n")
@@ -291,10 +278,10 @@ def main(argv=None):
                 if r["flag"].startswith("skipped"):
                     row.append("skipped")
                 else:
-                    cell = f"{C.fmt(r['error'])} ({C.fmt(r['wall_s'])})"
+                    cell = f"{H.fmt(r['error'])} ({H.fmt(r['wall_s'])})"
                     row.append(cell + (f" [{r['flag']}]" if r["flag"] else ""))
             trows.append(row)
-        md.append(C.md_table(["rtol", *METHODS], trows))
+        md.append(H.md_table(["rtol", *METHODS], trows))
     md.append(f"\nskipped: a looser rtol of the method already took more than {cap:g} s. "
               f"atol = {ATOL_RATIO:g} rtol. rockjit: medians of {3 if quick else 21} "
               "interleaved runs; scipy: median of 3 when a run takes < 1 s, else one run; "
@@ -302,34 +289,46 @@ def main(argv=None):
 
     md.append("\nTransient chaos, hb=1, alpha=0.969, omega=1.3 (overturns after ~45 impacts): "
               "the overturning time at ever tighter settings:\n\n")
-    md.append(C.md_table(["method", "setting", "status", "t", "impacts"],
+    md.append(H.md_table(["method", "setting", "status", "t", "impacts"],
                          [[a, b, c, f"{d:.12g}", e] for a, b, c, d, e in hard]))
-    md.append(f"\n{C.env_line(env)}\n")
-    md = "".join(md)
+    md.append(f"\n{H.env_line(env)}\n")
+    return "".join(md)
 
-    C.write_text(out / "work_precision.md", md)
-    C.update_readme(args, "work_precision", md)
-    csv_rows = []
-    for s in scenes.values():
-        for r in s["rows"]:
-            csv_rows.append([s["name"], r["method"], r["setting"], r["wall_s"], r["n_rhs"],
-                             r["error"], r["impact_time_error"], r["status"], r["n_impacts"],
-                             r["flag"]])
-    C.write_csv(out / "work_precision.csv",
-                ["scene", "method", "setting", "wall_median_s", "n_rhs", "error",
-                 "impact_time_error", "status", "n_impacts", "flag"], csv_rows)
-    C.write_json(out / "work_precision.json", dict(
-        quick=quick, cap_s=cap, atol_ratio=ATOL_RATIO, n_ref=N_REF,
-        ref2=REF2, ref_dop853=REF_DOP, environment=env, scenes=scenes,
-        hard=[dict(method=a, setting=b, status=c, t=d, n_impacts=e) for a, b, c, d, e in hard]))
-    for s in scenes.values():
-        plot(out / f"work_precision_{s['name']}.png", s, n_def)
-    print(md)
+
+def csv_rows(scenes):
+    return [[s["name"], r["method"], r["setting"], r["wall_s"], r["n_rhs"], r["error"],
+             r["impact_time_error"], r["status"], r["n_impacts"], r["flag"]]
+            for s in scenes.values() for r in s["rows"]]
+
+
+def main(argv=None):
+    def options(p):
+        p.add_argument("--cap", type=float, default=None,
+                       help="skip a method's tighter rtols once a run takes longer than this "
+                            "(seconds; default 8, 2 with --quick)")
+
+    b = H.Bench(__doc__, argv, options=options)
+    quick = b.quick
+    cap = b.args.cap if b.args.cap is not None else (2.0 if quick else 8.0)
+    rockjit.simulate(hb=1.0, alpha=0.6, omega=1.3, periods=2)  # load the kernel
+
+    scenes = {name: run_scene(name, sc, quick, cap) for name, sc in SCENES.items()}
+    hard = hard_table(quick)
+
+    b.report("work_precision", markdown=markdown(scenes, hard, cap, quick, b.env),
+             csv=(["scene", "method", "setting", "wall_median_s", "n_rhs", "error",
+                   "impact_time_error", "status", "n_impacts", "flag"], csv_rows(scenes)),
+             data=dict(quick=quick, cap_s=cap, atol_ratio=ATOL_RATIO, n_ref=N_REF, ref2=REF2,
+                       ref_dop853=REF_DOP, environment=b.env, scenes=scenes,
+                       hard=[dict(method=a, setting=m, status=c, t=d, n_impacts=e)
+                             for a, m, c, d, e in hard]),
+             figures=[(f"work_precision_{s['name']}.png", plot(s, rockjit.DEFAULT_N), 120)
+                      for s in scenes.values()])
     return 0
 
 
-def plot(path, s, n_def):
-    plt = C.pyplot()
+def plot(s, n_def):
+    plt = H.pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.6), layout="constrained")
     tiny = 1e-17
     marks = dict(rockjit="o", BDF="s", Radau="D", LSODA="^", RK45="v", DOP853="P")
@@ -366,8 +365,7 @@ def plot(path, s, n_def):
     ax.set_title(s["title"], fontsize=8)
     ax.grid(True, which="both", alpha=0.25)
     ax.legend(fontsize=6.5, loc="best")
-    C.save_figure(fig, path, dpi=120)
-    plt.close(fig)
+    return fig
 
 
 if __name__ == "__main__":

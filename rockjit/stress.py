@@ -1,7 +1,14 @@
-"""Seeded stress cases for ``rockjit.simulate`` and the checks every run must pass (issue 5).
+"""The numerical stress suite: seeded extreme cases for ``rockjit.simulate`` and the checks
+every run must pass.
 
-Imported by ``benchmarks/bench_stress.py`` (the full run) and ``tests/test_stress.py`` (a fast
-subset). Everything is a pure function of a seed, so a failing case can be rerun by its id.
+What it is for: finding inputs on which the compiled integrator misbehaves (a NaN, a wrong
+ending, unbounded work, impacts that stop advancing time, broken exact symmetries) by running
+thousands of seeded cases over and beyond the study's ranges, and checking each result against
+properties that must hold whatever the dynamics. It is test infrastructure shipped with the
+package so that both users of it import it the same way: ``tests/test_stress.py`` runs a fast
+subset in the test suite, and ``benchmarks/bench_stress.py`` runs the full suite and tabulates
+the outcome (benchmarks/README.md, "Stress suite"). Everything is a pure function of a seed, so a
+failing case can be rerun by its id (``python benchmarks/bench_stress.py --case ID``).
 
 Cases cover hb in [0.75, 20], alpha in [0, 3] (half of them with ``alpha omega^2 hb`` in [0, 4],
 near the uplift threshold), omega in [0.05, 20], e in [0, 1] (Housner, Mao and constant laws,
@@ -27,6 +34,27 @@ recording, and these initial states:
 ``impact_bound``
     ``max_impacts`` from 1 to 100, to exercise the bound.
 
+Issue 10 takes the suite beyond those ranges with three more categories, drawn by
+:func:`extreme_cases` (ids ``x<seed>-<i>``, so that the ids of the cases above stay what they
+were); their horizon is cut so that no run is given more than ``MAX_GRID_STEPS`` grid steps:
+
+``stiff_damping``
+    ``random`` cases with damping ``xi`` log-uniform in [0.5, 500] (500 itself now and then). The
+    fixed explicit step is stable only for ``h * 3/4 xi`` below a bound, so a default N must be
+    raised past it, and an explicit ``n_steps`` below it refused (a ``ValueError`` naming
+    ``n_steps``: counted as ``refused``);
+``wide_omega``
+    ``random`` cases with ``omega`` log-uniform in [1e-3, 1e3] (both ends now and then), half of
+    them with forcing near the uplift threshold (``alpha omega^2 hb`` in [0, 4], whatever alpha
+    that takes). At slow forcing the default N grows as ``T / 0.1``, ~63 000 steps per period at
+    omega = 1e-3, and such runs get few periods;
+``through_rest``
+    orbits that pass through rest: under forcing above the uplift threshold
+    (``alpha omega^2 = m cot(thc)``, ``m`` in [1.02, 4], mostly below 1.5), from rest
+    (``theta0 = theta0' = 0``) or rocking, mostly with a low restitution (``e`` in [0.02, 0.3])
+    so that impacts accumulate into a Zeno rest and the forcing lifts the block again; mostly
+    with exponents, and with ``rest_speed`` from 1e-8 to 1e-3.
+
 Checks of every run (:func:`check_run`; each returns a list of problems, empty when it passes):
 
 ``status``
@@ -34,9 +62,9 @@ Checks of every run (:func:`check_run`; each returns a list of problems, empty w
 ``finite``
     no NaN or inf in ``t, state, strobe, strobe_half, impacts, max_error_estimate, trajectory,
     lyapunov_running`` and the tangent; the exponents are finite except for their documented
-    sentinels: ``-inf`` for a run that came to rest, and from the first impact on with ``e = 0``
-    (which collapses every perturbation), ``nan`` when the run ended before the averaging window
-    began;
+    sentinels: ``-inf`` for a run that came to rest, from the first impact on with ``e = 0`` and
+    after a rest phase (both collapse every perturbation), ``nan`` when the run ended before the
+    averaging window began;
 ``time``
     ``0 <= t <= periods T``, ``t = periods T`` for ``done``, and as many stroboscopic samples as
     periods completed;
@@ -50,12 +78,18 @@ Checks of every run (:func:`check_run`; each returns a list of problems, empty w
     ``theta = theta' = 0`` with forcing too weak to lift it;
 ``progress``
     impacts advance time: no more than ``STALL`` (100) of them at one floating-point instant
-    (with ``rest_speed = 0``, which turns the Zeno cut-off off, such a stall is reported instead).
+    (with ``rest_speed = 0``, which turns the Zeno cut-off off, such a stall is reported instead);
+``rest_exponents``
+    an orbit that passes through rest within the averaging window (``n_rest_window > 0``) has no
+    positive exponent: a rest phase holds ``theta = theta' = 0`` until the forcing lifts the
+    block, whatever the perturbation, so every perturbation dies and the exponents are ``-inf``
+    (SPEC.md §5; issue 10 found lambda1 = +1.95 on such an orbit).
 
 Hitting the impact bound is not a failure; it is counted and reported as such. Neither is the
-refusal of a grid too coarse to integrate (``T/N`` above rockjit's step limit, or an embedded
-step beyond the oscillator's stability): it must be a ``ValueError`` naming ``n_steps`` (any
-other exception fails the ``status`` check), and it is counted as ``refused``.
+refusal of a grid too coarse to integrate (``T/N`` above rockjit's step limit, an embedded step
+beyond the oscillator's stability, or, issue 10, a step beyond the explicit stability of a large
+damping): it must be a ``ValueError`` naming ``n_steps`` first (any other exception fails the
+``status`` check), and it is counted as ``refused``.
 
 Exact checks that ride along:
 
@@ -85,13 +119,18 @@ from dataclasses import dataclass, field
 import numpy as np
 
 import rockjit
-from rockjit import analysis as an
-from rockjit.simulate import steps_per_period
+
+from . import analysis as an
+from .simulate import steps_per_period
 
 RANGES = dict(hb=(0.75, 20.0), alpha=(0.0, 3.0), omega=(0.05, 20.0), e=(0.0, 1.0))
 CATEGORIES = ("random", "near_zero", "grazing", "near_overturn", "long_horizon",
               "impact_bound")
-RUN_CHECKS = ("status", "finite", "time", "work", "bookkeeping", "progress")
+#: issue 10: the categories beyond the ranges above (:func:`extreme_cases`)
+EXTREME_CATEGORIES = ("stiff_damping", "wide_omega", "through_rest")
+EXTREME_RANGES = dict(xi=(0.5, 500.0), omega=(1e-3, 1e3))
+ALL_CATEGORIES = CATEGORIES + EXTREME_CATEGORIES
+RUN_CHECKS = ("status", "finite", "time", "work", "bookkeeping", "progress", "rest_exponents")
 EXACT_CHECKS = ("energy", "mirror_embedded", "mirror_closed", "threads")
 KNOWN_STATUS = ("done", "overturned", "rest", "max_impacts")
 HALF_PI = 0.5 * math.pi
@@ -106,6 +145,13 @@ STALL = 100
 #: rhs evaluations an event may cost beyond its grid step: 8 Newton re-steps of 6 stages, the
 #: re-started rest of the step (6) and the refreshed first stage (1), rounded up
 EVENT_RHS = 56
+
+#: The most grid steps (N times periods) an extreme case is given: its periods are cut to fit.
+MAX_GRID_STEPS = 400_000
+
+#: ``h * 3/4 xi`` an explicit Dormand–Prince step stays stable below (its stability interval
+#: on the negative real axis is ~3.3; taken lower to estimate the N a stiff case will need).
+STIFF_HXI = 2.5
 
 
 @dataclass
@@ -324,6 +370,101 @@ def cases(n, seed=0, *, max_periods=200, long_periods=20_000):
     return out
 
 
+# --------------------------------------------------------------------------- issue 10's cases
+
+
+def cost_n(kw):
+    """The N a case is expected to run with: :func:`grid_n`, and at least the N that keeps a
+    stiff damping stable (``h * 3/4 xi <= STIFF_HXI``)."""
+    n = grid_n(kw)
+    xi = kw.get("xi", 0.0)
+    if not kw.get("n_steps") and xi > 0:
+        n = max(n, 2 * math.ceil(2 * math.pi / kw["omega"] * 0.75 * xi / (2 * STIFF_HXI)))
+    return n
+
+
+def _fit(kw, max_steps=MAX_GRID_STEPS):
+    """Cut the horizon to ``max_steps`` grid steps (one period at least); no recording of runs
+    longer than 200 000 steps."""
+    n = cost_n(kw)
+    kw["periods"] = max(1, min(kw["periods"], max_steps // n))
+    if n * kw["periods"] > 200_000:
+        kw.pop("record_stride", None)
+    return kw
+
+
+def case_stiff_damping(rng, max_periods):
+    kw = case_random(rng, max_periods)
+    lo, hi = EXTREME_RANGES["xi"]
+    kw["xi"] = hi if rng.random() < 0.1 else _logu(rng, lo, hi)
+    return _fit(kw)
+
+
+def case_wide_omega(rng, max_periods):
+    kw = case_random(rng, max_periods)
+    lo, hi = EXTREME_RANGES["omega"]
+    u = rng.random()
+    kw["omega"] = lo if u < 0.05 else hi if u < 0.1 else _logu(rng, lo, hi)
+    if rng.random() < 0.5:
+        # near the uplift threshold, whatever alpha that takes (1e6 at omega = 1e-3)
+        kw["alpha"] = float(rng.uniform(0.0, 4.0)) / (kw["hb"] * kw["omega"] ** 2)
+    return _fit(kw)
+
+
+def case_through_rest(rng, max_periods):
+    kw = _params(rng)
+    cot = 1.0 / kw["hb"]
+    a_max = RANGES["alpha"][1]
+    # forcing above the uplift threshold, so that a block at rest is lifted again; mostly a
+    # little above it, where a lifted block comes back to rest within the period
+    m = _logu(rng, 1.02, 1.5) if rng.random() < 0.75 else _logu(rng, 1.5, 4.0)
+    om_lo = max(RANGES["omega"][0], math.sqrt(cot * m / a_max) * 1.0001)
+    kw["omega"] = _logu(rng, om_lo, RANGES["omega"][1])
+    kw["alpha"] = cot * m / kw["omega"] ** 2
+    if rng.random() < 0.7:  # a low restitution: impacts accumulate into a Zeno rest
+        kw["law"] = "constant"
+        kw["e"] = float(rng.uniform(0.02, 0.3))
+    if rng.random() < 0.5:
+        kw["theta0"] = 0.0
+        kw["dtheta0"] = 0.0
+    else:
+        tip = HALF_PI - _thc(kw)
+        kw["theta0"] = float(rng.uniform(-0.5, 0.5) * tip)
+        kw["dtheta0"] = float(rng.uniform(-0.3, 0.3))
+    _settings(rng, kw, max_periods, lo_periods=min(5, max_periods))
+    kw.pop("theta_over", None)
+    kw["lyapunov"] = bool(rng.random() < 0.7)
+    kw["rest_speed"] = float(_pick(rng, (1e-8, 1e-6, 1e-6, 1e-4, 1e-3)))
+    _phase(rng, kw)
+    return _fit(kw)
+
+
+def extreme_cases(n, seed=0, *, max_periods=200):
+    """``n`` seeded cases of issue 10's categories (:data:`EXTREME_CATEGORIES`), in turn.
+
+    Ids are ``x<seed>-<i>``, drawn from their own seeds, so that :func:`cases` keeps its ids.
+    """
+    out = []
+    for i in range(n):
+        cat = EXTREME_CATEGORIES[i % len(EXTREME_CATEGORIES)]
+        rng = np.random.default_rng([seed, 5, i])
+        kw = globals()[f"case_{cat}"](rng, max_periods)
+        out.append(Case(id=f"x{seed}-{i}", category=cat, kwargs=kw))
+    return out
+
+
+def case_by_id(case_id, *, max_periods=200, long_periods=20_000):
+    """The case ``s<seed>-<i>`` (:func:`cases`) or ``x<seed>-<i>`` (:func:`extreme_cases`)
+    drawn with the same horizon settings as the run that listed it."""
+    pre, idx = case_id.split("-")
+    kind, seed, i = pre[0], int(pre[1:]), int(idx)
+    if kind == "s":
+        return cases(i + 1, seed, max_periods=max_periods, long_periods=long_periods)[i]
+    if kind == "x":
+        return extreme_cases(i + 1, seed, max_periods=max_periods)[i]
+    raise ValueError(f"case id must look like s0-29 or x0-29 (got {case_id!r})")
+
+
 # --------------------------------------------------------------------------- per-run checks
 
 
@@ -345,9 +486,10 @@ def check_finite(kw, res):
         v = getattr(res, name)
         if v is not None and _bad(v):
             probs.append(f"non-finite in {name}")
+    # an impact with e = 0, and a rest phase, collapse every perturbation: -inf from there on
+    collapse = (res.block.restitution == 0.0 and res.n_impacts > 0) or res.n_rest > 0
     if res.lyapunov_running is not None:
         lr = np.asarray(res.lyapunov_running)
-        collapse = res.block.restitution == 0.0 and res.n_impacts > 0
         if np.any(np.isnan(lr)) or np.any(lr == np.inf) or \
                 (np.any(lr == -np.inf) and not collapse):
             probs.append("non-finite in lyapunov_running")
@@ -355,8 +497,6 @@ def check_finite(kw, res):
         probs.append("non-finite in extra['tangent']")
     if res.lyapunov is not None:
         lam = np.asarray(res.lyapunov)
-        # an impact with e = 0 collapses every perturbation: -inf from there on
-        collapse = res.block.restitution == 0.0 and res.n_impacts > 0
         if res.status == "rest":
             if not np.all(lam == -np.inf):
                 probs.append(f"lyapunov {lam} for a run at rest (expected -inf)")
@@ -491,8 +631,21 @@ def check_progress(kw, res):
     return []
 
 
+def check_rest_exponents(kw, res):
+    """An orbit through rest within the averaging window has no positive exponent: a rest phase
+    erases every perturbation (the exponents are ``-inf``, SPEC.md §5)."""
+    if res.lyapunov is None or res.n_rest_window == 0:
+        return []
+    lam = np.asarray(res.lyapunov)
+    if np.any(lam > 0.0):
+        return [f"lyapunov {lam} with {res.n_rest_window} rest phases in the window "
+                "(expected -inf: a rest phase erases every perturbation)"]
+    return []
+
+
 RUN_CHECK_FUNCS = dict(status=check_status, finite=check_finite, time=check_time,
-                       work=check_work, bookkeeping=check_bookkeeping, progress=check_progress)
+                       work=check_work, bookkeeping=check_bookkeeping, progress=check_progress,
+                       rest_exponents=check_rest_exponents)
 
 
 def check_run(kw, res):
@@ -507,15 +660,17 @@ def check_run(kw, res):
 
 
 def refused(exc):
-    """Is ``exc`` rockjit's documented refusal of a grid too coarse to integrate?"""
-    return isinstance(exc, ValueError) and str(exc).startswith("n_steps must be")
+    """Is ``exc`` rockjit's documented refusal of a grid too coarse to integrate (a
+    ``ValueError`` whose message opens with the parameter's name, ``n_steps``)?"""
+    return isinstance(exc, ValueError) and str(exc).startswith("n_steps")
 
 
 def run_case(case):
     """``(result, problems, refusal)``.
 
-    A grid too coarse to integrate (``T/N`` beyond rockjit's step limit, or an embedded step
-    beyond the oscillator's stability) must be refused with a ``ValueError`` naming ``n_steps``:
+    A grid too coarse to integrate (``T/N`` beyond rockjit's step limit, an embedded step beyond
+    the oscillator's stability, or a step beyond the explicit stability of a large damping) must
+    be refused with a ``ValueError`` naming ``n_steps``:
     that is ``(None, {no problems}, message)``. Any other exception is a failure of the
     ``status`` check.
     """

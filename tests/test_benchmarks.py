@@ -1,0 +1,146 @@
+"""Every benchmark script still runs: its ``--quick`` mode, into a temporary folder.
+
+Each script of ``benchmarks/`` runs as a user runs it (``python benchmarks/bench_X.py --quick
+--out DIR``, in a subprocess importing this checkout), and must exit cleanly and write the files
+benchmarks/README.md promises, each readable: the JSON strict (no NaN or Infinity literals:
+rockjit's convention writes them as strings), the CSV with the columns the README quotes and a
+rectangular body, the PNG a PNG, the Markdown a table. A ``--quick`` run must never touch the
+committed results or the README. No timing is asserted (timings are the scripts' business).
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+BENCH = ROOT / "benchmarks"
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+#: script -> (CSV columns, figures); the columns are the ones the scripts wrote before the
+#: harness was shared (benchmarks/README.md and the committed results quote them)
+SCRIPTS = {
+    "bench_reference_run.py": (
+        ["method", "n_steps_or_tol", "forcing", "wall_median_s", "compile_cold_s",
+         "compile_cached_s", "final_state_error", "max_impact_time_error", "n_rhs",
+         "speedup_vs_bdf"], ["reference_run.png"]),
+    "bench_event_accuracy.py": (
+        ["orbit", "n_steps", "vs_converged", "vs_dop853_atol_1e-12", "vs_dop853_atol_1e-14"],
+        ["event_accuracy.png"]),
+    "bench_lyapunov_cost.py": (
+        ["n_steps", "wall_median_off_s", "wall_median_on_s", "cost_ratio", "n_rhs", "lambda1",
+         "lambda2", "lambda_sum", "identity_rhs", "identity_error"], ["lyapunov_cost.png"]),
+    "bench_work_precision.py": (
+        ["scene", "method", "setting", "wall_median_s", "n_rhs", "error", "impact_time_error",
+         "status", "n_impacts", "flag"],
+        [f"work_precision_{s}.png" for s in ("periodic", "chaotic", "overturn",
+                                             "overturn_study")]),
+    "bench_throughput.py": (["table", "key", "value"], ["throughput.png"]),
+    "bench_grids.py": (
+        ["item", "case", "n_steps", "wall_median_s", "runs", "target_s", "agreement_percent"],
+        ["grids_timing.png", "grids_agreement.png", "grids_sweep_resolution.png"]),
+    "bench_paper.py": (
+        ["run", "kind", "wall_outside_s", "wall_s", "fig1", "fig2", "fig3", "fig4", "fig5",
+         "fig6"], ["paper.png"]),
+    "bench_distributed.py": (
+        ["run", "chunks", "wall median s", "ratio to in-process", "overhead per chunk s",
+         "identical to in-process"], ["distributed.png"]),
+    "bench_stress.py": (
+        ["id", "category", "hb", "alpha", "omega", "law", "e", "n_steps", "periods", "forcing",
+         "status", "t", "n_impacts", "n_rhs", "work_bound", "wall_s", "failed_checks"],
+        ["stress.png"]),
+}
+
+#: bench_stress.py exits with this status when the suite ran and its checks found failures
+#: (tests/test_stress.py is where they must be 0); any other non-zero status is a broken script
+STRESS_FOUND_FAILURES = 3
+
+
+def _env():
+    path = os.environ.get("PYTHONPATH", "")
+    return dict(os.environ, PYTHONPATH=str(ROOT) + (os.pathsep + path if path else ""),
+                MPLBACKEND="Agg")
+
+
+def _run(script, *args, cwd, timeout=600):
+    return subprocess.run([sys.executable, str(BENCH / script), *args], cwd=cwd, env=_env(),
+                          capture_output=True, text=True, timeout=timeout)
+
+
+def _strict(name):
+    raise ValueError(f"{name} is not strict JSON")
+
+
+def _fingerprint():
+    """The committed results and the README, as they are on disk."""
+    files = sorted(p for p in (BENCH / "results").glob("*") if p.is_file())
+    files.append(BENCH / "README.md")
+    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in files}
+
+
+def test_every_script_is_tested():
+    assert sorted(p.name for p in BENCH.glob("bench_*.py")) == sorted(SCRIPTS)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("script", sorted(SCRIPTS))
+def test_quick_mode_writes_what_it_promises(script, tmp_path):
+    if script == "bench_distributed.py":
+        pytest.importorskip("dask.distributed")
+    columns, figures = SCRIPTS[script]
+    name = script[len("bench_"):-len(".py")]
+    before = _fingerprint()
+    out = tmp_path / "out"
+    proc = _run(script, "--quick", "--out", str(out), cwd=tmp_path)
+    ok = (0, STRESS_FOUND_FAILURES) if script == "bench_stress.py" else (0,)
+    assert proc.returncode in ok, proc.stdout[-2000:] + proc.stderr[-4000:]
+
+    md = (out / f"{name}.md").read_text(encoding="utf-8")
+    assert "|---|" in md
+    if proc.returncode == STRESS_FOUND_FAILURES:
+        assert "Failures (rerun one with" in md
+
+    data = json.loads((out / f"{name}.json").read_text(encoding="utf-8"),
+                      parse_constant=_strict)
+    assert isinstance(data, dict) and data
+
+    with open(out / f"{name}.csv", newline="", encoding="utf-8") as f:
+        rows = list(csv.reader(f))
+    assert rows[0] == columns
+    assert len(rows) > 1 and all(len(r) == len(columns) for r in rows[1:])
+
+    for fig in figures:
+        assert (out / fig).read_bytes()[:8] == PNG_MAGIC, fig
+    assert _fingerprint() == before  # a smoke run never touches the committed results
+
+
+def test_quick_refuses_to_write_the_committed_results(tmp_path):
+    before = _fingerprint()
+    proc = _run("bench_event_accuracy.py", "--quick", "--out", str(BENCH / "results"),
+                cwd=tmp_path, timeout=120)
+    assert proc.returncode == 2
+    assert "--quick never writes to benchmarks/results/" in proc.stderr
+    assert _fingerprint() == before
+
+
+def test_quick_defaults_to_the_ignored_quick_folder(tmp_path):
+    code = ("import _common as H; "
+            "b = H.Bench('doc', ['--quick']); "
+            "print(b.out_path.resolve(), b.publishes); "
+            "b = H.Bench('doc', []); "
+            "print(b.out_path.resolve(), b.publishes)")
+    env = _env()
+    env["PYTHONPATH"] = str(BENCH) + os.pathsep + env["PYTHONPATH"]
+    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    lines = [x for x in proc.stdout.splitlines() if not x.startswith("Measured on")]
+    assert lines[-2] == f"{(BENCH / 'results' / 'quick').resolve()} False"
+    assert lines[-1] == f"{(BENCH / 'results').resolve()} True"
