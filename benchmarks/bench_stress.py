@@ -214,9 +214,7 @@ def markdown(m):
                            f"{exact[k]['refused']} refused" if exact[k]["refused"] else ""])
     obs_rows = [["impact bound hit (status `max_impacts`)", tally.obs["impact_bound"]],
                 [f"overturned off the threshold on a grid with h > {S.H_RESOLVED:g}",
-                 tally.obs["coarse_overturn_off_threshold"]],
-                [f"Zeno cascade stalled (> {S.STALL} impacts at one instant) with the cut-off "
-                 "off, `rest_speed = 0`", tally.obs["zeno_stall_without_cutoff"]]]
+                 tally.obs["coarse_overturn_off_threshold"]]]
     fail_rows = []
     for k in S.RUN_CHECKS:
         for f in tally.fail[k][:12]:

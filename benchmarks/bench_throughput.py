@@ -75,7 +75,7 @@ def step_internals():
     - ``rockjit.integrate``: ``rk_step``, ``rhs``, ``step_table``; the constants ``N_STAGES``,
       ``N_TAB``, ``N_PAR``, ``N_PARW`` and the parameter-vector indices ``P_THC``, ``P_OMEGA``,
       ``P_H``, ``P_STHC``, ``P_CTHC``;
-    - ``rockjit.simulate.pack`` (the float parameter vector);
+    - ``rockjit.kernel.pack`` (the float parameter vector);
     - ``rockjit.model.sincos_poly`` (the stepper's sine and cosine).
 
     Returns
@@ -88,7 +88,7 @@ def step_internals():
     """
     from rockjit import integrate as ig
     from rockjit.model import sincos_poly
-    from rockjit.simulate import pack
+    from rockjit.kernel import pack
 
     rk_step, rhs, n_stages = ig.rk_step, ig.rhs, ig.N_STAGES
 

@@ -107,7 +107,8 @@ def _grid_common(block, phi, *, periods, n_steps, window, early_stop, tol, pmax,
     par = kernel.pack(block, phi, n_steps, settle_tol)
     ipar = kernel.settings(n_steps, periods, max_impacts, w0,
                            settle_reps=settle_reps if early_stop else 0, pmax=pmax,
-                           stop_at_overturn=stop_at_overturn)
+                           stop_at_overturn=stop_at_overturn, h=block.period / n_steps,
+                           xi=block.xi)
     cpar = np.zeros(2)
     cpar[kernel.C_TOL] = tol
     cpar[kernel.C_LAMTOL] = lam_tol

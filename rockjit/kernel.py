@@ -73,10 +73,31 @@ def pack(block, phi, n_steps, settle_tol=0.0):
     return par
 
 
+#: Between two renormalisations the second tangent vector may lose at most exp(-QR_CONTRACTION)
+#: against the first: damping separates the two exponents by about 3/4 xi, and once the second
+#: vector's own direction falls below rounding relative to the first, Gram-Schmidt finds
+#: nothing left of it and the kernel takes it for a collapse (found by the stress suite: xi =
+#: 105 renormalised twice a period, exp(-73), gave lambda2 = -inf with no rest and no impact).
+#: exp(-20) = 2e-9 keeps seven digits of it.
+QR_CONTRACTION = 20.0
+
+
+def default_qr_every(n_steps, h, xi):
+    """Grid steps between renormalisations: twice a period, or often enough that damping
+    (rate ``3/4 xi``, step ``h``) separates the two vectors by at most
+    ``exp(-QR_CONTRACTION)``."""
+    n = n_steps // 2
+    c = 0.75 * xi * h
+    if c > 0.0:
+        n = min(n, max(1, int(QR_CONTRACTION / c)))
+    return n
+
+
 def settings(n_steps, periods, max_impacts, window, *, stride=1, settle_reps=0, qr_every=None,
-             pmax=1, stop_at_overturn=True):
+             pmax=1, stop_at_overturn=True, h=0.0, xi=0.0):
     """The integer settings ``ipar`` (layout ``I_*`` in :mod:`rockjit.integrate`);
-    ``qr_every`` defaults to twice per period."""
+    ``qr_every`` defaults to :func:`default_qr_every` (``h`` the largest step, ``xi`` the
+    damping)."""
     ipar = np.zeros(ig.N_IPAR, dtype=np.int64)
     ipar[ig.I_N] = n_steps
     ipar[ig.I_PERIODS] = periods
@@ -84,7 +105,7 @@ def settings(n_steps, periods, max_impacts, window, *, stride=1, settle_reps=0, 
     ipar[ig.I_STRIDE] = stride
     ipar[ig.I_WINDOW] = window
     ipar[ig.I_SETTLE] = settle_reps
-    ipar[ig.I_QR] = n_steps // 2 if qr_every is None else qr_every
+    ipar[ig.I_QR] = default_qr_every(n_steps, h, xi) if qr_every is None else qr_every
     ipar[ig.I_PMAX] = pmax
     ipar[ig.I_CONTINUE] = 0 if stop_at_overturn else 1
     return ipar
@@ -130,7 +151,8 @@ def run_single(block, y0, phi, *, n_steps, periods, window, max_impacts, record_
     run = ig.build(embed4=embed4, tangent=lyapunov, record=record_stride is not None)
     par = pack(block, phi, n_steps)
     ipar = settings(n_steps, periods, max_impacts, window, stride=record_stride or 1,
-                    qr_every=qr_every, stop_at_overturn=stop_at_overturn)
+                    qr_every=qr_every, stop_at_overturn=stop_at_overturn,
+                    h=block.period / n_steps, xi=block.xi)
     n_traj = periods * n_steps // record_stride + 1 if record_stride else 1
     out = outputs(periods, max_impacts, n_traj, lyapunov)
     y0 = np.asarray(y0, dtype=float)

@@ -101,8 +101,11 @@ def delta_e_percent(e1, e2):
 #: Allowed ranges of the block's parameters. They are wide (the study's values are hb 1-2,
 #: alpha <= 1, omega ~ 1, xi ~ 2e-4) and keep every product the integrator forms finite.
 HB_RANGE = (1e-2, 1e2)
-ALPHA_MAX = 1e3
+ALPHA_MAX = 1e9
 OMEGA_RANGE = (1e-4, 1e4)
+#: Largest forcing acceleration ``alpha omega^2`` (in units of g): slow forcing may take a
+#: large amplitude alpha, what the block feels is the acceleration.
+ACCEL_MAX = 1e8
 XI_MAX = 1e4
 REST_SPEED_MAX = 0.1
 
@@ -116,7 +119,7 @@ class Block:
     hb : float
         Slenderness ``h/b`` in ``[0.01, 100]`` (``>= 1/sqrt(2)`` for the Housner law).
     alpha : float
-        Forcing amplitude ``A/R`` in ``[0, 1000]``.
+        Forcing amplitude ``A/R`` in ``[0, 1e9]``, with ``alpha omega^2 <= 1e8``.
     omega : float
         Forcing frequency ``Omega/Omega0`` in ``[1e-4, 1e4]``.
     law : {"housner", "mao", "constant"}, optional
@@ -160,6 +163,10 @@ class Block:
             )
         alpha = real("alpha", self.alpha, 0.0, ALPHA_MAX)
         omega = real("omega", self.omega, *OMEGA_RANGE)
+        if alpha * omega**2 > ACCEL_MAX:
+            raise ValueError(f"the forcing acceleration alpha * omega**2 must be <= "
+                             f"{ACCEL_MAX:g} (got alpha = {alpha:g}, omega = {omega:g}: "
+                             f"{alpha * omega**2:.3g})")
         xi = real("xi", self.xi, 0.0, XI_MAX)
         theta_over = real("theta_over", self.theta_over, 0.0, 0.5 * math.pi, lo_open=True)
         if isinstance(self.rest_speed, (int, float)) and self.rest_speed == 0:

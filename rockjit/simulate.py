@@ -345,8 +345,9 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
         block at rest.
     qr_every : int, optional
         Grid steps between Gram–Schmidt renormalisations of the tangent vectors; default
-        ``n_steps // 2``; 0 renormalises only on entering rest, so that for a run without rest
-        phases ``result.extra["tangent"]`` is the Jacobian of the whole flow (short runs, tests).
+        twice a period, or more often under strong damping (:func:`rockjit.kernel.
+        default_qr_every`); 0 never renormalises, so that ``result.extra["tangent"]`` is the
+        Jacobian of the whole flow (zero across a rest phase; short runs, tests).
     stop_at_overturn : bool
         Stop when ``|theta|`` reaches ``theta_over`` (the physical rule, default). ``False``
         integrates on through the threshold with the same equations, as the study's own code
