@@ -16,7 +16,9 @@ Shooting
     Newton on ``F(x) = P^p(x) - x`` with the exact Jacobian ``M - I``, damped by halving the step
     until ``|F|`` decreases (and the trial run neither overturns nor rests), each step at most half
     the orbit's size. Unstable orbits converge like stable ones. Converged when
-    ``max|F| <= tol`` (default ``1e-11``, in the units of ``theta, theta'``).
+    ``max|F| <= tol max(1, |M|)`` (``tol`` default ``1e-12``, in the units of ``theta,
+    theta'``; ``|M|`` the monodromy's infinity norm, since the round-off of ``P^p(x)`` grows
+    with it), or when ``|F|`` stops decreasing within ten times that.
 Section
     An impact at a sampling instant makes the stroboscopic point jump (``theta' -> e theta'``):
     the map is discontinuous there although the orbit is not. Newton and continuation therefore
@@ -92,10 +94,12 @@ __all__ = ["BIFURCATION_TYPES", "N_ORBIT", "Bifurcation", "Branch", "Continuatio
            "OrbitRefused", "PeriodicOrbit", "continuation", "continue_branches",
            "periodic_orbit"]
 
-#: Steps per forcing period of the shooting runs. On the hb=1 Housner orbits over
-#: alpha in [0.5, 1.0] the fixed points at N = 256 have residuals below 1e-11 in a converged
-#: integration (N = 4096), against up to 8e-11 at N = 160 (benchmarks/bench_orbits.py).
-N_ORBIT = 256
+#: Steps per forcing period of the shooting runs. On orbits sampled along every branch of the
+#: hb=1 Housner case over alpha in [0.5, 1.0] (periods 1 to 8, |mu| up to 50), the fixed
+#: points found at N = 384 have residuals of at most 2.4e-11 in a converged plain run
+#: (N = 8192), against 2.2e-10 at N = 256 and 2.4e-9 at N = 160 (benchmarks/bench_orbits.py);
+#: a step costs little beside the fixed cost of a call (+13 % for the continuation over 256).
+N_ORBIT = 384
 
 BIFURCATION_TYPES = ("fold", "symmetry_breaking", "period_doubling", "neimark_sacker",
                      "grazing")
@@ -214,7 +218,8 @@ class PeriodicOrbit:
     alpha, omega, phase : float
         Forcing amplitude, frequency and phase.
     residual : float
-        ``max|P^p(x) - x|`` at the computational section (see the module docstring).
+        ``max|P^p(x) - x|`` at ``section_phase``: the requested phase, unless an impact sits so
+        close to it that Newton worked on a shifted section only (module docstring).
     multipliers : ndarray of complex, shape (2,)
         Floquet multipliers, largest modulus first.
     stable : bool
@@ -228,7 +233,7 @@ class PeriodicOrbit:
     iterations : int
         Newton iterations.
     monodromy : ndarray, shape (2, 2)
-        ``M`` at the computational section, phase ``section_phase``.
+        ``M`` at the phase ``section_phase``.
     max_theta : float
         Largest ``|theta|`` on the grid along the cycle.
     min_impact_speed : float
@@ -570,12 +575,19 @@ class _Info:
 # ---------------------------------------------------------------------------------------------
 
 class _Solver:
-    def __init__(self, flow, *, tol=1e-11, sym_tol=1e-6, fd_rel=1e-7):
+    def __init__(self, flow, *, tol=1e-12, sym_tol=1e-6, fd_rel=1e-7):
         self.flow = flow
         self.N = flow.N
         self.tol = tol
         self.sym_tol = sym_tol
         self.fd = fd_rel
+
+    def tol_for(self, ev):
+        """Newton's tolerance at an evaluation: ``tol`` times ``max(1, |M|)`` (the round-off
+        in ``P^p(x)`` grows with the orbit's expansion)."""
+        if ev.M is None:
+            return self.tol
+        return self.tol * max(1.0, float(np.abs(ev.M).sum(axis=1).max()))
 
     # -- residuals ----------------------------------------------------------------------------
     def full(self, x, lam, p, j):
@@ -640,10 +652,11 @@ class _Solver:
                 return False, y, ev, it, ev.reason
             g = float(n @ y) - c
             res = max(float(np.abs(ev.F).max()), abs(g))
-            if res <= self.tol:
+            tol = self.tol_for(ev)
+            if res <= tol:
                 return True, y, ev, it, None
             if it >= 3 and res > 0.5 * prev:
-                if res <= 10 * self.tol:  # round-off floor
+                if res <= 10 * tol:  # round-off floor
                     return True, y, ev, it, None
                 break
             prev = res
@@ -677,7 +690,7 @@ class _Solver:
         res = float(np.abs(ev.F).max())
         I2 = np.eye(2)
         for it in range(max_iter):
-            if res <= self.tol:
+            if res <= self.tol_for(ev):
                 return ev, it
             try:
                 dx = -np.linalg.solve(ev.M - I2, ev.F)
@@ -696,7 +709,7 @@ class _Solver:
                         break
                 step *= 0.5
             else:
-                if res <= 10 * self.tol:  # round-off floor
+                if res <= 10 * self.tol_for(ev):  # round-off floor
                     return ev, it
                 raise OrbitRefused("no_convergence",
                                    f"no decrease of |F| = {res:.3g} after {it} iterations")
@@ -705,9 +718,30 @@ class _Solver:
                                               f"iterates near the solution ({ev.nimp} -> "
                                               f"{et.nimp})")
             ev, res = et, rt
-        if res <= self.tol:
+        if res <= self.tol_for(ev):
             return ev, max_iter
         raise OrbitRefused("no_convergence", f"|F| = {res:.3g} after {max_iter} iterations")
+
+    def polish(self, ev, lam, p, j, steps=2):
+        """Newton steps beyond the tolerance while they reduce ``|F|`` (down to round-off)."""
+        res = float(np.abs(ev.F).max())
+        for _ in range(steps):
+            if res == 0.0:
+                break
+            try:
+                dx = -np.linalg.solve(ev.M - np.eye(2), ev.F)
+            except np.linalg.LinAlgError:
+                break
+            et = self.full(ev.x + dx, lam, p, j)
+            if not et.ok or et.nimp != ev.nimp:
+                break
+            rt = float(np.abs(et.F).max())
+            if rt >= 0.5 * res:
+                if rt < res:
+                    ev = et
+                break
+            ev, res = et, rt
+        return ev
 
     # -- analysis of a converged orbit --------------------------------------------------------
     def analyse(self, r, lam, p, j):
@@ -837,6 +871,21 @@ def _shoot(solver, x0, lam, p, refuse_grazing=True, graze_tol=1e-4, over_tol=1e-
         x = solver.shifted(info, best)
     ev, iters = solver.newton(x, lam, p, j, info.scale, max_iter=max_iter)
     info = solver.analyse(ev.r, lam, p, j)
+    done = False
+    if j != 0:
+        # the point at the requested phase, polished there: carried from the computational
+        # section along an expanding orbit the residual grows; Newton steps this small cannot
+        # cross an impact unless one sits at that very instant
+        eo = solver.full(info.cycle[0].copy(), lam, p, 0)
+        if eo.ok and eo.nimp == ev.nimp:
+            eo = solver.polish(eo, lam, p, 0)
+            if float(np.abs(eo.F).max()) <= max(10 * float(np.abs(ev.F).max()),
+                                                solver.tol_for(eo)):
+                ev, j, done = eo, 0, True
+                info = solver.analyse(ev.r, lam, p, 0)
+    if not done:
+        ev = solver.polish(ev, lam, p, j)
+        info = solver.analyse(ev.r, lam, p, j)
     res = float(np.abs(ev.F).max())
     if refuse_grazing:
         blk = flow.block
@@ -852,7 +901,7 @@ def _shoot(solver, x0, lam, p, refuse_grazing=True, graze_tol=1e-4, over_tol=1e-
     return info, ev.x.copy(), j, res, iters
 
 
-def periodic_orbit(block_or_params, x0, p=1, *, phase=0.0, n_steps=N_ORBIT, tol=1e-11,
+def periodic_orbit(block_or_params, x0, p=1, *, phase=0.0, n_steps=N_ORBIT, tol=1e-12,
                    max_iter=40, graze_tol=1e-4, over_tol=1e-3, sym_tol=1e-6,
                    max_impacts_per_period=1000) -> PeriodicOrbit:
     """A period-``p`` orbit of the stroboscopic map by Newton's method (shooting).
@@ -1441,7 +1490,7 @@ def _settings(kw):
         if k not in st and k not in ("tol", "sym_tol"):
             raise TypeError(f"unexpected keyword argument {k!r}")
         st[k] = v
-    st.setdefault("tol", 1e-11)
+    st.setdefault("tol", 1e-12)
     st.setdefault("sym_tol", 1e-6)
     for k in ("ds0", "ds_min", "ds_max", "join_tol", "graze_tol", "param_tol", "tol",
               "sym_tol"):
@@ -1484,7 +1533,7 @@ def continuation(block_or_params, seeds, *, parameter="alpha", bounds, phase=0.0
         (8); ``join_tol`` (1e-3: two cycles are the same orbit within this fraction of the
         orbit's size); ``max_calls`` (a bound on simulate calls); ``graze_tol`` (1e-4, seeds);
         ``param_tol`` (1e-8: bifurcations are located to this in the parameter); ``tol``
-        (1e-11, Newton); ``sym_tol`` (1e-6, symmetry and branch points).
+        (1e-12, Newton); ``sym_tol`` (1e-6, symmetry and branch points).
 
     Returns
     -------
