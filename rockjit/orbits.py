@@ -18,15 +18,19 @@ Shooting
     the orbit's size. Unstable orbits converge like stable ones. Converged when
     ``max|F| <= tol max(1, |M|)`` (``tol`` default ``1e-12``, in the units of ``theta,
     theta'``; ``|M|`` the monodromy's infinity norm, since the round-off of ``P^p(x)`` grows
-    with it), or when ``|F|`` stops decreasing within ten times that.
+    with it), or when ``|F|`` stops decreasing within ten times that. :func:`periodic_orbit`
+    then takes up to two more steps while they halve ``|F|`` (down to round-off), at the
+    requested phase.
 Section
     An impact at a sampling instant makes the stroboscopic point jump (``theta' -> e theta'``):
     the map is discontinuous there although the orbit is not. Newton and continuation therefore
     work on a *computational* section, the forcing phase shifted by a whole number ``j`` of grid
     steps so that it lies in the middle of the largest gap between impacts, and moved again when
     an impact comes within 30 % of the best achievable margin. States are reported at the
-    requested phase (read off the recorded trajectory, which has every grid point); multipliers
-    do not depend on the section.
+    requested phase (read off the recorded trajectory, which has every grid point, and for
+    :func:`periodic_orbit` polished there by Newton: carried along an expanding orbit, a
+    residual at round-off at one section grows at another); multipliers do not depend on the
+    section.
 Symmetry
     The equations are odd under ``theta -> -theta`` with the forcing shifted by ``T/2``. A cycle
     is *symmetric* when ``x(t + pT/2) = -x(t)``; this needs ``p`` odd (for ``p = 1``:
@@ -47,14 +51,23 @@ Refusals
     largest ``|theta|`` within a fraction ``over_tol`` of ``theta_over``, or an impact count that
     changes between Newton iterates near the solution.
 Continuation
-    Pseudo-arclength (Keller 1977; Seydel 2010 ch. 4; Doedel's AUTO): unknowns
+    Pseudo-arclength (Keller 1977; Seydel 2010 ch. 4; Doedel et al. 1991): unknowns
     ``y = (theta, theta', lambda)``, secant predictor, Newton corrector on the bordered system
     ``[F_x F_lambda; t^T]`` with ``F_lambda`` by a forward difference, step grown by 1.3 after a
     corrector of at most 3 iterations and halved after a failure. A step whose orbit has a
     different number of impacts per cycle brackets a grazing, which is then located by bisection
-    and ends the branch; so do overturning, rest, the range's end, a branch point (a doubled or
-    asymmetric branch folding back onto the orbit it was born from), joining a branch already
-    computed, or closing a loop.
+    (to ``param_tol``) and ends the branch. Near a grazing from the side without the extra
+    impact the map's derivative blows up (di Bernardo et al. 2008, ch. 6) and the corrector
+    fails before the count changes: when the step has shrunk to ``ds_min`` and the last orbit
+    turns back within ``1e-3`` of its size from ``theta = 0`` (or hits it at a speed that
+    small), the orbit is followed by damped Newton at fixed parameter values to where it stops
+    existing, by bisection (measured on the hb=1 Housner case: within ``3e-10`` of where the
+    turning point's depth, from dense plain runs, extrapolates to zero). Overturning and rest
+    end a branch likewise, located the same way and reported as a grazing (of ``theta_over``,
+    of rest). A branch also ends at the
+    range's end, at a branch point (a doubled or asymmetric branch folding back onto the orbit
+    it was born from, which is then seeded too), on joining a branch already computed (or its
+    mirror image), or on closing a loop.
 Bifurcations
     Test functions on consecutive branch points (Kuznetsov 2004 ch. 10; Seydel 2010 ch. 5):
     ``det(M - I)`` (a real multiplier through +1), ``det(M + I)`` (through -1),
@@ -65,9 +78,11 @@ Bifurcations
     symmetry-breaking pitchfork when ``A``'s eigenvalue crosses -1 and a fold when it crosses +1
     (then ``det(I - A)`` changes sign too); on other orbits it is a fold. Period doubling and
     symmetry breaking are followed onto the new branch (``2p``, resp. ``p`` without symmetry)
-    from the located point along the critical eigenvector. Neimark–Sacker cannot occur for
-    impacting orbits with ``e < 1``: ``det M = e^(2n) exp(-3 xi pT / 4) < 1`` with ``n`` impacts
-    per cycle (SPEC.md §5), so a complex pair has ``|mu| < 1``; the test is kept for ``e = 1``.
+    from the located point along the critical eigenvector. Neimark–Sacker cannot occur in this
+    model unless ``e = 1`` and ``xi = 0``: ``det M = e^(2n) exp(-3 xi pT / 4)`` with ``n``
+    impacts per cycle (the trace of the variational equation is ``-3 xi / 4`` and each
+    saltation matrix has determinant ``e^2``, SPEC.md §5), so a complex pair always has
+    ``|mu| < 1``; the test is kept for completeness.
 
 Notes
 -----
@@ -76,7 +91,8 @@ Dynamical Systems*, Springer, ch. 2 and 6 (grazing of impacting orbits). Continu
 functions: Seydel (2010), *Practical Bifurcation and Stability Analysis*, 3rd ed., Springer;
 Kuznetsov (2004), *Elements of Applied Bifurcation Theory*, 3rd ed., Springer; Doedel, Keller,
 Kernévez (1991), "Numerical analysis and control of bifurcation problems", Int. J. Bifurcation
-and Chaos 1(3), 493–520 and 1(4), 745–772.
+and Chaos 1(3), 493–520 and 1(4), 745–772; Keller (1977), "Numerical solution of bifurcation
+and nonlinear eigenvalue problems", in *Applications of Bifurcation Theory*, Academic Press.
 """
 
 from __future__ import annotations
@@ -566,8 +582,7 @@ class _Info:
 
     __slots__ = ("M", "mu", "stable", "nimp", "cycle", "half", "scale", "sym_defect",
                  "symmetric", "max_theta", "min_speed", "near_miss", "t_next", "t_next_half",
-                 "traj",
-                 "imp_o", "T", "psi", "run")
+                 "traj", "imp_o", "T", "psi", "run")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -575,6 +590,9 @@ class _Info:
 # ---------------------------------------------------------------------------------------------
 
 class _Solver:
+    """Shooting residuals (full and half map), Newton's method, and what a converged run says
+    about its orbit."""
+
     def __init__(self, flow, *, tol=1e-12, sym_tol=1e-6, fd_rel=1e-7):
         self.flow = flow
         self.N = flow.N
@@ -1126,7 +1144,9 @@ class _Continuer:
                     elif min(a.info.near_miss, a.info.min_speed) < self.end_graze:
                         # Newton fails at the grazing itself (the map's derivative is
                         # singular there): the last orbit converged is the located point
-                        self.graze_at(a, a.y[2] + fail_ds * t[2], p, bifs)
+                        last = self.graze_at(a, t, p, bifs)
+                        if last is not None:
+                            pts.append(last)
                         return pts, "grazing"
                     return pts, why
                 continue
@@ -1282,11 +1302,61 @@ class _Continuer:
                 hi, Phi = sv, Q
         return Plo, Phi, (hi - lo) * abs(c[2])
 
+    def refine_edge(self, P, direction, p):
+        """Where the orbit through ``P`` (with its impact count) stops existing, towards
+        ``direction`` (+-1) in the parameter: damped Newton at fixed parameter values, doubling
+        the distance from ``P`` until it fails, then bisection to ``param_tol / 10``.
+
+        Near a grazing the corrector's undamped steps fail some ``1e-8`` short of it; the
+        damped Newton with the impact-count guard gets within ``1e-9`` (measured on the hb=1
+        Housner case). Returns ``(point, bracket width)``; ``(P, inf)`` if no end is found
+        within ``1e-3``.
+        """
+        s = self.s
+        if direction == 0:
+            return P, math.inf
+
+        def trial(lam, x):
+            if not self.flow.valid(lam):
+                return None
+            try:
+                ev, _ = s.newton(x, lam, p, P.j, P.info.scale, max_iter=20)
+            except OrbitRefused:
+                return None
+            return ev if ev.nimp == P.info.nimp else None
+
+        lo, ev_lo, hi = float(P.y[2]), None, None
+        d = self.param_tol
+        while d <= 1e-3:
+            lam = lo + direction * d
+            ev = trial(lam, P.y[:2] if ev_lo is None else ev_lo.x)
+            if ev is None:
+                hi = lam
+                break
+            lo, ev_lo = lam, ev
+            d *= 2.0
+        if hi is None:
+            return P, math.inf
+        while abs(hi - lo) > 0.1 * self.param_tol:
+            mid = 0.5 * (lo + hi)
+            ev = trial(mid, P.y[:2] if ev_lo is None else ev_lo.x)
+            if ev is None:
+                hi = mid
+            else:
+                lo, ev_lo = mid, ev
+        if ev_lo is None:
+            return P, abs(hi - lo)
+        info = s.analyse(ev_lo.r, lo, p, P.j)
+        return _CPoint(np.r_[ev_lo.x, lo], P.j, P.j, info), abs(hi - lo)
+
     def locate_grazing(self, a, b, form, p, bifs):
         """The impact count changes between a and b: bisection on the count."""
         calls0 = self.flow.calls
         Plo, Phi, width = self._bisect(a, b.y - a.y, form, p,
                                        lambda Q: Q.info.nimp == a.info.nimp)
+        Q, w2 = self.refine_edge(Plo, np.sign(b.y[2] - a.y[2]), p)
+        if w2 < math.inf:
+            Plo, width = Q, w2
         if Plo is a:
             Plo = None
         P = Plo if Plo is not None else a
@@ -1300,20 +1370,28 @@ class _Continuer:
                                     calls0))
         return Plo
 
-    def graze_at(self, a, lam_fail, p, bifs):
+    def graze_at(self, a, t, p, bifs):
+        """The corrector fails next to a grazing: the orbit is followed to where it ends."""
+        calls0 = self.flow.calls
         nm, ms = a.info.near_miss, a.info.min_speed
-        what = (f"|theta| turns back {nm:.2g} (of its largest value) short of 0 without "
-                "impact" if nm <= ms else
-                f"an impact with |theta'-| = {ms:.2g} of the largest |theta'|")
-        detail = (f"{what}; Newton fails beyond (bracket {abs(lam_fail - a.y[2]):.1g} wide)")
+        what = (f"|theta| turns back short of 0 without impact (by {nm:.2g} of its largest "
+                "value at the last point continued)" if nm <= ms else
+                f"an impact with |theta'-| -> 0 ({ms:.2g} of the largest |theta'| at the last "
+                "point continued)")
+        Q, width = self.refine_edge(a, np.sign(t[2]), p)
+        detail = f"{what}; located to a bracket {width:.1g} wide"
         mu_b = np.full(2, np.nan, complex)
-        bifs.append(self._graze_bif(a, a.y[2], lam_fail, a.info.mu, mu_b, p, detail,
-                                    self.flow.calls))
+        bifs.append(self._graze_bif(Q, a.y[2], Q.y[2] + np.sign(t[2]) * width, a.info.mu,
+                                    mu_b, p, detail, calls0))
+        return None if Q is a else Q
 
     def locate_end(self, a, t, ds_fail, form, p, why, bifs):
         """The branch ends by overturning or rest: bisection on where it stops existing."""
         calls0 = self.flow.calls
         Plo, Phi, width = self._bisect(a, ds_fail * t, form, p, lambda Q: True)
+        Q, w2 = self.refine_edge(Plo, np.sign(t[2]), p)
+        if w2 < math.inf:
+            Plo, width = Q, w2
         P = a if Plo is a else Plo
         what = {"overturn": "max |theta| reaches theta_over (the orbit overturns)",
                 "rest": "the orbit comes to rest",

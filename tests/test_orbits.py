@@ -302,20 +302,24 @@ def test_grazing_end_of_the_unstable_symmetric_arm(study):
     assert len(g) == 1
     a = g[0].alpha
     # the orbit turns back short of theta = 0 without impact, ever closer as alpha -> a: the
-    # depth of that turn, read off dense plain runs, extrapolates to 0 at a
+    # depth of that turn, read off dense plain runs (the vertex of a parabola through the
+    # three grid points around it), extrapolates to 0 at a
     depth = []
-    (a1, a2) = (a - 1e-4, a - 3e-6)
-    for da in (a1 - a, a2 - a):
-        o = orbits.periodic_orbit(block(a + da), g[0].state, 1, phase=cont.phase, graze_tol=0)
+    (a1, a2) = (a - 3e-7, a - 1e-7)
+    for al in (a1, a2):
+        o = orbits.periodic_orbit(block(al), g[0].state, 1, phase=cont.phase, graze_tol=0)
         assert o.impacts == 2 and not o.stable
-        r = plain(o.state, a + da, 1, phase=cont.phase, record_stride=1)
+        r = plain(o.state, al, 1, phase=cont.phase, record_stride=1, n_steps=16384)
         th = r.trajectory[:, 1]
         same = (th[:-2] * th[1:-1] > 0) & (th[1:-1] * th[2:] > 0)
         turn = same & (np.abs(th[1:-1]) <= np.abs(th[:-2])) & \
             (np.abs(th[1:-1]) <= np.abs(th[2:]))
-        depth.append(np.abs(th[1:-1][turn]).min())
+        k = np.nonzero(turn)[0] + 1
+        k = k[np.argmin(np.abs(th[k]))]
+        m = np.abs(th[k - 1:k + 2])
+        depth.append(m[1] - (m[2] - m[0]) ** 2 / (8 * (m[2] - 2 * m[1] + m[0])))
     a0 = a1 - depth[0] * (a2 - a1) / (depth[1] - depth[0])
-    assert abs(a0 - a) < 3e-7
+    assert abs(a0 - a) < 1e-8
     with pytest.raises(OrbitRefused) as e:
         orbits.periodic_orbit(block(a - 5e-7), g[0].state, 1, phase=cont.phase)
     assert e.value.reason == "grazing"
