@@ -826,10 +826,13 @@ class _Solver:
     # -- sections -----------------------------------------------------------------------------
     def margins(self, info, j):
         """``(margin at section j, best section, its margin)``, margins in units of T."""
-        T = info.T
-        if info.imp_o.size == 0:
+        return self.margins_of(info.imp_o, info.T, j)
+
+    def margins_of(self, imp_o, T, j):
+        """As :meth:`margins`, from impact times after the output section."""
+        if imp_o.size == 0:
             return 0.5, j, 0.5
-        ph = np.sort(info.imp_o % T) / T
+        ph = np.sort(imp_o % T) / T
         gaps = np.diff(np.r_[ph, ph[0] + 1.0])
         i = int(np.argmax(gaps))
         best = int(round((ph[i] + 0.5 * gaps[i]) * self.N)) % self.N
@@ -880,30 +883,30 @@ def _shoot(solver, x0, lam, p, refuse_grazing=True, graze_tol=1e-4, over_tol=1e-
     ev = solver.full(x0, lam, p, 0)
     if not ev.ok:
         raise OrbitRefused(ev.reason, "at the seed")
-    info = solver.analyse(ev.r, lam, p, 0)
     j = 0
-    cur, best, mbest = solver.margins(info, 0)
+    traj = ev.r.trajectory[:, 1:3]
+    scale = max(float(np.abs(traj).max()), 1e-12)
+    cur, best, mbest = solver.margins_of(ev.r.impacts[:, 0], flow.period(lam), 0)
     x = x0
     if cur < 0.3 * mbest:
         j = best
-        x = solver.shifted(info, best)
-    ev, iters = solver.newton(x, lam, p, j, info.scale, max_iter=max_iter)
-    info = solver.analyse(ev.r, lam, p, j)
+        x = traj[best].copy()
+    ev, iters = solver.newton(x, lam, p, j, scale, max_iter=max_iter)
     done = False
     if j != 0:
         # the point at the requested phase, polished there: carried from the computational
         # section along an expanding orbit the residual grows; Newton steps this small cannot
         # cross an impact unless one sits at that very instant
-        eo = solver.full(info.cycle[0].copy(), lam, p, 0)
+        x_o = ev.r.trajectory[(-j) % (p * solver.N), 1:3].copy()
+        eo = solver.full(x_o, lam, p, 0)
         if eo.ok and eo.nimp == ev.nimp:
             eo = solver.polish(eo, lam, p, 0)
             if float(np.abs(eo.F).max()) <= max(10 * float(np.abs(ev.F).max()),
                                                 solver.tol_for(eo)):
                 ev, j, done = eo, 0, True
-                info = solver.analyse(ev.r, lam, p, 0)
     if not done:
         ev = solver.polish(ev, lam, p, j)
-        info = solver.analyse(ev.r, lam, p, j)
+    info = solver.analyse(ev.r, lam, p, j)
     res = float(np.abs(ev.F).max())
     if refuse_grazing:
         blk = flow.block
@@ -1142,8 +1145,8 @@ class _Continuer:
                         if last is not None:
                             pts.append(last)
                     elif min(a.info.near_miss, a.info.min_speed) < self.end_graze:
-                        # Newton fails at the grazing itself (the map's derivative is
-                        # singular there): the last orbit converged is the located point
+                        # the corrector fails next to a grazing (the map's derivative is
+                        # singular there): follow the orbit to where it ends
                         last = self.graze_at(a, t, p, bifs)
                         if last is not None:
                             pts.append(last)
