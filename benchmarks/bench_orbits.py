@@ -288,7 +288,7 @@ def main(argv=None):
         ("first solve in a fresh process, empty cache",
          compile_info["cold"]["first_s"] if compile_info["cold"] else math.nan, "s", None),
     ]
-    bif_rows = [(b.type, b.alpha, b.period, fmt_mu(b.multipliers), b.n_simulate, s,
+    bif_rows = [(b.type, f"{b.alpha:.10f}", b.period, fmt_mu(b.multipliers), b.n_simulate, s,
                  "" if b.located else "not located")
                 for b, s in sorted(zip(c.bifurcations, shift), key=lambda t: t[0].alpha)]
     md = [f"# Periodic orbits: shooting and continuation ({'quick' if quick else 'full'})", "",
@@ -303,8 +303,8 @@ def main(argv=None):
                       f"shift at N = {n2}", "note"], bif_rows), "",
           "## Branches", "",
           C.md_table(["#", "p", "symmetric", "points", "alpha from", "to", "ends", "origin"],
-                     [(i, br.period, str(br.symmetric), len(br), float(br.value.min()),
-                       float(br.value.max()), " / ".join(br.ends), br.origin)
+                     [(i, br.period, str(br.symmetric), len(br), f"{br.value.min():.6f}",
+                       f"{br.value.max():.6f}", " / ".join(br.ends), br.origin)
                       for i, br in enumerate(c.branches)])]
     io.write_text(out / "orbits.md", "\n".join(md))
     io.write_csv(out / "orbits.csv", ["measurement", "value", "unit", "target"], rows)
