@@ -706,7 +706,7 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
             lo, hi = float(ys.min()), float(ys.max())
             pad = 0.05 * max(hi - lo, 1e-3)
             ax.set_ylim(lo - pad, hi + pad)
-    ax.legend(handles=handles, loc="upper left", fontsize=7, ncols=2, framealpha=0.85)
+    ax.legend(handles=handles, loc="best", fontsize=7, ncols=2, framealpha=0.85)
     lines = [f"{'#':>2}  {'type':<6} {sym:<12} {'p':<2} \u03bc1, \u03bc2"]
     for i, bf in enumerate(bifs[:max_listed]):
         mu = [f"{m.real:.4g}" if abs(m.imag) < 1e-12 else f"{m.real:.3g}{m.imag:+.3g}i"
