@@ -352,6 +352,11 @@ class Branch:
         return self.cycle[:, 0, :]
 
     @property
+    def impacts_per_period(self) -> np.ndarray:
+        """``(n,)``: impacts per forcing period (``impacts / p``)."""
+        return self.impacts / self.period
+
+    @property
     def mirror_cycle(self) -> np.ndarray | None:
         """``(n, p, 2)``: the mirror-image orbit ``-x(kT + T/2)``; ``None`` if symmetric."""
         return None if self.symmetric else -self.cycle_half
@@ -1556,6 +1561,9 @@ def _run(block, parameter, bounds, phase, seeds, n_steps, settings, origin_fmt):
     cont = _Continuer(solver, bounds, **settings)
     for val, x, p, orb in seeds:
         if orb is not None:
+            if not math.isclose(orb.phase, phase, abs_tol=1e-12):
+                raise ValueError(f"a PeriodicOrbit seed must be at the continuation's phase "
+                                 f"{phase!r} (got {orb.phase!r})")
             val = orb.alpha if parameter == "alpha" else orb.omega
             x = orb.cycle[0]
         cont.follow_seed(val, x, p, origin_fmt(val, p))
