@@ -705,3 +705,177 @@ def fig_plane(plane_result, state=0, title=None):
     fig.suptitle(title or f"{_law(p.block)}, h/b = {p.block.hb:g}, from (\u03b8, \u03b8\u2032,"
                  f" r, s) = ({z[0]:g}, {z[1]:g}, {z[2]:g}, {z[3]:g})", fontsize=11)
     return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# Periodic-orbit branches (rockjit.orbits) over a sweep
+# ---------------------------------------------------------------------------------------------
+
+#: Marker of each bifurcation type in :func:`fig_branches`.
+BIFURCATION_MARKERS = {"fold": "o", "symmetry_breaking": "D", "period_doubling": "s",
+                       "neimark_sacker": "*", "grazing": "X"}
+_BIF_SHORT = {"fold": "fold", "symmetry_breaking": "SB", "period_doubling": "PD",
+              "neimark_sacker": "NS", "grazing": "graze"}
+
+
+#: Colours of the periods of orbit branches (distinct from BEHAVIOUR_COLOURS).
+PERIOD_COLOURS = ("#222222", "#8c564b", "#17becf", "#bcbd22", "#7f7f7f", "#393b79", "#ad494a",
+                  "#637939")
+
+
+def _branch_runs(value, y, stable, t_next, period):
+    """Pieces ``(x, y, stable)`` of one branch line: broken where an impact crosses the
+    sampling instant (the time to the next impact jumps by more than a quarter period, and the
+    sampled point jumps) and where the stability changes (the point of change belongs to both
+    pieces, so the line stays connected)."""
+    n = value.shape[0]
+    cut = np.zeros(n, bool)  # cut[i]: no line between i-1 and i
+    if n > 1:
+        jump = np.abs(np.diff(t_next)) > 0.25 * period[1:]
+        cut[1:] = jump | ~np.isfinite(y[1:]) | ~np.isfinite(y[:-1])
+    runs = []
+    start = 0
+    for i in range(1, n + 1):
+        if i == n or cut[i] or stable[i] != stable[start]:
+            stop = i if (i == n or cut[i]) else i + 1
+            if stop - start >= 2 or (stop - start == 1 and (i == n or cut[i])):
+                runs.append((value[start:stop], y[start:stop], bool(stable[start])))
+            start = i
+    return runs
+
+
+def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=None,
+                 mirrors=True, max_listed=32):
+    """Branches of periodic orbits drawn over a sweep's dots, bifurcations marked and listed.
+
+    Parameters
+    ----------
+    continuation : rockjit.orbits.Continuation
+        From :func:`rockjit.orbits.continue_branches` (or :func:`~rockjit.orbits.continuation`).
+    sweep : SweepResult, optional
+        Its stroboscopic points are drawn as dots coloured by behaviour; it must be sampled at
+        the continuation's forcing phase (``continue_branches`` uses the sweep's).
+    component : {0, 1}
+        Draw ``theta`` (0) or ``theta'`` (1, the bifurcation diagrams' choice) at ``kT``.
+    title : str, optional
+    limits : (float, float), optional
+        Parameter range drawn.
+    mirrors : bool
+        Also draw the mirror image ``-x(kT + T/2)`` of every non-symmetric orbit (the same
+        multipliers; a sweep from one initial state shows one of the two).
+    max_listed : int
+        Bifurcations listed beside the plot (the rest are counted).
+
+    Notes
+    -----
+    Stable orbits (both multipliers inside the unit circle) are solid lines, unstable ones
+    dashed; one colour per period. The line of each cycle point breaks where an impact crosses
+    the sampling instant ``kT``, where the sampled ``theta'`` jumps by the factor ``e``.
+    Bifurcations are numbered in the list in order of the parameter.
+    """
+    from matplotlib.lines import Line2D
+
+    c = continuation
+    comp = int(component)
+    if comp not in (0, 1):
+        raise ValueError(f"component must be 0 (theta) or 1 (theta') (got {component!r})")
+    pname = c.parameter
+    sym = _GREEK.get(pname, pname)
+    fig = _figure(figsize=(13.0, 6.4))
+    gs = fig.add_gridspec(1, 2, width_ratios=(3.2, 1.25))
+    ax = fig.add_subplot(gs[0])
+    ax_l = fig.add_subplot(gs[1])
+    ax_l.axis("off")
+    handles = []
+    if sweep is not None:
+        alpha = np.asarray(sweep.alpha)
+        label = np.asarray(sweep.label)
+        pts = np.asarray(sweep.strobe)[:, :, comp]
+        names = [str(n) for n in sweep.names]
+        for code, name in enumerate(names):
+            m = label == code
+            if not m.any():
+                continue
+            a = np.repeat(alpha[m], pts.shape[1])
+            yv = pts[m].ravel()
+            ok = np.isfinite(yv)
+            if not ok.any():
+                continue
+            ax.scatter(a[ok], yv[ok], s=1.6, color=BEHAVIOUR_COLOURS[name], lw=0, alpha=0.7,
+                       rasterized=True, zorder=4)
+            handles.append(Line2D([], [], ls="", marker="o", ms=4, alpha=0.7,
+                                  color=BEHAVIOUR_COLOURS[name], label=f"sweep: {name}"))
+    periods = sorted({br.period for br in c.branches})
+    pcol = {p: PERIOD_COLOURS[i % len(PERIOD_COLOURS)] for i, p in enumerate(periods)}
+    for br in c.branches:
+        T = 2.0 * np.pi / np.asarray(br.omega)
+        cycles = [(br.cycle, br.t_next_impact, 1.1)]
+        if mirrors and br.mirror_cycle is not None:
+            # the mirror orbit at kT is the orbit at kT + T/2, reflected
+            cycles.append((br.mirror_cycle, br.t_next_impact_half, 0.8))
+        for cyc, tn, lw in cycles:
+            for k in range(br.period):
+                for x, yv, st in _branch_runs(np.asarray(br.value), cyc[:, k, comp],
+                                              np.asarray(br.stable), tn[:, k], T):
+                    ax.plot(x, yv, ls="-" if st else (0, (4, 2.5)), lw=lw,
+                            color=pcol[br.period], zorder=3)
+    for p in periods:
+        handles.append(Line2D([], [], color=pcol[p], lw=1.5, label=f"period {p}"))
+    handles.append(Line2D([], [], color="k", lw=1.3, ls="-", label="stable"))
+    handles.append(Line2D([], [], color="k", lw=1.3, ls="--", label="unstable"))
+    bifs = sorted(c.bifurcations, key=lambda b: b.value)
+    present = []
+    for i, bf in enumerate(bifs):
+        mk = BIFURCATION_MARKERS.get(bf.type, "o")
+        cyc = np.asarray(bf.cycle)
+        pts_b = [cyc]
+        if mirrors and bf.has_mirror and getattr(bf, "cycle_half", None) is not None:
+            pts_b.append(-np.asarray(bf.cycle_half))
+        for cy in pts_b:
+            ax.scatter(np.full(cy.shape[0], bf.value), cy[:, comp], marker=mk,
+                       s=40 if bf.period <= 2 else 18, facecolor="white", edgecolor="k",
+                       lw=1.0, zorder=5)
+        ax.annotate(str(i + 1), (bf.value, cyc[0, comp]), textcoords="offset points",
+                    xytext=(4, 4), fontsize=7, zorder=6)
+        if bf.type not in present:
+            present.append(bf.type)
+    for t in present:
+        handles.append(Line2D([], [], ls="", marker=BIFURCATION_MARKERS.get(t, "o"), ms=6,
+                              markerfacecolor="white", markeredgecolor="k",
+                              label=t.replace("_", " ")))
+    ax.set_xlabel(sym)
+    ax.set_ylabel("\u03b8\u2032(kT)" if comp == 1 else "\u03b8(kT)")
+    xlim = tuple(float(v) for v in (limits if limits is not None else c.bounds))
+    ax.set_xlim(*xlim)
+    if limits is not None:  # fit the vertical range to what is drawn in the window
+        ys = []
+        for line in ax.get_lines():
+            x, yv = (np.asarray(v, float) for v in line.get_data())
+            ys.append(yv[(x >= xlim[0]) & (x <= xlim[1])])
+        for coll in ax.collections:
+            off = np.asarray(coll.get_offsets(), float).reshape(-1, 2)
+            ys.append(off[(off[:, 0] >= xlim[0]) & (off[:, 0] <= xlim[1]), 1])
+        ys = np.concatenate(ys) if ys else np.zeros(0)
+        ys = ys[np.isfinite(ys)]
+        if ys.size:
+            lo, hi = float(ys.min()), float(ys.max())
+            pad = 0.05 * max(hi - lo, 1e-3)
+            ax.set_ylim(lo - pad, hi + pad)
+    ax.legend(handles=handles, loc="best", fontsize=7, ncols=2, framealpha=0.85)
+    lines = [f"{'#':>2}  {'type':<6} {sym:<12} {'p':<2} \u03bc1, \u03bc2"]
+    for i, bf in enumerate(bifs[:max_listed]):
+        mu = [f"{m.real:.4g}" if abs(m.imag) < 1e-12 else f"{m.real:.3g}{m.imag:+.3g}i"
+              for m in np.asarray(bf.multipliers)]
+        lines.append(f"{i + 1:>2}  {_BIF_SHORT.get(bf.type, bf.type):<6} "
+                     f"{bf.value:<12.9f} {bf.period:<2} {', '.join(mu)}")
+    if len(bifs) > max_listed:
+        lines.append(f"... and {len(bifs) - max_listed} more")
+    if not bifs:
+        lines.append("(no bifurcation located)")
+    ax_l.text(0.0, 1.0, "\n".join(lines), va="top", ha="left", family="monospace",
+              fontsize=7.5, transform=ax_l.transAxes)
+    b = c.block
+    fixed = (f"\u03c9 = {b.omega:g}" if pname == "alpha" else f"\u03b1 = {b.alpha:g}")
+    ax.set_title(title or f"Periodic orbits: {_law(b)}, h/b = {b.hb:g}, {fixed}, "
+                 f"phase {c.phase:.4g}", fontsize=10)
+    return fig

@@ -1,0 +1,386 @@
+"""Periodic orbits (rockjit.orbits): shooting, continuation and bifurcations against independent
+references: plain and scipy runs, finite differences, Lyapunov exponents, brute-force sweeps."""
+
+import math
+
+import numpy as np
+import pytest
+
+import rockjit
+from rockjit import Block, analysis, orbits
+from rockjit.orbits import OrbitRefused
+
+HB, OMEGA = 1.0, 1.3
+T = 2 * math.pi / OMEGA
+
+
+def block(alpha, **kw):
+    return Block(hb=HB, alpha=alpha, omega=OMEGA, law="housner", **kw)
+
+
+def settle(alpha, x0=(0.1, 0.0), periods=400):
+    """A plain long run at phase 0: the attractor's stroboscopic point (an independent seed)."""
+    r = rockjit.simulate(HB, alpha, OMEGA, "housner", theta0=x0[0], dtheta0=x0[1], phase=0.0,
+                         periods=periods)
+    assert r.status == "done"
+    return r.strobe[-1, :2]
+
+
+def plain(x, alpha, p, phase=0.0, n_steps=4096, **kw):
+    return rockjit.simulate(HB, alpha, OMEGA, "housner", theta0=x[0], dtheta0=x[1],
+                            phase=phase, periods=p, n_steps=n_steps, **kw)
+
+
+@pytest.fixture(scope="module")
+def asym08():
+    """The study's asymmetric orbit (alpha = 0.8), stable, real multipliers."""
+    return orbits.periodic_orbit(block(0.8), settle(0.8) + 0.01, 1)
+
+
+@pytest.fixture(scope="module")
+def sym085():
+    """The symmetric orbit continued past its pitchfork: unstable (seeded from alpha = 0.75)."""
+    seed = orbits.periodic_orbit(block(0.75), settle(0.75), 1)
+    assert seed.symmetric and seed.stable
+    return orbits.periodic_orbit(block(0.85), seed.state, 1)
+
+
+@pytest.fixture(scope="module")
+def study():
+    """The hb=1 Housner branches over [0.5, 1.0] from a sweep's attractors."""
+    sw = analysis.sweep(HB, OMEGA, law="housner", alpha_range=(0.5, 1.0), alpha_step=0.002)
+    return sw, orbits.continue_branches(HB, "housner", OMEGA, (0.5, 1.0), sweep=sw)
+
+
+def of_type(cont, kind, period=None, lo=-math.inf, hi=math.inf):
+    return [b for b in cont.bifurcations if b.type == kind and lo <= b.alpha <= hi
+            and (period is None or b.period == period)]
+
+
+# --------------------------------------------------------------------------- shooting
+
+@pytest.mark.parametrize("alpha,p,x0", [(0.8, 1, (0.1, 0.0)), (0.92, 2, (0.1, 0.0)),
+                                         (0.6, 1, (0.3, 0.0))])
+def test_fixed_point_confirmed_by_a_converged_plain_run(alpha, p, x0):
+    o = orbits.periodic_orbit(block(alpha), settle(alpha, x0) + 0.005, p)
+    assert o.residual <= 1e-11
+    # an independent run (no tangent vectors, 16x finer grid) over p periods
+    r = plain(o.state, alpha, p)
+    assert np.abs(r.strobe[p, :2] - o.state).max() <= 1e-10
+    # the cycle's points are the stroboscopic samples of that run
+    assert np.abs(r.strobe[:p, :2] - o.cycle).max() <= 1e-10
+    assert np.abs(r.strobe_half[:p, :2] - o.cycle_half).max() <= 1e-10
+    assert o.impacts == r.n_impacts
+
+
+def test_unstable_orbit_converges_and_is_unstable(sym085):
+    o = sym085
+    assert o.symmetric and not o.stable
+    mu = o.multipliers[0]
+    assert abs(mu.imag) == 0 and 1.2 < mu.real < 1.7
+    r = plain(o.state, 0.85, 1)
+    assert np.abs(r.strobe[1, :2] - o.state).max() <= 1e-10
+    assert np.abs(r.strobe_half[0, :2] + o.state).max() <= 1e-10   # x(T/2) = -x(0)
+    # independent: a small perturbation grows by mu per period (the other multiplier, 3e-3,
+    # has wiped out its other component after a few periods)
+    far = plain(o.state + 1e-10 * np.array([1.0, 0.3]), 0.85, 30, n_steps=256)
+    d = np.abs(far.strobe[:, :2] - o.state).max(axis=1)
+    rate = (d[30] / d[10]) ** (1 / 20)
+    assert abs(rate - abs(mu)) <= 1e-4 * abs(mu)
+
+
+def test_multipliers_against_scipy_finite_differences(asym08, sym085):
+    for o in (asym08, sym085):
+        h = 1e-5
+        M = np.empty((2, 2))
+        for i in range(2):
+            cols = []
+            for sgn in (1, -1):
+                x = o.state.copy()
+                x[i] += sgn * h
+                r = rockjit.simulate(HB, o.alpha, OMEGA, "housner", theta0=x[0], dtheta0=x[1],
+                                     phase=o.phase, periods=1, method="scipy:DOP853",
+                                     rtol=1e-12, atol=1e-12)
+                assert r.n_impacts == o.impacts
+                cols.append(r.strobe[1, :2])
+            M[:, i] = (cols[0] - cols[1]) / (2 * h)
+        mu = np.sort_complex(np.linalg.eigvals(M))
+        # (measured: 4e-10; central differences of the scipy path at rtol 1e-12)
+        assert np.allclose(mu, np.sort_complex(o.multipliers), rtol=0, atol=1e-8 * max(
+            1.0, abs(o.multipliers[0])))
+
+
+def test_det_monodromy_identity(asym08, sym085):
+    # SPEC.md section 5: lambda1 + lambda2 = -3/4 xi + 2 nu ln e, i.e. over one cycle
+    # det M = e^(2 n) exp(-3/4 xi p T), n impacts per cycle
+    for o in (asym08, sym085):
+        b = o.block
+        expect = b.restitution ** (2 * o.impacts) * math.exp(-0.75 * b.xi * o.period * T)
+        assert abs(np.prod(o.multipliers).real - expect) <= 1e-10 * expect
+
+
+def test_lyapunov_exponents_equal_log_multipliers(asym08):
+    o = asym08
+    r = rockjit.simulate(HB, 0.8, OMEGA, "housner", theta0=o.state[0], dtheta0=o.state[1],
+                         phase=o.phase, periods=300, n_steps=o.n_steps, lyapunov=True,
+                         window=100)
+    assert r.status == "done"
+    lam = np.log(np.abs(o.multipliers)) / T
+    assert np.allclose(r.lyapunov, lam, rtol=0, atol=1e-10)
+    assert np.allclose(o.lyapunov, lam)
+
+
+def test_phase_is_the_section_and_states_match_a_trajectory(asym08):
+    # the same orbit sampled at another forcing phase, on the grid of a plain run: phase
+    # 2 pi j / N is the instant t = j T / N
+    o = asym08
+    j, n = 37, 4096
+    o2 = orbits.periodic_orbit(block(0.8), o.state, 1, phase=2 * math.pi * j * 16 / n)
+    assert np.allclose(np.sort(np.abs(o2.multipliers)), np.sort(np.abs(o.multipliers)),
+                       rtol=1e-8)
+    r = plain(o.state, 0.8, 1, record_stride=16, n_steps=n)
+    assert np.abs(r.trajectory[j, 1:3] - o2.state).max() <= 1e-10
+
+
+# --------------------------------------------------------------------------- refusals
+
+def test_refusals():
+    with pytest.raises(OrbitRefused) as e:
+        orbits.periodic_orbit(block(0.8), (1.4, 2.0))
+    assert e.value.reason == "overturn"
+    assert plain((1.4, 2.0), 0.8, 1, n_steps=256).status == "overturned"
+    with pytest.raises(OrbitRefused) as e:
+        orbits.periodic_orbit(block(0.4), (0.05, 0.0))
+    assert e.value.reason == "rest"
+    assert plain((0.05, 0.0), 0.4, 1, n_steps=256).status == "rest"
+    with pytest.raises(OrbitRefused) as e:
+        orbits.periodic_orbit(block(0.65), (0.01, 0.0))
+    assert e.value.reason == "passes_through_rest"
+    assert plain((0.01, 0.0), 0.65, 1, n_steps=256).n_rest > 0
+
+
+def test_bad_input():
+    with pytest.raises(ValueError, match="p must be"):
+        orbits.periodic_orbit(block(0.8), (0.1, 0.1), 0)
+    with pytest.raises(ValueError, match="x0"):
+        orbits.periodic_orbit(block(0.8), (0.1, 0.1, 0.2))
+    with pytest.raises(ValueError, match="x0 must be finite"):
+        orbits.periodic_orbit(block(0.8), (0.1, math.nan))
+    with pytest.raises(ValueError, match="n_steps must be even"):
+        orbits.periodic_orbit(block(0.8), (0.1, 0.1), n_steps=255)
+    with pytest.raises(ValueError, match="block_or_params"):
+        orbits.periodic_orbit(0.8, (0.1, 0.1))
+    with pytest.raises(ValueError, match="parameter must be"):
+        orbits.continuation(block(0.8), [], parameter="xi", bounds=(0.5, 1.0))
+    with pytest.raises(ValueError, match="alpha_range"):
+        orbits.continue_branches(HB, "housner", OMEGA, (1.0, 0.5), seeds=[])
+    with pytest.raises(ValueError, match=r"seeds\[0\]"):
+        orbits.continuation(block(0.8), [(0.8, (0.1,), 1)], bounds=(0.5, 1.0))
+
+
+# --------------------------------------------------------------------------- continuation
+
+def test_period_doubling_where_the_sweeps_period_two_window_opens(study):
+    sw, cont = study
+    pd = of_type(cont, "period_doubling", 1, 0.85, 0.95)
+    assert len(pd) == 1
+    a = pd[0].alpha
+    assert 0.90 < a < 0.92  # the gallery's period-2 orbit (alpha = 0.92) lies just beyond
+    # a brute-force sweep from the study's z0 on either side of it
+    near = analysis.sweep(HB, OMEGA, [a - 0.004, a - 0.002, a + 0.002, a + 0.004],
+                          law="housner")
+    assert list(near.period) == [1, 1, 2, 2]
+    # the doubled branch was switched onto and is stable beyond the point
+    br = cont.branches[pd[0].new_branch]
+    assert br.period == 2 and br.parent == pd[0].branch
+    k = int(np.argmin(np.abs(br.value - (a + 0.004))))
+    assert br.stable[k]
+
+
+def test_bifurcations_bracketed_by_their_neighbours(study):
+    _, cont = study
+    crit = {"fold": 1.0, "symmetry_breaking": 1.0, "period_doubling": -1.0}
+    seen = 0
+    for b in cont.bifurcations:
+        if b.type not in crit or not b.located:
+            continue
+        seen += 1
+        c = crit[b.type]
+        # the test function det(M - c I) = prod(mu - c) changes sign between the neighbours
+        f = [np.prod(np.asarray(mu) - c).real for mu in b.neighbour_multipliers]
+        assert f[0] * f[1] < 0, b
+        # and a multiplier sits on c at the located point
+        assert np.min(np.abs(np.asarray(b.multipliers) - c)) <= 1e-6, b
+        lo, hi = sorted(b.neighbours)
+        if b.type == "fold":
+            # a turning point: the branch's neighbours both lie on one side
+            assert not lo < b.alpha < hi or min(hi - b.alpha, b.alpha - lo) < 1e-6
+        else:
+            assert lo <= b.alpha <= hi
+    assert seen >= 8
+
+
+def test_located_to_1e8_by_independent_shooting(study):
+    """Re-solve the orbit 2e-8 to either side of the located alpha: the critical multiplier is
+    on either side of -1 (period doubling) or +1 (symmetry breaking)."""
+    _, cont = study
+    for b in of_type(cont, "period_doubling", 1) + of_type(cont, "period_doubling", 2) + \
+            of_type(cont, "symmetry_breaking", 1):
+        c = -1.0 if b.type == "period_doubling" else 1.0
+        side = []
+        for da in (-2e-8, 2e-8):
+            o = orbits.periodic_orbit(block(b.alpha + da), b.state, b.period, phase=cont.phase,
+                                      graze_tol=0)
+            assert o.symmetric == (b.type == "symmetry_breaking")
+            mu = o.multipliers[np.argmin(np.abs(o.multipliers - c))]
+            side.append(np.sign(abs(mu.real) - 1.0))
+        assert side[0] * side[1] < 0, b
+
+
+def test_symmetry_breaking_near_078(study):
+    sw, cont = study
+    sb = of_type(cont, "symmetry_breaking", 1, 0.7, 0.85)
+    assert len(sb) == 1
+    a = sb[0].alpha
+    assert abs(a - 0.78) < 0.005
+    assert sb[0].new_branch is not None and not cont.branches[sb[0].new_branch].symmetric
+    # independent: plain runs from the symmetric orbit, slightly perturbed, settle on a
+    # symmetric orbit below the point and on an asymmetric one above it
+    for da, want in ((-0.005, "symmetric"), (0.005, "asymmetric")):
+        o = orbits.periodic_orbit(block(a + da), sb[0].state, 1, phase=cont.phase)
+        assert o.symmetric and o.stable == (da < 0)
+        r = rockjit.simulate(HB, a + da, OMEGA, "housner", theta0=o.state[0] + 1e-6,
+                             dtheta0=o.state[1], phase=cont.phase, periods=1500)
+        assert analysis.classify_result(r) == (want, 1)
+    # the sweep labels the two sides the same way
+    def label(x):
+        return str(sw.names[sw.label[int(np.argmin(np.abs(sw.alpha - x)))]])
+    assert label(0.76) == "symmetric" and label(0.8) == "asymmetric"
+
+
+def test_every_periodic_sweep_cell_lies_on_a_stable_branch(study):
+    sw, cont = study
+    bif_a = np.array([b.alpha for b in cont.bifurcations])
+    checked = 0
+    for i in range(0, sw.alpha.size, 5):
+        a, p = float(sw.alpha[i]), int(sw.period[i])
+        if not 1 <= p <= 8 or np.min(np.abs(bif_a - a)) < 3e-3:
+            continue
+        pts = sw.strobe[i][np.all(np.isfinite(sw.strobe[i]), axis=1)][-p:]
+        scale = np.abs(pts).max()
+        hit = False
+        for br in cont.branches:
+            if br.period != p:
+                continue
+            dist = np.where(br.stable, np.abs(br.value - a), np.inf)  # a fold has two arms
+            k = int(np.argmin(dist))
+            if dist[k] > 0.02:
+                continue
+            o = orbits.periodic_orbit(block(a), br.cycle[k], p, phase=cont.phase)
+            for cyc in (o.cycle, -o.cycle_half):
+                d = min(np.abs(pts - np.roll(cyc, s, axis=0)).max() for s in range(p))
+                hit |= d <= 1e-5 * scale  # the sweep's grid is N = 64
+        assert hit, (a, p)
+        checked += 1
+    assert checked >= 20
+
+
+def test_unstable_branch_points_are_orbits(study):
+    _, cont = study
+    br = next(b for b in cont.branches if b.symmetric)
+    bad = np.nonzero(~br.stable & (np.abs(br.multipliers[:, 0]) < 10))[0]
+    assert bad.size >= 5
+    for k in bad[:: max(1, bad.size // 4)]:
+        x = br.cycle[k, 0]
+        r = plain(x, br.value[k], 1, phase=cont.phase)
+        assert np.abs(r.strobe[1, :2] - x).max() <= 1e-9 * max(1, abs(br.multipliers[k, 0]))
+
+
+def test_grazing_end_of_the_unstable_symmetric_arm(study):
+    _, cont = study
+    g = of_type(cont, "grazing", 1, 0.6, 0.76)
+    assert len(g) == 1
+    a = g[0].alpha
+    # the orbit turns back short of theta = 0 without impact, ever closer as alpha -> a: the
+    # depth of that turn, read off dense plain runs (the vertex of a parabola through the
+    # three grid points around it), extrapolates to 0 at a
+    depth = []
+    (a1, a2) = (a - 3e-7, a - 1e-7)
+    for al in (a1, a2):
+        o = orbits.periodic_orbit(block(al), g[0].state, 1, phase=cont.phase, graze_tol=0)
+        assert o.impacts == 2 and not o.stable
+        r = plain(o.state, al, 1, phase=cont.phase, record_stride=1, n_steps=16384)
+        th = r.trajectory[:, 1]
+        same = (th[:-2] * th[1:-1] > 0) & (th[1:-1] * th[2:] > 0)
+        turn = same & (np.abs(th[1:-1]) <= np.abs(th[:-2])) & \
+            (np.abs(th[1:-1]) <= np.abs(th[2:]))
+        k = np.nonzero(turn)[0] + 1
+        k = k[np.argmin(np.abs(th[k]))]
+        m = np.abs(th[k - 1:k + 2])
+        depth.append(m[1] - (m[2] - m[0]) ** 2 / (8 * (m[2] - 2 * m[1] + m[0])))
+    a0 = a1 - depth[0] * (a2 - a1) / (depth[1] - depth[0])
+    assert abs(a0 - a) < 1e-8
+    with pytest.raises(OrbitRefused) as e:
+        orbits.periodic_orbit(block(a - 5e-7), g[0].state, 1, phase=cont.phase)
+    assert e.value.reason == "grazing"
+
+
+def test_cascade_ratios_approach_feigenbaums(study):
+    _, cont = study
+    pd = sorted(b.alpha for b in cont.bifurcations if b.type == "period_doubling"
+                and b.period in (1, 2, 4, 8) and 0.9 < b.alpha < 0.94)
+    assert len(pd) == 4
+    r1 = (pd[1] - pd[0]) / (pd[2] - pd[1])
+    r2 = (pd[2] - pd[1]) / (pd[3] - pd[2])
+    assert abs(r2 - 4.669) < abs(r1 - 4.669) < 1.0
+
+
+def test_continuation_in_omega_uses_the_same_code(asym08):
+    c = orbits.continuation(block(0.8), [(OMEGA, asym08.state, 1)], parameter="omega",
+                            bounds=(1.25, 1.35), switch=False)
+    br = c.branches[0]
+    k = int(np.argmin(np.abs(br.value - OMEGA)))
+    assert abs(br.value[k] - OMEGA) < 1e-12
+    assert np.allclose(br.alpha, 0.8) and np.allclose(br.omega, br.value)
+    # the asymmetric branch ends where it meets the symmetric one (the pitchfork in omega)
+    assert "branch_point" in br.ends
+    for k in (0, len(br) // 2, len(br) - 1):
+        w = br.value[k]
+        x = br.cycle[k, 0]
+        r = rockjit.simulate(HB, 0.8, w, "housner", theta0=x[0], dtheta0=x[1], phase=0.0,
+                             periods=1, n_steps=4096)
+        assert np.abs(r.strobe[1, :2] - x).max() <= 1e-9
+
+
+def test_summary_and_arrays_round_trip(study, tmp_path):
+    from rockjit import io
+    _, cont = study
+    summary, arrays = cont.to_summary()
+    io.write_json(tmp_path / "summary.json", summary)
+    io.write_npz(tmp_path / "branches.npz", **arrays)
+    import json
+    back = json.loads((tmp_path / "summary.json").read_text())
+    assert len(back["bifurcations"]) == len(cont.bifurcations)
+    for d in back["bifurcations"]:
+        assert d["type"] in orbits.BIFURCATION_TYPES
+        assert len(d["multipliers"]) == 2 and len(d["multipliers"][0]) == 2
+        assert len(d["state"]) == 2
+        float(d["alpha"])
+    z = np.load(tmp_path / "branches.npz")
+    assert z["bif_type"].shape == (len(cont.bifurcations),)
+    for i, br in enumerate(cont.branches):
+        assert z[f"branch{i}_cycle"].shape == (len(br), br.period, 2)
+
+
+def test_fig_branches(study):
+    from rockjit import plotting
+    sw, cont = study
+    fig = plotting.fig_branches(cont, sw)
+    ax = fig.axes[0]
+    styles = {ln.get_linestyle() for ln in ax.get_lines() if len(ln.get_xdata()) > 1}
+    assert "-" in styles and "--" in styles
+    text = "".join(t.get_text() for t in fig.axes[1].texts)
+    assert "PD" in text and "SB" in text
+    fig2 = plotting.fig_branches(cont, sw, limits=(0.9, 0.96), component=0)
+    lo, hi = fig2.axes[0].get_xlim()
+    assert (lo, hi) == (0.9, 0.96)
