@@ -230,7 +230,8 @@ def _grid_run(writer, name):
     line's progress, Dask client and chunk store, then written by ``outputs.<writer>``."""
     def run_it(args, plans, out):
         from . import analysis, erosion, outputs
-        run = erosion.run if writer == "erosion" else analysis.run
+        from . import orbits
+        run = dict(erosion=erosion.run, orbits=orbits.run).get(writer, analysis.run)
         t0 = time.perf_counter()
         if isinstance(plans, dict):
             res = {law: _grid(args, run, p, law) for law, p in plans.items()}
@@ -240,6 +241,13 @@ def _grid_run(writer, name):
         _say(args, f"{args.command}: computed in {wall:.1f} s")
         return wall, getattr(outputs, writer)(out, res)
     return run_it
+
+
+def _orbits_plan(args):
+    from .orbits import plan_orbits
+    return plan_orbits(args.hb, args.law, args.omega, args.alpha_range, e=args.e, xi=args.xi,
+                       sweep_step=args.alpha_step, periods=args.periods, threads=args.threads,
+                       max_period=args.max_period)
 
 
 def _fate_plan(args):
@@ -475,6 +483,18 @@ def build_parser():
     _add_common(p)
     _add_scheduler(p)
 
+    p = _command(sub, "orbits", _orbits_plan, _grid_run("orbits", "sweep"),
+                 "periodic orbits continued in alpha, bifurcations located",
+                 "Seed from every periodic attractor of a sweep, follow each orbit both ways "
+                 "in alpha (stable and unstable), locate its bifurcations; write orbits.npz, "
+                 "orbits.png (branches over the sweep) and summary.json (\"bifurcations\").")
+    _add_block(p, alpha=False)
+    _add_alphas(p, 0.001)
+    p.add_argument("--periods", type=int, default=500, help="periods of the seeding sweep")
+    p.add_argument("--max-period", type=int, default=8, help="longest period followed")
+    _add_common(p)
+    _add_scheduler(p)
+
     p = _command(sub, "fate", _fate_plan, _fate_run, "outcome probabilities of nearby runs",
                  "Run an ensemble from initial states perturbed by a few ulps to 1e-10 "
                  "(relative): each outcome's probability, the transient's exponent and the "
@@ -532,6 +552,16 @@ def _error(msg):
     return 2
 
 
+def _internal_error(exc):
+    import traceback
+    fd, path = tempfile.mkstemp(prefix=f"{PROG}-error-", suffix=".txt")
+    with os.fdopen(fd, "w") as f:
+        traceback.print_exception(exc, file=f)
+    print(f"{PROG}: internal error: {type(exc).__name__}: {' '.join(str(exc).split())}; --out "
+          f"is as it was; the traceback is in {path} (please report it)", file=sys.stderr)
+    return 1
+
+
 def main(argv=None):
     """Run the command line; returns the exit status (0, 2 bad input, 130 interrupted)."""
     from .io import OutputDir, sigterm_interrupts
@@ -566,6 +596,9 @@ def main(argv=None):
     except (UsageError, ValueError) as exc:  # a check made only once running
         out.discard()
         return _error(exc)
+    except Exception as exc:  # a bug: one line, the traceback kept for the report
+        out.discard()
+        return _internal_error(exc)
     try:
         if note:
             _warn(note)

@@ -105,6 +105,7 @@ import numpy as np
 
 from .model import Block
 from .simulate import simulate
+from .validate import integer, pair, real
 
 __all__ = ["BIFURCATION_TYPES", "N_ORBIT", "Bifurcation", "Branch", "Continuation",
            "OrbitRefused", "PeriodicOrbit", "continuation", "continue_branches",
@@ -148,38 +149,6 @@ class OrbitRefused(RuntimeError):
 # input checks
 # ---------------------------------------------------------------------------------------------
 
-def _real(name, value):
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number (got {value!r})") from None
-    if not math.isfinite(v):
-        raise ValueError(f"{name} must be finite (got {v})")
-    return v
-
-
-def _positive(name, value):
-    v = _real(name, value)
-    if v <= 0:
-        raise ValueError(f"{name} must be > 0 (got {v})")
-    return v
-
-
-def _int(name, value, lo, hi=None):
-    ok = not isinstance(value, bool)
-    try:
-        ok = ok and float(value) == int(value)
-    except (TypeError, ValueError, OverflowError):
-        ok = False
-    if not ok:
-        raise ValueError(f"{name} must be an integer (got {value!r})")
-    v = int(value)
-    if v < lo or (hi is not None and v > hi):
-        rng = f">= {lo}" if hi is None else f"in [{lo}, {hi}]"
-        raise ValueError(f"{name} must be {rng} (got {v})")
-    return v
-
-
 def _as_block(block_or_params):
     if isinstance(block_or_params, Block):
         return block_or_params
@@ -202,12 +171,9 @@ def _state(name, x0, p):
 
 
 def _range(name, rng, lo):
-    try:
-        a, b = (float(v) for v in rng)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be two numbers (got {rng!r})") from None
-    if not (math.isfinite(a) and math.isfinite(b)) or a < lo or b <= a:
-        raise ValueError(f"{name} must satisfy {lo} <= start < end, both finite (got {a}, {b})")
+    a, b = pair(name, rng, lo)
+    if b <= a:
+        raise ValueError(f"{name} must satisfy start < end (got {a:g}, {b:g})")
     return a, b
 
 
@@ -505,7 +471,8 @@ class Continuation:
             restitution=b.restitution, xi=b.xi,
             **({"omega": b.omega} if self.parameter == "alpha" else {"alpha": b.alpha}),
             phase=self.phase, n_steps=self.n_steps, branches=branches, bifurcations=bifs,
-            n_simulate=self.n_simulate, wall_s=self.wall_s, seeds_tried=self.seeds_tried,
+            n_simulate=self.n_simulate, continuation_wall_s=self.wall_s,
+            seeds_tried=self.seeds_tried,
             settings=self.settings)
         return summary, arrays
 
@@ -977,22 +944,22 @@ def periodic_orbit(block_or_params, x0, p=1, *, phase=0.0, n_steps=N_ORBIT, tol=
     periodic orbits by shooting: Seydel (2010), §7.3.
     """
     block = _as_block(block_or_params)
-    p = _int("p", p, 1, 256)
+    p = integer("p", p, 1, 256)
     x0 = _state("x0", x0, p)
-    phase = _real("phase", phase)
-    n_steps = _int("n_steps", n_steps, 8)
+    phase = real("phase", phase)
+    n_steps = integer("n_steps", n_steps, 8)
     if n_steps % 2:
         raise ValueError(f"n_steps must be even (got {n_steps})")
-    tol = _positive("tol", tol)
-    max_iter = _int("max_iter", max_iter, 1)
-    graze_tol = _real("graze_tol", graze_tol)
-    over_tol = _real("over_tol", over_tol)
+    tol = real("tol", tol, 0.0, None, lo_open=True)
+    max_iter = integer("max_iter", max_iter, 1)
+    graze_tol = real("graze_tol", graze_tol)
+    over_tol = real("over_tol", over_tol)
     if not 0 <= graze_tol < 1:
         raise ValueError(f"graze_tol must be in [0, 1) (got {graze_tol})")
     if not 0 <= over_tol < 1:
         raise ValueError(f"over_tol must be in [0, 1) (got {over_tol})")
-    sym_tol = _positive("sym_tol", sym_tol)
-    imp = _int("max_impacts_per_period", max_impacts_per_period, 1)
+    sym_tol = real("sym_tol", sym_tol, 0.0, None, lo_open=True)
+    imp = integer("max_impacts_per_period", max_impacts_per_period, 1)
     flow = _Flow(block, "alpha", n_steps, phase, imp)
     solver = _Solver(flow, tol=tol, sym_tol=sym_tol)
     info, x, j, res, iters = _shoot(solver, x0, block.alpha, p, True, graze_tol, over_tol,
@@ -1548,8 +1515,8 @@ def _seed_list(seeds, name):
         except (TypeError, ValueError):
             raise ValueError(f"{name}[{i}] must be (parameter value, state or cycle, p) or a "
                              f"PeriodicOrbit (got {sd!r})") from None
-        p = _int(f"{name}[{i}] period", p, 1, 256)
-        out.append((_real(f"{name}[{i}] value", val), _state(f"{name}[{i}] state", x, p), p,
+        p = integer(f"{name}[{i}] period", p, 1, 256)
+        out.append((real(f"{name}[{i}] value", val), _state(f"{name}[{i}] state", x, p), p,
                     None))
     return out
 
@@ -1567,10 +1534,33 @@ def _run(block, parameter, bounds, phase, seeds, n_steps, settings, origin_fmt):
             val = orb.alpha if parameter == "alpha" else orb.omega
             x = orb.cycle[0]
         cont.follow_seed(val, x, p, origin_fmt(val, p))
+    branches, bifs = _within(cont.branches, cont.bifs, bounds)
     return Continuation(parameter=parameter, bounds=tuple(bounds), block=block, phase=phase,
-                        n_steps=n_steps, branches=cont.branches, bifurcations=cont.bifs,
+                        n_steps=n_steps, branches=branches, bifurcations=bifs,
                         n_simulate=flow.calls, wall_s=time.perf_counter() - t0,
                         seeds_tried=cont.seeds_tried, settings=dict(settings))
+
+
+def _within(branches, bifs, bounds):
+    """The branches' points and the bifurcations inside ``bounds`` (a branch switched onto at a
+    bifurcation may be followed past the range before its march ends; what lies outside was
+    not asked for)."""
+    lo, hi = bounds
+    tol = 1e-9 * max(1.0, abs(hi))
+    kept = []
+    for br in branches:
+        m = (br.value >= lo - tol) & (br.value <= hi + tol)
+        if not m.all():
+            arrays = {f: getattr(br, f)[m] for f in ("value", "alpha", "omega", "cycle",
+                                                     "cycle_half", "multipliers", "stable",
+                                                     "impacts", "symmetric_points",
+                                                     "t_next_impact", "t_next_impact_half")}
+            ends = tuple("range" if not (lo - tol <= v <= hi + tol) else e
+                         for v, e in zip((br.value[0], br.value[-1]), br.ends))
+            br = Branch(parameter=br.parameter, period=br.period, symmetric=br.symmetric,
+                        ends=ends, origin=br.origin, parent=br.parent, **arrays)
+        kept.append(br)
+    return kept, [b for b in bifs if lo - tol <= b.value <= hi + tol]
 
 
 def _settings(kw):
@@ -1583,13 +1573,13 @@ def _settings(kw):
     st.setdefault("sym_tol", 1e-6)
     for k in ("ds0", "ds_min", "ds_max", "join_tol", "graze_tol", "param_tol", "tol",
               "sym_tol"):
-        st[k] = _positive(k, st[k])
+        st[k] = real(k, st[k], 0.0, None, lo_open=True)
     if not st["ds_min"] <= st["ds0"] <= st["ds_max"]:
         raise ValueError(f"need ds_min <= ds0 <= ds_max (got {st['ds_min']}, {st['ds0']}, "
                          f"{st['ds_max']})")
-    st["max_points"] = _int("max_points", st["max_points"], 2)
-    st["max_period"] = _int("max_period", st["max_period"], 1, 256)
-    st["max_calls"] = _int("max_calls", st["max_calls"], 1)
+    st["max_points"] = integer("max_points", st["max_points"], 2)
+    st["max_period"] = integer("max_period", st["max_period"], 1, 256)
+    st["max_calls"] = integer("max_calls", st["max_calls"], 1)
     st["switch"] = bool(st.get("switch", True))
     return st
 
@@ -1634,8 +1624,8 @@ def continuation(block_or_params, seeds, *, parameter="alpha", bounds, phase=0.0
     bounds = _range("bounds", bounds, 0.0)
     if parameter == "omega" and bounds[0] <= 0:
         raise ValueError(f"bounds must be > 0 for omega (got {bounds})")
-    phase = _real("phase", phase)
-    n_steps = _int("n_steps", n_steps, 8)
+    phase = real("phase", phase)
+    n_steps = integer("n_steps", n_steps, 8)
     if n_steps % 2:
         raise ValueError(f"n_steps must be even (got {n_steps})")
     st = _settings(dict(options, switch=switch))
@@ -1705,7 +1695,7 @@ def continue_branches(hb, law, omega, alpha_range, seeds=None, sweep=None, *, e=
     st = _settings(dict(options, switch=switch))
     if seeds is None and sweep is None:
         sweep = analysis.sweep(hb, omega, law=law, e=e, xi=xi, alpha_range=(a0, a1),
-                               alpha_step=_positive("sweep_step", sweep_step))
+                               alpha_step=real("sweep_step", sweep_step, 0.0, None, lo_open=True))
     sl = []
     if sweep is not None:
         sb = sweep.block
@@ -1717,17 +1707,61 @@ def continue_branches(hb, law, omega, alpha_range, seeds=None, sweep=None, *, e=
                              f"hb={sb.hb}, omega={sb.omega}, law={sb.law}, xi={sb.xi}")
         z = sweep.settings.get("z0")
         sphase = math.atan2(z[2], z[3]) if z is not None else 0.0
-        if phase is not None and not math.isclose(_real("phase", phase), sphase,
+        if phase is not None and not math.isclose(real("phase", phase), sphase,
                                                   abs_tol=1e-12):
             raise ValueError(f"phase must be the sweep's forcing phase {sphase!r} (got "
                              f"{phase!r})")
         phase = sphase
         sl += _sweep_seeds(sweep, st["max_period"])
-    phase = 0.0 if phase is None else _real("phase", phase)
+    phase = 0.0 if phase is None else real("phase", phase)
     if seeds is not None:
         sl = _seed_list(seeds, "seeds") + sl
-    n_steps = _int("n_steps", n_steps, 8)
+    n_steps = integer("n_steps", n_steps, 8)
     if n_steps % 2:
         raise ValueError(f"n_steps must be even (got {n_steps})")
     return _run(block, "alpha", (a0, a1), phase, sl, n_steps, st,
                 lambda v, p: f"seed p={p} at alpha = {v:.6g}")
+
+
+# ---------------------------------------------------------------------------------------------
+# the command line's entry: a plan (validation only), then the sweep and the continuation
+# ---------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class OrbitsPlan:
+    """A validated ``rockjit orbits``: the seeding sweep's plan and the continuation's
+    settings."""
+
+    sweep_plan: object
+    alpha_range: tuple
+    n_steps: int
+    settings: dict
+
+
+def plan_orbits(hb, law, omega, alpha_range, *, e=None, xi=None, sweep_step=0.001,
+                n_steps=N_ORBIT, periods=500, threads=None, **options) -> OrbitsPlan:
+    """Validate :func:`continue_branches` seeded by a sweep of step ``sweep_step`` from the
+    study's ``z0`` (same parameters); nothing is run."""
+    from . import analysis
+    a0, a1 = _range("alpha_range", alpha_range, 0.0)
+    sp = analysis.plan_sweep(hb, omega, law=law, e=e, xi=xi, alpha_range=(a0, a1),
+                             alpha_step=sweep_step, periods=periods, threads=threads)
+    n_steps = integer("n_steps", n_steps, 8, 10**6)
+    if n_steps % 2:
+        raise ValueError(f"n_steps must be even (got {n_steps})")
+    return OrbitsPlan(sweep_plan=sp, alpha_range=(a0, a1), n_steps=n_steps,
+                      settings=_settings(options))
+
+
+def run(plan: OrbitsPlan, *, progress=False, client=None, store=None, message=None):
+    """Execute an :class:`OrbitsPlan`: the sweep, then the branches from its periodic
+    attractors. Returns ``(Continuation, SweepResult)``."""
+    from . import analysis
+    sw = analysis.run(plan.sweep_plan, progress=progress, client=client, store=store,
+                      message=message)
+    b = sw.block
+    st = dict(plan.settings)
+    switch = st.pop("switch")
+    cont = continue_branches(b.hb, b.law, b.omega, plan.alpha_range, sweep=sw, e=b.e,
+                             xi=b.xi, n_steps=plan.n_steps, switch=switch, **st)
+    return cont, sw

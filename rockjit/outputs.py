@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["basins", "erosion", "fate", "plane", "sweep", "trajectory"]
+__all__ = ["basins", "erosion", "fate", "orbits", "plane", "sweep", "trajectory"]
 
 
 def trajectory(out, res, *, npz="trajectory.npz", png="trajectory.png"):
@@ -117,3 +117,16 @@ def fate(out, fr, *, npz="fate.npz", png="fate.png"):
     out.npz(npz, initial=fr.initial, outcome=fr.outcome, t_end=fr.t_end)
     out.figure(png, fig_fate(fr))
     return fr.to_summary()
+
+
+def orbits(out, res, *, npz="orbits.npz", png="orbits.png"):
+    """Branches of periodic orbits (``(Continuation, SweepResult)``): the branches' and
+    bifurcations' arrays, the diagram with the branches over the sweep's dots, and the summary
+    (``"bifurcations"``: type, alpha, period, multipliers, state)."""
+    from .plotting import fig_branches
+    cont, sw = res
+    summary, arrays = cont.to_summary()
+    out.npz(npz, **arrays)
+    out.figure(png, fig_branches(cont, sw))
+    summary["sweep_fractions"] = sw.fractions()
+    return summary

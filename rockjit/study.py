@@ -5,8 +5,9 @@ and amplitude ranges, the sweeps' step, the zoom, the initial states of the sing
 gallery, the basins. :func:`plan_paper` validates a paper's settings (nothing computed) and
 :func:`paper` computes every figure and table and writes them into an output directory object
 (:class:`rockjit.io.OutputDir` on the command line): figures 1-6 of the study, and beyond it
-the attractor maps of its basins with their entropy and integrity (figure 7) and the erosion
-profiles of both laws (figure 8). Its grids run on the chunk store, so an interrupted paper
+the branches of periodic orbits over its bifurcation diagrams with their located bifurcations
+(figure 5's ``fig5_branches_*``, ``bifurcation_table``), the attractor maps of its basins with
+their entropy and integrity (figure 7) and the erosion profiles of both laws (figure 8). Its grids run on the chunk store, so an interrupted paper
 resumes, and on a Dask cluster when a client is given.
 """
 
@@ -234,8 +235,10 @@ def paper(out, plan=None, *, progress=False, client=None, store=None, say=None, 
     from pathlib import Path
 
     from .attractors import attractor_agreement
+    from .orbits import continue_branches
     from .plotting import (agreement, fig_attractors, fig_basin_compare, fig_bifurcation,
-                           fig_erosion, fig_gallery, fig_laws_timeseries, fig_trajectory)
+                           fig_branches, fig_erosion, fig_gallery, fig_laws_timeseries,
+                           fig_trajectory)
 
     p = plan_paper() if plan is None else plan
     say = say or (lambda msg: None)
@@ -334,6 +337,23 @@ def paper(out, plan=None, *, progress=False, client=None, store=None, say=None, 
               {h: ".1f" for h in sweep_header[6:]} | {"omega": "g", "alpha_start": "g",
                                                       "alpha_end": "g"})
     results["fig5"] = [dict(zip(sweep_header, r)) for r in sweep_rows]
+    # the branches of periodic orbits over the diagrams, bifurcations located (issue 13)
+    bif_rows = []
+    conts = {}
+    for (hb, law), sw in sweeps.items():
+        say(f"paper: periodic orbits {law} hb={hb:g}, continued from the sweep's attractors")
+        conts[(hb, law)] = cont = continue_branches(float(hb), law, STUDY[hb]["omega"],
+                                                    STUDY[hb]["alpha_range"][law], sweep=sw)
+        out.figure(f"fig5_branches_hb{hb}_{law}.png", fig_branches(cont, sw))
+        for bf in sorted(cont.bifurcations, key=lambda b: b.alpha):
+            mu = sorted(np.abs(bf.multipliers), reverse=True)
+            bif_rows.append([hb, law, bf.type, bf.alpha, bf.period, mu[0], mu[1]])
+    out.figure("fig5_branches_zoom.png", fig_branches(conts[(1, "housner")], zsw,
+                                                      limits=tuple(p.zoom)))
+    bif_header = ["hb", "law", "type", "alpha", "period", "abs_mu1", "abs_mu2"]
+    out.table("bifurcation_table", bif_header, bif_rows,
+              {"hb": "g", "alpha": ".9f", "abs_mu1": ".4g", "abs_mu2": ".4g"})
+    results["bifurcations"] = [dict(zip(bif_header, r)) for r in bif_rows]
     if p.published:
         results["fig5_as_published"] = {}
         for hb in STUDY:

@@ -416,3 +416,18 @@ def test_fate_command_and_a_trajectory_past_overturning(tmp_path):
     s = _summary(out)
     assert s["behaviour"] == "overturn" and s["status"] == "done"
     assert 0 < float(s["t_overturn"]) < 20 * 2 * math.pi / 1.3
+
+
+def test_orbits_command(tmp_path):
+    out = tmp_path / "o"
+    assert main(["orbits", "--hb", "1", "--omega", "1.3", "--alpha-range", "0.70", "0.85",
+                 "--alpha-step", "0.005", "--periods", "300", "--out", str(out),
+                 "--quiet"]) == 0
+    s = _summary(out)
+    types = [b["type"] for b in s["bifurcations"]]
+    assert "symmetry_breaking" in types
+    sb = next(b for b in s["bifurcations"] if b["type"] == "symmetry_breaking")
+    assert 0.77 < sb["alpha"] < 0.79  # the sweep's symmetric-to-asymmetric transition
+    z = np.load(out / "orbits.npz")
+    assert z["bif_alpha"].size == len(types)
+    assert _is_png(out / "orbits.png")

@@ -384,3 +384,14 @@ def test_fig_branches(study):
     fig2 = plotting.fig_branches(cont, sw, limits=(0.9, 0.96), component=0)
     lo, hi = fig2.axes[0].get_xlim()
     assert (lo, hi) == (0.9, 0.96)
+
+
+def test_branches_and_bifurcations_stay_inside_the_range():
+    # the asymmetric branch switched onto at Mao hb=1's symmetry breaking (alpha = 0.7876) was
+    # followed to alpha = 1.93 and a grazing reported there, outside the requested (0.3, 0.8)
+    from rockjit import analysis as an
+    sw = an.sweep(1.0, 1.3, law="mao", alpha_range=(0.3, 0.8), alpha_step=0.004, periods=300)
+    c = orbits.continue_branches(1.0, "mao", 1.3, (0.3, 0.8), sweep=sw)
+    assert c.bifurcations and all(0.3 <= b.alpha <= 0.8 for b in c.bifurcations)
+    for br in c.branches:
+        assert br.value.min() >= 0.3 - 1e-9 and br.value.max() <= 0.8 + 1e-9
