@@ -45,7 +45,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import _common as C  # noqa: E402
 
 import rockjit  # noqa: E402
-from rockjit import analysis, io, orbits, plotting  # noqa: E402
+from rockjit import analysis, orbits, plotting  # noqa: E402
 
 CASE = dict(hb=1.0, law="housner", omega=1.3)
 RANGE = (0.5, 1.0)
@@ -172,13 +172,12 @@ def fmt_mu(mu):
 
 
 def main(argv=None):
-    args = C.parser(__doc__.splitlines()[0]).parse_args(argv)
-    out = C.out_dir(args)
-    quick = args.quick
+    b = C.Bench(__doc__, argv)
+    quick = b.quick
     step = 0.005 if quick else 0.001
     rep_newton = 5 if quick else 41
     rep_cont = 1 if quick else 5
-    env = C.environment()
+    env = b.env
     print(C.env_line(env))
 
     # -- the sweep (seeds), first calls (compile or load from cache) --------------------------
@@ -211,8 +210,8 @@ def main(argv=None):
         res["cont"] = orbits.continue_branches(CASE["hb"], CASE["law"], CASE["omega"], RANGE,
                                                sweep=sw)
 
-    times = C.interleaved({"newton": newton, "rough": newton_rough, "cont": cont}, rep_newton,
-                          counts={"cont": rep_cont})
+    times = C.side_by_side({"newton": newton, "rough": newton_rough, "cont": cont}, rep_newton,
+                           counts={"cont": rep_cont}).wall
     t_newton = C.median(times["newton"])
     t_rough = C.median(times["rough"])
     t_cont = C.median(times["cont"])
@@ -259,8 +258,6 @@ def main(argv=None):
         if v:
             print(f"first solve in a fresh process ({k} kernels): {v['first_s']:.2f} s "
                   f"(compile/load {v['compile_s']:.2f} s, import {v['import_s']:.2f} s)")
-    C.check_unchanged(env)
-
     # -- tables -----------------------------------------------------------------------------
     rows = [
         ("one Newton solve, period 1 (alpha = 0.8), warm", t_newton * 1e3, "ms",
@@ -306,10 +303,9 @@ def main(argv=None):
                      [(i, br.period, str(br.symmetric), len(br), f"{br.value.min():.6f}",
                        f"{br.value.max():.6f}", " / ".join(br.ends), br.origin)
                       for i, br in enumerate(c.branches)])]
-    io.write_text(out / "orbits.md", "\n".join(md))
-    io.write_csv(out / "orbits.csv", ["measurement", "value", "unit", "target"], rows)
+    # -- figures ----------------------------------------------------------------------------
     summary, _ = c.to_summary()
-    io.write_json(out / "orbits.json", dict(
+    data = dict(
         environment=env, quick=quick, case=dict(**CASE, alpha_range=list(RANGE),
                                                 sweep_step=step, phase=phase),
         newton=dict(median_s=t_newton, repeats=len(times["newton"]), iterations=orb.iterations,
@@ -323,10 +319,7 @@ def main(argv=None):
                           seconds_in_simulate=tm.seconds, seconds_profiled=t_prof),
         sweep_s=t_sweep, first_calls=dict(newton_s=t_first_newton, continuation_s=t_first_cont),
         call_cost=cost, residuals={str(k): v for k, v in resid.items()},
-        shift_2n=dict(n_steps=n2, shift=shift), compile=compile_info, result=summary))
-
-    # -- figures ----------------------------------------------------------------------------
-    io.save_figure(plotting.fig_branches(c, sw), out / "orbits_branches.png")
+        shift_2n=dict(n_steps=n2, shift=shift), compile=compile_info, result=summary)
     from matplotlib.figure import Figure
     fig = Figure(figsize=(11, 4), layout="constrained")
     ax1, ax2, ax3 = fig.subplots(1, 3)
@@ -348,9 +341,12 @@ def main(argv=None):
     ax3.set_ylabel(f"\u00b5s per call (tangent, N = {orbits.N_ORBIT})")
     ax3.set_title(f"{cost['per_call_s'] * 1e6:.0f} \u00b5s per call + "
                   f"{cost['per_period_s'] * 1e6:.0f} \u00b5s per period", fontsize=10)
-    io.save_figure(fig, out / "orbits.png")
-    print(f"wrote {out}/orbits.{{md,csv,json,png}} and orbits_branches.png")
+    b.report("orbits", markdown="\n".join(md),
+             csv=(["measurement", "value", "unit", "target"], rows), data=data,
+             figures=[("orbits.png", fig, 150),
+                      ("orbits_branches.png", plotting.fig_branches(c, sw), 150)])
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -52,6 +52,8 @@ SCRIPTS = {
     "bench_distributed.py": (
         ["run", "chunks", "wall median s", "ratio to in-process", "overhead per chunk s",
          "identical to in-process"], ["distributed.png"]),
+    "bench_orbits.py": (["measurement", "value", "unit", "target"],
+                        ["orbits.png", "orbits_branches.png"]),
     "bench_stress.py": (
         ["id", "category", "hb", "alpha", "omega", "law", "e", "n_steps", "periods", "forcing",
          "status", "t", "n_impacts", "n_rhs", "work_bound", "wall_s", "failed_checks"],
