@@ -52,6 +52,9 @@ SCRIPTS = {
     "bench_distributed.py": (
         ["run", "chunks", "wall median s", "ratio to in-process", "overhead per chunk s",
          "identical to in-process"], ["distributed.png"]),
+    "bench_attractors.py": (["hb", "alpha", "omega", "law", "grid", "without_s", "with_s",
+                             "overhead", "measures_s", "n_attractors", "labels_equal"],
+                            ["attractors.png"]),
     "bench_orbits.py": (["measurement", "value", "unit", "target"],
                         ["orbits.png", "orbits_branches.png"]),
     "bench_stress.py": (
