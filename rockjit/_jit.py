@@ -189,4 +189,19 @@ def check_cache(pkg=None):
             pass  # read-only: numba then caches in the next folder, or not at all
 
 
+def cached_kernels(pkg=None):
+    """Whether numba's cache already holds compiled kernels of the package (any cache file of
+    ``integrate.py``, where every kernel's loop lives): a cold first run compiles for a minute."""
+    pkg = Path(__file__).parent if pkg is None else Path(pkg)
+    pattern = _cache_file_pattern(["integrate", "kernel"])
+    for home in _cache_dirs(pkg):
+        try:
+            if any(f.name.endswith(".nbc") and pattern.fullmatch(f.name)
+                   for f in home.iterdir()):
+                return True
+        except OSError:
+            continue
+    return False
+
+
 check_cache()

@@ -510,6 +510,13 @@ def build_parser():
     p.add_argument("--seed", type=int, default=0, help="seed of the perturbations")
     _add_common(p)
 
+    p = sub.add_parser("compile", help="compile every kernel into numba's cache",
+                       description="Compile the kernel variants the commands use (--all: every "
+                       "variant) into numba's on-disk cache, in parallel processes, so that the "
+                       "first run of a command only loads them: for images, CI and Dask workers.")
+    p.add_argument("--all", action="store_true", help="every variant (the embedding too)")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+
     p = _command(sub, "cor", _cor_plan, _cor_run, "restitution laws: figure 1 and the e-table",
                  "Figure 1 (e_H, e_M against thc, with delta e %) and a table of e_H, e_M, "
                  "delta e % (CSV and Markdown).")
@@ -562,6 +569,24 @@ def _internal_error(exc):
     return 1
 
 
+def _compile(args):
+    """``rockjit compile``: every kernel variant the common commands use (``--all``: every one)
+    into numba's cache, in parallel worker processes."""
+    from .kernel import COMMON, VARIANTS, compile_kernels
+    names = list(VARIANTS) if args.all else list(COMMON)
+    _say(args, f"compile: {len(names)} kernel variants into numba's cache (a minute or two "
+               f"from cold on two cores; seconds if cached)")
+    t0 = time.perf_counter()
+    try:
+        compile_kernels(names, progress=lambda i, n, name, s: _say(
+            args, f"compile: [{i}/{n}] {name} ({VARIANTS[name][0]}): {s:.1f} s"))
+    except KeyboardInterrupt:
+        print(f"\n{PROG}: interrupted; the variants compiled so far are cached", file=sys.stderr)
+        return 130
+    _say(args, f"compile: done in {time.perf_counter() - t0:.1f} s")
+    return 0
+
+
 def main(argv=None):
     """Run the command line; returns the exit status (0, 2 bad input, 130 interrupted)."""
     from .io import OutputDir, sigterm_interrupts
@@ -571,11 +596,18 @@ def main(argv=None):
         return _error(exc)
     except SystemExit as exc:  # --help, --version
         return exc.code if isinstance(exc.code, int) else 0
+    if args.command == "compile":
+        return _compile(args)
     try:
         plan = args.plan(args)
         _check_run(args)
     except (UsageError, ValueError) as exc:
         return _error(exc)
+    from ._jit import cached_kernels
+    if args.command != "cor" and not cached_kernels():
+        _say(args, "first run here: numba compiles rockjit's kernels into its cache, about "
+                   "20-40 s per kernel variant on two cores, once (`rockjit compile` does it "
+                   "ahead of time)")
     import matplotlib
     matplotlib.use("Agg")
     out = OutputDir(args.out, command=args.command)

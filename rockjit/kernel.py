@@ -379,3 +379,79 @@ def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, threads, progr
                                   threads), n, chunk, outputs_, client=client, store=cs,
                       progress=progress, label=label)
     return outputs_
+
+
+# ---------------------------------------------------------------------------------------------
+# compiling ahead of time (``rockjit compile``)
+# ---------------------------------------------------------------------------------------------
+
+#: Every compiled variant: ``name -> (what it serves, its switches)``. A single run's variant
+#: is ``(embed4, tangent, record)``; a grid's is its tangent switch. The first five are what the
+#: common commands need (``rockjit compile`` without ``--all``).
+VARIANTS = {
+    "run": ("single runs (closed-form forcing)", ("run", False, False, False)),
+    "run+record": ("trajectory", ("run", False, False, True)),
+    "run+tangent+record": ("trajectory --lyapunov, the paper's runs", ("run", False, True, True)),
+    "grid": ("basins, erosion, fate", ("grid", False)),
+    "grid+tangent": ("sweeps, planes (exponents)", ("grid", True)),
+    "run+tangent": ("Floquet multipliers, periodic orbits", ("run", False, True, False)),
+    "embedded": ("the 4-D embedding", ("run", True, False, False)),
+    "embedded+record": ("trajectory --forcing embedded", ("run", True, False, True)),
+    "embedded+tangent": ("exponents with the embedding", ("run", True, True, False)),
+    "embedded+tangent+record": ("the embedding, all switches", ("run", True, True, True)),
+}
+COMMON = ("run", "run+record", "run+tangent+record", "grid", "grid+tangent", "run+tangent")
+
+
+def compile_variant(name):
+    """Compile (or load from numba's cache) one variant of :data:`VARIANTS` by running it on
+    a tiny input; returns the seconds it took. Module-level, so worker processes can run it."""
+    import time as _time
+
+    from .model import Block
+    t0 = _time.perf_counter()
+    spec = VARIANTS[name][1]
+    block = Block(hb=1.0, alpha=0.6, omega=1.3)
+    if spec[0] == "run":
+        _, embed4, tangent, record = spec
+        run_single(block, (0.1, 0.0, 0.0, 1.0), 0.0, n_steps=8, periods=2, window=1,
+                   max_impacts=100, record_stride=1 if record else None, embed4=embed4,
+                   lyapunov=tangent, qr_every=None)
+    else:
+        par = pack(block, 0.0, 8, 1e-9)
+        ipar = settings(8, 2, 100, 1, pmax=1)
+        run_chunk(spec[1], np.array([[0.1, 0.0, 0.0, 1.0]]), par[None, :], ipar,
+                  np.array([1e-6, 1e-2]), 1, 1)
+    return _time.perf_counter() - t0
+
+
+def compile_kernels(names=COMMON, *, processes=None, progress=None):
+    """Compile the variants ``names`` into numba's cache, ``processes`` at a time (default: as
+    many as cores; numba's cache is safe across processes), so that later runs only load them.
+    ``progress(done, total, name, seconds)`` hears of each. Returns ``{name: seconds}``."""
+    import concurrent.futures as cf
+    import multiprocessing
+    import os
+
+    names = list(names)
+    for n in names:
+        if n not in VARIANTS:
+            raise ValueError(f"kernel variant must be one of {', '.join(VARIANTS)} (got {n!r})")
+    processes = processes or min(len(names), os.cpu_count() or 1)
+    out = {}
+    if processes <= 1:
+        for i, n in enumerate(names):
+            out[n] = compile_variant(n)
+            if progress:
+                progress(i + 1, len(names), n, out[n])
+        return out
+    ctx = multiprocessing.get_context("spawn")
+    with cf.ProcessPoolExecutor(max_workers=processes, mp_context=ctx) as ex:
+        futures = {ex.submit(compile_variant, n): n for n in names}
+        for i, f in enumerate(cf.as_completed(futures)):
+            n = futures[f]
+            out[n] = f.result()
+            if progress:
+                progress(i + 1, len(names), n, out[n])
+    # this process loads them from the cache it may use next
+    return out

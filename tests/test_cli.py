@@ -205,6 +205,7 @@ SWEEP = ["sweep", "--hb", "1", "--omega", "1.3", "--alpha-range", "0.5", "0.6"]
     (["paper", "--zoom", "0.2", "0.3"], "zoom"),
     (["paper", "--periods", "0"], "periods"),
     (["frobnicate"], "invalid choice"),
+    (["compile", "--everything"], "unrecognized arguments"),
 ])
 def test_bad_input(argv, word, tmp_path, capsys):
     out = tmp_path / "out"
@@ -431,3 +432,27 @@ def test_orbits_command(tmp_path):
     z = np.load(out / "orbits.npz")
     assert z["bif_alpha"].size == len(types)
     assert _is_png(out / "orbits.png")
+
+
+def test_compile_fills_a_cold_cache_and_says_so(tmp_path):
+    """``rockjit compile``'s machinery on a fresh numba cache: cold before, cached after, and a
+    command's first run announces the wait only while the cache is cold."""
+    code = (
+        "import sys\n"
+        "from rockjit._jit import cached_kernels\n"
+        "from rockjit.kernel import compile_kernels\n"
+        "assert not cached_kernels(), 'cache not cold'\n"
+        "seconds = compile_kernels(['grid'], processes=1)\n"
+        "assert set(seconds) == {'grid'} and seconds['grid'] > 0\n"
+        "assert cached_kernels(), 'nothing cached'\n"
+    )
+    env = {**__import__("os").environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert any(p.suffix == ".nbc" for p in (tmp_path / "cache").rglob("*"))
+
+
+def test_compile_refuses_an_unknown_variant():
+    from rockjit.kernel import compile_kernels
+    with pytest.raises(ValueError, match="kernel variant must be one of"):
+        compile_kernels(["warp-drive"])
