@@ -194,7 +194,10 @@ def cached_kernels(pkg=None):
     ``integrate.py``, where every kernel's loop lives): a cold first run compiles for a minute."""
     pkg = Path(__file__).parent if pkg is None else Path(pkg)
     pattern = _cache_file_pattern(["integrate", "kernel"])
-    for home in _cache_dirs(pkg):
+    homes = _cache_dirs(pkg)
+    if os.environ.get("NUMBA_CACHE_DIR"):  # numba then looks nowhere else
+        homes = homes[:len({os.path.abspath(pkg), os.path.realpath(pkg)})]
+    for home in homes:
         try:
             if any(f.name.endswith(".nbc") and pattern.fullmatch(f.name)
                    for f in home.iterdir()):

@@ -21,7 +21,6 @@ import math
 import os
 import re
 import sys
-import tempfile
 import time
 import warnings
 from pathlib import Path
@@ -66,9 +65,8 @@ def _warn(msg):
 # ---------------------------------------------------------------------------------------------
 
 def _check_run(args):
-    """``--out`` must be a directory or creatable as one, beside a creatable ``<out>.chunks``
-    (probed by making and removing a temporary directory where the outputs will be staged);
-    ``--scheduler`` needs dask; ``--threads`` (of every command) fits numba's."""
+    """``--threads`` fits numba's; ``--scheduler`` needs dask; ``--out`` can be written
+    (:func:`rockjit.io.check_out`)."""
     if getattr(args, "threads", None) is not None:
         import numba
         from .validate import integer
@@ -78,27 +76,13 @@ def _check_run(args):
             import dask.distributed  # noqa: F401
         except ImportError:
             raise UsageError("--scheduler needs dask: pip install 'rockjit[dask]'") from None
-    if not args.out.strip():
-        raise UsageError("--out must name a directory (got an empty string)")
-    p = Path(args.out)
-    if p.exists() and not p.is_dir():
-        raise UsageError(f"--out must be a directory (got {args.out}, an existing file)")
-    chunks = _chunk_root(args)
-    if chunks.exists() and not chunks.is_dir():
-        raise UsageError(f"{chunks} (where --out's unfinished chunks wait) exists and is not a "
-                         f"directory; move it away or choose another --out")
-    q = p.absolute().parent
-    while not q.exists():
-        q = q.parent
-    try:
-        os.rmdir(tempfile.mkdtemp(prefix=f".{PROG}-probe-", dir=q))
-    except OSError as exc:
-        raise UsageError(f"--out {args.out} cannot be created or written "
-                         f"({exc.strerror or exc})") from None
+    from .io import check_out
+    check_out(args.out, name="--out")
 
 
 def _chunk_root(args):
-    return Path(str(Path(args.out)) + ".chunks")
+    from .io import chunk_root
+    return chunk_root(args.out)
 
 
 def _client(args):
@@ -113,14 +97,12 @@ def _client(args):
         raise UsageError(f"cannot reach the Dask scheduler at {args.scheduler} ({exc})")
 
 
-def _block_kw(args):
-    """The block's options, and the initial state's, and the grids' settings, by API name."""
+def _block_kw(args):  # these three: the options by their API names
     return dict(law=args.law, e=args.e, xi=args.xi)
 
 
 def _state_kw(args):
-    return dict(theta0=args.theta0, dtheta0=args.dtheta0, r0=args.r0, s0=args.s0,
-                phase=args.phase)
+    return dict(theta0=args.theta0, dtheta0=args.dtheta0, r0=args.r0, s0=args.s0, phase=args.phase)
 
 
 def _grid_kw(args):
@@ -131,20 +113,8 @@ def _grid_kw(args):
 
 
 def _z0(args):
-    """The sweep's and plane's initial state, by simulate's rule: the study's z0 when none is
-    given, else the angles given (0 where not) and the forcing at its phase (default 0)."""
-    from .simulate import forcing_phase, initial_state
-    th, dth, r0, s0 = initial_state(args.theta0, args.dtheta0, None, args.r0, args.s0,
-                                    args.phase)
-    return (th, dth) + forcing_phase(args.phase, r0, s0, "closed", embedded_hint=False)[1:]
-
-
-def _summary(args, wall, out, **results):
-    from .result import BEHAVIOURS
-    inputs = {k: v for k, v in vars(args).items() if not callable(v)}
-    return dict(command=args.command, rockjit_version=__version__, inputs=inputs, wall_s=wall,
-                behaviours=list(BEHAVIOURS), files=sorted(out.written + ["summary.json"]),
-                **results)
+    from .simulate import closed_form_z0
+    return closed_form_z0(args.theta0, args.dtheta0, args.r0, args.s0, args.phase)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -169,18 +139,9 @@ def _trajectory_run(args, p, out):
     from .simulate import run
     _say(args, f"trajectory: {p.periods} periods, {p.method}")
     t0 = time.perf_counter()
-    res = run(p)
-    wall = time.perf_counter() - t0
-    if res.stopped_early:
-        _warn(f"the run stopped at t = {res.t:.6g} of {p.periods * res.period:.6g}: "
-              f"{res.message}" + ("; raise --max-impacts" if res.status == "max_impacts" else ""))
-    if p.lyapunov and res.window and res.t <= res.window[0]:
-        _warn("the run ended before the averaging window began: lambda is nan")
-    if p.lyapunov and res.beyond_horizon:
-        _warn(f"the run ended at t = {res.t:.4g}, beyond its predictability horizon "
-              f"t* = {res.horizon:.4g} (rounding grown to 1 % at lambda1 = "
-              f"{res.lyapunov_running[-1, 0]:.3g}): its outcome is one sample; "
-              f"`rockjit fate` gives the probabilities")
+    res, wall = run(p), time.perf_counter() - t0
+    for note in res.caveats(cli=True):
+        _warn(note)
     return wall, dict(outputs.trajectory(out, res), record_stride=p.record_stride)
 
 
@@ -229,8 +190,7 @@ def _grid_run(writer, name):
     """The run of a grid command: its plan (or one plan per law) computed with the command
     line's progress, Dask client and chunk store, then written by ``outputs.<writer>``."""
     def run_it(args, plans, out):
-        from . import analysis, erosion, outputs
-        from . import orbits
+        from . import analysis, erosion, orbits, outputs
         run = dict(erosion=erosion.run, orbits=orbits.run).get(writer, analysis.run)
         t0 = time.perf_counter()
         if isinstance(plans, dict):
@@ -272,10 +232,8 @@ def _fate_run(args, p, out):
 def _cor_plan(args):
     from .model import Block
     from .validate import real
-    for hb in args.hb_values:
-        Block(hb=hb, alpha=0.0, omega=1.0, law="housner")
+    [Block(hb=hb, alpha=0.0, omega=1.0, law="housner") for hb in args.hb_values]
     real("hb_max", args.hb_max, 1 / math.sqrt(2), 100.0, lo_open=True)
-    return None
 
 
 def _cor_run(args, _, out):
@@ -290,8 +248,7 @@ def _paper_plan(args):
     return plan_paper(grid=args.grid, periods=args.periods, n_steps=args.n_steps,
                       alpha_step=args.alpha_step, zoom=args.zoom, zoom_step=args.zoom_step,
                       erosion_step=args.erosion_step, erosion_grid=args.erosion_grid,
-                      as_published=args.as_published,
-                      threads=args.threads)
+                      as_published=args.as_published, threads=args.threads)
 
 
 def _paper_run(args, p, out):
@@ -362,6 +319,11 @@ def _add_phase(p, default_note):
                    help=f"forcing oscillator s(0) (with --r0); {default_note}")
 
 
+def _add_forcing(p):
+    p.add_argument("--forcing", default="closed", choices=("closed", "embedded"),
+                   help="closed-form forcing or the 4-D oscillator embedding")
+
+
 def _add_common(p, threads=True):
     p.add_argument("--out", required=True, help="output directory (created if missing)")
     if threads:
@@ -423,8 +385,7 @@ def build_parser():
     _add_run(p)
     p.add_argument("--method", default="rockjit",
                    help="rockjit (compiled), scipy or scipy:<solve_ivp method> (default rockjit)")
-    p.add_argument("--forcing", default="closed", choices=("closed", "embedded"),
-                   help="closed-form forcing or the 4-D oscillator embedding")
+    _add_forcing(p)
     p.add_argument("--rtol", type=float, default=1e-6, help="scipy path tolerance")
     p.add_argument("--atol", type=float, default=1e-9, help="scipy path tolerance")
     p.add_argument("--rest-speed", type=float, default=1e-6,
@@ -434,7 +395,7 @@ def build_parser():
                    help="at most this many recorded points (default 50000)")
     _add_common(p)
 
-    p = _command(sub, "sweep", _sweep_plan, _grid_run("sweep", "sweep"), "bifurcation sweep over alpha",
+    p = _command(sub, "sweep", _sweep_plan, _grid_run("sweep", "sweep"), "sweep over alpha",
                  "Sweep the forcing amplitude; write sweep.npz, bifurcation.png and "
                  "summary.json (fractions of each behaviour).")
     _add_block(p, alpha=False)
@@ -455,7 +416,7 @@ def build_parser():
     _add_phase(p, "default (r0, s0) = (0, 1)")
     _add_grid_run(p, lyapunov_default=False)
 
-    p = _command(sub, "plane", _plane_plan, _grid_run("plane", "plane"), "behaviours over (alpha, omega)",
+    p = _command(sub, "plane", _plane_plan, _grid_run("plane", "plane"), "the (alpha, omega) plane",
                  "Classify a grid over the forcing plane (alpha, omega) from one initial state; "
                  "write plane.npz (label[i, j] belongs to alpha[i], omega[j]), plane.png and "
                  "summary.json. Runs in-process or, with --scheduler, on a Dask cluster; an "
@@ -502,18 +463,16 @@ def build_parser():
     _add_block(p)
     _add_state(p, "default: the study's z0")
     _add_run(p)
-    p.add_argument("--forcing", default="closed", choices=("closed", "embedded"),
-                   help="closed-form forcing or the 4-D oscillator embedding")
+    _add_forcing(p)
     p.add_argument("--ensemble", type=int, default=64, help="members (default 64)")
     p.add_argument("--spread", type=float, nargs=2, default=None, metavar=("LO", "HI"),
                    help="relative perturbations, log-uniform (default 8.9e-16 1e-10)")
     p.add_argument("--seed", type=int, default=0, help="seed of the perturbations")
     _add_common(p)
 
-    p = sub.add_parser("compile", help="compile every kernel into numba's cache",
-                       description="Compile the kernel variants the commands use (--all: every "
-                       "variant) into numba's on-disk cache, in parallel processes, so that the "
-                       "first run of a command only loads them: for images, CI and Dask workers.")
+    p = sub.add_parser("compile", help="compile every kernel into numba's cache", description=
+                       "Compile the kernel variants the commands use into numba's cache, in "
+                       "parallel processes: later runs only load them (images, CI, Dask).")
     p.add_argument("--all", action="store_true", help="every variant (the embedding too)")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
 
@@ -570,13 +529,10 @@ def _internal_error(exc):
 
 
 def _compile(args):
-    """``rockjit compile``: every kernel variant the common commands use (``--all``: every one)
-    into numba's cache, in parallel worker processes."""
+    """``rockjit compile [--all]``: the kernel variants into numba's cache, in parallel."""
     from .kernel import COMMON, VARIANTS, compile_kernels
-    names = list(VARIANTS) if args.all else list(COMMON)
-    _say(args, f"compile: {len(names)} kernel variants into numba's cache (a minute or two "
-               f"from cold on two cores; seconds if cached)")
-    t0 = time.perf_counter()
+    names, t0 = list(VARIANTS if args.all else COMMON), time.perf_counter()
+    _say(args, f"compile: {len(names)} kernel variants (a minute or two cold on two cores)")
     try:
         compile_kernels(names, progress=lambda i, n, name, s: _say(
             args, f"compile: [{i}/{n}] {name} ({VARIANTS[name][0]}): {s:.1f} s"))
@@ -589,6 +545,7 @@ def _compile(args):
 
 def main(argv=None):
     """Run the command line; returns the exit status (0, 2 bad input, 130 interrupted)."""
+    from . import outputs
     from .io import OutputDir, sigterm_interrupts
     try:
         args = build_parser().parse_args(argv)
@@ -616,7 +573,8 @@ def main(argv=None):
             if args.quiet:
                 warnings.simplefilter("ignore")
             wall, results = args.run(args, plan, out)
-            out.json("summary.json", _summary(args, wall, out, **results))
+            inputs = {k: v for k, v in vars(args).items() if not callable(v)}
+            out.json("summary.json", outputs.summary(out, args.command, inputs, wall, **results))
             note = out.publish()
     except KeyboardInterrupt:
         if not out.published:

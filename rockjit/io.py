@@ -335,6 +335,35 @@ def _check_name(name):
     return name
 
 
+def chunk_root(out):
+    """Where the unfinished chunks of the grids of a command writing ``out`` wait."""
+    return Path(str(Path(out)) + ".chunks")
+
+
+def check_out(out, *, name="out"):
+    """Refuse (``ValueError`` naming ``name``) an output directory that cannot be written: an
+    empty name, an existing file, a ``<out>.chunks`` that is not a directory, or a place where
+    no directory can be made (probed by making and removing a temporary one where the outputs
+    will be staged)."""
+    if not str(out).strip():
+        raise ValueError(f"{name} must name a directory (got an empty string)")
+    p = Path(out)
+    if p.exists() and not p.is_dir():
+        raise ValueError(f"{name} must be a directory (got {out}, an existing file)")
+    chunks = chunk_root(out)
+    if chunks.exists() and not chunks.is_dir():
+        raise ValueError(f"{chunks} (where {name}'s unfinished chunks wait) exists and is not "
+                         f"a directory; move it away or choose another {name}")
+    q = p.absolute().parent
+    while not q.exists():
+        q = q.parent
+    try:
+        os.rmdir(_mkdir_unique(q, ".rockjit-probe-"))
+    except OSError as exc:
+        raise ValueError(f"{name} {out} cannot be created or written "
+                         f"({exc.strerror or exc})") from None
+
+
 class OutputDir:
     """The files of one command, staged in a hidden directory and published together.
 

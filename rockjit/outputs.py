@@ -14,6 +14,16 @@ import numpy as np
 __all__ = ["basins", "erosion", "fate", "orbits", "plane", "sweep", "trajectory"]
 
 
+def summary(out, command, inputs, wall, **results):
+    """``summary.json``'s content: the command and its inputs, rockjit's version, the wall
+    time, the behaviour names, every file written, and the command's ``results``."""
+    from . import __version__
+    from .result import BEHAVIOURS
+    return dict(command=command, rockjit_version=__version__, inputs=inputs, wall_s=wall,
+                behaviours=list(BEHAVIOURS), files=sorted(out.written + ["summary.json"]),
+                **results)
+
+
 def trajectory(out, res, *, npz="trajectory.npz", png="trajectory.png"):
     """One run: its arrays (``Result.arrays``) and :func:`rockjit.plotting.fig_trajectory`."""
     from .analysis import classify_result

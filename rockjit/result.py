@@ -196,6 +196,26 @@ class Result:
         physics (the impact bound, a non-finite number)."""
         return self.status in ("max_impacts", "nonfinite")
 
+    def caveats(self, *, cli=False):
+        """What a reader of this run must be told, as sentences: a stop before the requested
+        end, exponents with no averaging window, an outcome beyond the predictability horizon
+        (``cli``: options named as the command line spells them)."""
+        out = []
+        if self.stopped_early:
+            raise_ = "; raise " + ("--max-impacts" if cli else "max_impacts")
+            out.append(f"the run stopped at t = {self.t:.6g} of {self.periods * self.period:.6g}: "
+                       f"{self.message}"
+                       + (raise_ if self.status == "max_impacts" else ""))
+        if self.lyapunov is not None and self.window and self.t <= self.window[0]:
+            out.append("the run ended before the averaging window began: lambda is nan")
+        if self.lyapunov is not None and self.beyond_horizon:
+            out.append(f"the run ended at t = {self.t:.4g}, beyond its predictability horizon "
+                       f"t* = {self.horizon:.4g} (rounding grown to 1 % at lambda1 = "
+                       f"{self.lyapunov_running[-1, 0]:.3g}): its outcome is one sample; "
+                       + ("`rockjit fate`" if cli else "rockjit.fate") + " gives the "
+                       "probabilities")
+        return out
+
     def __repr__(self) -> str:
         b = self.block
         return (f"Result({self.method}, hb={b.hb}, alpha={b.alpha}, omega={b.omega}, "
