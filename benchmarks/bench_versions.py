@@ -1,0 +1,192 @@
+"""Two versions of rockjit side by side: step time, basin and sweep time, and identical results.
+
+The issues that reshape the kernels (11: the kernel's I/O and the split loop; 15: compile time;
+17: lanes) promise warm speed within a few percent of an earlier commit and the same results.
+This script measures exactly that: it checks the earlier commit out into a temporary git
+worktree, starts one worker process per version (each imports its own rockjit and warms its
+kernels), and times the same calls in both, interleaved round by round in rotating order, so
+the ratio of the medians is taken side by side on one noisy machine:
+
+- ``run``: the study's reference run (hb=1, alpha=0.6, omega=1.3, Housner, z0, 500 periods),
+  nanoseconds per step; ``run+lyapunov``: the same with the exponents;
+- ``basin``: the study's 100x100 hb=1 Housner basin (alpha=0.66, omega=1.3, (r0, s0) = (0, 1),
+  early stopping, no exponents; attractor identification off where the version has it);
+- ``sweep``: hb=1 Housner over alpha in [0.5, 1.0] every 0.005 with exponents.
+
+Each case also reports whether both versions returned the same numbers, bit for bit (the final
+state and impact count of a run; the labels, periods, exponents and strobe points of a grid).
+
+    python benchmarks/bench_versions.py --base 4b22de6           # this checkout against 4b22de6
+    python benchmarks/bench_versions.py --quick   # smoke: this checkout against itself, small
+
+Without ``--base`` both workers import this checkout (a self-comparison: every case must come
+out identical, and the ratios near 1 show the method's noise).
+
+Writes versions.{md,csv,json,png} to benchmarks/results/ (and its block of
+benchmarks/README.md), or to benchmarks/results/quick/ with ``--quick``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import textwrap
+from pathlib import Path
+
+import _common as H
+
+#: The cases: name -> (function, keyword arguments); ``quick`` shrinks them.
+CASES = {
+    "run": ("simulate", dict(H.REFERENCE_RUN, periods=500)),
+    "run+lyapunov": ("simulate", dict(H.REFERENCE_RUN, periods=500, lyapunov=True)),
+    "basin": ("basin", dict(hb=1.0, alpha=0.66, omega=1.3, law="housner", grid=100, r0=0.0,
+                            s0=1.0, attractors=False)),
+    "sweep": ("sweep", dict(hb=1.0, omega=1.3, law="housner", alpha_range=(0.5, 1.0),
+                            alpha_step=0.005, lyapunov=True, attractors=False)),
+}
+QUICK = {"run": dict(periods=50), "run+lyapunov": dict(periods=50), "basin": dict(grid=20,
+         periods=50), "sweep": dict(alpha_step=0.05, periods=50)}
+
+#: The worker: reads one JSON request per line, answers one JSON line (seconds and a digest).
+_WORKER = textwrap.dedent("""
+    import hashlib, inspect, json, sys, time
+    import numpy as np
+    import rockjit
+    from rockjit import analysis
+    FN = dict(simulate=rockjit.simulate, basin=analysis.basin, sweep=analysis.sweep)
+
+    def digest(res):
+        h = hashlib.sha256()
+        names = ("state", "n_impacts") if hasattr(res, "state") else (
+            "label", "period", "lambda_max", "strobe")
+        for name in names:
+            v = getattr(res, name, None)
+            if v is not None:
+                h.update(np.ascontiguousarray(np.asarray(v, dtype=float)).tobytes())
+        return h.hexdigest()
+
+    for line in sys.stdin:
+        fn_name, kw = json.loads(line)
+        fn = FN[fn_name]
+        known = inspect.signature(fn).parameters
+        kw = {k: v for k, v in kw.items() if k in known}
+        t0 = time.perf_counter()
+        res = fn(**kw)
+        wall = time.perf_counter() - t0
+        steps = getattr(res, "n_steps", 0) * kw.get("periods", 0) if fn_name == "simulate" else 0
+        print(json.dumps(dict(wall=wall, digest=digest(res), steps=steps,
+                              file=rockjit.__file__)), flush=True)
+""")
+
+
+class Worker:
+    """One Python process importing the rockjit under ``src``."""
+
+    def __init__(self, src):
+        env = dict(os.environ, PYTHONPATH=str(src))
+        self.proc = subprocess.Popen([sys.executable, "-c", _WORKER], env=env, cwd=str(src),
+                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+
+    def __call__(self, fn, kw):
+        self.proc.stdin.write(json.dumps([fn, kw]) + "\n")
+        self.proc.stdin.flush()
+        line = self.proc.stdout.readline()
+        if not line:
+            raise RuntimeError(f"a worker died running {fn}({kw})")
+        return json.loads(line)
+
+    def close(self):
+        self.proc.stdin.close()
+        self.proc.wait(timeout=60)
+
+
+def options(p):
+    p.add_argument("--base", default=None,
+                   help="the earlier commit (any git revision); default: this checkout itself")
+    p.add_argument("--repeats", type=int, default=None, help="rounds (default 15; quick 3)")
+
+
+def measure(bench, base_src, cases, repeats):
+    """Every case in both versions, interleaved; rows and the raw times."""
+    here = H.ROOT
+    workers = {"base": Worker(base_src), "this": Worker(here)}
+    try:
+        for name, (fn, kw) in cases.items():  # warm: compile or load every variant once
+            for w in workers.values():
+                w(fn, kw)
+        order = list(workers)
+        raw = {(c, v): [] for c in cases for v in workers}
+        last = {}
+        for rep in range(repeats):
+            for c, (fn, kw) in cases.items():
+                for v in (order if rep % 2 else order[::-1]):
+                    r = workers[v](fn, kw)
+                    raw[c, v].append(r["wall"])
+                    last[c, v] = r
+    finally:
+        for w in workers.values():
+            w.close()
+    rows = []
+    for c in cases:
+        b, t = H.median(raw[c, "base"]), H.median(raw[c, "this"])
+        steps = last[c, "this"]["steps"]
+        rows.append(dict(case=c, base_s=b, this_s=t, ratio=t / b,
+                         base_ns_step=b / steps * 1e9 if steps else None,
+                         this_ns_step=t / steps * 1e9 if steps else None,
+                         identical=last[c, "base"]["digest"] == last[c, "this"]["digest"]))
+    return rows, {f"{c}/{v}": ts for (c, v), ts in raw.items()}
+
+
+def main(argv=None):
+    bench = H.Bench(__doc__, argv, options=options)
+    a = bench.args
+    repeats = a.repeats or (3 if bench.quick else 15)
+    cases = {c: (fn, dict(kw, **(QUICK[c] if bench.quick else {})))
+             for c, (fn, kw) in CASES.items()}
+    if a.base is None:
+        rev = "this checkout"
+        rows, raw = measure(bench, H.ROOT, cases, repeats)
+    else:
+        rev = subprocess.run(["git", "-C", str(H.ROOT), "rev-parse", "--short", a.base],
+                             capture_output=True, text=True, check=True).stdout.strip()
+        with tempfile.TemporaryDirectory(prefix="rockjit-base-") as tmp:
+            src = Path(tmp) / "src"
+            subprocess.run(["git", "-C", str(H.ROOT), "worktree", "add", "--detach", "--quiet",
+                            str(src), rev], check=True)
+            try:
+                rows, raw = measure(bench, src, cases, repeats)
+            finally:
+                subprocess.run(["git", "-C", str(H.ROOT), "worktree", "remove", "--force",
+                                str(src)], check=False)
+    this = bench.env.get("commit", "this checkout")
+    lines = [f"#### Two versions side by side: {rev} (base) and {this} (this)", "",
+             f"Medians of {repeats} rounds, each case run in both versions back to back (order "
+             f"alternating), after one warm-up call each; `identical`: both returned the same "
+             f"numbers bit for bit.", "",
+             "| case | base | this | this/base | ns/step base | ns/step this | identical |",
+             "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        ns = ("", "") if r["base_ns_step"] is None else (f"{r['base_ns_step']:.0f}",
+                                                        f"{r['this_ns_step']:.0f}")
+        lines.append(f"| {r['case']} | {r['base_s']:.4g} s | {r['this_s']:.4g} s | "
+                     f"{r['ratio']:.3f} | {ns[0]} | {ns[1]} | {'yes' if r['identical'] else 'no'} |")
+    markdown = "\n".join(lines) + "\n"
+    plt = H.pyplot()
+    fig, ax = plt.subplots(figsize=(6, 3.2))
+    ax.barh([r["case"] for r in rows], [r["ratio"] for r in rows], color="tab:blue")
+    ax.axvline(1.0, color="k", lw=0.8)
+    ax.set_xlabel(f"wall time, this / base ({rev})")
+    ax.invert_yaxis()
+    fig.tight_layout()
+    keys = list(rows[0])
+    bench.report("versions", markdown=markdown, csv=(keys, [[r[k] for k in keys] for r in rows]),
+                 data=dict(base=rev, rows=rows, raw=raw, env=bench.env),
+                 figures=[("versions.png", fig, 120)])
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
