@@ -299,8 +299,8 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
              forcing="closed", method="rockjit", rtol=1e-6, atol=1e-9, lyapunov=False,
              window=None, record_stride=None, max_impacts=None,
              theta_over=0.5 * math.pi, rest_speed=1e-6, qr_every=None,
-             stop_at_overturn=True, ensemble=None, spread=None, seed=0):
-    """Simulate the harmonically forced rocking block (``ensemble=K``: K nearby runs).
+             stop_at_overturn=True) -> Result:
+    """Simulate the harmonically forced rocking block.
 
     Parameters
     ----------
@@ -361,15 +361,15 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
         integrates on through the threshold with the same equations, as the study's own code
         did; ``result.t_overturn`` records the first crossing and the run counts as overturned
         (:func:`rockjit.analysis.classify_result`).
-    ensemble, spread, seed : optional
-        ``ensemble=K`` runs K copies from initial states perturbed at relative sizes
-        log-uniform over ``spread`` (default a few ulps to 1e-10) with ``seed``, and returns
-        their outcome probabilities, the transient's exponent and the predictability horizon
-        (:func:`rockjit.fate.fate`, whose result this is; compiled path only).
 
     Returns
     -------
-    Result, or :class:`rockjit.fate.FateResult` with ``ensemble``
+    Result
+
+    See Also
+    --------
+    rockjit.fate.fate : ``K`` runs from nearby initial states, the same keywords: each
+        outcome's probability and the predictability horizon.
 
     Raises
     ------
@@ -377,18 +377,6 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
         For any parameter out of its range; the message names the parameter, the allowed range
         and the value given. Also for a run whose arrays would not fit in memory.
     """
-    if ensemble is not None:
-        if method != "rockjit" or record_stride is not None:
-            raise ValueError("an ensemble runs on the compiled path without recording "
-                             "(method='rockjit', record_stride=None)")
-        from .fate import fate
-        return fate(hb, alpha, omega, law, ensemble=ensemble, spread=spread, seed=seed, e=e,
-                    xi=xi, theta0=theta0, dtheta0=dtheta0, z0=z0, phase=phase, r0=r0, s0=s0,
-                    periods=periods, n_steps=n_steps, forcing=forcing, window=window,
-                    max_impacts=max_impacts, theta_over=theta_over, rest_speed=rest_speed,
-                    qr_every=qr_every, stop_at_overturn=stop_at_overturn)
-    if spread is not None:
-        raise ValueError("spread goes with ensemble=K (the number of perturbed runs)")
     return run(plan(hb, alpha, omega, law, e=e, xi=xi, theta0=theta0, dtheta0=dtheta0, z0=z0,
                     phase=phase, r0=r0, s0=s0, periods=periods, n_steps=n_steps,
                     forcing=forcing, method=method, rtol=rtol, atol=atol, lyapunov=lyapunov,

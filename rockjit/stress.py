@@ -120,7 +120,7 @@ import numpy as np
 import rockjit
 
 from . import analysis as an
-from .simulate import steps_per_period
+from .simulate import default_max_impacts, steps_per_period
 
 RANGES = dict(hb=(0.75, 20.0), alpha=(0.0, 3.0), omega=(0.05, 20.0), e=(0.0, 1.0))
 CATEGORIES = ("random", "near_zero", "grazing", "near_overturn", "long_horizon",
@@ -544,7 +544,7 @@ def check_work(kw, res):
 def check_bookkeeping(kw, res):
     probs = []
     b = res.block
-    max_imp = kw.get("max_impacts", 100_000)
+    max_imp = kw.get("max_impacts") or default_max_impacts(res.periods)
     n = res.n_impacts
     if n > max_imp:
         probs.append(f"{n} impacts > max_impacts {max_imp}")

@@ -85,14 +85,12 @@ def test_fate_refuses_bad_input(kw, match):
         F.fate(1.0, 0.969, 1.3, "housner", periods=10, **kw)
 
 
-def test_simulate_with_an_ensemble_is_each_member_run_alone():
-    """``simulate(ensemble=K)``: each member's end against a plain run from its own start."""
+def test_each_member_of_an_ensemble_is_its_own_plain_run():
+    """The ensemble's grid kernel against a plain ``simulate`` from each member's start."""
     kw = dict(hb=1.0, alpha=0.969, omega=1.3, law="housner", periods=150)
-    fr = rockjit.simulate(**kw, ensemble=6, seed=3)
+    fr = F.fate(**kw, ensemble=6, seed=3)
     assert isinstance(fr, F.FateResult) and len(fr.t_end) == 6
     for (th, dth), t_end, outcome in zip(fr.initial, fr.t_end, fr.outcome):
         alone = rockjit.simulate(**kw, z0=(th, dth) + Z0_STUDY[2:])  # fate's default z0
         assert alone.t == pytest.approx(t_end, abs=1e-9)
         assert (alone.status == "overturned") == (outcome == -1)
-    with pytest.raises(ValueError, match="spread goes with ensemble"):
-        rockjit.simulate(**kw, spread=(1e-12, 1e-10))

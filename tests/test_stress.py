@@ -334,3 +334,16 @@ def test_embedding_far_off_the_circle_stays_finite_or_is_refused():
         return
     probs = S.check_run(kw, res)
     assert not any(probs.values()), probs
+
+
+def test_bookkeeping_knows_the_default_impact_bound_grows_with_periods():
+    """The default bound is 10,000 impacts a period, at least 100,000 (issue 10); the check
+    assumed 100,000 and failed 8 long runs that rightly went past it (s0-2812: 614,224 impacts
+    in 811 periods, status done). Reduced: an elastic bounce at 1e-6 rad/s over 15 periods
+    piles 150,000 impacts, reaching its own bound exactly (s0-1711)."""
+    kw = dict(hb=1.6637121582875023, alpha=0.0, omega=6.517861886497169, law="constant", e=1.0,
+              periods=15, theta0=-1e-15, dtheta0=-1e-06, phase=5.333658663223674)
+    res = rockjit.simulate(**kw)
+    assert res.status == "max_impacts" and res.n_impacts == 15 * 10_000  # independent: the rule
+    assert S.check_bookkeeping(kw, res) == []
+    assert S.check_bookkeeping(dict(kw, max_impacts=100_000), res) != []  # a smaller bound fails
