@@ -3,7 +3,7 @@
 Runs the command as a user would, ``python -m rockjit paper --out DIR --quiet`` in a subprocess
 (grid 100, 500 periods, alpha step 0.001: the command's defaults), and reports the wall time seen
 from outside (Python start-up, import, compilation or cache loading, computation, writing) and
-the per-part wall times of the command's own ``summary.json`` (``wall_s_parts``: fig1 ... fig6).
+the per-part wall times of the command's own ``summary.json`` (``wall_s_parts``: fig1 ... fig8).
 
 * **cold**: one run with a fresh, empty ``NUMBA_CACHE_DIR``, so every kernel compiles;
 * **second**: the next run on that cache, reported apart: before commit 4e61b69 it compiled
@@ -37,13 +37,16 @@ from rockjit.analysis import GRID_N
 
 TARGET_S = 60.0
 SECTION = H.RESULTS / "grids_section.md"
-PARTS = ("fig1", "fig2", "fig3", "fig4", "fig5", "fig6")
+PARTS = ("fig1", "fig2", "fig3", "fig4", "fig5", "fig6", "fig7", "fig8")
 PART_NAMES = {"fig1": "fig1 restitution laws + e-table", "fig2": "fig2 reference run",
               "fig3": "fig3 behaviour gallery (5 runs)", "fig4": "fig4 Housner vs Mao (6 runs)",
-              "fig5": "fig5 sweeps (4 diagrams + zoom, lambda on)",
-              "fig6": "fig6 basins (2 cases x 2 laws)"}
+              "fig5": "fig5 sweeps (4 + zoom, lambda on), orbit branches",
+              "fig6": "fig6 basins (2 cases x 2 laws)",
+              "fig7": "fig7 attractor maps, entropy, integrity",
+              "fig8": "fig8 erosion profiles (survey, 2 cases x 2 laws)"}
 FULL = dict(extra=[], repeats=3)
-QUICK = dict(extra=["--grid", "20", "--periods", "50", "--alpha-step", "0.02"], repeats=1)
+QUICK = dict(extra=["--grid", "20", "--periods", "50", "--alpha-step", "0.02", "--erosion-grid",
+                    "12", "--erosion-step", "0.1"], repeats=1)
 
 
 # --------------------------------------------------------------------------- the experiment
@@ -101,7 +104,8 @@ def markdown(runs, sm, inputs, quick, env):
     cold = runs[0]
     second = None if quick else runs[1]
     warm, med_out = sm["warm"], sm["med_out"]
-    q = " (QUICK MODE: grid 20, 50 periods, alpha step 0.02)" if quick else ""
+    q = " (QUICK MODE: grid 20, 50 periods, alpha step 0.02, erosion 12x12 every 0.1)" \
+        if quick else ""
     settings = (f"grid {inputs['grid']}, {inputs['periods']} periods, alpha step "
                 f"{inputs['alpha_step']:g} (zoom step {inputs['alpha_step'] / 4:g}), n_steps "
                 f"default ({DEFAULT_N} single runs, {GRID_N} sweeps and basins), all threads")
@@ -154,7 +158,7 @@ def plot(runs, sm, quick):
             *([] if second is None else
               [("second run", second["parts"], second["wall_outside_s"])]),
             (f"warm\n(median of {len(sm['warm'])})", sm["med_parts"], sm["med_out"])]
-    colours = dict(zip(PARTS, ("C7", "C0", "C2", "C4", "C1", "C3")))
+    colours = dict(zip(PARTS, ("C7", "C0", "C2", "C4", "C1", "C3", "C5", "C6")))
     for y, (name, parts, outside) in enumerate(bars):
         left = 0.0
         for p in PARTS:

@@ -48,7 +48,7 @@ SCRIPTS = {
         ["grids_timing.png", "grids_agreement.png", "grids_sweep_resolution.png"]),
     "bench_paper.py": (
         ["run", "kind", "wall_outside_s", "wall_s", "fig1", "fig2", "fig3", "fig4", "fig5",
-         "fig6"], ["paper.png"]),
+         "fig6", "fig7", "fig8"], ["paper.png"]),
     "bench_distributed.py": (
         ["run", "chunks", "wall median s", "ratio to in-process", "overhead per chunk s",
          "identical to in-process"], ["distributed.png"]),
