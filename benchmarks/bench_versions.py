@@ -73,11 +73,11 @@ _WORKER = textwrap.dedent("""
         fn = FN[fn_name]
         known = inspect.signature(fn).parameters
         kw = {k: v for k, v in kw.items() if k in known}
-        t0 = time.perf_counter()
+        c0, t0 = time.process_time(), time.perf_counter()
         res = fn(**kw)
-        wall = time.perf_counter() - t0
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         steps = getattr(res, "n_steps", 0) * kw.get("periods", 0) if fn_name == "simulate" else 0
-        print(json.dumps(dict(wall=wall, digest=digest(res), steps=steps,
+        print(json.dumps(dict(wall=wall, cpu=cpu, digest=digest(res), steps=steps,
                               file=rockjit.__file__)), flush=True)
 """)
 
@@ -119,12 +119,14 @@ def measure(bench, base_src, cases, repeats):
                 w(fn, kw)
         order = list(workers)
         raw = {(c, v): [] for c in cases for v in workers}
+        cpu = {(c, v): [] for c in cases for v in workers}
         last = {}
         for rep in range(repeats):
             for c, (fn, kw) in cases.items():
                 for v in (order if rep % 2 else order[::-1]):
                     r = workers[v](fn, kw)
                     raw[c, v].append(r["wall"])
+                    cpu[c, v].append(r["cpu"])
                     last[c, v] = r
     finally:
         for w in workers.values():
@@ -133,11 +135,13 @@ def measure(bench, base_src, cases, repeats):
     for c in cases:
         b, t = H.median(raw[c, "base"]), H.median(raw[c, "this"])
         steps = last[c, "this"]["steps"]
-        rows.append(dict(case=c, base_s=b, this_s=t, ratio=t / b,
+        cb, ct = H.median(cpu[c, "base"]), H.median(cpu[c, "this"])
+        rows.append(dict(case=c, base_s=b, this_s=t, ratio=t / b, cpu_ratio=ct / cb,
                          base_ns_step=b / steps * 1e9 if steps else None,
                          this_ns_step=t / steps * 1e9 if steps else None,
                          identical=last[c, "base"]["digest"] == last[c, "this"]["digest"]))
-    return rows, {f"{c}/{v}": ts for (c, v), ts in raw.items()}
+    return rows, {f"{c}/{v}/{k}": ts for k, d in (("wall", raw), ("cpu", cpu))
+                  for (c, v), ts in d.items()}
 
 
 def main(argv=None):
@@ -164,15 +168,16 @@ def main(argv=None):
     this = bench.env.get("commit", "this checkout")
     lines = [f"#### Two versions side by side: {rev} (base) and {this} (this)", "",
              f"Medians of {repeats} rounds, each case run in both versions back to back (order "
-             f"alternating), after one warm-up call each; `identical`: both returned the same "
-             f"numbers bit for bit.", "",
-             "| case | base | this | this/base | ns/step base | ns/step this | identical |",
-             "|---|---|---|---|---|---|---|"]
+             f"alternating), after one warm-up call each; `this/base` compares wall times, `CPU "
+             f"this/base` the process CPU times (all threads; less sensitive to other work on a "
+             f"shared machine); `identical`: both returned the same numbers bit for bit.", "",
+             "| case | base | this | this/base | CPU this/base | ns/step base | ns/step this "
+             "| identical |", "|---|---|---|---|---|---|---|---|"]
     for r in rows:
         ns = ("", "") if r["base_ns_step"] is None else (f"{r['base_ns_step']:.0f}",
                                                         f"{r['this_ns_step']:.0f}")
         lines.append(f"| {r['case']} | {r['base_s']:.4g} s | {r['this_s']:.4g} s | "
-                     f"{r['ratio']:.3f} | {ns[0]} | {ns[1]} | {'yes' if r['identical'] else 'no'} |")
+                     f"{r['ratio']:.3f} | {r['cpu_ratio']:.3f} | {ns[0]} | {ns[1]} | {'yes' if r['identical'] else 'no'} |")
     markdown = "\n".join(lines) + "\n"
     plt = H.pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.2))

@@ -57,7 +57,7 @@ SCRIPTS = {
                             ["attractors.png"]),
     "bench_orbits.py": (["measurement", "value", "unit", "target"],
                         ["orbits.png", "orbits_branches.png"]),
-    "bench_versions.py": (["case", "base_s", "this_s", "ratio", "base_ns_step", "this_ns_step",
+    "bench_versions.py": (["case", "base_s", "this_s", "ratio", "cpu_ratio", "base_ns_step", "this_ns_step",
                            "identical"], ["versions.png"]),
     "bench_stress.py": (
         ["id", "category", "hb", "alpha", "omega", "law", "e", "n_steps", "periods", "forcing",
