@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import numbers
 import os
+import time
 
 import numpy as np
 
@@ -95,9 +96,20 @@ def pair(name, value, lo=None, hi=None, *, lo_open=False, increasing=True):
 
 # ---- memory -----------------------------------------------------------------------------------
 
+_AVAILABLE = [-math.inf, None]  # (when read, bytes): read at most once a second
+
+
 def available_memory():
     """Bytes this process may allocate: ``MemAvailable`` (Linux), else physical memory, else
-    ``None`` (unknown: no check)."""
+    ``None`` (unknown: no check). Read at most once a second (reading ``/proc/meminfo`` took
+    a third of a one-period run's fixed cost)."""
+    now = time.monotonic()
+    if now - _AVAILABLE[0] > 1.0:
+        _AVAILABLE[:] = now, _read_available_memory()
+    return _AVAILABLE[1]
+
+
+def _read_available_memory():
     try:
         with open("/proc/meminfo") as f:
             for line in f:
