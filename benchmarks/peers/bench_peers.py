@@ -32,13 +32,10 @@ extra: ``pip install -e ".[peers]"``; a peer that does not import is reported an
 
 from __future__ import annotations
 
-import argparse
 import importlib
 import math
 import os
-import platform
 import statistics
-import subprocess
 import sys
 import time
 import warnings
@@ -53,12 +50,13 @@ warnings.filterwarnings("ignore", message=".*First-class function type.*")
 
 import common as C  # noqa: E402
 
+sys.path.insert(0, str(HERE.parent))
+import _common as H  # noqa: E402
+
 import rockjit  # noqa: E402
 from rockjit import analysis  # noqa: E402
-from rockjit.io import save_figure, write_csv, write_json, write_text  # noqa: E402
 from rockjit.result import BEHAVIOURS  # noqa: E402
 
-RESULTS = HERE.parent / "results"
 N_REF = 8192
 NS = (16, 32, 64, 128, 256, 512, 1024)
 RTOLS = tuple(10.0 ** -k for k in range(3, 13))
@@ -79,88 +77,31 @@ SLOW_BASIN = ("cvode",)
 
 # ----------------------------------------------------------------------------- helpers
 
-def timed(fn):
-    t0 = time.perf_counter()
-    out = fn()
-    return time.perf_counter() - t0, out
+timed = H.timed
+fmt = H.fmt
+md_table = H.md_table
 
 
 def interleaved(cases, repeats, counts=None):
-    """``{key: [seconds]}``: ``repeats`` rounds, each case once a round (``counts[key]`` of
-    the rounds only, spread evenly), the order rotated and reversed from round to round."""
-    keys = list(cases)
-    counts = counts or {}
-    rounds = {k: ({int(i * repeats / counts[k]) for i in range(counts[k])} if k in counts
-                  else set(range(repeats))) for k in keys}
-    times = {k: [] for k in keys}
-    for rep in range(repeats):
-        i = rep % len(keys)
-        order = keys[i:] + keys[:i]
-        if rep % 2:
-            order = order[::-1]
-        for k in order:
-            if rep in rounds[k]:
-                times[k].append(timed(cases[k])[0])
-    return times
+    """``{key: [seconds]}``: the harness's :func:`_common.side_by_side` wall times."""
+    return H.side_by_side(cases, repeats, counts=counts).wall
 
 
-def fmt(x, digits=3):
-    if x is None:
-        return "—"
-    if isinstance(x, str):
-        return x
-    if isinstance(x, (bool, np.bool_)):
-        return "yes" if x else "no"
-    if isinstance(x, (int, np.integer)):
-        return str(int(x))
-    if not math.isfinite(x):
-        return "—" if math.isnan(x) else str(x)
-    if x == 0:
-        return "0"
-    if 1e-3 <= abs(x) < 1e5:
-        return f"{x:.{digits}g}"
-    return f"{x:.{digits - 1}e}"
-
-
-def md_table(headers, rows):
-    out = ["| " + " | ".join(headers) + " |", "|" + "|".join("---" for _ in headers) + "|"]
-    out += ["| " + " | ".join(fmt(v) for v in row) + " |" for row in rows]
-    return "\n".join(out) + "\n"
-
-
-def environment():
-    import numba
-    import scipy
+def peer_versions():
+    """``{distribution: version or None}`` of the peers' packages."""
+    from importlib.metadata import PackageNotFoundError, version
     vers = {}
-    for mod, dist in (("jax", "jax"), ("diffrax", "diffrax"), ("sksundae", "scikit-sundae"),
-                      ("nbkode", "numbakit-ode")):
+    for dist in ("jax", "diffrax", "scikit-sundae", "numbakit-ode"):
         try:
-            from importlib.metadata import version
             vers[dist] = version(dist)
-        except Exception:  # noqa: BLE001 - a missing peer is reported, not fatal
+        except PackageNotFoundError:
             vers[dist] = None
-    cpu = platform.processor()
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    repo = Path(rockjit.__file__).resolve().parent.parent
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=repo,
-                            capture_output=True, text=True).stdout.strip()
-    return dict(cpu=cpu, cpus=os.cpu_count(), python=platform.python_version(),
-                numpy=np.__version__, numba=numba.__version__, scipy=scipy.__version__,
-                rockjit=rockjit.__version__, commit=commit, peers=vers,
-                date=time.strftime("%Y-%m-%d %H:%M:%S %z"))
+    return vers
 
 
 def env_line(env):
     peers = ", ".join(f"{k} {v}" for k, v in env["peers"].items() if v)
-    return (f"Measured on {env['cpu']} ({env['cpus']} logical CPUs), Python {env['python']}, "
-            f"numpy {env['numpy']}, numba {env['numba']}, scipy {env['scipy']}, {peers}, "
-            f"rockjit {env['rockjit']} at commit {env['commit']}, {env['date']}.")
+    return H.env_line(env).rstrip(".") + f"; peers: {peers}."
 
 
 def load_peers(names):
@@ -193,6 +134,7 @@ def reference_check(peers, periods):
             else math.nan
         rows.append(dict(peer=name, method=method, rtol=rtol, atol=atol, status=r.status,
                          n_impacts=r.n_impacts, ref_n_impacts=ref.n_impacts,
+                         ref_status=ref.status,
                          impact_time_error=dt, final_state_error=err, label=C.label(r, periods),
                          ref_label=analysis.classify_result(ref)[0], wall_s=wall,
                          first_call_s=first))
@@ -384,10 +326,46 @@ def basin_part(peers, quick, sub, sub_slow, full_cap, repeats):
 
 # ----------------------------------------------------------------------------- output
 
-def plot_wp(path, s):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+#: A peer reproduces the reference run when it ends with rockjit's status and impact count and
+#: every impact time is within this of rockjit's at N = 8192 (the peers run it at rtol 1e-12).
+IMPACT_TIME_TOL = 1e-8
+
+
+def correctness(ref_rows, basin):
+    """``{peer: dict(reference=bool, basin=bool or None, why=str)}``: the checks made before
+    any time is read (SPEC.md's model reproduced: the reference run's impact times, the
+    basin's labels at >= 99.5 % agreement), with the reason where one fails."""
+    out = {}
+    for r in ref_rows:
+        ok = (r["status"] == r["ref_status"] and r["n_impacts"] == r["ref_n_impacts"]
+              and r["impact_time_error"] <= IMPACT_TIME_TOL)
+        why = "" if ok else (
+            f"reference run: {r['status']} with {r['n_impacts']} impacts against rockjit's "
+            f"{r['ref_status']} with {r['ref_n_impacts']}; max impact-time error "
+            f"{fmt(r['impact_time_error'])}")
+        out[r["peer"]] = dict(reference=bool(ok), basin=None, why=why)
+    if basin is not None:
+        for name, rec in basin[1].items():
+            best = max(rec["ladder"], key=lambda st: st["agree"])
+            ok = best["agree"] >= AGREE
+            full = rec.get("full")
+            if full is not None:
+                ok = ok and full["agree"] >= AGREE
+            out.setdefault(name, dict(reference=None, why=""))["basin"] = bool(ok)
+            if not ok:
+                cells = "; ".join(f"({a:.3f}, {b_:.3f}) {got} vs rockjit {want}"
+                                  for a, b_, got, want in best["differing"][:5])
+                out[name]["why"] += (" " if out[name]["why"] else "") + (
+                    f"basin: best agreement {best['agree']:.2f} % (rtol {best['rtol']:.0e}) on "
+                    f"the {rec['sub']}x{rec['sub']} subgrid; differing cells "
+                    f"(theta0, theta0') peer vs rockjit: {cells}")
+    return out
+
+
+
+def plot_wp(s):
+    """The work–precision figure of one scene."""
+    plt = H.pyplot()
     fig, ax = plt.subplots(figsize=(6.6, 4.8), layout="constrained")
     methods = list(dict.fromkeys(r["method"] for r in s["rows"]))
     marks = "osD^vP*Xh"
@@ -413,14 +391,12 @@ def plot_wp(path, s):
     ax.set_title(s["title"] + " (shaded: the goal's 1e-4..1e-10)", fontsize=8)
     ax.grid(True, which="both", alpha=0.25)
     ax.legend(fontsize=6.5, loc="best")
-    save_figure(fig, path, dpi=120)
-    plt.close(fig)
+    return fig
 
 
-def plot_basin(path, rj, basins):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+def plot_basin(rj, basins):
+    """Bars: the 100 x 100 basin's time at equal label accuracy, rockjit and each peer."""
+    plt = H.pyplot()
     names = ["rockjit", "rockjit full length"]
     vals = [rj["wall_s"], rj["full_length_wall_s"]]
     hatch = ["", ""]
@@ -445,15 +421,11 @@ def plot_basin(path, rj, basins):
                  "(hatched: estimated from the subgrid)", fontsize=8)
     for i, v in enumerate(vals):
         ax.text(i, v, fmt(v), ha="center", va="bottom", fontsize=7)
-    save_figure(fig, path, dpi=120)
-    plt.close(fig)
+    return fig
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="smoke mode (a few minutes)")
-    ap.add_argument("--out", type=Path, default=None,
-                    help="output folder (default benchmarks/results, or .../results/quick)")
+def options(ap):
+    """The script's own options, after the harness's ``--quick`` and ``--out``."""
     ap.add_argument("--peers", nargs="*", default=list(PEER_METHODS),
                     help="peers to run (default all)")
     ap.add_argument("--repeats", type=int, default=None,
@@ -465,20 +437,19 @@ def main(argv=None):
                     help="subgrid side for the slow peers (CVODE; default 15; 6 quick)")
     ap.add_argument("--full-basin-cap", type=float, default=None,
                     help="run a peer's whole 100 x 100 basin when its subgrid estimate is "
-                         "below this many seconds (default 900; 0 quick)")
+                         "below this many seconds (default 600; 0 quick)")
     ap.add_argument("--skip-basin", action="store_true", help="leave the basin part out")
-    args = ap.parse_args(argv)
-    quick = args.quick
-    out = args.out or (RESULTS / "quick" if quick else RESULTS)
-    out.mkdir(parents=True, exist_ok=True)
-    if quick and args.out is None and not (out / ".gitignore").exists():
-        write_text(out / ".gitignore", "*\n")
+
+
+def main(argv=None):
+    b = H.Bench(__doc__, argv, options=options)
+    args, quick = b.args, b.quick
     repeats = args.repeats or (3 if quick else 9)
     sub = args.basin_sub or (10 if quick else 30)
     sub_slow = args.basin_sub_slow or (6 if quick else 15)
-    cap = args.full_basin_cap if args.full_basin_cap is not None else (0.0 if quick else 900.0)
-    env = environment()
-    load0 = os.getloadavg()
+    cap = args.full_basin_cap if args.full_basin_cap is not None else (0.0 if quick else 600.0)
+    env = dict(b.env, peers=peer_versions())
+    load0 = H.loadavg()
     print(env_line(env), flush=True)
     t_start = time.perf_counter()
     peers, missing = load_peers(args.peers)
@@ -493,7 +464,8 @@ def main(argv=None):
     basin = None
     if not args.skip_basin:
         basin = basin_part(peers, quick, sub, sub_slow, cap, 3 if quick else 7)
-    load1 = os.getloadavg()
+    checks = correctness(ref_rows, basin)
+    load1 = H.loadavg()
     total = time.perf_counter() - t_start
 
     # ---- tables
@@ -511,6 +483,14 @@ def main(argv=None):
                          r["impact_time_error"], r["final_state_error"],
                          f"{r['label']} ({r['ref_label']})", r["first_call_s"], r["wall_s"]]
                         for r in ref_rows]))
+    md.append("\n**Checks before timing** (reference run: rockjit's status and impact count, "
+              f"impact times within {IMPACT_TIME_TOL:.0e}; basin: >= {AGREE} % of cells "
+              "labelled as rockjit labels them):\n\n")
+    md.append(md_table(["peer", "reference run", "basin labels", "where and why not"],
+                       [[name, "—" if c["reference"] is None else
+                         ("pass" if c["reference"] else "**FAIL**"),
+                         "—" if c["basin"] is None else ("pass" if c["basin"] else "**FAIL**"),
+                         c["why"] or "—"] for name, c in checks.items()]))
     wp_rows = []
     for target in TARGETS:
         for s in scenes.values():
@@ -623,7 +603,6 @@ def main(argv=None):
               "all.\n")
     md.append(f"\n{env_line(env)}\n")
     md = "".join(md)
-    write_text(out / "peers.md", md)
     csv_rows = [[s["name"], r["method"], r["setting"], r["wall_s"], r["error"], r["status"],
                  r["n_impacts"], r["flag"]] for s in scenes.values() for r in s["rows"]]
     if basin is not None:
@@ -633,19 +612,19 @@ def main(argv=None):
                                  step["wall_s"], 100.0 - step["agree"], "", "",
                                  f"{rec['sub']}x{rec['sub']} subgrid; error column = % cells "
                                  "differing"])
-    write_csv(out / "peers.csv", ["scene", "method", "setting", "wall_median_s", "error",
-                                  "status", "n_impacts", "flag"], csv_rows)
-    write_json(out / "peers.json", dict(
-        quick=quick, repeats=repeats, environment=env, missing=missing,
-        reference_check=ref_rows, reference=ref_info, call_floor_s=floor_calls, scenes=scenes, summary=wp_rows,
-        basin=None if basin is None else dict(rockjit=basin[0], peers=basin[1],
-                                              periods=basin[2]),
-        load_average=dict(start=load0, end=load1), total_s=total))
-    for s in scenes.values():
-        plot_wp(out / f"peers_wp_{s['name']}.png", s)
+    figures = [(f"peers_wp_{s['name']}.png", plot_wp(s), 120) for s in scenes.values()]
     if basin is not None:
-        plot_basin(out / "peers_basin.png", basin[0], basin[1])
-    print(md)
+        figures.append(("peers_basin.png", plot_basin(basin[0], basin[1]), 120))
+    b.report("peers", markdown=md,
+             csv=(["scene", "method", "setting", "wall_median_s", "error", "status",
+                   "n_impacts", "flag"], csv_rows),
+             data=dict(quick=quick, repeats=repeats, environment=env, missing=missing,
+                       checks=checks, reference_check=ref_rows, reference=ref_info,
+                       call_floor_s=floor_calls, scenes=scenes, summary=wp_rows,
+                       basin=None if basin is None else dict(rockjit=basin[0], peers=basin[1],
+                                                             periods=basin[2]),
+                       load_average=dict(start=load0, end=load1), total_s=total),
+             figures=figures)
     return 0
 
 
