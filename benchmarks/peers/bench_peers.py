@@ -1,6 +1,6 @@
 """Issue 16: rockjit side by side with the compiled peers a user would pick instead.
 
-Peers (``benchmarks/peers/peer_*.py``, see ``benchmarks/peers/README.md``): diffrax (JAX),
+Peers (``benchmarks/peers/peer_*.py``, described in benchmarks/README.md): diffrax (JAX),
 SUNDIALS CVODE through scikit-sundae, numbakit-ode (nbkode) inside a numba impact loop; and the
 best scipy method of ``bench_work_precision.py`` (DOP853) through rockjit's scipy path.
 
@@ -21,8 +21,8 @@ best scipy method of ``bench_work_precision.py`` (DOP853) through rockjit's scip
    agree with rockjit's in >= 99.5 % of the subgrid's cells, and its time; the time for the
    100 x 100 grid measured (full grid run) or estimated (subgrid time x cells ratio, marked).
 
-    python benchmarks/peers/bench_peers.py            # full (~40 min on a quiet 2-core machine)
-    python benchmarks/peers/bench_peers.py --quick    # smoke (~3 min: fewer tolerances, 10 x 10
+    python benchmarks/peers/bench_peers.py            # full (~30 min on a quiet 2-core machine)
+    python benchmarks/peers/bench_peers.py --quick    # smoke (~4 min: fewer tolerances, 10 x 10
                                                       # subgrid, 100-period basin)
 
 Writes peers.{md,csv,json}, peers_wp_periodic.png, peers_wp_chaotic.png and peers_basin.png to
