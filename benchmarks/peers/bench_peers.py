@@ -524,7 +524,8 @@ def main(argv=None):
                      w["ratio"],
                      "—" if w["scipy"] is None else f"{fmt(w['scipy'][0])} s ({w['scipy'][1]})",
                      w["ratio_scipy"],
-                     "—" if math.isnan(w["ratio"]) else ("yes" if w["ratio"] >= 10 else "**no**")])
+                     "—" if math.isnan(w["ratio"]) else
+                     ("yes" if w["ratio"] >= 10 else "**no**")])
     md.append(md_table(["target", "scene", "rockjit", "fastest peer", "peer / rockjit",
                         "scipy DOP853", "DOP853 / rockjit", ">= 10x"], rows))
     md.append("\nEvery method's cheapest run per target (wall s, setting):\n\n")

@@ -168,6 +168,21 @@ def label(run: PeerRun, periods):
     return BEHAVIOURS[label_code(run.status, run.strobe, run.half, run.per_imp, periods)]
 
 
+def uplift_time(t, aw2, cot, omega, phi):
+    """SPEC.md §3's uplift instant: the first ``t' >= t`` with ``|aw2 sin(omega t' + phi)| >
+    cot`` (``inf`` if never), when a block at rest from ``t`` lifts off."""
+    if aw2 <= cot:
+        return math.inf
+    a = math.asin(cot / aw2)
+    psi = omega * t + phi
+    u = psi - math.pi * math.floor(psi / math.pi)
+    if a < u < math.pi - a:
+        return t
+    if u <= a:
+        return t + (a - u) / omega
+    return t + (math.pi - u + a) / omega
+
+
 def basin_axes(grid=BASIN["grid"]):
     """The study's basin lattice: ``theta0`` and ``theta0'`` on ``linspace(-1, 1, grid)``."""
     return np.linspace(-1.0, 1.0, grid), np.linspace(-1.0, 1.0, grid)

@@ -81,18 +81,8 @@ def _clear(events):
     events._i_cnt[:] = 0
 
 
-def uplift_time(t, aw2, cot, omega, phi):
-    """First ``t' >= t`` with ``|aw2 sin(omega t' + phi)| > cot`` (``inf`` if never)."""
-    if aw2 <= cot:
-        return math.inf
-    a = math.asin(cot / aw2)
-    psi = omega * t + phi
-    u = psi - math.pi * math.floor(psi / math.pi)
-    if a < u < math.pi - a:
-        return t
-    if u <= a:
-        return t + (a - u) / omega
-    return t + (math.pi - u + a) / omega
+#: SPEC.md §3's uplift instant (plain Python: CVODE's driver is Python).
+uplift_time = C.uplift_time
 
 
 def run(p: C.Params, theta0, dtheta0, periods, rtol, atol, method="Adams"):

@@ -65,19 +65,8 @@ def make_rhs(p: C.Params):
     return rhs
 
 
-@numba.njit
-def uplift_time(t, aw2, cot, omega, phi):
-    """First ``t' >= t`` with ``|aw2 sin(omega t' + phi)| > cot`` (``inf`` if never)."""
-    if aw2 <= cot:
-        return math.inf
-    a = math.asin(cot / aw2)
-    psi = omega * t + phi
-    u = psi - math.pi * math.floor(psi / math.pi)
-    if a < u < math.pi - a:
-        return t
-    if u <= a:
-        return t + (a - u) / omega
-    return t + (math.pi - u + a) / omega
+#: SPEC.md §3's uplift instant, compiled for the impact loop.
+uplift_time = numba.njit(C.uplift_time)
 
 
 def _build(method):
