@@ -450,7 +450,7 @@ def main(argv=None):
     cap = args.full_basin_cap if args.full_basin_cap is not None else (0.0 if quick else 600.0)
     env = dict(b.env, peers=peer_versions())
     load0 = H.loadavg()
-    print(env_line(env), flush=True)
+    print("peers: " + ", ".join(f"{k} {v}" for k, v in env["peers"].items()), flush=True)
     t_start = time.perf_counter()
     peers, missing = load_peers(args.peers)
     for k, v in missing.items():

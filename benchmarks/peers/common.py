@@ -31,7 +31,9 @@ from rockjit.result import BEHAVIOURS, OVERTURN, REST, UNRESOLVED
 
 #: Statuses, as rockjit names them.
 DONE, OVERTURNED, RESTED, MAX_IMPACTS = "done", "overturned", "rest", "max_impacts"
-STATUS_CODES = (DONE, OVERTURNED, RESTED, MAX_IMPACTS)
+#: A peer's own failure (a solver error, its step bound): labelled unresolved.
+FAILED = "failed"
+STATUS_CODES = (DONE, OVERTURNED, RESTED, MAX_IMPACTS, FAILED)
 
 #: rockjit's classification defaults (rockjit.analysis.TOL, PMAX, LAM_TOL).
 TOL, PMAX, LAM_TOL = 1e-6, 16, 1e-2
@@ -105,7 +107,8 @@ class PeerRun:
     Attributes
     ----------
     status : str
-        ``done``, ``overturned``, ``rest`` (at rest for good) or ``max_impacts``.
+        ``done``, ``overturned``, ``rest`` (at rest for good), ``max_impacts`` or ``failed``
+        (the peer's solver gave up).
     t : float
         Time reached.
     state : ndarray, shape (2,)

@@ -40,7 +40,7 @@ NAME = "diffrax"
 METHODS = ("Tsit5", "Dopri5", "Dopri8")
 ST_RUN, ST_DONE, ST_OVER, ST_REST, ST_MAXIMP, ST_FAIL = range(6)
 _STATUS = {ST_DONE: C.DONE, ST_OVER: C.OVERTURNED, ST_REST: C.RESTED,
-           ST_MAXIMP: C.MAX_IMPACTS, ST_FAIL: "failed"}
+           ST_MAXIMP: C.MAX_IMPACTS, ST_FAIL: C.FAILED}
 MAX_STEPS = 100_000   # steps of one diffeqsolve (one half period at most)
 _TINY = float(np.finfo(np.float64).tiny)
 
@@ -194,8 +194,6 @@ def run(p: C.Params, theta0, dtheta0, periods, rtol, atol, method="Tsit5", n_rec
     out = jax.block_until_ready(f(_par(p), jnp.float64(theta0), jnp.float64(dtheta0),
                                   jnp.float64(rtol), jnp.float64(atol)))
     st, t, y, samples, n_s, per_imp, imp_t, n_imp, n_steps = (np.asarray(v) for v in out)
-    if int(st) == ST_FAIL:
-        raise RuntimeError(f"diffrax failed (max_steps or a solver error) at t={float(t)}")
     strobe, half = C.samples_from(2 * periods + 1, samples, int(n_s))
     n_imp = int(n_imp)
     return C.PeerRun(status=_STATUS[int(st)], t=float(t), state=y.copy(),
@@ -233,8 +231,8 @@ def basin(p: C.Params, theta0s, dtheta0s, periods, rtol, atol, method="Tsit5", c
                                       jnp.float64(atol)))
         st, _, _, samples, n_s, per_imp, _, _, _ = (np.asarray(v) for v in out)
         for i in range(n):
-            if int(st[i]) == ST_FAIL:
-                raise RuntimeError("diffrax failed in a basin cell")
+            # a failed cell (diffeqsolve's max_steps, or its root find) is labelled
+            # unresolved, so the benchmark's label check lists it
             strobe, half = C.samples_from(2 * periods + 1, samples[i], int(n_s[i]))
             labels[a + i] = C.label_code(_STATUS[int(st[i])], strobe, half,
                                          per_imp[i][:strobe.shape[0]], periods)
