@@ -151,3 +151,35 @@ def test_quick_defaults_to_the_ignored_quick_folder(tmp_path):
     lines = [x for x in proc.stdout.splitlines() if not x.startswith("Measured on")]
     assert lines[-2] == f"{(BENCH / 'results' / 'quick').resolve()} False"
     assert lines[-1] == f"{(BENCH / 'results').resolve()} True"
+
+
+@pytest.mark.slow
+def test_peers_quick_mode_checks_before_it_times(tmp_path):
+    """benchmarks/peers/bench_peers.py --quick (issue 16): only where the optional peers are
+    installed (``pip install -e ".[peers]"``; CI installs ".[test]" and skips this). Besides
+    the files, the quick run's own correctness checks must hold for every peer: the reference
+    run's impact count and times (against rockjit at N = 8192) and the basin's labels (against
+    ``rockjit.analysis.basin``) on its subgrid, each peer's model written independently."""
+    for module in ("jax", "diffrax", "optimistix", "sksundae", "nbkode"):
+        pytest.importorskip(module)
+    before = _fingerprint()
+    out = tmp_path / "out"
+    proc = _run("peers/bench_peers.py", "--quick", "--out", str(out), cwd=tmp_path,
+                timeout=1800)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-4000:]
+    assert "|---|" in (out / "peers.md").read_text(encoding="utf-8")
+    data = json.loads((out / "peers.json").read_text(encoding="utf-8"),
+                      parse_constant=_strict)
+    assert sorted(data["checks"]) == ["cvode", "diffrax", "nbkode"], data.get("missing")
+    for peer, check in data["checks"].items():
+        assert check["reference"] and check["basin"], (peer, check["why"])
+    for row in data["reference_check"]:
+        assert row["n_impacts"] == row["ref_n_impacts"] > 0, row
+    with open(out / "peers.csv", newline="", encoding="utf-8") as f:
+        rows = list(csv.reader(f))
+    assert rows[0] == ["scene", "method", "setting", "wall_median_s", "error", "status",
+                       "n_impacts", "flag"]
+    assert len(rows) > 1 and all(len(r) == len(rows[0]) for r in rows[1:])
+    for fig in ("peers_wp_periodic.png", "peers_wp_chaotic.png", "peers_basin.png"):
+        assert (out / fig).read_bytes()[:8] == PNG_MAGIC, fig
+    assert _fingerprint() == before  # a smoke run never touches the committed results
