@@ -31,7 +31,7 @@ What is measured
   basin, a tiny sweep and ``rockjit compile`` (its worker processes compile; the parent's
   breakdown is empty). The install of the package is not measured.
 - **warm speed**, the guard of any change made to cut compile time: the per-step time of the
-  500-period reference run (``simulate(1, 0.6, 1.3)`` over its ``n_grid_steps``), with and
+  reference run (``simulate(1, 0.6, 1.3, periods=5000)`` over its ``n_grid_steps``), with and
   without exponents, a basin of the study (hb 1, alpha 0.66, omega 1.3, ``r0, s0 = 0, 1``) and
   a sweep of the study (hb 1, omega 1.3, alpha 0.5..1, exponents on), every package root in one
   process, interleaved; and whether every root's results are bit-identical to the first's.
@@ -99,8 +99,7 @@ CSV_COLUMNS = ["root", "group", "item", "mode", "n", "wall_s", "wall_min_s", "wa
                "cpu_s", "first_call_s", "compile_cpu_s", "compiles"] + PART_NAMES
 
 #: Speed cases: settings (full, quick).
-SPEED = dict(full=dict(periods=500, grid=60, alpha_step=0.004, repeats=7),
-             quick=dict(periods=20, grid=4, alpha_step=0.25, repeats=2))
+SPEED = dict(run_periods=5000, periods=500, grid=60, alpha_step=0.004, repeats=7)
 
 
 # =========================================================================== the child process
@@ -292,10 +291,10 @@ def _speed_child(spec):
 
     cases, last = {}, {}
     for n in names:
-        cases[(n, "run_ns_per_step")] = lambda n=n: mods[n].simulate(1, 0.6, 1.3,
-                                                                      periods=periods)
+        cases[(n, "run_ns_per_step")] = lambda n=n: mods[n].simulate(
+            1, 0.6, 1.3, periods=spec["run_periods"])
         cases[(n, "run_lyapunov_ns_per_step")] = lambda n=n: mods[n].simulate(
-            1, 0.6, 1.3, periods=periods, lyapunov=True)
+            1, 0.6, 1.3, periods=spec["run_periods"], lyapunov=True)
         cases[(n, "basin_s")] = lambda n=n: ana[n].basin(1, 0.66, 1.3, **bkw)
         cases[(n, "sweep_s")] = lambda n=n: ana[n].sweep(1, 1.3, alphas, periods=periods,
                                                          z0=mods[n].Z0_STUDY, threads=threads)
@@ -373,7 +372,8 @@ def _items(args, quick):
         for seq in () if args.variants else SEQUENCES:
             items.append(("kernel", " then ".join(seq), dict(kind="kernel", names=list(seq))))
     if "commands" in args.parts:
-        for n, argv in COMMANDS.items():
+        for n in args.commands.split(",") if args.commands else COMMANDS:
+            argv = COMMANDS[n]
             items.append(("command", f"rockjit {n}", dict(kind="command", argv=argv)))
     return items
 
@@ -421,8 +421,8 @@ def speed(args, roots, tmp):
         a = f"rockjit_bench_{i}"
         os.symlink(Path(root).resolve() / "rockjit", alias_dir / a)
         aliases.append(a)
-    st = dict(SPEED["full"])
-    for k in ("periods", "grid", "alpha_step"):
+    st = dict(SPEED)
+    for k in ("run_periods", "periods", "grid", "alpha_step"):
         if getattr(args, f"speed_{k}") is not None:
             st[k] = getattr(args, f"speed_{k}")
     st["repeats"] = args.speed_repeats or st["repeats"]
@@ -588,8 +588,8 @@ def markdown(b, args, rows, summary, spd, quick):
     if spd:
         st = spd["settings"]
         md.append("\n#### Warm speed (one process, roots interleaved)\n")
-        md.append(f"Reference run hb=1, alpha=0.6, omega=1.3, {st['periods']} periods (ns per "
-                  f"grid step, without and with exponents); basin hb=1, alpha=0.66, omega=1.3, "
+        md.append(f"Reference run hb=1, alpha=0.6, omega=1.3, {st['run_periods']} periods (ns "
+                  f"per grid step, without and with exponents); basin hb=1, alpha=0.66, omega=1.3, "
                   f"{st['grid']} x {st['grid']}, and sweep hb=1, omega=1.3, alpha 0.5..1 step "
                   f"{st['alpha_step']:g} (s, {st['periods']} periods, threads="
                   f"{st['threads'] or 'all'}); medians of {st['repeats']} [min-max], ratio to "
@@ -669,9 +669,15 @@ def options(p):
                    "common ones (rockjit.kernel.COMMON)")
     p.add_argument("--variants", default=None,
                    help="comma-separated kernel variants to measure (then no sequences)")
+    p.add_argument("--commands", default=None,
+                   help="comma-separated commands to measure (keys of COMMANDS, e.g. "
+                        "'trajectory,compile')")
     p.add_argument("--repeats", type=int, default=1, help="cold/warm pairs per item and root")
     p.add_argument("--speed-repeats", type=int, default=None)
-    p.add_argument("--speed-periods", type=int, default=None)
+    p.add_argument("--speed-run-periods", type=int, default=None,
+                   help="periods of the reference run timed per step (default 5000)")
+    p.add_argument("--speed-periods", type=int, default=None,
+                   help="periods of the basin and sweep (default 500)")
     p.add_argument("--speed-grid", type=int, default=None)
     p.add_argument("--speed-alpha-step", type=float, default=None)
     p.add_argument("--speed-cache", type=Path, default=None,
