@@ -50,6 +50,7 @@ Writes compile.{md,csv,json,png} through the shared harness (benchmarks/_common.
 from __future__ import annotations
 
 import collections
+import hashlib
 import json
 import math
 import os
@@ -415,11 +416,17 @@ def measure(args, roots, tmp, quick):
 
 def speed(args, roots, tmp):
     """Warm speed of every root, in one process (see :func:`_speed_child`)."""
-    alias_dir = Path(tempfile.mkdtemp(prefix="aliases-", dir=tmp))
+    # numba keys its cache on the path a module was imported from: with --speed-cache the
+    # aliases live beside it, named after their root, so that a rerun loads what one compiled
+    alias_dir = (Path(args.speed_cache) / "aliases" if args.speed_cache
+                 else Path(tempfile.mkdtemp(prefix="aliases-", dir=tmp)))
+    alias_dir.mkdir(parents=True, exist_ok=True)
     aliases = []
-    for i, root in enumerate(roots.values()):
-        a = f"rockjit_bench_{i}"
-        os.symlink(Path(root).resolve() / "rockjit", alias_dir / a)
+    for root in roots.values():
+        pkg = Path(root).resolve() / "rockjit"
+        a = "rockjit_bench_" + hashlib.sha1(str(pkg).encode()).hexdigest()[:10]
+        if not (alias_dir / a).is_symlink():
+            os.symlink(pkg, alias_dir / a)
         aliases.append(a)
     st = dict(SPEED)
     for k in ("run_periods", "periods", "grid", "alpha_step"):

@@ -199,7 +199,10 @@ def cached_kernels(pkg=None):
     ``integrate.py``, where every kernel's loop lives): a cold first run compiles for a minute."""
     pkg = Path(__file__).parent if pkg is None else Path(pkg)
     pattern = _cache_file_pattern(["integrate", "kernel"])
+    root = os.environ.get("NUMBA_CACHE_DIR")
     for home in _cache_dirs(pkg):
+        if root and Path(root) not in home.parents:
+            continue  # with NUMBA_CACHE_DIR set, numba reads and writes only there
         try:
             if any(f.name.endswith(".nbc") and pattern.fullmatch(f.name)
                    for f in home.iterdir()):
