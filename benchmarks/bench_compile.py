@@ -100,7 +100,7 @@ CSV_COLUMNS = ["root", "group", "item", "mode", "n", "wall_s", "wall_min_s", "wa
                "cpu_s", "first_call_s", "compile_cpu_s", "compiles"] + PART_NAMES
 
 #: Speed cases: settings (full, quick).
-SPEED = dict(run_periods=5000, periods=500, grid=60, alpha_step=0.004, repeats=7)
+SPEED = dict(run_periods=5000, periods=500, grid=100, alpha_step=0.001, repeats=11)
 
 
 # =========================================================================== the child process
