@@ -20,13 +20,17 @@ block's part of a step is written out stage by stage (:func:`block_step`) so tha
 stay in registers; a stage's angle is kept as an offset from the step's start angle, computed
 straight from the accelerations (Nyström's form of the tableau), and enters only a short
 polynomial (:func:`rockjit.model.accel_near`); the forcing at the stages of a grid step is
-tabulated once per run. The step's pieces are inlined into :func:`_loop`, which is compiled
-without numba's reference counting.
+tabulated once per run. The step's pieces are inlined into :func:`_loop` by LLVM (they are
+marked ``alwaysinline``: :func:`rockjit._jit.jit`), which is compiled without numba's reference
+counting.
 
 The state lives in one array ``y``: ``theta, theta'``, then ``r, s`` when the oscillator
 embedding is integrated, then the 2×2 tangent matrix (column-major) when Lyapunov exponents are
 asked for. Which of these exist is decided at compile time by :func:`build`; a run that does not
-ask for tangent vectors or a trajectory compiles without them (STYLE.md 3).
+ask for tangent vectors compiles without them (STYLE.md 3). Recording a trajectory is the one
+run-time switch (one test per grid step, in :func:`grid_point`): measured side by side it costs
+nothing distinguishable per step, and it halves the variants to compile (issue 15,
+benchmarks/README.md, "Cold start").
 
 Kernels never raise; they return the status codes below, which :mod:`rockjit.simulate` turns into
 messages.
