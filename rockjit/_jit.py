@@ -30,14 +30,19 @@ def jit(func=None, *, parallel=False, nrt=True, inline=False):
     every call increments and decrements the count of each array argument with a locked
     (serialising) instruction, which cost a third of a step's time.
 
-    ``inline=True`` inlines the function into its callers in numba's own IR (``inline=
-    "always"``). For the pieces of the step: LLVM declines to inline a function that large at
-    more than one call site, and an out-of-line call passes every array as seven scalars on the
-    stack and hides the stage chain from the scheduler.
+    ``inline=True`` marks the function ``alwaysinline`` for LLVM (numba's ``forceinline``):
+    it is typed and lowered once, as a function of its own, and LLVM inlines it into every
+    caller when the caller's module is linked. For the pieces of the step: left to its own
+    heuristics, LLVM declines to inline a function that large at more than one call site, and
+    an out-of-line call passes every array as seven scalars on the stack and hides the stage
+    chain from the scheduler (1.6x the time per step). Inlining in numba's own IR
+    (``inline="always"``, used before) gave the same speed but re-typed and re-lowered the piece
+    at every call site: the step's pieces made a cold compile 1.5x longer (issue 15,
+    benchmarks/bench_compile.py). The flag is set on every function, off where not asked for:
+    numba would otherwise let a callee inherit it from its caller.
     """
-    opts = dict(cache=True, fastmath=set(FASTMATH), parallel=parallel, error_model="numpy")
-    if inline:
-        opts["inline"] = "always"
+    opts = dict(cache=True, fastmath=set(FASTMATH), parallel=parallel, error_model="numpy",
+                forceinline=bool(inline))
     if not nrt:
         opts["_nrt"] = False
     deco = numba.njit(**opts)
@@ -194,10 +199,10 @@ def cached_kernels(pkg=None):
     ``integrate.py``, where every kernel's loop lives): a cold first run compiles for a minute."""
     pkg = Path(__file__).parent if pkg is None else Path(pkg)
     pattern = _cache_file_pattern(["integrate", "kernel"])
-    homes = _cache_dirs(pkg)
-    if os.environ.get("NUMBA_CACHE_DIR"):  # numba then looks nowhere else
-        homes = homes[:len({os.path.abspath(pkg), os.path.realpath(pkg)})]
-    for home in homes:
+    root = os.environ.get("NUMBA_CACHE_DIR")
+    for home in _cache_dirs(pkg):
+        if root and Path(root) not in home.parents:
+            continue  # with NUMBA_CACHE_DIR set, numba reads and writes only there
         try:
             if any(f.name.endswith(".nbc") and pattern.fullmatch(f.name)
                    for f in home.iterdir()):

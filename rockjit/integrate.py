@@ -20,13 +20,17 @@ block's part of a step is written out stage by stage (:func:`block_step`) so tha
 stay in registers; a stage's angle is kept as an offset from the step's start angle, computed
 straight from the accelerations (Nyström's form of the tableau), and enters only a short
 polynomial (:func:`rockjit.model.accel_near`); the forcing at the stages of a grid step is
-tabulated once per run. The step's pieces are inlined into :func:`_loop`, which is compiled
-without numba's reference counting.
+tabulated once per run. The step's pieces are inlined into :func:`_loop` by LLVM (they are
+marked ``alwaysinline``: :func:`rockjit._jit.jit`), which is compiled without numba's reference
+counting.
 
 The state lives in one array ``y``: ``theta, theta'``, then ``r, s`` when the oscillator
 embedding is integrated, then the 2×2 tangent matrix (column-major) when Lyapunov exponents are
 asked for. Which of these exist is decided at compile time by :func:`build`; a run that does not
-ask for tangent vectors or a trajectory compiles without them (STYLE.md 3).
+ask for tangent vectors compiles without them (STYLE.md 3). Recording a trajectory is the one
+run-time switch (one test per grid step, in :func:`grid_point`): measured side by side it costs
+nothing distinguishable per step, and it halves the variants to compile (issue 15,
+benchmarks/README.md, "Cold start").
 
 Kernels never raise; they return the status codes below, which :mod:`rockjit.simulate` turns into
 messages.
@@ -154,7 +158,9 @@ def build(embed4: bool = False, tangent: bool = False, record: bool = False):
     tangent : bool
         Carry the 2×2 tangent matrix for Lyapunov exponents (SPEC.md §5).
     record : bool
-        Record the dense trajectory every ``stride`` steps.
+        Whether the caller will record the dense trajectory every ``stride`` steps. Ignored:
+        recording is a run-time switch of the same compiled code (a ``traj`` of more than one
+        row, see :func:`_run`), which saves compiling a variant per switch (issue 15).
 
     Returns
     -------
@@ -162,7 +168,7 @@ def build(embed4: bool = False, tangent: bool = False, record: bool = False):
         ``run(y0, side0, par, ipar, out)`` with ``out`` an :data:`Outputs`; returns the status
         code (see :func:`_loop`).
     """
-    return _build(bool(embed4), bool(tangent), bool(record))
+    return _build(bool(embed4), bool(tangent))
 
 
 @jit(nrt=False)
@@ -736,11 +742,15 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par_in, ipar, out):
              np.zeros(4), np.zeros((N_TAB, N_STAGES + 1)), np.zeros((N_TAB, N_STAGES + 1)),
              np.zeros(N_STAGES + 1), np.zeros(N_STAGES + 1), np.zeros(4),
              np.zeros((ipar[I_N], N_STAGES + 1)))
-    return _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, out, w)
+    # Recording is a run-time switch (a trajectory array of more than one row), not a
+    # compile-time one: one compiled loop serves runs with and without it and the grids, which
+    # pass RECORD = False (ignored); its test costs nothing measurable per step (issue 15).
+    record = out.traj.shape[0] > 1
+    return _loop(EMBED4, TANGENT, record, y0, side0, par, ipar, out, w)
 
 
 @jit(nrt=False, inline=True)
-def start(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, out, w):
+def start(EMBED4, TANGENT, y0, side0, par, ipar, out, w):
     """Before the first step: the step tables, the initial state and its samples, the field at
     the start. Returns the status (overturned already, or running)."""
     NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
@@ -763,10 +773,10 @@ def start(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, out, w):
         out.iout[m] = 0
     sample(EMBED4, 0.0, y, par, out.strobe[0])
     out.iout[O_NSTROBE] = 1
-    if RECORD:
-        out.traj[0, 0] = 0.0
-        sample(EMBED4, 0.0, y, par, out.traj[0, 1:])
-        out.iout[O_NTRAJ] = 1
+    # the trajectory's first row: every caller's ``traj`` has one (it is read only when recording)
+    out.traj[0, 0] = 0.0
+    sample(EMBED4, 0.0, y, par, out.traj[0, 1:])
+    out.iout[O_NTRAJ] = 1
     if TANGENT:
         for c in range(3):
             out.lam_run[0, c] = 0.0
@@ -992,7 +1002,7 @@ def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, out, w):
     h = par[P_H]
     y = w.y
     K = w.K
-    status = start(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, out, w)
+    status = start(EMBED4, TANGENT, y0, side0, par, ipar, out, w)
     side = side0
     t = 0.0
     max_err = 0.0
@@ -1117,11 +1127,12 @@ def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, out, w):
 
 
 @functools.lru_cache(maxsize=None)
-def _build(EMBED4, TANGENT, RECORD):
+def _build(EMBED4, TANGENT):
     # The closure only forwards its flags: numba types them as literals, so _run and its helpers
     # are specialised (and cached, being module-level) once per combination of switches.
+    # Recording is decided at run time (see _run).
     @jit
     def run(y0, side0, par, ipar, out):
-        return _run(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, out)
+        return _run(EMBED4, TANGENT, False, y0, side0, par, ipar, out)
 
     return run
