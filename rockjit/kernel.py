@@ -214,6 +214,12 @@ def _impacts_in_order(ring, n_imp):
 def _cell(TANGENT, y0, side0, par, ipar, cpar, out, res):
     """Run one cell and classify it; scalar results go to ``res`` (layout ``R_*``)."""
     status = ig._run(False, TANGENT, False, y0, side0, par, ipar, out)
+    _classify(TANGENT, status, ipar, cpar, out, res)
+
+
+@jit(nrt=False)
+def _classify(TANGENT, status, ipar, cpar, out, res):
+    """Classify a cell's finished run (status code ``status``, outputs ``out``) into ``res``."""
     iout = out.iout
     k1 = iout[ig.O_NSTROBE] - 1
     if status == ig.SETTLED:
@@ -277,32 +283,40 @@ def _grid(TANGENT, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n
                          np.zeros(ig.N_IOUT, dtype=np.int64), np.zeros(ig.N_FOUT))
         y0 = y0s[i]
         _cell(TANGENT, y0, initial_side(y0[0], y0[1]), par, ipar, cpar, out, res[i])
-        k0 = int(res[i, R_K0])
-        k1 = int(res[i, R_K1])
-        st = int(res[i, R_STATUS])
-        bounded = st == ig.DONE or st == ig.SETTLED  # it ran to a classified stretch
-        if n_pts > 0:
-            m = 0
-            if bounded:
-                for k in range(max(k0, k1 - n_pts + 1), k1 + 1):
-                    pts[i, m, 0] = out.strobe[k, 0]
-                    pts[i, m, 1] = out.strobe[k, 1]
+        _collect(i, T, n_pts, n_imp_pts, out, res, pts, imp_pts, n_got, n_imp_got)
+
+
+@jit(nrt=False)
+def _collect(i, T, n_pts, n_imp_pts, out, res, pts, imp_pts, n_got, n_imp_got):
+    """Cell ``i``'s stroboscopic samples and impact section from its finished run ``out``
+    (classified into ``res[i]``; ``T`` the forcing period)."""
+    cap = out.impacts.shape[0]
+    k0 = int(res[i, R_K0])
+    k1 = int(res[i, R_K1])
+    st = int(res[i, R_STATUS])
+    bounded = st == ig.DONE or st == ig.SETTLED  # it ran to a classified stretch
+    if n_pts > 0:
+        m = 0
+        if bounded:
+            for k in range(max(k0, k1 - n_pts + 1), k1 + 1):
+                pts[i, m, 0] = out.strobe[k, 0]
+                pts[i, m, 1] = out.strobe[k, 1]
+                m += 1
+        n_got[i] = m
+    if n_imp_pts > 0:
+        m = 0
+        if bounded:
+            nimp = out.iout[ig.O_IMPACTS]
+            t_from = k0 * T
+            first = max(0, nimp - cap)
+            for q in range(first, nimp):
+                row = q % cap
+                if out.impacts[row, 0] >= t_from:
+                    tt = out.impacts[row, 0]
+                    imp_pts[i, m, 0] = tt - T * math.floor(tt / T)
+                    imp_pts[i, m, 1] = out.impacts[row, 1]
                     m += 1
-            n_got[i] = m
-        if n_imp_pts > 0:
-            m = 0
-            if bounded:
-                nimp = out.iout[ig.O_IMPACTS]
-                t_from = k0 * T
-                first = max(0, nimp - cap)
-                for q in range(first, nimp):
-                    row = q % cap
-                    if out.impacts[row, 0] >= t_from:
-                        tt = out.impacts[row, 0]
-                        imp_pts[i, m, 0] = tt - T * math.floor(tt / T)
-                        imp_pts[i, m, 1] = out.impacts[row, 1]
-                        m += 1
-            n_imp_got[i] = m
+        n_imp_got[i] = m
 
 
 @functools.lru_cache(maxsize=None)

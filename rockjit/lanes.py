@@ -15,13 +15,19 @@ bit the single-lane step's (a vector FMA rounds once, as the scalar one).
 
 from __future__ import annotations
 
+import math
+from collections import namedtuple
+
 import numpy as np
+from numba import prange
 
 from . import integrate as ig
+from . import kernel as kn
 from ._jit import fma, jit
-from .model import NEAR_RANGE, SINCOS_RANGE, accel_near, corner, rotate, sincos_poly
+from .model import (NEAR_RANGE, SINCOS_RANGE, accel_near, corner, initial_side, rotate,
+                    sincos_poly)
 
-__all__ = ["block_step_lanes", "lane_tables"]
+__all__ = ["W", "bank", "block_step_lanes", "lane_tables", "run_lanes", "scalar_step"]
 
 # rows of the lane-major step table ``tabl`` (:func:`lane_tables`): the entries of
 # integrate's table that the block's step reads, lane innermost
@@ -162,3 +168,396 @@ def block_step_lanes(n, lin, lout):
         lout[(O_V) * W + l] = v6
         lout[(O_S) * W + l] = s6
         lout[(O_C) * W + l] = c6
+
+
+# ---------------------------------------------------------------------------------------------
+# a grid's cells in lanes
+# ---------------------------------------------------------------------------------------------
+
+# layout of a lane's loop state: integers ``st`` and floats ``fs`` (the variables of
+# rockjit.integrate._loop)
+(S_STATUS, S_SIDE, S_NIMP, S_STEP, S_JPER, S_KPER, S_JQR, S_JREC, S_NCOL, S_NCOLWIN,
+ S_CELL) = range(11)
+N_ST = 11
+F_TT, F_MAXERR, F_TLIFT = range(3)
+N_FS = 3
+
+
+@jit(nrt=False)
+def scalar_step(TANGENT, st, fs, par, ipar, out, w):
+    """One grid step of a lane on the scalar path: the body of the loop of
+    :func:`rockjit.integrate._loop` (closed-form forcing, no trajectory), its variables kept in
+    ``st`` and ``fs``. Used for every step the lanes' fast path does not take (an event, a rest
+    phase, a stage out of the polynomial's range), so that each lane runs exactly the
+    single-lane code there."""
+    EMBED4 = False
+    RECORD = False
+    NS = 2
+    NY = NS + (4 if TANGENT else 0)
+    n_per = ipar[ig.I_N]
+    win_step = ipar[ig.I_WINDOW] * n_per
+    h = par[ig.P_H]
+    y = w.y
+    K = w.K
+    status = st[S_STATUS]
+    side = st[S_SIDE]
+    n_imp = st[S_NIMP]
+    step = st[S_STEP]
+    j_per = st[S_JPER]
+    k_per = st[S_KPER]
+    j_qr = st[S_JQR]
+    j_rec = st[S_JREC]
+    n_col = st[S_NCOL]
+    n_col_win = st[S_NCOLWIN]
+    t = fs[F_TT]
+    max_err = fs[F_MAXERR]
+    t_lift = fs[F_TLIFT]
+    t_grid = (step + 1) * h
+    in_window = step >= win_step
+    fresh = True
+    hold = False
+    while True:
+        if side == 0:
+            action, t, side = ig.leave_rest(EMBED4, t, t_grid, hold, y, side, par, w, out.iout)
+            if action == ig.REST_END:
+                status = ig.REST
+                break
+            if action == ig.REST_HOLD:
+                break
+            if action == ig.REST_LIFT:
+                t_lift = t
+                fresh = EMBED4 and fresh
+                continue
+        if fresh:
+            hh = h
+            ig.rk_step(EMBED4, TANGENT, not EMBED4, 0.0, 0.0, y, K, side, par, w.ytmp, w.ynew,
+                       w.tab_h, w.fr if EMBED4 else w.ftab[j_per], w.jac, w.trig)
+        else:
+            hh = t_grid - t
+            psi = par[ig.P_OMEGA] * t + par[ig.P_PHI]
+            ig.step_table(par[ig.P_OMEGA], hh, w.tab)
+            ig.rk_step(EMBED4, TANGENT, False, math.sin(psi), math.cos(psi), y, K, side, par,
+                       w.ytmp, w.ynew, w.tab, w.fr, w.jac, w.trig)
+        out.iout[ig.O_RHS] += ig.N_STAGES
+        out.iout[ig.O_SUBSTEPS] += 1
+        kind, lo, hi = ig.detect(y, w.ynew, hh, K, side, par)
+        if hold and kind == ig.EV_UPLIFT:
+            kind = ig.EV_NONE
+        if kind == ig.EV_NONE:
+            max_err = ig.accept(NS, NY, side, hh, max_err, w)
+            t = t_grid
+            break
+        if hi > lo:
+            tau = ig.locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, w.ytmp,
+                            w.yev, out.iout, w.tab, w.fr, w.jac, w.trig)
+        else:
+            tau = 0.0
+            for m in range(NY):
+                w.yev[m] = y[m]
+            w.yev[1] = 0.0
+        t = t + tau
+        fresh = False
+        for m in range(NY):
+            y[m] = w.yev[m]
+        if kind == ig.EV_OVERTURN:
+            if ipar[ig.I_CONTINUE] == 0:
+                status = ig.OVERTURNED
+                break
+            out.fout[ig.F_TOVER] = t
+            par[ig.P_THOVER] = math.inf
+            ig.rhs(EMBED4, ig.forcing_at(t, par), y, side, par, K, w.jac, w.trig)
+            out.iout[ig.O_RHS] += 1
+            continue
+        if kind == ig.EV_UPLIFT:
+            y[0] = 0.0
+            y[1] = 0.0
+            side = 1 if y[2] > 0.0 else -1
+            t_lift = t
+            ig.rhs(EMBED4, ig.forcing_at(t, par), y, side, par, K, w.jac, w.trig)
+            out.iout[ig.O_RHS] += 1
+            continue
+        side, n_imp, rests, held = ig.impact(EMBED4, TANGENT, t, t_lift, side, n_imp,
+                                             in_window, par, out, w)
+        if rests:
+            hold = hold or held
+            if TANGENT:
+                ig.reset_tangent(EMBED4, y)
+                n_col += 1
+                if in_window:
+                    n_col_win += 1
+        if n_imp >= ipar[ig.I_MAXIMP]:
+            status = ig.MAX_IMPACTS
+            break
+    if status == ig.RUNNING:
+        step += 1
+        if not (math.isfinite(y[0]) and math.isfinite(y[1])):
+            status = ig.NONFINITE
+        else:
+            status, j_per, k_per, j_qr, j_rec, collapsed = ig.grid_point(
+                EMBED4, TANGENT, RECORD, t, step, side, n_imp, n_col, in_window, ipar, par,
+                out, w, j_per, k_per, j_qr, j_rec)
+            if collapsed:
+                n_col += 1
+                if in_window:
+                    n_col_win += 1
+    st[S_STATUS] = status
+    st[S_SIDE] = side
+    st[S_NIMP] = n_imp
+    st[S_STEP] = step
+    st[S_JPER] = j_per
+    st[S_KPER] = k_per
+    st[S_JQR] = j_qr
+    st[S_JREC] = j_rec
+    st[S_NCOL] = n_col
+    st[S_NCOLWIN] = n_col_win
+    fs[F_TT] = t
+    fs[F_MAXERR] = max_err
+    fs[F_TLIFT] = t_lift
+
+
+#: A block of lanes' arrays: each lane's loop state (``st``, ``fs``), parameters (``par``,
+#: ``N_PARW``), the lanes' step input and output (``lin``, ``lout``), and each lane's
+#: :data:`rockjit.integrate.Outputs` and :data:`rockjit.integrate.Work` arrays (first index:
+#: the lane).
+Bank = namedtuple("Bank", "st fs par lin lout strobe half impacts traj lam_run per_imp iout "
+                          "fout K states lam tab_h tab fr jac trig ftab")
+
+
+def bank(periods, n_per, n_imp_pts):
+    """Fresh arrays for ``W`` lanes (a run's outputs as :func:`rockjit.kernel._grid` makes
+    them, the work arrays as :func:`rockjit.integrate._run`)."""
+    return _bank(periods, n_per, max(n_imp_pts, 1))
+
+
+@jit
+def _bank(periods, n_per, cap):
+    n_st = ig.N_STAGES + 1
+    return Bank(np.zeros((W, N_ST), dtype=np.int64), np.zeros((W, N_FS)),
+                np.zeros((W, ig.N_PARW)), np.zeros(N_LIN * W), np.zeros(N_LOUT * W),
+                np.zeros((W, periods + 1, 4)), np.zeros((W, periods + 1, 4)),
+                np.zeros((W, cap, 3)), np.zeros((W, 1, 5)), np.zeros((W, 1, 3)),
+                np.zeros((W, periods + 1), dtype=np.int64),
+                np.zeros((W, ig.N_IOUT), dtype=np.int64), np.zeros((W, ig.N_FOUT)),
+                np.zeros((W, n_st, 2)), np.zeros((W, 4, 2)), np.zeros((W, 4)),
+                np.zeros((W, ig.N_TAB, n_st)), np.zeros((W, ig.N_TAB, n_st)),
+                np.zeros((W, n_st)), np.zeros((W, n_st)), np.zeros((W, 4)),
+                np.zeros((W, n_per, n_st)))
+
+
+@jit(nrt=False, inline=True)
+def lane_outputs(b, l):
+    return ig.Outputs(b.strobe[l], b.half[l], b.impacts[l], b.traj[l], b.lam_run[l],
+                      b.per_imp[l], b.iout[l], b.fout[l])
+
+
+@jit(nrt=False, inline=True)
+def lane_work(b, l):
+    s = b.states[l]
+    return ig.Work(b.K[l], s[0], s[1], s[2], s[3], b.lam[l], b.tab_h[l], b.tab[l], b.fr[l],
+                   b.jac[l], b.trig[l], b.ftab[l])
+
+
+@jit(nrt=False)
+def _zero(a):
+    f = a.reshape(a.size)
+    for m in range(f.size):
+        f[m] = 0
+
+
+@jit(nrt=False)
+def _load(l, i, y0s, pars, ipar, b):
+    """Start cell ``i`` in lane ``l`` (:func:`rockjit.integrate._run` and the start of its
+    loop, on fresh arrays). Returns whether it runs (False: it ended before its first step)."""
+    _zero(b.strobe[l])
+    _zero(b.half[l])
+    _zero(b.impacts[l])
+    _zero(b.traj[l])
+    _zero(b.lam_run[l])
+    _zero(b.fout[l])
+    _zero(b.K[l])
+    _zero(b.states[l])
+    _zero(b.lam[l])
+    _zero(b.tab_h[l])
+    _zero(b.tab[l])
+    _zero(b.fr[l])
+    _zero(b.jac[l])
+    _zero(b.trig[l])
+    _zero(b.ftab[l])
+    _zero(b.per_imp[l])
+    _zero(b.iout[l])
+    par = b.par[l]
+    for m in range(ig.N_PARW):
+        par[m] = 0.0
+    for m in range(ig.N_PAR):
+        par[m] = pars[i, m]
+    par[ig.P_STHC] = math.sin(pars[i, ig.P_THC])
+    par[ig.P_CTHC] = math.cos(pars[i, ig.P_THC])
+    out = lane_outputs(b, l)
+    w = lane_work(b, l)
+    y0 = y0s[i]
+    side0 = initial_side(y0[0], y0[1])
+    status = ig.start(False, False, False, y0, side0, par, ipar, out, w)
+    st = b.st[l]
+    fs = b.fs[l]
+    for m in range(N_ST):
+        st[m] = 0
+    st[S_STATUS] = status
+    st[S_SIDE] = side0
+    st[S_NCOL] = out.iout[ig.O_NCOL]
+    st[S_NCOLWIN] = st[S_NCOL] if ipar[ig.I_WINDOW] == 0 else 0
+    st[S_CELL] = i
+    fs[F_TT] = 0.0
+    fs[F_MAXERR] = 0.0
+    fs[F_TLIFT] = -math.inf
+    lane_tables(w.tab_h, b.lin, l)
+    b.lin[I_STHC * W + l] = par[ig.P_STHC]
+    b.lin[I_CTHC * W + l] = par[ig.P_CTHC]
+    b.lin[I_XI * W + l] = par[ig.P_XI]
+    _refresh(l, b)
+    return status == ig.RUNNING and ipar[ig.I_N] * ipar[ig.I_PERIODS] > 0
+
+
+@jit(nrt=False, inline=True)
+def _refresh(l, b):
+    """The lane's step input from its state (after a load or a step)."""
+    s = b.states[l]
+    b.lin[I_X * W + l] = s[0, 0]
+    b.lin[I_V * W + l] = s[0, 1]
+    b.lin[I_K * W + l] = b.K[l, 0, 1]
+    b.lin[I_S * W + l] = b.trig[l, 0]
+    b.lin[I_C * W + l] = b.trig[l, 1]
+    b.lin[I_SG * W + l] = b.st[l, S_SIDE]
+
+
+@jit(nrt=False)
+def _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b):
+    """Lane ``l``'s run has ended: its outputs (:func:`rockjit.integrate._loop`'s end), its
+    classification and samples (:func:`rockjit.kernel._grid`); the lane is free."""
+    st = b.st[l]
+    fs = b.fs[l]
+    par = b.par[l]
+    out = lane_outputs(b, l)
+    w = lane_work(b, l)
+    status = st[S_STATUS]
+    if status == ig.RUNNING:
+        status = ig.DONE
+    out.iout[ig.O_NCOL] = st[S_NCOL]
+    ig.finish(False, False, status, fs[F_TT], st[S_STEP], st[S_NIMP], st[S_NCOLWIN],
+              fs[F_MAXERR], ipar, par, out, w)
+    i = st[S_CELL]
+    kn._classify(False, status, ipar, cpar, out, res[i])
+    kn._collect(i, par[ig.P_H] * ipar[ig.I_N], n_pts, n_imp_pts, out, res, pts, imp_pts,
+                n_got, n_imp_got)
+    st[S_CELL] = -1
+
+
+@jit(nrt=False)
+def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts,
+              n_got, n_imp_got, b):
+    """Cells ``i0 .. i1 - 1`` through ``n_lanes <= W`` lanes (no tangent vectors), a freed lane refilled
+    from the next pending cell; outputs as :func:`rockjit.kernel._grid`'s.
+
+    Each grid step: the fast path, :func:`block_step_lanes` for all lanes at once; then per lane,
+    when that step has no event (the tests of :func:`rockjit.integrate.detect` that find none),
+    stays in the polynomials' range and the block is not at rest, the step is accepted as
+    :func:`rockjit.integrate.accept` would; otherwise the lane's step is taken again by
+    :func:`scalar_step`, the single-lane code. A lane's arithmetic is the single-lane kernel's
+    either way, so its results are bit for bit those of :func:`rockjit.kernel._grid` (the
+    running error estimate ``max_err`` is not kept on the fast path: no grid output reads it).
+    """
+    n_per = ipar[ig.I_N]
+    total = n_per * ipar[ig.I_PERIODS]
+    half = n_per // 2
+    lin = b.lin
+    lout = b.lout
+    nxt = i0
+    for l in range(W):
+        b.st[l, S_CELL] = -1
+    while True:
+        busy = 0
+        for l in range(n_lanes):
+            while b.st[l, S_CELL] < 0 and nxt < i1:
+                i = nxt
+                nxt += 1
+                if not _load(l, i, y0s, pars, ipar, b):
+                    b.st[l, S_CELL] = i
+                    _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got,
+                         n_imp_got, b)
+            if b.st[l, S_CELL] >= 0:
+                busy += 1
+                j = b.st[l, S_JPER]
+                for s in range(ig.N_STAGES + 1):
+                    lin[(I_FR + s) * W + l] = b.ftab[l, j, s]
+        if busy == 0:
+            break
+        block_step_lanes(W, lin, lout)  # all W: one vector, whatever n_lanes
+        for l in range(n_lanes):
+            st = b.st[l]
+            if st[S_CELL] < 0:
+                continue
+            side = st[S_SIDE]
+            y = b.states[l, 0]
+            fast = False
+            if side != 0 and lout[O_FAR * W + l] <= 1.0:
+                x6 = lout[O_X * W + l]
+                v6 = lout[O_V * W + l]
+                g0 = side * y[0]
+                g1 = side * x6
+                fast = (g1 < b.par[l, ig.P_THOVER] and g1 >= 0.0
+                        and not (g0 > 0.0 and side * y[1] < 0.0 and side * v6 > 0.0))
+            if fast:
+                y[0] = x6
+                y[1] = v6
+                b.K[l, 0, 0] = v6
+                b.K[l, 0, 1] = lout[(O_KA + ig.N_STAGES) * W + l]
+                b.trig[l, 0] = lout[O_S * W + l]
+                b.trig[l, 1] = lout[O_C * W + l]
+                iout = b.iout[l]
+                iout[ig.O_RHS] += ig.N_STAGES
+                iout[ig.O_SUBSTEPS] += 1
+                step = st[S_STEP] + 1
+                st[S_STEP] = step
+                t = step * b.par[l, ig.P_H]
+                b.fs[l, F_TT] = t
+                if not (math.isfinite(x6) and math.isfinite(v6)):
+                    st[S_STATUS] = ig.NONFINITE
+                elif st[S_JPER] + 1 != n_per and st[S_JPER] + 1 != half:
+                    st[S_JPER] += 1
+                else:
+                    out = lane_outputs(b, l)
+                    w = lane_work(b, l)
+                    status, j_per, k_per, j_qr, j_rec, collapsed = ig.grid_point(
+                        False, False, False, t, step, side, st[S_NIMP], st[S_NCOL],
+                        step - 1 >= ipar[ig.I_WINDOW] * n_per, ipar, b.par[l], out, w,
+                        st[S_JPER], st[S_KPER], st[S_JQR], st[S_JREC])
+                    st[S_STATUS] = status
+                    st[S_JPER] = j_per
+                    st[S_KPER] = k_per
+                    st[S_JQR] = j_qr
+                    st[S_JREC] = j_rec
+            else:
+                scalar_step(False, st, b.fs[l], b.par[l], ipar, lane_outputs(b, l),
+                            lane_work(b, l))
+            if st[S_STATUS] != ig.RUNNING or st[S_STEP] >= total:
+                _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b)
+            else:
+                _refresh(l, b)
+
+
+#: Cells per block of lanes: a block is one task of the parallel loop, its cells run through
+#: one set of lanes (a freed lane takes the block's next pending cell).
+BLOCK = 256
+
+
+@jit(parallel=True)
+def grid_lanes(n_lanes, block, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts,
+               n_got, n_imp_got):
+    """:func:`rockjit.kernel._grid` without tangent vectors, ``n_lanes`` cells at a time per
+    thread: blocks of ``block`` cells, each through :func:`run_lanes` on fresh arrays. A cell's
+    results do not depend on its block, lane or thread."""
+    n = y0s.shape[0]
+    nb = (n + block - 1) // block
+    for g in prange(nb):
+        b = _bank(ipar[ig.I_PERIODS], ipar[ig.I_N], max(n_imp_pts, 1))
+        run_lanes(n_lanes, g * block, min(n, (g + 1) * block), y0s, pars, ipar, cpar, n_pts,
+                  n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b)
