@@ -19,7 +19,9 @@ import math
 from collections import namedtuple
 
 import numpy as np
-from numba import prange
+from llvmlite import ir
+from numba import prange, types
+from numba.extending import intrinsic
 
 from . import integrate as ig
 from . import kernel as kn
@@ -68,39 +70,65 @@ def lane_tables(tab, lin, lane):
 #: vectoriser knows rows apart)
 W = 8
 
+
+@intrinsic
+def cycles(typingctx):
+    """The CPU's cycle counter (LLVM's ``readcyclecounter``: ``rdtsc`` on x86-64), for the
+    lanes' own accounting of where their time goes."""
+    sig = types.int64()
+
+    def codegen(context, builder, signature, args):
+        fn = builder.module.declare_intrinsic("llvm.readcyclecounter", fnty=ir.FunctionType(
+            ir.IntType(64), []))
+        return builder.call(fn, [])
+
+    return sig, codegen
+
+
 # rows of the lanes' input ``lin`` and output ``lout`` (:func:`block_step_lanes`)
-I_X, I_V, I_K, I_S, I_C, I_SG, I_STHC, I_CTHC, I_XI = range(9)
-I_FR = 9                       # 7 rows: the forcing acceleration at each stage
-I_TAB = I_FR + ig.N_STAGES + 1  # N_LTAB rows: the step's table
+I_X, I_V, I_K, I_S, I_C, I_SG, I_STHC, I_CTHC, I_XI, I_THOVER = range(10)
+I_TAB = 10                     # N_LTAB rows: the step's table
 N_LIN = I_TAB + N_LTAB
 O_X, O_V, O_S, O_C, O_FAR = range(5)
 O_KV = O_FAR                    # rows O_KV + 1 .. O_KV + 6
 O_KA = O_KV + ig.N_STAGES       # rows O_KA + 1 .. O_KA + 6
-N_LOUT = O_KA + ig.N_STAGES + 1
+O_FAST = O_KA + ig.N_STAGES + 1
+N_LOUT = O_FAST + 1
 
 @jit(nrt=False)
-def block_step_lanes(n, lin, lout):
+def block_step_lanes(n, j, lin, lout, ftl):
     """One Dormand–Prince step of the block in ``n`` lanes at once (fast path, no slopes).
 
     Parameters
     ----------
     n : int
         Lanes.
-    lin : ndarray, (N_LIN, L)
-        What each lane's step reads, lane innermost (rows ``I_*``): angle, velocity,
-        acceleration, and sine and cosine of the angle at the step's start; the corner (as a
-        float, +1 or -1), ``sin(thc)``, ``cos(thc)``, the damping; the forcing acceleration at
-        each stage (``I_FR + i``); the step's table (``I_TAB + r``, :func:`lane_tables`).
-    lout : ndarray, (N_LOUT, L)
+    j : int
+        The step's index in the forcing period (the same in every lane).
+    lin : ndarray, (N_LIN * W,)
+        Each lane's state and constants, row ``r`` of lane ``l`` at ``r * W + l`` (rows
+        ``I_*``): angle, velocity, acceleration, and sine and cosine of the angle at the step's
+        start; the corner (as a float: +1, -1, or 0 at rest), ``sin(thc)``, ``cos(thc)``, the
+        damping, the overturning angle; the step's table (``I_TAB + r``, :func:`lane_tables`).
+        A lane whose step is *fast* (below) has its state advanced to the step's end here.
+    lout : ndarray, (N_LOUT * W,)
         Receives the stages' velocities and accelerations (``O_KV + i``, ``O_KA + i``, rows
         ``i = 1..6``: ``K[i, 0]`` and ``K[i, 1]`` of :func:`rockjit.integrate.block_step`), the
-        angle and velocity at the step's end, the sine and cosine of that angle, and ``far``
-        (``> 1``: the lane must redo its step on the slow path).
+        angle and velocity at the step's end, the sine and cosine of that angle, ``far``
+        (``> 1``: the step left the polynomials' range) and ``O_FAST``: 1 when the step is
+        accepted as it is (in flight, in range, and none of the events that
+        :func:`rockjit.integrate.detect` looks for), else 0 (the lane's state is left as it was,
+        for the single-lane code to take the step).
+    ftl : ndarray, (N * 7 * W,)
+        Each lane's forcing acceleration at stage ``i`` of step ``j`` at ``(7 j + i) W + l``.
 
     Notes
     -----
-    Two arrays, one read and one written: LLVM's loop vectoriser then needs a single overlap
-    check (with one array per quantity it gives up: "too many memory checks").
+    Three flat arrays whose rows lie a compile-time stride ``W`` apart: LLVM's loop vectoriser
+    then needs three overlap checks (with one array per quantity it gives up: "too many memory
+    checks"). The state is written back here, as a vector, so that the next step's vector loads
+    never wait on single-lane stores (a failed store-to-load forwarding cost three times the
+    step).
     """
     for l in range(n):
         xl = lin[(I_X) * W + l]
@@ -114,44 +142,45 @@ def block_step_lanes(n, lin, lout):
         dmp = lin[(I_XI) * W + l]
         d1 = lin[(I_TAB + L_C1) * W + l] * vl
         v1 = fma(lin[(I_TAB + L_A10) * W + l], kl, vl)
-        P, Q = corner(lin[(I_FR + 1) * W + l], side, st, ct)
+        P, Q = corner(ftl[(j * 7 + 1) * W + l], side, st, ct)
         Pr, Qr = rotate(P, Q, sl, cl)
         k1 = accel_near(Pr, Qr, d1, v1, dmp)
         d2 = fma(lin[(I_TAB + L_AA20) * W + l], kl, lin[(I_TAB + L_C2) * W + l] * vl)
         v2 = fma(lin[(I_TAB + L_A21) * W + l], k1, fma(lin[(I_TAB + L_A20) * W + l], kl, vl))
-        P, Q = corner(lin[(I_FR + 2) * W + l], side, st, ct)
+        P, Q = corner(ftl[(j * 7 + 2) * W + l], side, st, ct)
         Pr, Qr = rotate(P, Q, sl, cl)
         k2 = accel_near(Pr, Qr, d2, v2, dmp)
         d3 = fma(lin[(I_TAB + L_AA31) * W + l], k1, fma(lin[(I_TAB + L_AA30) * W + l], kl, lin[(I_TAB + L_C3) * W + l] * vl))
         v3 = fma(lin[(I_TAB + L_A32) * W + l], k2, fma(lin[(I_TAB + L_A31) * W + l], k1, fma(lin[(I_TAB + L_A30) * W + l], kl, vl)))
-        P, Q = corner(lin[(I_FR + 3) * W + l], side, st, ct)
+        P, Q = corner(ftl[(j * 7 + 3) * W + l], side, st, ct)
         Pr, Qr = rotate(P, Q, sl, cl)
         k3 = accel_near(Pr, Qr, d3, v3, dmp)
         d4 = fma(lin[(I_TAB + L_AA42) * W + l], k2, fma(lin[(I_TAB + L_AA41) * W + l], k1,
                  fma(lin[(I_TAB + L_AA40) * W + l], kl, lin[(I_TAB + L_C4) * W + l] * vl)))
         v4 = fma(lin[(I_TAB + L_A43) * W + l], k3, fma(lin[(I_TAB + L_A42) * W + l], k2, fma(lin[(I_TAB + L_A41) * W + l], k1,
                  fma(lin[(I_TAB + L_A40) * W + l], kl, vl))))
-        P, Q = corner(lin[(I_FR + 4) * W + l], side, st, ct)
+        P, Q = corner(ftl[(j * 7 + 4) * W + l], side, st, ct)
         Pr, Qr = rotate(P, Q, sl, cl)
         k4 = accel_near(Pr, Qr, d4, v4, dmp)
         d5 = fma(lin[(I_TAB + L_AA53) * W + l], k3, fma(lin[(I_TAB + L_AA52) * W + l], k2, fma(lin[(I_TAB + L_AA51) * W + l], k1,
                  fma(lin[(I_TAB + L_AA50) * W + l], kl, lin[(I_TAB + L_C5) * W + l] * vl))))
         v5 = fma(lin[(I_TAB + L_A54) * W + l], k4, fma(lin[(I_TAB + L_A53) * W + l], k3, fma(lin[(I_TAB + L_A52) * W + l], k2,
                  fma(lin[(I_TAB + L_A51) * W + l], k1, fma(lin[(I_TAB + L_A50) * W + l], kl, vl)))))
-        P, Q = corner(lin[(I_FR + 5) * W + l], side, st, ct)
+        P, Q = corner(ftl[(j * 7 + 5) * W + l], side, st, ct)
         Pr, Qr = rotate(P, Q, sl, cl)
         k5 = accel_near(Pr, Qr, d5, v5, dmp)
         d6 = fma(lin[(I_TAB + L_BA4) * W + l], k4, fma(lin[(I_TAB + L_BA3) * W + l], k3, fma(lin[(I_TAB + L_BA2) * W + l], k2,
                  fma(lin[(I_TAB + L_BA0) * W + l], kl, lin[(I_TAB + L_C6) * W + l] * vl))))
         v6 = fma(lin[(I_TAB + L_B5) * W + l], k5, fma(lin[(I_TAB + L_B4) * W + l], k4, fma(lin[(I_TAB + L_B3) * W + l], k3,
                  fma(lin[(I_TAB + L_B2) * W + l], k2, fma(lin[(I_TAB + L_B0) * W + l], kl, vl)))))
-        P, Q = corner(lin[(I_FR + 6) * W + l], side, st, ct)
+        P, Q = corner(ftl[(j * 7 + 6) * W + l], side, st, ct)
         Pr, Qr = rotate(P, Q, sl, cl)
         k6 = accel_near(Pr, Qr, d6, v6, dmp)
         x6 = xl + d6
         s6, c6 = sincos_poly(x6)
         f = max(max(max(abs(d1), abs(d2)), max(abs(d3), abs(d4))), max(abs(d5), abs(d6)))
-        lout[(O_FAR) * W + l] = max(f * (1.0 / NEAR_RANGE), abs(x6) * (1.0 / SINCOS_RANGE))
+        far = max(f * (1.0 / NEAR_RANGE), abs(x6) * (1.0 / SINCOS_RANGE))
+        lout[(O_FAR) * W + l] = far
         lout[(O_KV + 1) * W + l] = v1
         lout[(O_KV + 2) * W + l] = v2
         lout[(O_KV + 3) * W + l] = v3
@@ -168,6 +197,17 @@ def block_step_lanes(n, lin, lout):
         lout[(O_V) * W + l] = v6
         lout[(O_S) * W + l] = s6
         lout[(O_C) * W + l] = c6
+        g0 = side * xl
+        g1 = side * x6
+        graze = (g0 > 0.0) & (side * vl < 0.0) & (side * v6 > 0.0)
+        fast = ((side != 0.0) & (far <= 1.0) & (g1 < lin[I_THOVER * W + l]) & (g1 >= 0.0)
+                & (not graze))
+        lout[O_FAST * W + l] = 1.0 if fast else 0.0
+        lin[I_X * W + l] = x6 if fast else xl
+        lin[I_V * W + l] = v6 if fast else vl
+        lin[I_K * W + l] = k6 if fast else kl
+        lin[I_S * W + l] = s6 if fast else sl
+        lin[I_C * W + l] = c6 if fast else cl
 
 
 # ---------------------------------------------------------------------------------------------
@@ -316,10 +356,11 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w):
 
 
 #: A block of lanes' arrays: each lane's loop state (``st``, ``fs``), parameters (``par``,
-#: ``N_PARW``), the lanes' step input and output (``lin``, ``lout``), and each lane's
+#: ``N_PARW``), the lanes' step input and output (``lin``, ``lout``) and forcing table
+#: (``ftl``), and each lane's
 #: :data:`rockjit.integrate.Outputs` and :data:`rockjit.integrate.Work` arrays (first index:
 #: the lane).
-Bank = namedtuple("Bank", "st fs par lin lout strobe half impacts traj lam_run per_imp iout "
+Bank = namedtuple("Bank", "st fs par lin lout ftl strobe half impacts traj lam_run per_imp iout "
                           "fout K states lam tab_h tab fr jac trig ftab")
 
 
@@ -334,6 +375,7 @@ def _bank(periods, n_per, cap):
     n_st = ig.N_STAGES + 1
     return Bank(np.zeros((W, N_ST), dtype=np.int64), np.zeros((W, N_FS)),
                 np.zeros((W, ig.N_PARW)), np.zeros(N_LIN * W), np.zeros(N_LOUT * W),
+                np.zeros(n_per * n_st * W),
                 np.zeros((W, periods + 1, 4)), np.zeros((W, periods + 1, 4)),
                 np.zeros((W, cap, 3)), np.zeros((W, 1, 5)), np.zeros((W, 1, 3)),
                 np.zeros((W, periods + 1), dtype=np.int64),
@@ -410,6 +452,9 @@ def _load(l, i, y0s, pars, ipar, b):
     fs[F_MAXERR] = 0.0
     fs[F_TLIFT] = -math.inf
     lane_tables(w.tab_h, b.lin, l)
+    for jj in range(ipar[ig.I_N]):
+        for s in range(ig.N_STAGES + 1):
+            b.ftl[(jj * (ig.N_STAGES + 1) + s) * W + l] = w.ftab[jj, s]
     b.lin[I_STHC * W + l] = par[ig.P_STHC]
     b.lin[I_CTHC * W + l] = par[ig.P_CTHC]
     b.lin[I_XI * W + l] = par[ig.P_XI]
@@ -427,6 +472,19 @@ def _refresh(l, b):
     b.lin[I_S * W + l] = b.trig[l, 0]
     b.lin[I_C * W + l] = b.trig[l, 1]
     b.lin[I_SG * W + l] = b.st[l, S_SIDE]
+    b.lin[I_THOVER * W + l] = b.par[l, ig.P_THOVER]
+
+
+@jit(nrt=False, inline=True)
+def _sync(l, b):
+    """The lane's single-lane state from its step input (the fast path keeps it there only)."""
+    s = b.states[l]
+    s[0, 0] = b.lin[I_X * W + l]
+    s[0, 1] = b.lin[I_V * W + l]
+    b.K[l, 0, 0] = b.lin[I_V * W + l]
+    b.K[l, 0, 1] = b.lin[I_K * W + l]
+    b.trig[l, 0] = b.lin[I_S * W + l]
+    b.trig[l, 1] = b.lin[I_C * W + l]
 
 
 @jit(nrt=False)
@@ -453,30 +511,36 @@ def _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b
 
 @jit(nrt=False)
 def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts,
-              n_got, n_imp_got, b):
-    """Cells ``i0 .. i1 - 1`` through ``n_lanes <= W`` lanes (no tangent vectors), a freed lane refilled
-    from the next pending cell; outputs as :func:`rockjit.kernel._grid`'s.
+              n_got, n_imp_got, b, counts):
+    """Cells ``i0 .. i1 - 1`` through ``n_lanes <= W`` lanes (no tangent vectors), a freed
+    lane refilled from the next pending cell at the next period's start (all lanes then step
+    through the period together: one forcing row for all); outputs as
+    :func:`rockjit.kernel._grid`'s.
 
-    Each grid step: the fast path, :func:`block_step_lanes` for all lanes at once; then per lane,
-    when that step has no event (the tests of :func:`rockjit.integrate.detect` that find none),
-    stays in the polynomials' range and the block is not at rest, the step is accepted as
-    :func:`rockjit.integrate.accept` would; otherwise the lane's step is taken again by
-    :func:`scalar_step`, the single-lane code. A lane's arithmetic is the single-lane kernel's
-    either way, so its results are bit for bit those of :func:`rockjit.kernel._grid` (the
-    running error estimate ``max_err`` is not kept on the fast path: no grid output reads it).
+    Each grid step: :func:`block_step_lanes` for all lanes at once, which accepts the step of
+    every lane in flight whose step has no event, stays in the polynomials' range; every other
+    lane's step (an event, a rest phase) is taken again by :func:`scalar_step`, the single-lane
+    code. A lane's arithmetic is the single-lane kernel's either way, so its results are bit for
+    bit those of :func:`rockjit.kernel._grid` (the running error estimate ``max_err`` is not
+    kept on the fast path: no grid output reads it). ``counts``: the fast and the scalar steps,
+    the vector steps taken, and the cycles (``readcyclecounter``) spent in the vector steps, in
+    the scalar steps, and in all.
     """
+    c_start = cycles()
     n_per = ipar[ig.I_N]
     total = n_per * ipar[ig.I_PERIODS]
     half = n_per // 2
     lin = b.lin
     lout = b.lout
+    ftl = b.ftl
     nxt = i0
     for l in range(W):
         b.st[l, S_CELL] = -1
+    j = 0  # the step's index in the period, the same in every lane
     while True:
         busy = 0
         for l in range(n_lanes):
-            while b.st[l, S_CELL] < 0 and nxt < i1:
+            while j == 0 and b.st[l, S_CELL] < 0 and nxt < i1:
                 i = nxt
                 nxt += 1
                 if not _load(l, i, y0s, pars, ipar, b):
@@ -485,33 +549,25 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
                          n_imp_got, b)
             if b.st[l, S_CELL] >= 0:
                 busy += 1
-                j = b.st[l, S_JPER]
-                for s in range(ig.N_STAGES + 1):
-                    lin[(I_FR + s) * W + l] = b.ftab[l, j, s]
         if busy == 0:
-            break
-        block_step_lanes(W, lin, lout)  # all W: one vector, whatever n_lanes
+            if nxt >= i1:
+                break
+            j = 0  # no lane busy: the next cells start now
+            continue
+        c0 = cycles()
+        # all W lanes, one vector, whatever n_lanes; the count is read from an array's shape
+        # so that LLVM does not know it: a known count of 8 unrolls the loop fully, and the
+        # unrolled code is not vectorised
+        block_step_lanes(b.st.shape[0], j, lin, lout, ftl)
+        c1 = cycles()
+        counts[2] += 1
+        counts[3] += c1 - c0
         for l in range(n_lanes):
             st = b.st[l]
             if st[S_CELL] < 0:
                 continue
-            side = st[S_SIDE]
-            y = b.states[l, 0]
-            fast = False
-            if side != 0 and lout[O_FAR * W + l] <= 1.0:
-                x6 = lout[O_X * W + l]
-                v6 = lout[O_V * W + l]
-                g0 = side * y[0]
-                g1 = side * x6
-                fast = (g1 < b.par[l, ig.P_THOVER] and g1 >= 0.0
-                        and not (g0 > 0.0 and side * y[1] < 0.0 and side * v6 > 0.0))
-            if fast:
-                y[0] = x6
-                y[1] = v6
-                b.K[l, 0, 0] = v6
-                b.K[l, 0, 1] = lout[(O_KA + ig.N_STAGES) * W + l]
-                b.trig[l, 0] = lout[O_S * W + l]
-                b.trig[l, 1] = lout[O_C * W + l]
+            if lout[O_FAST * W + l] != 0.0:
+                counts[0] += 1
                 iout = b.iout[l]
                 iout[ig.O_RHS] += ig.N_STAGES
                 iout[ig.O_SUBSTEPS] += 1
@@ -519,29 +575,37 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
                 st[S_STEP] = step
                 t = step * b.par[l, ig.P_H]
                 b.fs[l, F_TT] = t
-                if not (math.isfinite(x6) and math.isfinite(v6)):
+                if not (math.isfinite(lin[I_X * W + l]) and math.isfinite(lin[I_V * W + l])):
                     st[S_STATUS] = ig.NONFINITE
-                elif st[S_JPER] + 1 != n_per and st[S_JPER] + 1 != half:
-                    st[S_JPER] += 1
+                elif j + 1 != n_per and j + 1 != half:
+                    st[S_JPER] = j + 1
                 else:
-                    out = lane_outputs(b, l)
-                    w = lane_work(b, l)
+                    _sync(l, b)
                     status, j_per, k_per, j_qr, j_rec, collapsed = ig.grid_point(
-                        False, False, False, t, step, side, st[S_NIMP], st[S_NCOL],
-                        step - 1 >= ipar[ig.I_WINDOW] * n_per, ipar, b.par[l], out, w,
-                        st[S_JPER], st[S_KPER], st[S_JQR], st[S_JREC])
+                        False, False, False, t, step, st[S_SIDE], st[S_NIMP], st[S_NCOL],
+                        step - 1 >= ipar[ig.I_WINDOW] * n_per, ipar, b.par[l],
+                        lane_outputs(b, l), lane_work(b, l), st[S_JPER], st[S_KPER],
+                        st[S_JQR], st[S_JREC])
                     st[S_STATUS] = status
                     st[S_JPER] = j_per
                     st[S_KPER] = k_per
                     st[S_JQR] = j_qr
                     st[S_JREC] = j_rec
             else:
+                counts[1] += 1
+                c0 = cycles()
+                _sync(l, b)
                 scalar_step(False, st, b.fs[l], b.par[l], ipar, lane_outputs(b, l),
                             lane_work(b, l))
-            if st[S_STATUS] != ig.RUNNING or st[S_STEP] >= total:
-                _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b)
-            else:
                 _refresh(l, b)
+                counts[4] += cycles() - c0
+            if st[S_STATUS] != ig.RUNNING or st[S_STEP] >= total:
+                _sync(l, b)
+                _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b)
+        j += 1
+        if j == n_per:
+            j = 0
+    counts[5] += cycles() - c_start
 
 
 #: Cells per block of lanes: a block is one task of the parallel loop, its cells run through
@@ -551,13 +615,14 @@ BLOCK = 256
 
 @jit(parallel=True)
 def grid_lanes(n_lanes, block, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts,
-               n_got, n_imp_got):
+               n_got, n_imp_got, counts):
     """:func:`rockjit.kernel._grid` without tangent vectors, ``n_lanes`` cells at a time per
     thread: blocks of ``block`` cells, each through :func:`run_lanes` on fresh arrays. A cell's
-    results do not depend on its block, lane or thread."""
+    results do not depend on its block, lane or thread. ``counts[g]`` receives block ``g``'s
+    step counts (:func:`run_lanes`)."""
     n = y0s.shape[0]
     nb = (n + block - 1) // block
     for g in prange(nb):
         b = _bank(ipar[ig.I_PERIODS], ipar[ig.I_N], max(n_imp_pts, 1))
         run_lanes(n_lanes, g * block, min(n, (g + 1) * block), y0s, pars, ipar, cpar, n_pts,
-                  n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b)
+                  n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b, counts[g])
