@@ -7,18 +7,24 @@ put back to its start, rarely):
 - ``scalar``: today's step (:func:`rockjit.integrate.rk_step`) for each of L independent cells in
   turn, then the step's acceptance; the out-of-order core may overlap neighbouring cells' chains;
 - ``lanes``: :func:`rockjit.lanes.block_step_lanes`, the same arithmetic written as one loop over
-  lanes (SIMD), then the acceptance in lane arrays;
-- ``lanes + bookkeeping``: ``lanes`` plus what a grid kernel does per lane after the step:
-  the results copied into the lane's own stage array, event detection
-  (:func:`rockjit.integrate.detect`) and acceptance (:func:`rockjit.integrate.accept`).
+  lanes, vectorised (it always computes all ``W`` = 8 lanes, one AVX-512 vector; L of them
+  count), which also accepts the step.
 
-The lanes' end states are checked equal, bit for bit, to the scalar step's. The arithmetic
+(That the vector step equals the scalar one bit for bit is tests/test_lanes.py's.) The arithmetic
 bound drawn in the plot is :data:`FLOPS_PER_STEP` floating-point instructions (counted from the
 source, below) at :data:`FP_PER_CYCLE` per cycle (two FMA/multiply pipes), scalar and at the
 vector width.
 
-    flock /work/timing.lock python benchmarks/bench_lanes.py           # ~1 min after compiling
+Then the grid kernel itself (:func:`rockjit.kernel.run_chunk_counted`, ``lanes`` = 1, 2, 4, 8,
+side by side, outputs checked equal to ``lanes=1``'s): cells per second and wall ns per
+cell-step on the study's hb=1 Housner basin, full length and early-stopped, on the same threads,
+and from the lanes' own cycle counters the share of the time in the vector steps and in the
+steps taken by the single-lane code (events, rest phases), with the speed-up that remains
+possible if those keep their cost (Amdahl: the L=1 time over the time of the scalar steps).
+
+    flock /work/timing.lock python benchmarks/bench_lanes.py           # ~10 min
     flock /work/timing.lock python benchmarks/bench_lanes.py --quick
+    flock /work/timing.lock python benchmarks/bench_lanes.py --grid-full 40 --periods-full 200
 
 Writes lanes.{md,json} and lanes.png to benchmarks/results/ (quick/ with --quick, or --out).
 """
@@ -35,12 +41,17 @@ import _common as H
 import rockjit
 from rockjit import integrate as ig
 from rockjit import lanes as ln
+from rockjit import analysis as an
+from rockjit import kernel as kn
 from rockjit.analysis import GRID_N
 from rockjit.kernel import pack
 
 LS = (1, 2, 4, 8)
-FULL = dict(steps=2_000_000, reps=7)
-QUICK = dict(steps=40_000, reps=3)
+FULL = dict(steps=2_000_000, reps=7, grid_full=100, periods_full=500, reps_full=1, grid_es=100,
+            reps_es=3)
+QUICK = dict(steps=40_000, reps=3, grid_full=12, periods_full=40, reps_full=2, grid_es=20,
+             reps_es=2)
+BASIN = dict(hb=1.0, alpha=0.66, omega=1.3, law="housner")  # the study's hb=1 basin
 
 #: Multiplies and FMAs of one block step (fast path, no slopes), from the source: per stage
 #: corner 2 FMA, rotate 2 FMA + 2 mul, near_poly 3 mul + 9 FMA, accel_near 2 mul + 2 FMA (22);
@@ -52,6 +63,13 @@ FLOPS_PER_STEP = 132 + 40 + 20 + 4
 FP_PER_CYCLE = 2
 #: Doubles per vector (AVX2: 4; the 512-bit instructions of this CPU run as two halves on Zen 4).
 VECTOR = 4
+
+
+def _options(p):
+    p.add_argument("--grid-full", type=int, default=None,
+                   help="cells per side of the full-length basin (default 100)")
+    p.add_argument("--periods-full", type=int, default=None,
+                   help="periods of the full-length basin (default 500)")
 
 
 def cpu_mhz():
@@ -66,10 +84,12 @@ def cpu_mhz():
 
 
 def kernels():
-    """The three measured loops, compiled (numba, not cached: a benchmark's own code)."""
+    """The two measured loops, compiled (numba, not cached: a benchmark's own code). A lane is
+    put back to its start when its step would cross theta = 0 (an impact) or leave the
+    polynomials' range, the same rule in both."""
     n_st = ig.N_STAGES
-    rk_step, rhs, detect, accept = ig.rk_step, ig.rhs, ig.detect, ig.accept
-    Work = ig.Work
+    rk_step, rhs = ig.rk_step, ig.rhs
+    W = ln.W
 
     @numba.njit(cache=False, _nrt=False)
     def restart(l, y, K, par, jac, trig):
@@ -78,7 +98,7 @@ def kernels():
         rhs(False, 0.0, y[l], 1, par, K[l], jac[l], trig[l])
 
     @numba.njit(cache=False, _nrt=False)
-    def scalar(n, L, BOOK, y, K, par, ytmp, ynew, tab, ftab, jac, trig, lam, tab_full):
+    def scalar(n, L, y, K, par, ytmp, ynew, tab, ftab, jac, trig, lin, lout, ftl, nv):
         n_per = ftab.shape[0]
         for l in range(L):
             restart(l, y, K, par, jac, trig)
@@ -88,14 +108,8 @@ def kernels():
                 Kl = K[l]
                 rk_step(False, False, True, 0.0, 1.0, y[l], Kl, 1, par, ytmp[l], ynew[l], tab,
                         ftab[j], jac[l], trig[l])
-                if BOOK:
-                    w = Work(Kl, y[l], ytmp[l], ynew[l], ytmp[l], lam, tab_full, tab_full,
-                             ftab[j], jac[l], trig[l], ftab)
-                    kind, lo, hi = detect(y[l], ynew[l], tab[ig.T_HC, 6], Kl, 1, par)
-                    if kind == ig.EV_NONE or kind == ig.EV_IMPACT:
-                        accept(2, 2, 1, tab[ig.T_HC, 6], 0.0, w)
-                    if y[l, 0] < -0.3:
-                        restart(l, y, K, par, jac, trig)
+                if ynew[l, 0] < 0.0:
+                    restart(l, y, K, par, jac, trig)
                     continue
                 y[l, 0] = ynew[l, 0]
                 y[l, 1] = ynew[l, 1]
@@ -103,64 +117,39 @@ def kernels():
                 Kl[0, 1] = Kl[n_st, 1]
                 trig[l, 0] = trig[l, 2]
                 trig[l, 1] = trig[l, 3]
-                if y[l, 0] < -0.3:
-                    restart(l, y, K, par, jac, trig)
             j += 1
             if j == n_per:
                 j = 0
 
-    W = ln.W
+    @numba.njit(cache=False, _nrt=False)
+    def load(l, y, K, par, jac, trig, lin, tab):
+        restart(l, y, K, par, jac, trig)
+        lin[ln.I_X * W + l] = y[l, 0]
+        lin[ln.I_V * W + l] = y[l, 1]
+        lin[ln.I_K * W + l] = K[l, 0, 1]
+        lin[ln.I_S * W + l] = trig[l, 0]
+        lin[ln.I_C * W + l] = trig[l, 1]
+        lin[ln.I_SG * W + l] = 1.0
+        lin[ln.I_STHC * W + l] = par[ig.P_STHC]
+        lin[ln.I_CTHC * W + l] = par[ig.P_CTHC]
+        lin[ln.I_XI * W + l] = par[ig.P_XI]
+        lin[ln.I_THOVER * W + l] = par[ig.P_THOVER]
+        ln.lane_tables(tab, lin, l)
 
     @numba.njit(cache=False, _nrt=False)
-    def lanes(n, L, BOOK, y, K, par, ytmp, ynew, tab, ftab, jac, trig, lin, lout, lam,
-              tab_full):
+    def lanes(n, L, y, K, par, ytmp, ynew, tab, ftab, jac, trig, lin, lout, ftl, nv):
         n_per = ftab.shape[0]
-        for l in range(L):
-            restart(l, y, K, par, jac, trig)
-            lin[ln.I_X * W + l] = y[l, 0]
-            lin[ln.I_V * W + l] = y[l, 1]
-            lin[ln.I_K * W + l] = K[l, 0, 1]
-            lin[ln.I_S * W + l] = trig[l, 0]
-            lin[ln.I_C * W + l] = trig[l, 1]
-            lin[ln.I_SG * W + l] = 1.0
-            lin[ln.I_STHC * W + l] = par[ig.P_STHC]
-            lin[ln.I_CTHC * W + l] = par[ig.P_CTHC]
-            lin[ln.I_XI * W + l] = par[ig.P_XI]
-            ln.lane_tables(tab, lin, l)
+        for l in range(W):
+            load(l, y, K, par, jac, trig, lin, tab)
+            for jj in range(n_per):
+                for i in range(n_st + 1):
+                    ftl[(jj * (n_st + 1) + i) * W + l] = ftab[jj, i]
         j = 0
         for _ in range(n):
+            ln.block_step_lanes(nv.shape[0], j, lin, lout, ftl)  # all W lanes, one vector
             for l in range(L):
-                for i in range(n_st + 1):
-                    lin[(ln.I_FR + i) * W + l] = ftab[j, i]
-            ln.block_step_lanes(L, lin, lout)
-            for l in range(L):
-                if BOOK:
-                    Kl = K[l]
-                    for i in range(1, n_st + 1):
-                        Kl[i, 0] = lout[(ln.O_KV + i) * W + l]
-                        Kl[i, 1] = lout[(ln.O_KA + i) * W + l]
-                    ynew[l, 0] = lout[ln.O_X * W + l]
-                    ynew[l, 1] = lout[ln.O_V * W + l]
-                    trig[l, 2] = lout[ln.O_S * W + l]
-                    trig[l, 3] = lout[ln.O_C * W + l]
-                    w = Work(Kl, y[l], ytmp[l], ynew[l], ytmp[l], lam, tab_full, tab_full,
-                             ftab[j], jac[l], trig[l], ftab)
-                    kind, lo, hi = detect(y[l], ynew[l], tab[ig.T_HC, 6], Kl, 1, par)
-                    if kind == ig.EV_NONE or kind == ig.EV_IMPACT:
-                        accept(2, 2, 1, tab[ig.T_HC, 6], 0.0, w)
-                else:
-                    y[l, 0] = lout[ln.O_X * W + l]
-                    y[l, 1] = lout[ln.O_V * W + l]
-                    K[l, 0, 1] = lout[(ln.O_KA + n_st) * W + l]
-                    trig[l, 0] = lout[ln.O_S * W + l]
-                    trig[l, 1] = lout[ln.O_C * W + l]
-                if y[l, 0] < -0.3:
-                    restart(l, y, K, par, jac, trig)
-                lin[ln.I_X * W + l] = y[l, 0]
-                lin[ln.I_V * W + l] = y[l, 1]
-                lin[ln.I_K * W + l] = K[l, 0, 1]
-                lin[ln.I_S * W + l] = trig[l, 0]
-                lin[ln.I_C * W + l] = trig[l, 1]
+                if lout[ln.O_FAST * W + l] == 0.0:
+                    load(l, y, K, par, jac, trig, lin, tab)
             j += 1
             if j == n_per:
                 j = 0
@@ -185,56 +174,94 @@ def setup(L):
         for i in range(n_st + 1):
             c = ig.C[i] if i < n_st else 1.0
             ftab[j, i] = par[ig.P_AW2] * math.sin(par[ig.P_PHI] + 2 * math.pi * (j + c) / n_per)
+    W = ln.W
     z = lambda *s: np.zeros(s)  # noqa: E731
-    common = dict(y=z(L, 2), K=z(L, n_st + 1, 2), par=par, ytmp=z(L, 2), ynew=z(L, 2),
-                  tab=tab, ftab=ftab, jac=z(L, n_st + 1), trig=z(L, 4))
-    book = dict(lam=z(4), tab_full=z(ig.N_TAB, n_st + 1))
-    lanes = dict(lin=z(ln.N_LIN * ln.W), lout=z(ln.N_LOUT * ln.W), **book)
-    return common, lanes, book
+    return dict(y=z(W, 2), K=z(W, n_st + 1, 2), par=par, ytmp=z(W, 2), ynew=z(W, 2), tab=tab,
+                ftab=ftab, jac=z(W, n_st + 1), trig=z(W, 4), lin=z(ln.N_LIN * W),
+                lout=z(ln.N_LOUT * W), ftl=z(n_per * (n_st + 1) * W), nv=z(W))
 
 
 def measure(cfg):
+    """ns per cell-step of the two loops for each L (the vector step always computes W lanes;
+    L of them are counted)."""
     scalar, lanes = kernels()
     n = cfg["steps"]
     cases = {}
     for L in LS:
-        c1, _, b1 = setup(L)
-        c2, l2, _ = setup(L)
-        c3, l3, _ = setup(L)
-        c4, _, b4 = setup(L)
-        # compile and check: equal end states after the same number of steps
-        m = 1000
-        scalar(m, L, False, *c1.values(), *b1.values())
-        scalar(m, L, True, *c4.values(), *b4.values())
-        lanes(m, L, False, *c2.values(), *l2.values())
-        lanes(m, L, True, *c3.values(), *l3.values())
-        for c in (c2, c3, c4):
-            if not np.array_equal(c1["y"], c["y"]):
-                raise SystemExit(f"L={L}: lanes differ from the scalar step: {c1['y']} {c['y']}")
+        c1, c2 = setup(L), setup(L)
+        scalar(100, L, *c1.values())
+        lanes(100, L, *c2.values())
         s = max(1, n // L)
-        cases[("scalar", L)] = lambda L=L, c=c1, d=b1, s=s: scalar(s, L, False, *c.values(),
-                                                                 *d.values())
-        cases[("scalar + bookkeeping", L)] = lambda L=L, c=c4, d=b4, s=s: scalar(
-            s, L, True, *c.values(), *d.values())
-        cases[("lanes", L)] = lambda L=L, c=c2, d=l2, s=s: lanes(s, L, False, *c.values(),
-                                                               *d.values())
-        cases[("lanes + bookkeeping", L)] = lambda L=L, c=c3, d=l3, s=s: lanes(
-            s, L, True, *c.values(), *d.values())
+        cases[("scalar", L)] = lambda L=L, c=c1, s=s: scalar(s, L, *c.values())
+        cases[("lanes", L)] = lambda L=L, c=c2, s=s: lanes(s, L, *c.values())
     t = H.side_by_side(cases, cfg["reps"])
     out = {}
     for (kind, L) in cases:
-        cell_steps = max(1, n // L) * L
-        out[(kind, L)] = 1e9 * t.median((kind, L)) / cell_steps
+        out[(kind, L)] = 1e9 * t.median((kind, L)) / (max(1, n // L) * L)
     return out, {f"{k[0]}|{k[1]}": v for k, v in t.wall.items()}
 
 
+def grids(cfg, threads):
+    """The grid kernel with L = 1, 2, 4, 8 lanes side by side on the study's basin, full length
+    and early-stopped; outputs checked equal to L=1's."""
+    rows, data = [], {}
+    for name, grid, periods, early, reps in (
+            ("full length", cfg["grid_full"], cfg["periods_full"], False, cfg["reps_full"]),
+            ("early stop", cfg["grid_es"], 500, True, cfg["reps_es"])):
+        plan = an.plan_basin(**BASIN, grid=grid, periods=periods, early_stop=early)
+        args = (plan.tangent, plan.y0s, plan.pars, plan.ipar, plan.cpar, plan.n_pts,
+                plan.n_imp_pts, threads)
+        for L in LS:
+            kn.run_chunk_counted(*args[:1], plan.y0s[:4], plan.pars[:4], *args[3:], L)
+        t = H.side_by_side({L: (lambda L=L: kn.run_chunk_counted(*args, L)) for L in LS}, reps)
+        ref = t.result[1][0]
+        for L in LS:
+            out = t.result[L][0]
+            for k in ("res", "pts", "imp", "n_got", "n_imp_got"):
+                if not np.array_equal(ref[k], out[k], equal_nan=True):
+                    raise SystemExit(f"{name}, L={L}: {k} differs from L=1")
+        steps = float(np.sum(ref["res"][:, kn.R_T] / plan.pars[:, ig.P_H]))
+        n = plan.y0s.shape[0]
+        w1 = t.median(1)
+        for L in LS:
+            w = t.median(L)
+            c = t.result[L][1]
+            row = [name, f"{grid}x{grid}, {periods} periods", L, n / w, 1e9 * w / steps,
+                   w1 / w]
+            if c is None:
+                row += ["", "", "", ""]
+            else:
+                c = c.sum(axis=0).astype(float)
+                scalar_frac = c[1] / (c[0] + c[1])
+                # the cycle counter ticks at the TSC's rate: seconds per thread
+                scalar_s = c[4] / (H_TSC_HZ * threads)
+                row += [scalar_frac, c[3] / c[5], c[4] / c[5], w1 / scalar_s]
+            rows.append(row)
+        data[name] = dict(raw={str(k): v for k, v in t.wall.items()}, steps=steps, cells=n)
+        print(name, rows[-len(LS):], flush=True)
+    return rows, data
+
+
+#: The rate of the cycle counter (``rdtsc``: the nominal clock, here the one /proc/cpuinfo
+#: reports; set in main).
+H_TSC_HZ = math.nan
+
+
 def main(argv=None):
-    b = H.Bench(__doc__, argv)
-    cfg = QUICK if b.quick else FULL
-    numba.set_num_threads(1)
+    global H_TSC_HZ
+    b = H.Bench(__doc__, argv, options=_options)
+    cfg = dict(QUICK if b.quick else FULL)
+    if b.args.grid_full:
+        cfg["grid_full"] = b.args.grid_full
+    if b.args.periods_full:
+        cfg["periods_full"] = b.args.periods_full
+    threads = numba.get_num_threads()
     mhz = cpu_mhz()
+    H_TSC_HZ = mhz * 1e6
+    grid_rows, grid_data = grids(cfg, threads)
+    numba.set_num_threads(1)
     ns, raw = measure(cfg)
-    kinds = ("scalar", "lanes", "scalar + bookkeeping", "lanes + bookkeeping")
+    kinds = ("scalar", "lanes")
     rows = []
     for L in LS:
         rows.append([L] + [f"{ns[(k, L)]:.1f} / {ns[(k, L)] * mhz / 1e3:.0f}" for k in kinds])
@@ -243,12 +270,23 @@ def main(argv=None):
     md = ("#### Lanes: cycles per cell-step\n\n"
           f"One thread, the block's free-flight step at N={GRID_N} (hb=1, alpha=0.6, "
           f"omega=1.3), {cfg['steps']} cell-steps per case, medians of {cfg['reps']} "
-          f"interleaved runs; ns / cycles per cell-step at {mhz:.0f} MHz. End states equal "
-          "bit for bit to the scalar step's.\n\n"
+          f"interleaved runs; ns / cycles per cell-step at {mhz:.0f} MHz.\n\n"
           + H.md_table(["L"] + [f"{k} (ns / cycles)" for k in kinds], rows)
           + f"\n\nArithmetic bound: {FLOPS_PER_STEP} multiplies and FMAs per step at "
           f"{FP_PER_CYCLE} per cycle: {bound_scalar:.0f} cycles scalar, {bound_vec:.0f} at "
-          f"{VECTOR} doubles per vector.\n\n" + H.env_line(b.env) + "\n")
+          f"{VECTOR} doubles per vector.\n\n"
+          f"#### Lanes in the grid kernel\n\n"
+          f"The study's hb=1 Housner basin (alpha=0.66, omega=1.3, N={GRID_N}), "
+          f"{threads} threads, medians of interleaved runs; outputs equal to L=1's bit for "
+          "bit. Scalar steps: the steps the single-lane code takes (events, rest phases); "
+          "time shares from the lanes' cycle counters; bound: the speed-up left if the "
+          "scalar steps keep their cost (L=1 wall over their time).\n\n"
+          + H.md_table(["basin", "grid", "L", "cells / s", "wall ns / cell-step",
+                        "speed-up vs L=1", "scalar steps", "time in vector steps",
+                        "time in scalar steps", "bound"],
+                       [[r[0], r[1], r[2], H.fmt(r[3]), H.fmt(r[4]), H.fmt(r[5])]
+                        + [H.fmt(x) if x != "" else "" for x in r[6:]] for r in grid_rows])
+          + "\n\n" + H.env_line(b.env) + "\n")
     plt = H.pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))
     for k in kinds:
@@ -264,7 +302,8 @@ def main(argv=None):
     ax.set_title("free-flight step, one thread")
     b.report("lanes", markdown=md, data=dict(ns_per_cell_step={f"{k}|{L}": ns[(k, L)]
                                                                for (k, L) in ns},
-                                             mhz=mhz, raw=raw, cfg=cfg),
+                                             mhz=mhz, raw=raw, cfg=cfg, grid_rows=grid_rows,
+                                             grids=grid_data, threads=threads),
              figures=[("lanes.png", fig, 120)])
 
 

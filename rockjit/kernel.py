@@ -33,8 +33,8 @@ from .model import initial_side
 from .result import OVERTURN, REST, UNRESOLVED, Result
 from .validate import integer
 
-__all__ = ["IMPACT_RECORD", "N_RES", "grid_bytes", "outputs", "pack", "run_bytes", "run_chunk",
-           "run_grid", "run_single", "settings"]
+__all__ = ["IMPACT_RECORD", "LANES_MAX", "N_RES", "grid_bytes", "outputs", "pack", "run_bytes",
+           "run_chunk", "run_chunk_counted", "run_grid", "run_single", "settings"]
 
 #: Rows of the impact record of a single run: beyond this many impacts only the latest are kept
 #: (``Result.n_impacts`` counts all of them).
@@ -355,17 +355,49 @@ def _grid_outputs(n, n_pts, n_imp_pts):
                 n_got=np.zeros(n, dtype=np.int64), n_imp_got=np.zeros(n, dtype=np.int64))
 
 
-def run_chunk(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=None):
+def run_chunk(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=None, lanes=1):
     """Run the grid kernel on one chunk of cells; returns its outputs by name.
 
     The unit of work of :func:`rockjit.chunks.run_chunks`, in this process or on a Dask worker.
+    ``lanes > 1`` runs that many cells per thread in lockstep (:mod:`rockjit.lanes`; without
+    tangent vectors only, the same outputs bit for bit).
     """
+    return run_chunk_counted(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads,
+                             lanes)[0]
+
+
+def run_chunk_counted(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=None,
+                      lanes=1):
+    """:func:`run_chunk`, and the lanes' counts per block of cells (``None`` without lanes):
+    fast and scalar steps, vector steps, cycles in vector steps, in scalar steps, in all
+    (:func:`rockjit.lanes.run_lanes`)."""
+    lanes = integer("lanes", lanes, 1, LANES_MAX)
+    y0s = np.ascontiguousarray(y0s)
+    pars = np.ascontiguousarray(pars)
     out = _grid_outputs(y0s.shape[0], n_pts, n_imp_pts)
+    counts = None
     with _threads(threads):
-        _kernel(tangent)(np.ascontiguousarray(y0s), np.ascontiguousarray(pars), ipar, cpar,
-                         n_pts, n_imp_pts, out["res"], out["pts"], out["imp"], out["n_got"],
-                         out["n_imp_got"])
-    return out
+        if lanes > 1 and not tangent:
+            from . import lanes as ln
+            n = y0s.shape[0]
+            block = lane_block(n, numba.get_num_threads())
+            counts = np.zeros(((n + block - 1) // block, 6), dtype=np.int64)
+            ln.grid_lanes(lanes, block, y0s, pars, ipar, cpar, n_pts, n_imp_pts, out["res"],
+                          out["pts"], out["imp"], out["n_got"], out["n_imp_got"], counts)
+        else:
+            _kernel(tangent)(y0s, pars, ipar, cpar, n_pts, n_imp_pts, out["res"], out["pts"],
+                             out["imp"], out["n_got"], out["n_imp_got"])
+    return out, counts
+
+
+#: Cells per thread in lockstep at most (:data:`rockjit.lanes.W`, the vector's width).
+LANES_MAX = 8
+
+
+def lane_block(n, threads):
+    """Cells per block of lanes (one task of the parallel loop): 256, or fewer so that every
+    thread gets four blocks. Results do not depend on it."""
+    return max(1, min(256, -(-n // (4 * max(1, threads)))))
 
 
 def default_chunk(n):
@@ -374,12 +406,12 @@ def default_chunk(n):
 
 
 def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, threads, progress, label,
-             chunk=None, client=None, store=None, message=None):
+             chunk=None, client=None, store=None, message=None, lanes=1):
     """All cells through :func:`run_chunk`, chunk by chunk (progress between chunks).
 
     Returns the outputs by name: ``res`` (rows in the ``R_*`` layout), ``pts``, ``imp``,
     ``n_got``, ``n_imp_got``. ``message(text)`` hears what the chunk store has to say (default
-    a line on stderr).
+    a line on stderr). ``lanes``: cells per thread in lockstep (:func:`run_chunk`).
     """
     n = y0s.shape[0]
     chunk = default_chunk(n) if chunk is None else chunk
@@ -390,7 +422,7 @@ def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, threads, progr
                                  dict(tangent=bool(tangent), n_pts=n_pts, n_imp_pts=n_imp_pts))
         cs = chunks.ChunkStore(store, key, n, chunk, message=message)
     chunks.run_chunks(run_chunk, (bool(tangent), y0s, pars, ipar, cpar, n_pts, n_imp_pts,
-                                  threads), n, chunk, outputs_, client=client, store=cs,
+                                  threads, lanes), n, chunk, outputs_, client=client, store=cs,
                       progress=progress, label=label)
     return outputs_
 
