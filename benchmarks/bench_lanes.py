@@ -37,6 +37,7 @@ import numba
 import numpy as np
 
 import _common as H
+from bench_throughput import cpu_mhz
 
 import rockjit
 from rockjit import integrate as ig
@@ -70,17 +71,6 @@ def _options(p):
                    help="cells per side of the full-length basin (default 100)")
     p.add_argument("--periods-full", type=int, default=None,
                    help="periods of the full-length basin (default 500)")
-
-
-def cpu_mhz():
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("cpu MHz"):
-                    return float(line.split(":")[1])
-    except OSError:
-        pass
-    return math.nan
 
 
 def kernels():

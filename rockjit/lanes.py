@@ -224,12 +224,14 @@ N_FS = 3
 
 
 @jit(nrt=False)
-def scalar_step(TANGENT, st, fs, par, ipar, out, w):
+def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre):
     """One grid step of a lane on the scalar path: the body of the loop of
     :func:`rockjit.integrate._loop` (closed-form forcing, no trajectory), its variables kept in
     ``st`` and ``fs``. Used for every step the lanes' fast path does not take (an event, a rest
     phase, a stage out of the polynomial's range), so that each lane runs exactly the
-    single-lane code there."""
+    single-lane code there. ``pre``: the grid step's first Runge–Kutta step is in ``w``
+    already (``K[1:]``, ``ynew``, ``trig[2:4]``: the vector step's, which equals it when it
+    stayed in range), so it is not taken again."""
     EMBED4 = False
     RECORD = False
     NS = 2
@@ -270,8 +272,10 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w):
                 continue
         if fresh:
             hh = h
-            ig.rk_step(EMBED4, TANGENT, not EMBED4, 0.0, 0.0, y, K, side, par, w.ytmp, w.ynew,
-                       w.tab_h, w.fr if EMBED4 else w.ftab[j_per], w.jac, w.trig)
+            if not pre:
+                ig.rk_step(EMBED4, TANGENT, not EMBED4, 0.0, 0.0, y, K, side, par, w.ytmp,
+                           w.ynew, w.tab_h, w.fr if EMBED4 else w.ftab[j_per], w.jac, w.trig)
+            pre = False
         else:
             hh = t_grid - t
             psi = par[ig.P_OMEGA] * t + par[ig.P_PHI]
@@ -487,6 +491,21 @@ def _sync(l, b):
     b.trig[l, 1] = b.lin[I_C * W + l]
 
 
+@jit(nrt=False, inline=True)
+def _stages(l, b):
+    """The vector step's stages and end into the lane's work arrays, as
+    :func:`rockjit.integrate.rk_step` would leave them (no tangent)."""
+    K = b.K[l]
+    for i in range(1, ig.N_STAGES + 1):
+        K[i, 0] = b.lout[(O_KV + i) * W + l]
+        K[i, 1] = b.lout[(O_KA + i) * W + l]
+    s = b.states[l]
+    s[2, 0] = b.lout[O_X * W + l]  # ynew
+    s[2, 1] = b.lout[O_V * W + l]
+    b.trig[l, 2] = b.lout[O_S * W + l]
+    b.trig[l, 3] = b.lout[O_C * W + l]
+
+
 @jit(nrt=False)
 def _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b):
     """Lane ``l``'s run has ended: its outputs (:func:`rockjit.integrate._loop`'s end), its
@@ -595,8 +614,11 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
                 counts[1] += 1
                 c0 = cycles()
                 _sync(l, b)
+                pre = st[S_SIDE] != 0 and lout[O_FAR * W + l] <= 1.0
+                if pre:
+                    _stages(l, b)
                 scalar_step(False, st, b.fs[l], b.par[l], ipar, lane_outputs(b, l),
-                            lane_work(b, l))
+                            lane_work(b, l), pre)
                 _refresh(l, b)
                 counts[4] += cycles() - c0
             if st[S_STATUS] != ig.RUNNING or st[S_STEP] >= total:
