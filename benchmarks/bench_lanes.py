@@ -194,7 +194,7 @@ def measure(cfg):
 def grids(cfg, threads):
     """The grid kernel with L = 1, 2, 4, 8 lanes side by side on the study's basin, full length
     and early-stopped; outputs checked equal to L=1's."""
-    rows, data = [], {}
+    rows, data, parts = [], {}, {}
     for name, grid, periods, early, reps in (
             ("full length", cfg["grid_full"], cfg["periods_full"], False, cfg["reps_full"]),
             ("early stop", cfg["grid_es"], 500, True, cfg["reps_es"])):
@@ -226,10 +226,13 @@ def grids(cfg, threads):
                 # the cycle counter ticks at the TSC's rate: seconds per thread
                 scalar_s = c[4] / (H_TSC_HZ * threads)
                 row += [scalar_frac, c[3] / c[5], c[4] / c[5], w1 / scalar_s]
+                parts[(name, L)] = dict(zip(("rest", "after event", "locate", "impact"),
+                                            (c[6:10] / c[4]).tolist()))
             rows.append(row)
-        data[name] = dict(raw={str(k): v for k, v in t.wall.items()}, steps=steps, cells=n)
-        print(name, rows[-len(LS):], flush=True)
-    return rows, data
+        data[name] = dict(raw={str(k): v for k, v in t.wall.items()}, steps=steps, cells=n,
+                          scalar_parts={str(L): parts.get((name, L)) for L in LS})
+        print(name, rows[-len(LS):], parts.get((name, 8)), flush=True)
+    return rows, data, parts
 
 
 #: The rate of the cycle counter (``rdtsc``: the nominal clock, here the one /proc/cpuinfo
@@ -248,7 +251,7 @@ def main(argv=None):
     threads = numba.get_num_threads()
     mhz = cpu_mhz()
     H_TSC_HZ = mhz * 1e6
-    grid_rows, grid_data = grids(cfg, threads)
+    grid_rows, grid_data, parts = grids(cfg, threads)
     numba.set_num_threads(1)
     ns, raw = measure(cfg)
     kinds = ("scalar", "lanes")
@@ -260,7 +263,8 @@ def main(argv=None):
     md = ("#### Lanes: cycles per cell-step\n\n"
           f"One thread, the block's free-flight step at N={GRID_N} (hb=1, alpha=0.6, "
           f"omega=1.3), {cfg['steps']} cell-steps per case, medians of {cfg['reps']} "
-          f"interleaved runs; ns / cycles per cell-step at {mhz:.0f} MHz.\n\n"
+          f"interleaved runs; ns / cycles per cell-step at {mhz:.0f} MHz, the nominal clock "
+          "(a core that runs faster spends more cycles than these).\n\n"
           + H.md_table(["L"] + [f"{k} (ns / cycles)" for k in kinds], rows)
           + f"\n\nArithmetic bound: {FLOPS_PER_STEP} multiplies and FMAs per step at "
           f"{FP_PER_CYCLE} per cycle: {bound_scalar:.0f} cycles scalar, {bound_vec:.0f} at "
@@ -276,7 +280,11 @@ def main(argv=None):
                         "time in scalar steps", "bound"],
                        [[r[0], r[1], r[2], H.fmt(r[3]), H.fmt(r[4]), H.fmt(r[5])]
                         + [H.fmt(x) if x != "" else "" for x in r[6:]] for r in grid_rows])
-          + "\n\n" + H.env_line(b.env) + "\n")
+          + "\n\nWhere the scalar steps' time goes (L=8, share of their cycles): "
+          + "; ".join(f"{name}: " + ", ".join(f"{k} {v:.2f}" for k, v in p.items())
+                      for (name, L), p in parts.items() if L == 8)
+          + " (the rest: the grid step's first Runge-Kutta step, detection, bookkeeping).\n\n"
+          + H.env_line(b.env) + "\n")
     plt = H.pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))
     for k in kinds:
@@ -287,7 +295,7 @@ def main(argv=None):
     ax.set_xticks(LS, [str(L) for L in LS])
     ax.set_ylim(bottom=0)
     ax.set_xlabel("lanes L (cells per thread in lockstep)")
-    ax.set_ylabel("cycles per cell-step")
+    ax.set_ylabel(f"cycles per cell-step (at the nominal {mhz:.0f} MHz)")
     ax.legend(fontsize=8)
     ax.set_title("free-flight step, one thread")
     b.report("lanes", markdown=md, data=dict(ns_per_cell_step={f"{k}|{L}": ns[(k, L)]

@@ -368,9 +368,8 @@ def run_chunk(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=None, la
 
 def run_chunk_counted(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=None,
                       lanes=1):
-    """:func:`run_chunk`, and the lanes' counts per block of cells (``None`` without lanes):
-    fast and scalar steps, vector steps, cycles in vector steps, in scalar steps, in all
-    (:func:`rockjit.lanes.run_lanes`)."""
+    """:func:`run_chunk`, and the lanes' counts per block of cells (``None`` without lanes;
+    columns as :data:`N_LANE_COUNTS` says)."""
     lanes = integer("lanes", lanes, 1, LANES_MAX)
     y0s = np.ascontiguousarray(y0s)
     pars = np.ascontiguousarray(pars)
@@ -381,7 +380,7 @@ def run_chunk_counted(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=
             from . import lanes as ln
             n = y0s.shape[0]
             block = lane_block(n, numba.get_num_threads())
-            counts = np.zeros(((n + block - 1) // block, 6), dtype=np.int64)
+            counts = np.zeros(((n + block - 1) // block, N_LANE_COUNTS), dtype=np.int64)
             ln.grid_lanes(lanes, block, y0s, pars, ipar, cpar, n_pts, n_imp_pts, out["res"],
                           out["pts"], out["imp"], out["n_got"], out["n_imp_got"], counts)
         else:
@@ -389,6 +388,11 @@ def run_chunk_counted(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=
                              out["imp"], out["n_got"], out["n_imp_got"])
     return out, counts
 
+
+#: The lanes' counters per block (:func:`rockjit.lanes.run_lanes`): fast steps, scalar steps,
+#: vector steps; cycles in vector steps, in scalar steps, in all; cycles in rest phases, in the
+#: steps after events, in locating events, in impacts.
+N_LANE_COUNTS = 10
 
 #: Cells per thread in lockstep at most (:data:`rockjit.lanes.W`, the vector's width).
 LANES_MAX = 8

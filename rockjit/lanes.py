@@ -224,14 +224,17 @@ N_FS = 3
 
 
 @jit(nrt=False)
-def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre):
+def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, counts):
     """One grid step of a lane on the scalar path: the body of the loop of
     :func:`rockjit.integrate._loop` (closed-form forcing, no trajectory), its variables kept in
     ``st`` and ``fs``. Used for every step the lanes' fast path does not take (an event, a rest
     phase, a stage out of the polynomial's range), so that each lane runs exactly the
     single-lane code there. ``pre``: the grid step's first Runge–Kutta step is in ``w``
     already (``K[1:]``, ``ynew``, ``trig[2:4]``: the vector step's, which equals it when it
-    stayed in range), so it is not taken again."""
+    stayed in range), so it is not taken again. ``counts[6:10]`` receive the cycles spent in
+    rest phases (:func:`rockjit.integrate.leave_rest`), in the steps after an event (from the
+    event to the grid point), in locating events (:func:`rockjit.integrate.locate`) and in
+    impacts (:func:`rockjit.integrate.impact`)."""
     EMBED4 = False
     RECORD = False
     NS = 2
@@ -260,7 +263,9 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre):
     hold = False
     while True:
         if side == 0:
+            c0 = cycles()
             action, t, side = ig.leave_rest(EMBED4, t, t_grid, hold, y, side, par, w, out.iout)
+            counts[6] += cycles() - c0
             if action == ig.REST_END:
                 status = ig.REST
                 break
@@ -277,11 +282,13 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre):
                            w.ynew, w.tab_h, w.fr if EMBED4 else w.ftab[j_per], w.jac, w.trig)
             pre = False
         else:
+            c0 = cycles()
             hh = t_grid - t
             psi = par[ig.P_OMEGA] * t + par[ig.P_PHI]
             ig.step_table(par[ig.P_OMEGA], hh, w.tab)
             ig.rk_step(EMBED4, TANGENT, False, math.sin(psi), math.cos(psi), y, K, side, par,
                        w.ytmp, w.ynew, w.tab, w.fr, w.jac, w.trig)
+            counts[7] += cycles() - c0
         out.iout[ig.O_RHS] += ig.N_STAGES
         out.iout[ig.O_SUBSTEPS] += 1
         kind, lo, hi = ig.detect(y, w.ynew, hh, K, side, par)
@@ -292,8 +299,10 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre):
             t = t_grid
             break
         if hi > lo:
+            c0 = cycles()
             tau = ig.locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, w.ytmp,
                             w.yev, out.iout, w.tab, w.fr, w.jac, w.trig)
+            counts[8] += cycles() - c0
         else:
             tau = 0.0
             for m in range(NY):
@@ -320,8 +329,10 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre):
             ig.rhs(EMBED4, ig.forcing_at(t, par), y, side, par, K, w.jac, w.trig)
             out.iout[ig.O_RHS] += 1
             continue
+        c0 = cycles()
         side, n_imp, rests, held = ig.impact(EMBED4, TANGENT, t, t_lift, side, n_imp,
                                              in_window, par, out, w)
+        counts[9] += cycles() - c0
         if rests:
             hold = hold or held
             if TANGENT:
@@ -543,7 +554,7 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
     bit those of :func:`rockjit.kernel._grid` (the running error estimate ``max_err`` is not
     kept on the fast path: no grid output reads it). ``counts``: the fast and the scalar steps,
     the vector steps taken, and the cycles (``readcyclecounter``) spent in the vector steps, in
-    the scalar steps, and in all.
+    the scalar steps, and in all; then the parts of the scalar steps (:func:`scalar_step`).
     """
     c_start = cycles()
     n_per = ipar[ig.I_N]
@@ -618,7 +629,7 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
                 if pre:
                     _stages(l, b)
                 scalar_step(False, st, b.fs[l], b.par[l], ipar, lane_outputs(b, l),
-                            lane_work(b, l), pre)
+                            lane_work(b, l), pre, counts)
                 _refresh(l, b)
                 counts[4] += cycles() - c0
             if st[S_STATUS] != ig.RUNNING or st[S_STEP] >= total:
