@@ -226,8 +226,9 @@ def grids(cfg, threads):
                 # the cycle counter ticks at the TSC's rate: seconds per thread
                 scalar_s = c[4] / (H_TSC_HZ * threads)
                 row += [scalar_frac, c[3] / c[5], c[4] / c[5], w1 / scalar_s]
-                parts[(name, L)] = dict(zip(("rest", "after event", "locate", "impact"),
-                                            (c[6:10] / c[4]).tolist()))
+                parts[(name, L)] = dict(zip(("rest", "after event", "locate", "impact",
+                                             "detect", "first step again", "grid point"),
+                                            (c[6:13] / c[4]).tolist()))
             rows.append(row)
         data[name] = dict(raw={str(k): v for k, v in t.wall.items()}, steps=steps, cells=n,
                           scalar_parts={str(L): parts.get((name, L)) for L in LS})
@@ -283,7 +284,7 @@ def main(argv=None):
           + "\n\nWhere the scalar steps' time goes (L=8, share of their cycles): "
           + "; ".join(f"{name}: " + ", ".join(f"{k} {v:.2f}" for k, v in p.items())
                       for (name, L), p in parts.items() if L == 8)
-          + " (the rest: the grid step's first Runge-Kutta step, detection, bookkeeping).\n\n"
+          + " (the rest: the lanes' bookkeeping and the cycle counter's own reads).\n\n"
           + H.env_line(b.env) + "\n")
     plt = H.pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))

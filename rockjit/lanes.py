@@ -231,10 +231,13 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, counts):
     phase, a stage out of the polynomial's range), so that each lane runs exactly the
     single-lane code there. ``pre``: the grid step's first Runge–Kutta step is in ``w``
     already (``K[1:]``, ``ynew``, ``trig[2:4]``: the vector step's, which equals it when it
-    stayed in range), so it is not taken again. ``counts[6:10]`` receive the cycles spent in
+    stayed in range), so it is not taken again. ``counts[6:13]`` receive the cycles spent in
     rest phases (:func:`rockjit.integrate.leave_rest`), in the steps after an event (from the
-    event to the grid point), in locating events (:func:`rockjit.integrate.locate`) and in
-    impacts (:func:`rockjit.integrate.impact`)."""
+    event to the grid point), in locating events (:func:`rockjit.integrate.locate`), in
+    impacts (:func:`rockjit.integrate.impact`), in detection (:func:`rockjit.integrate.detect`),
+    in the grid step's first Runge–Kutta step where it was taken again (the vector step's left
+    the polynomials' range, or the block was at rest) and at the grid point
+    (:func:`rockjit.integrate.grid_point`)."""
     EMBED4 = False
     RECORD = False
     NS = 2
@@ -278,8 +281,10 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, counts):
         if fresh:
             hh = h
             if not pre:
+                c0 = cycles()
                 ig.rk_step(EMBED4, TANGENT, not EMBED4, 0.0, 0.0, y, K, side, par, w.ytmp,
                            w.ynew, w.tab_h, w.fr if EMBED4 else w.ftab[j_per], w.jac, w.trig)
+                counts[11] += cycles() - c0
             pre = False
         else:
             c0 = cycles()
@@ -291,7 +296,9 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, counts):
             counts[7] += cycles() - c0
         out.iout[ig.O_RHS] += ig.N_STAGES
         out.iout[ig.O_SUBSTEPS] += 1
+        c0 = cycles()
         kind, lo, hi = ig.detect(y, w.ynew, hh, K, side, par)
+        counts[10] += cycles() - c0
         if hold and kind == ig.EV_UPLIFT:
             kind = ig.EV_NONE
         if kind == ig.EV_NONE:
@@ -348,9 +355,11 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, counts):
         if not (math.isfinite(y[0]) and math.isfinite(y[1])):
             status = ig.NONFINITE
         else:
+            c0 = cycles()
             status, j_per, k_per, j_qr, j_rec, collapsed = ig.grid_point(
                 EMBED4, TANGENT, RECORD, t, step, side, n_imp, n_col, in_window, ipar, par,
                 out, w, j_per, k_per, j_qr, j_rec)
+            counts[12] += cycles() - c0
             if collapsed:
                 n_col += 1
                 if in_window:
