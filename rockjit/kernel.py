@@ -367,9 +367,10 @@ def run_chunk(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=None, la
 
 
 def run_chunk_counted(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=None,
-                      lanes=1):
+                      lanes=1, profile=False):
     """:func:`run_chunk`, and the lanes' counts per block of cells (``None`` without lanes;
-    columns as :data:`N_LANE_COUNTS` says)."""
+    columns as :data:`N_LANE_COUNTS` says; the cycle counts only with ``profile``, which
+    costs time)."""
     lanes = integer("lanes", lanes, 1, LANES_MAX)
     y0s = np.ascontiguousarray(y0s)
     pars = np.ascontiguousarray(pars)
@@ -382,7 +383,8 @@ def run_chunk_counted(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=
             block = lane_block(n, numba.get_num_threads())
             counts = np.zeros(((n + block - 1) // block, N_LANE_COUNTS), dtype=np.int64)
             ln.grid_lanes(lanes, block, y0s, pars, ipar, cpar, n_pts, n_imp_pts, out["res"],
-                          out["pts"], out["imp"], out["n_got"], out["n_imp_got"], counts)
+                          out["pts"], out["imp"], out["n_got"], out["n_imp_got"], bool(profile),
+                          counts)
         else:
             _kernel(tangent)(y0s, pars, ipar, cpar, n_pts, n_imp_pts, out["res"], out["pts"],
                              out["imp"], out["n_got"], out["n_imp_got"])

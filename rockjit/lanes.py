@@ -224,14 +224,14 @@ N_FS = 3
 
 
 @jit(nrt=False)
-def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, counts):
+def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, prof, counts):
     """One grid step of a lane on the scalar path: the body of the loop of
     :func:`rockjit.integrate._loop` (closed-form forcing, no trajectory), its variables kept in
     ``st`` and ``fs``. Used for every step the lanes' fast path does not take (an event, a rest
     phase, a stage out of the polynomial's range), so that each lane runs exactly the
     single-lane code there. ``pre``: the grid step's first Runge–Kutta step is in ``w``
     already (``K[1:]``, ``ynew``, ``trig[2:4]``: the vector step's, which equals it when it
-    stayed in range), so it is not taken again. ``counts[6:13]`` receive the cycles spent in
+    stayed in range), so it is not taken again. With ``prof``, ``counts[6:13]`` receive the cycles spent in
     rest phases (:func:`rockjit.integrate.leave_rest`), in the steps after an event (from the
     event to the grid point), in locating events (:func:`rockjit.integrate.locate`), in
     impacts (:func:`rockjit.integrate.impact`), in detection (:func:`rockjit.integrate.detect`),
@@ -266,9 +266,9 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, counts):
     hold = False
     while True:
         if side == 0:
-            c0 = cycles()
+            c0 = cycles() if prof else 0
             action, t, side = ig.leave_rest(EMBED4, t, t_grid, hold, y, side, par, w, out.iout)
-            counts[6] += cycles() - c0
+            counts[6] += (cycles() - c0) if prof else 0
             if action == ig.REST_END:
                 status = ig.REST
                 break
@@ -281,24 +281,24 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, counts):
         if fresh:
             hh = h
             if not pre:
-                c0 = cycles()
+                c0 = cycles() if prof else 0
                 ig.rk_step(EMBED4, TANGENT, not EMBED4, 0.0, 0.0, y, K, side, par, w.ytmp,
                            w.ynew, w.tab_h, w.fr if EMBED4 else w.ftab[j_per], w.jac, w.trig)
-                counts[11] += cycles() - c0
+                counts[11] += (cycles() - c0) if prof else 0
             pre = False
         else:
-            c0 = cycles()
+            c0 = cycles() if prof else 0
             hh = t_grid - t
             psi = par[ig.P_OMEGA] * t + par[ig.P_PHI]
             ig.step_table(par[ig.P_OMEGA], hh, w.tab)
             ig.rk_step(EMBED4, TANGENT, False, math.sin(psi), math.cos(psi), y, K, side, par,
                        w.ytmp, w.ynew, w.tab, w.fr, w.jac, w.trig)
-            counts[7] += cycles() - c0
+            counts[7] += (cycles() - c0) if prof else 0
         out.iout[ig.O_RHS] += ig.N_STAGES
         out.iout[ig.O_SUBSTEPS] += 1
-        c0 = cycles()
+        c0 = cycles() if prof else 0
         kind, lo, hi = ig.detect(y, w.ynew, hh, K, side, par)
-        counts[10] += cycles() - c0
+        counts[10] += (cycles() - c0) if prof else 0
         if hold and kind == ig.EV_UPLIFT:
             kind = ig.EV_NONE
         if kind == ig.EV_NONE:
@@ -306,10 +306,10 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, counts):
             t = t_grid
             break
         if hi > lo:
-            c0 = cycles()
+            c0 = cycles() if prof else 0
             tau = ig.locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, w.ytmp,
                             w.yev, out.iout, w.tab, w.fr, w.jac, w.trig)
-            counts[8] += cycles() - c0
+            counts[8] += (cycles() - c0) if prof else 0
         else:
             tau = 0.0
             for m in range(NY):
@@ -336,10 +336,10 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, counts):
             ig.rhs(EMBED4, ig.forcing_at(t, par), y, side, par, K, w.jac, w.trig)
             out.iout[ig.O_RHS] += 1
             continue
-        c0 = cycles()
+        c0 = cycles() if prof else 0
         side, n_imp, rests, held = ig.impact(EMBED4, TANGENT, t, t_lift, side, n_imp,
                                              in_window, par, out, w)
-        counts[9] += cycles() - c0
+        counts[9] += (cycles() - c0) if prof else 0
         if rests:
             hold = hold or held
             if TANGENT:
@@ -355,11 +355,11 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, counts):
         if not (math.isfinite(y[0]) and math.isfinite(y[1])):
             status = ig.NONFINITE
         else:
-            c0 = cycles()
+            c0 = cycles() if prof else 0
             status, j_per, k_per, j_qr, j_rec, collapsed = ig.grid_point(
                 EMBED4, TANGENT, RECORD, t, step, side, n_imp, n_col, in_window, ipar, par,
                 out, w, j_per, k_per, j_qr, j_rec)
-            counts[12] += cycles() - c0
+            counts[12] += (cycles() - c0) if prof else 0
             if collapsed:
                 n_col += 1
                 if in_window:
@@ -550,7 +550,7 @@ def _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b
 
 @jit(nrt=False)
 def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts,
-              n_got, n_imp_got, b, counts):
+              n_got, n_imp_got, b, prof, counts):
     """Cells ``i0 .. i1 - 1`` through ``n_lanes <= W`` lanes (no tangent vectors), a freed
     lane refilled from the next pending cell at the next period's start (all lanes then step
     through the period together: one forcing row for all); outputs as
@@ -562,10 +562,12 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
     code. A lane's arithmetic is the single-lane kernel's either way, so its results are bit for
     bit those of :func:`rockjit.kernel._grid` (the running error estimate ``max_err`` is not
     kept on the fast path: no grid output reads it). ``counts``: the fast and the scalar steps,
-    the vector steps taken, and the cycles (``readcyclecounter``) spent in the vector steps, in
-    the scalar steps, and in all; then the parts of the scalar steps (:func:`scalar_step`).
+    the vector steps taken, and with ``prof`` the cycles (``readcyclecounter``) spent in the
+    vector steps, in the scalar steps, and in all, then the parts of the scalar steps
+    (:func:`scalar_step`); without, the cycle counter is not read (its reads cost ~10 % of a
+    basin's time).
     """
-    c_start = cycles()
+    c_start = cycles() if prof else 0
     n_per = ipar[ig.I_N]
     total = n_per * ipar[ig.I_PERIODS]
     half = n_per // 2
@@ -593,12 +595,12 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
                 break
             j = 0  # no lane busy: the next cells start now
             continue
-        c0 = cycles()
+        c0 = cycles() if prof else 0
         # all W lanes, one vector, whatever n_lanes; the count is read from an array's shape
         # so that LLVM does not know it: a known count of 8 unrolls the loop fully, and the
         # unrolled code is not vectorised
         block_step_lanes(b.st.shape[0], j, lin, lout, ftl)
-        c1 = cycles()
+        c1 = cycles() if prof else 0
         counts[2] += 1
         counts[3] += c1 - c0
         for l in range(n_lanes):
@@ -632,22 +634,23 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
                     st[S_JREC] = j_rec
             else:
                 counts[1] += 1
-                c0 = cycles()
+                c0 = cycles() if prof else 0
                 _sync(l, b)
                 pre = st[S_SIDE] != 0 and lout[O_FAR * W + l] <= 1.0
                 if pre:
                     _stages(l, b)
                 scalar_step(False, st, b.fs[l], b.par[l], ipar, lane_outputs(b, l),
-                            lane_work(b, l), pre, counts)
+                            lane_work(b, l), pre, prof, counts)
                 _refresh(l, b)
-                counts[4] += cycles() - c0
+                counts[4] += (cycles() - c0) if prof else 0
             if st[S_STATUS] != ig.RUNNING or st[S_STEP] >= total:
                 _sync(l, b)
                 _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b)
         j += 1
         if j == n_per:
             j = 0
-    counts[5] += cycles() - c_start
+    if prof:
+        counts[5] += cycles() - c_start
 
 
 #: Cells per block of lanes: a block is one task of the parallel loop, its cells run through
@@ -657,14 +660,14 @@ BLOCK = 256
 
 @jit(parallel=True)
 def grid_lanes(n_lanes, block, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts,
-               n_got, n_imp_got, counts):
+               n_got, n_imp_got, prof, counts):
     """:func:`rockjit.kernel._grid` without tangent vectors, ``n_lanes`` cells at a time per
     thread: blocks of ``block`` cells, each through :func:`run_lanes` on fresh arrays. A cell's
     results do not depend on its block, lane or thread. ``counts[g]`` receives block ``g``'s
-    step counts (:func:`run_lanes`)."""
+    step counts, and with ``prof`` its cycle counts (:func:`run_lanes`)."""
     n = y0s.shape[0]
     nb = (n + block - 1) // block
     for g in prange(nb):
         b = _bank(ipar[ig.I_PERIODS], ipar[ig.I_N], max(n_imp_pts, 1))
         run_lanes(n_lanes, g * block, min(n, (g + 1) * block), y0s, pars, ipar, cpar, n_pts,
-                  n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b, counts[g])
+                  n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b, prof, counts[g])
