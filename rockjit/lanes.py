@@ -140,39 +140,42 @@ def block_step_lanes(n, j, lin, lout, ftl):
         st = lin[(I_STHC) * W + l]
         ct = lin[(I_CTHC) * W + l]
         dmp = lin[(I_XI) * W + l]
-        d1 = lin[(I_TAB + L_C1) * W + l] * vl
-        v1 = fma(lin[(I_TAB + L_A10) * W + l], kl, vl)
+        tb = I_TAB * W + l  # the lane's step table: row r at tb + r W
+        d1 = lin[tb + L_C1 * W] * vl
+        v1 = fma(lin[tb + L_A10 * W], kl, vl)
         P, Q = corner(ftl[(j * 7 + 1) * W + l], side, st, ct)
         Pr, Qr = rotate(P, Q, sl, cl)
         k1 = accel_near(Pr, Qr, d1, v1, dmp)
-        d2 = fma(lin[(I_TAB + L_AA20) * W + l], kl, lin[(I_TAB + L_C2) * W + l] * vl)
-        v2 = fma(lin[(I_TAB + L_A21) * W + l], k1, fma(lin[(I_TAB + L_A20) * W + l], kl, vl))
+        d2 = fma(lin[tb + L_AA20 * W], kl, lin[tb + L_C2 * W] * vl)
+        v2 = fma(lin[tb + L_A21 * W], k1, fma(lin[tb + L_A20 * W], kl, vl))
         P, Q = corner(ftl[(j * 7 + 2) * W + l], side, st, ct)
         Pr, Qr = rotate(P, Q, sl, cl)
         k2 = accel_near(Pr, Qr, d2, v2, dmp)
-        d3 = fma(lin[(I_TAB + L_AA31) * W + l], k1, fma(lin[(I_TAB + L_AA30) * W + l], kl, lin[(I_TAB + L_C3) * W + l] * vl))
-        v3 = fma(lin[(I_TAB + L_A32) * W + l], k2, fma(lin[(I_TAB + L_A31) * W + l], k1, fma(lin[(I_TAB + L_A30) * W + l], kl, vl)))
+        d3 = fma(lin[tb + L_AA31 * W], k1, fma(lin[tb + L_AA30 * W], kl, lin[tb + L_C3 * W] * vl))
+        v3 = fma(lin[tb + L_A32 * W], k2,
+                 fma(lin[tb + L_A31 * W], k1, fma(lin[tb + L_A30 * W], kl, vl)))
         P, Q = corner(ftl[(j * 7 + 3) * W + l], side, st, ct)
         Pr, Qr = rotate(P, Q, sl, cl)
         k3 = accel_near(Pr, Qr, d3, v3, dmp)
-        d4 = fma(lin[(I_TAB + L_AA42) * W + l], k2, fma(lin[(I_TAB + L_AA41) * W + l], k1,
-                 fma(lin[(I_TAB + L_AA40) * W + l], kl, lin[(I_TAB + L_C4) * W + l] * vl)))
-        v4 = fma(lin[(I_TAB + L_A43) * W + l], k3, fma(lin[(I_TAB + L_A42) * W + l], k2, fma(lin[(I_TAB + L_A41) * W + l], k1,
-                 fma(lin[(I_TAB + L_A40) * W + l], kl, vl))))
+        d4 = fma(lin[tb + L_AA42 * W], k2, fma(lin[tb + L_AA41 * W], k1,
+                 fma(lin[tb + L_AA40 * W], kl, lin[tb + L_C4 * W] * vl)))
+        v4 = fma(lin[tb + L_A43 * W], k3, fma(lin[tb + L_A42 * W], k2, fma(lin[tb + L_A41 * W], k1,
+                 fma(lin[tb + L_A40 * W], kl, vl))))
         P, Q = corner(ftl[(j * 7 + 4) * W + l], side, st, ct)
         Pr, Qr = rotate(P, Q, sl, cl)
         k4 = accel_near(Pr, Qr, d4, v4, dmp)
-        d5 = fma(lin[(I_TAB + L_AA53) * W + l], k3, fma(lin[(I_TAB + L_AA52) * W + l], k2, fma(lin[(I_TAB + L_AA51) * W + l], k1,
-                 fma(lin[(I_TAB + L_AA50) * W + l], kl, lin[(I_TAB + L_C5) * W + l] * vl))))
-        v5 = fma(lin[(I_TAB + L_A54) * W + l], k4, fma(lin[(I_TAB + L_A53) * W + l], k3, fma(lin[(I_TAB + L_A52) * W + l], k2,
-                 fma(lin[(I_TAB + L_A51) * W + l], k1, fma(lin[(I_TAB + L_A50) * W + l], kl, vl)))))
+        d5 = fma(lin[tb + L_AA53 * W], k3,
+                 fma(lin[tb + L_AA52 * W], k2, fma(lin[tb + L_AA51 * W], k1,
+                 fma(lin[tb + L_AA50 * W], kl, lin[tb + L_C5 * W] * vl))))
+        v5 = fma(lin[tb + L_A54 * W], k4, fma(lin[tb + L_A53 * W], k3, fma(lin[tb + L_A52 * W], k2,
+                 fma(lin[tb + L_A51 * W], k1, fma(lin[tb + L_A50 * W], kl, vl)))))
         P, Q = corner(ftl[(j * 7 + 5) * W + l], side, st, ct)
         Pr, Qr = rotate(P, Q, sl, cl)
         k5 = accel_near(Pr, Qr, d5, v5, dmp)
-        d6 = fma(lin[(I_TAB + L_BA4) * W + l], k4, fma(lin[(I_TAB + L_BA3) * W + l], k3, fma(lin[(I_TAB + L_BA2) * W + l], k2,
-                 fma(lin[(I_TAB + L_BA0) * W + l], kl, lin[(I_TAB + L_C6) * W + l] * vl))))
-        v6 = fma(lin[(I_TAB + L_B5) * W + l], k5, fma(lin[(I_TAB + L_B4) * W + l], k4, fma(lin[(I_TAB + L_B3) * W + l], k3,
-                 fma(lin[(I_TAB + L_B2) * W + l], k2, fma(lin[(I_TAB + L_B0) * W + l], kl, vl)))))
+        d6 = fma(lin[tb + L_BA4 * W], k4, fma(lin[tb + L_BA3 * W], k3, fma(lin[tb + L_BA2 * W], k2,
+                 fma(lin[tb + L_BA0 * W], kl, lin[tb + L_C6 * W] * vl))))
+        v6 = fma(lin[tb + L_B5 * W], k5, fma(lin[tb + L_B4 * W], k4, fma(lin[tb + L_B3 * W], k3,
+                 fma(lin[tb + L_B2 * W], k2, fma(lin[tb + L_B0 * W], kl, vl)))))
         P, Q = corner(ftl[(j * 7 + 6) * W + l], side, st, ct)
         Pr, Qr = rotate(P, Q, sl, cl)
         k6 = accel_near(Pr, Qr, d6, v6, dmp)
@@ -231,10 +234,11 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, prof, counts):
     phase, a stage out of the polynomial's range), so that each lane runs exactly the
     single-lane code there. ``pre``: the grid step's first Runge–Kutta step is in ``w``
     already (``K[1:]``, ``ynew``, ``trig[2:4]``: the vector step's, which equals it when it
-    stayed in range), so it is not taken again. With ``prof``, ``counts[6:13]`` receive the cycles spent in
-    rest phases (:func:`rockjit.integrate.leave_rest`), in the steps after an event (from the
-    event to the grid point), in locating events (:func:`rockjit.integrate.locate`), in
-    impacts (:func:`rockjit.integrate.impact`), in detection (:func:`rockjit.integrate.detect`),
+    stayed in range), so it is not taken again. With ``prof``, ``counts[6:13]`` receive the
+    cycles spent in rest phases (:func:`rockjit.integrate.leave_rest`), in the steps after an
+    event (from the event to the grid point), in locating events
+    (:func:`rockjit.integrate.locate`), in impacts (:func:`rockjit.integrate.impact`), in
+    detection (:func:`rockjit.integrate.detect`),
     in the grid step's first Runge–Kutta step where it was taken again (the vector step's left
     the polynomials' range, or the block was at rest) and at the grid point
     (:func:`rockjit.integrate.grid_point`)."""
