@@ -80,6 +80,7 @@ class GridPlan:
     attractors: bool = False  # identify the attractors (rockjit.attractors)
     phi: float = 0.0          # the forcing phase (basins: of every cell)
     uncertainty: float | None = None  # flag the cells whose outcome moves with eps
+    lanes: int = 1            # cells per thread in lockstep (rockjit.lanes; same results)
 
 
 def _classification(tol, pmax, lam_tol, settle_tol, settle_reps):
@@ -350,7 +351,7 @@ def run(plan: GridPlan, *, progress=False, client=None, store=None, message=None
     out = kernel.run_grid(p.y0s, p.pars, p.ipar, p.cpar, tangent=p.tangent, n_pts=p.n_pts,
                           n_imp_pts=p.n_imp_pts, threads=p.threads, progress=progress,
                           label=p.kind, chunk=p.chunk, client=client, store=store,
-                          message=message)
+                          message=message, lanes=p.lanes)
     res = out["res"]
     label = res[:, kernel.R_LABEL].astype(np.int64).reshape(p.shape)
     period = res[:, kernel.R_PERIOD].astype(np.int64).reshape(p.shape)

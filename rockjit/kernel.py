@@ -33,8 +33,8 @@ from .model import initial_side
 from .result import OVERTURN, REST, UNRESOLVED, Result
 from .validate import integer
 
-__all__ = ["IMPACT_RECORD", "N_RES", "grid_bytes", "outputs", "pack", "run_bytes", "run_chunk",
-           "run_grid", "run_single", "settings"]
+__all__ = ["IMPACT_RECORD", "LANES_MAX", "N_RES", "grid_bytes", "outputs", "pack", "run_bytes",
+           "run_chunk", "run_chunk_counted", "run_grid", "run_single", "settings"]
 
 #: Rows of the impact record of a single run: beyond this many impacts only the latest are kept
 #: (``Result.n_impacts`` counts all of them).
@@ -214,6 +214,12 @@ def _impacts_in_order(ring, n_imp):
 def _cell(TANGENT, y0, side0, par, ipar, cpar, out, res):
     """Run one cell and classify it; scalar results go to ``res`` (layout ``R_*``)."""
     status = ig._run(False, TANGENT, False, y0, side0, par, ipar, out)
+    _classify(TANGENT, status, ipar, cpar, out, res)
+
+
+@jit(nrt=False)
+def _classify(TANGENT, status, ipar, cpar, out, res):
+    """Classify a cell's finished run (status code ``status``, outputs ``out``) into ``res``."""
     iout = out.iout
     k1 = iout[ig.O_NSTROBE] - 1
     if status == ig.SETTLED:
@@ -277,32 +283,40 @@ def _grid(TANGENT, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n
                          np.zeros(ig.N_IOUT, dtype=np.int64), np.zeros(ig.N_FOUT))
         y0 = y0s[i]
         _cell(TANGENT, y0, initial_side(y0[0], y0[1]), par, ipar, cpar, out, res[i])
-        k0 = int(res[i, R_K0])
-        k1 = int(res[i, R_K1])
-        st = int(res[i, R_STATUS])
-        bounded = st == ig.DONE or st == ig.SETTLED  # it ran to a classified stretch
-        if n_pts > 0:
-            m = 0
-            if bounded:
-                for k in range(max(k0, k1 - n_pts + 1), k1 + 1):
-                    pts[i, m, 0] = out.strobe[k, 0]
-                    pts[i, m, 1] = out.strobe[k, 1]
+        _collect(i, T, n_pts, n_imp_pts, out, res, pts, imp_pts, n_got, n_imp_got)
+
+
+@jit(nrt=False)
+def _collect(i, T, n_pts, n_imp_pts, out, res, pts, imp_pts, n_got, n_imp_got):
+    """Cell ``i``'s stroboscopic samples and impact section from its finished run ``out``
+    (classified into ``res[i]``; ``T`` the forcing period)."""
+    cap = out.impacts.shape[0]
+    k0 = int(res[i, R_K0])
+    k1 = int(res[i, R_K1])
+    st = int(res[i, R_STATUS])
+    bounded = st == ig.DONE or st == ig.SETTLED  # it ran to a classified stretch
+    if n_pts > 0:
+        m = 0
+        if bounded:
+            for k in range(max(k0, k1 - n_pts + 1), k1 + 1):
+                pts[i, m, 0] = out.strobe[k, 0]
+                pts[i, m, 1] = out.strobe[k, 1]
+                m += 1
+        n_got[i] = m
+    if n_imp_pts > 0:
+        m = 0
+        if bounded:
+            nimp = out.iout[ig.O_IMPACTS]
+            t_from = k0 * T
+            first = max(0, nimp - cap)
+            for q in range(first, nimp):
+                row = q % cap
+                if out.impacts[row, 0] >= t_from:
+                    tt = out.impacts[row, 0]
+                    imp_pts[i, m, 0] = tt - T * math.floor(tt / T)
+                    imp_pts[i, m, 1] = out.impacts[row, 1]
                     m += 1
-            n_got[i] = m
-        if n_imp_pts > 0:
-            m = 0
-            if bounded:
-                nimp = out.iout[ig.O_IMPACTS]
-                t_from = k0 * T
-                first = max(0, nimp - cap)
-                for q in range(first, nimp):
-                    row = q % cap
-                    if out.impacts[row, 0] >= t_from:
-                        tt = out.impacts[row, 0]
-                        imp_pts[i, m, 0] = tt - T * math.floor(tt / T)
-                        imp_pts[i, m, 1] = out.impacts[row, 1]
-                        m += 1
-            n_imp_got[i] = m
+        n_imp_got[i] = m
 
 
 @functools.lru_cache(maxsize=None)
@@ -341,17 +355,56 @@ def _grid_outputs(n, n_pts, n_imp_pts):
                 n_got=np.zeros(n, dtype=np.int64), n_imp_got=np.zeros(n, dtype=np.int64))
 
 
-def run_chunk(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=None):
+def run_chunk(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=None, lanes=1):
     """Run the grid kernel on one chunk of cells; returns its outputs by name.
 
     The unit of work of :func:`rockjit.chunks.run_chunks`, in this process or on a Dask worker.
+    ``lanes > 1`` runs that many cells per thread in lockstep (:mod:`rockjit.lanes`; without
+    tangent vectors only, the same outputs bit for bit).
     """
+    return run_chunk_counted(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads,
+                             lanes)[0]
+
+
+def run_chunk_counted(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=None,
+                      lanes=1, profile=False):
+    """:func:`run_chunk`, and the lanes' counts per block of cells (``None`` without lanes;
+    columns as :data:`N_LANE_COUNTS` says; the cycle counts only with ``profile``, which
+    costs time)."""
+    lanes = integer("lanes", lanes, 1, LANES_MAX)
+    y0s = np.ascontiguousarray(y0s)
+    pars = np.ascontiguousarray(pars)
     out = _grid_outputs(y0s.shape[0], n_pts, n_imp_pts)
+    counts = None
     with _threads(threads):
-        _kernel(tangent)(np.ascontiguousarray(y0s), np.ascontiguousarray(pars), ipar, cpar,
-                         n_pts, n_imp_pts, out["res"], out["pts"], out["imp"], out["n_got"],
-                         out["n_imp_got"])
-    return out
+        if lanes > 1 and not tangent:
+            from . import lanes as ln
+            n = y0s.shape[0]
+            block = lane_block(n, numba.get_num_threads())
+            counts = np.zeros(((n + block - 1) // block, N_LANE_COUNTS), dtype=np.int64)
+            ln.grid_lanes(lanes, block, y0s, pars, ipar, cpar, n_pts, n_imp_pts, out["res"],
+                          out["pts"], out["imp"], out["n_got"], out["n_imp_got"], bool(profile),
+                          counts)
+        else:
+            _kernel(tangent)(y0s, pars, ipar, cpar, n_pts, n_imp_pts, out["res"], out["pts"],
+                             out["imp"], out["n_got"], out["n_imp_got"])
+    return out, counts
+
+
+#: The lanes' counters per block (:func:`rockjit.lanes.run_lanes`): fast steps, scalar steps,
+#: vector steps; cycles in vector steps, in scalar steps, in all; within the scalar steps, cycles
+#: in rest phases, in the steps after events, in locating events, in impacts, in detection, in
+#: first steps taken again, at grid points (:func:`rockjit.lanes.scalar_step`).
+N_LANE_COUNTS = 13
+
+#: Cells per thread in lockstep at most (:data:`rockjit.lanes.W`, the vector's width).
+LANES_MAX = 8
+
+
+def lane_block(n, threads):
+    """Cells per block of lanes (one task of the parallel loop): 256, or fewer so that every
+    thread gets four blocks. Results do not depend on it."""
+    return max(1, min(256, -(-n // (4 * max(1, threads)))))
 
 
 def default_chunk(n):
@@ -360,12 +413,12 @@ def default_chunk(n):
 
 
 def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, threads, progress, label,
-             chunk=None, client=None, store=None, message=None):
+             chunk=None, client=None, store=None, message=None, lanes=1):
     """All cells through :func:`run_chunk`, chunk by chunk (progress between chunks).
 
     Returns the outputs by name: ``res`` (rows in the ``R_*`` layout), ``pts``, ``imp``,
     ``n_got``, ``n_imp_got``. ``message(text)`` hears what the chunk store has to say (default
-    a line on stderr).
+    a line on stderr). ``lanes``: cells per thread in lockstep (:func:`run_chunk`).
     """
     n = y0s.shape[0]
     chunk = default_chunk(n) if chunk is None else chunk
@@ -376,7 +429,7 @@ def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, threads, progr
                                  dict(tangent=bool(tangent), n_pts=n_pts, n_imp_pts=n_imp_pts))
         cs = chunks.ChunkStore(store, key, n, chunk, message=message)
     chunks.run_chunks(run_chunk, (bool(tangent), y0s, pars, ipar, cpar, n_pts, n_imp_pts,
-                                  threads), n, chunk, outputs_, client=client, store=cs,
+                                  threads, lanes), n, chunk, outputs_, client=client, store=cs,
                       progress=progress, label=label)
     return outputs_
 

@@ -1,0 +1,677 @@
+"""Several grid cells per thread in lockstep (issue 17): the free-flight step of ``L`` lanes.
+
+rockjit's step is a fixed-step Dormand–Prince step: every cell of a grid steps on the same time
+grid, and an event inside a step is handled within that step. ``L`` cells advanced together
+therefore stay on one grid; only their events differ. One cell's step is a chain of six stages,
+each waiting for the last (its cost is latency, not arithmetic); ``L`` independent chains side
+by side let the core overlap them, and written as one loop over lanes with no branch in it,
+LLVM turns the lanes into SIMD vectors.
+
+:func:`block_step_lanes` is :func:`rockjit.integrate.block_step` (fast path, no slopes) for
+``L`` lanes with the lane as the innermost, contiguous index of every array: the same
+operations in the same order, fused multiply-adds included, so each lane's result is bit for
+bit the single-lane step's (a vector FMA rounds once, as the scalar one).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+from llvmlite import ir
+from numba import prange, types
+from numba.extending import intrinsic
+
+from . import integrate as ig
+from . import kernel as kn
+from ._jit import fma, jit
+from .model import (NEAR_RANGE, SINCOS_RANGE, accel_near, corner, initial_side, rotate,
+                    sincos_poly)
+
+__all__ = ["W", "bank", "block_step_lanes", "lane_tables", "run_lanes", "scalar_step"]
+
+# rows of the lane-major step table ``tabl`` (:func:`lane_tables`): the entries of
+# integrate's table that the block's step reads, lane innermost
+(L_A10, L_A20, L_A21, L_A30, L_A31, L_A32, L_A40, L_A41, L_A42, L_A43, L_A50, L_A51, L_A52,
+ L_A53, L_A54, L_B0, L_B2, L_B3, L_B4, L_B5, L_AA20, L_AA30, L_AA31, L_AA40, L_AA41, L_AA42,
+ L_AA50, L_AA51, L_AA52, L_AA53, L_BA0, L_BA2, L_BA3, L_BA4, L_C1, L_C2, L_C3, L_C4, L_C5,
+ L_C6) = range(40)
+N_LTAB = 40
+
+
+def _lane_rows():
+    """``(row, column)`` of integrate's step table for each row of the lane table."""
+    rows = [(1, 0), (2, 0), (2, 1), (3, 0), (3, 1), (3, 2), (4, 0), (4, 1), (4, 2), (4, 3),
+            (5, 0), (5, 1), (5, 2), (5, 3), (5, 4)]
+    rows += [(ig.T_HB, j) for j in (0, 2, 3, 4, 5)]
+    rows += [(ig.T_HAA + 2, 0), (ig.T_HAA + 3, 0), (ig.T_HAA + 3, 1), (ig.T_HAA + 4, 0),
+             (ig.T_HAA + 4, 1), (ig.T_HAA + 4, 2), (ig.T_HAA + 5, 0), (ig.T_HAA + 5, 1),
+             (ig.T_HAA + 5, 2), (ig.T_HAA + 5, 3)]
+    rows += [(ig.T_HBA, j) for j in (0, 2, 3, 4)]
+    rows += [(ig.T_HC, i) for i in range(1, 7)]
+    assert len(rows) == N_LTAB
+    return np.array(rows, dtype=np.int64)
+
+
+LANE_ROWS = _lane_rows()
+
+
+@jit(nrt=False)
+def lane_tables(tab, lin, lane):
+    """Copy the entries of integrate's step table ``tab`` that the block's step reads into
+    column ``lane`` of the lanes' input ``lin`` (rows ``I_TAB ..``)."""
+    for r in range(N_LTAB):
+        lin[(I_TAB + r) * W + lane] = tab[LANE_ROWS[r, 0], LANE_ROWS[r, 1]]
+
+
+
+#: Lanes at most (the row length of the lanes' arrays: a compile-time constant, so that the
+#: vectoriser knows rows apart)
+W = 8
+
+
+@intrinsic
+def cycles(typingctx):
+    """The CPU's cycle counter (LLVM's ``readcyclecounter``: ``rdtsc`` on x86-64), for the
+    lanes' own accounting of where their time goes."""
+    sig = types.int64()
+
+    def codegen(context, builder, signature, args):
+        fn = builder.module.declare_intrinsic("llvm.readcyclecounter", fnty=ir.FunctionType(
+            ir.IntType(64), []))
+        return builder.call(fn, [])
+
+    return sig, codegen
+
+
+# rows of the lanes' input ``lin`` and output ``lout`` (:func:`block_step_lanes`)
+I_X, I_V, I_K, I_S, I_C, I_SG, I_STHC, I_CTHC, I_XI, I_THOVER = range(10)
+I_TAB = 10                     # N_LTAB rows: the step's table
+N_LIN = I_TAB + N_LTAB
+O_X, O_V, O_S, O_C, O_FAR = range(5)
+O_KV = O_FAR                    # rows O_KV + 1 .. O_KV + 6
+O_KA = O_KV + ig.N_STAGES       # rows O_KA + 1 .. O_KA + 6
+O_FAST = O_KA + ig.N_STAGES + 1
+N_LOUT = O_FAST + 1
+
+@jit(nrt=False)
+def block_step_lanes(n, j, lin, lout, ftl):
+    """One Dormand–Prince step of the block in ``n`` lanes at once (fast path, no slopes).
+
+    Parameters
+    ----------
+    n : int
+        Lanes.
+    j : int
+        The step's index in the forcing period (the same in every lane).
+    lin : ndarray, (N_LIN * W,)
+        Each lane's state and constants, row ``r`` of lane ``l`` at ``r * W + l`` (rows
+        ``I_*``): angle, velocity, acceleration, and sine and cosine of the angle at the step's
+        start; the corner (as a float: +1, -1, or 0 at rest), ``sin(thc)``, ``cos(thc)``, the
+        damping, the overturning angle; the step's table (``I_TAB + r``, :func:`lane_tables`).
+        A lane whose step is *fast* (below) has its state advanced to the step's end here.
+    lout : ndarray, (N_LOUT * W,)
+        Receives the stages' velocities and accelerations (``O_KV + i``, ``O_KA + i``, rows
+        ``i = 1..6``: ``K[i, 0]`` and ``K[i, 1]`` of :func:`rockjit.integrate.block_step`), the
+        angle and velocity at the step's end, the sine and cosine of that angle, ``far``
+        (``> 1``: the step left the polynomials' range) and ``O_FAST``: 1 when the step is
+        accepted as it is (in flight, in range, and none of the events that
+        :func:`rockjit.integrate.detect` looks for), else 0 (the lane's state is left as it was,
+        for the single-lane code to take the step).
+    ftl : ndarray, (N * 7 * W,)
+        Each lane's forcing acceleration at stage ``i`` of step ``j`` at ``(7 j + i) W + l``.
+
+    Notes
+    -----
+    Three flat arrays whose rows lie a compile-time stride ``W`` apart: LLVM's loop vectoriser
+    then needs three overlap checks (with one array per quantity it gives up: "too many memory
+    checks"). The state is written back here, as a vector, so that the next step's vector loads
+    never wait on single-lane stores (a failed store-to-load forwarding cost three times the
+    step).
+    """
+    for l in range(n):
+        xl = lin[(I_X) * W + l]
+        vl = lin[(I_V) * W + l]
+        kl = lin[(I_K) * W + l]
+        sl = lin[(I_S) * W + l]
+        cl = lin[(I_C) * W + l]
+        side = lin[(I_SG) * W + l]
+        st = lin[(I_STHC) * W + l]
+        ct = lin[(I_CTHC) * W + l]
+        dmp = lin[(I_XI) * W + l]
+        tb = I_TAB * W + l  # the lane's step table: row r at tb + r W
+        d1 = lin[tb + L_C1 * W] * vl
+        v1 = fma(lin[tb + L_A10 * W], kl, vl)
+        P, Q = corner(ftl[(j * 7 + 1) * W + l], side, st, ct)
+        Pr, Qr = rotate(P, Q, sl, cl)
+        k1 = accel_near(Pr, Qr, d1, v1, dmp)
+        d2 = fma(lin[tb + L_AA20 * W], kl, lin[tb + L_C2 * W] * vl)
+        v2 = fma(lin[tb + L_A21 * W], k1, fma(lin[tb + L_A20 * W], kl, vl))
+        P, Q = corner(ftl[(j * 7 + 2) * W + l], side, st, ct)
+        Pr, Qr = rotate(P, Q, sl, cl)
+        k2 = accel_near(Pr, Qr, d2, v2, dmp)
+        d3 = fma(lin[tb + L_AA31 * W], k1, fma(lin[tb + L_AA30 * W], kl, lin[tb + L_C3 * W] * vl))
+        v3 = fma(lin[tb + L_A32 * W], k2,
+                 fma(lin[tb + L_A31 * W], k1, fma(lin[tb + L_A30 * W], kl, vl)))
+        P, Q = corner(ftl[(j * 7 + 3) * W + l], side, st, ct)
+        Pr, Qr = rotate(P, Q, sl, cl)
+        k3 = accel_near(Pr, Qr, d3, v3, dmp)
+        d4 = fma(lin[tb + L_AA42 * W], k2, fma(lin[tb + L_AA41 * W], k1,
+                 fma(lin[tb + L_AA40 * W], kl, lin[tb + L_C4 * W] * vl)))
+        v4 = fma(lin[tb + L_A43 * W], k3, fma(lin[tb + L_A42 * W], k2, fma(lin[tb + L_A41 * W], k1,
+                 fma(lin[tb + L_A40 * W], kl, vl))))
+        P, Q = corner(ftl[(j * 7 + 4) * W + l], side, st, ct)
+        Pr, Qr = rotate(P, Q, sl, cl)
+        k4 = accel_near(Pr, Qr, d4, v4, dmp)
+        d5 = fma(lin[tb + L_AA53 * W], k3,
+                 fma(lin[tb + L_AA52 * W], k2, fma(lin[tb + L_AA51 * W], k1,
+                 fma(lin[tb + L_AA50 * W], kl, lin[tb + L_C5 * W] * vl))))
+        v5 = fma(lin[tb + L_A54 * W], k4, fma(lin[tb + L_A53 * W], k3, fma(lin[tb + L_A52 * W], k2,
+                 fma(lin[tb + L_A51 * W], k1, fma(lin[tb + L_A50 * W], kl, vl)))))
+        P, Q = corner(ftl[(j * 7 + 5) * W + l], side, st, ct)
+        Pr, Qr = rotate(P, Q, sl, cl)
+        k5 = accel_near(Pr, Qr, d5, v5, dmp)
+        d6 = fma(lin[tb + L_BA4 * W], k4, fma(lin[tb + L_BA3 * W], k3, fma(lin[tb + L_BA2 * W], k2,
+                 fma(lin[tb + L_BA0 * W], kl, lin[tb + L_C6 * W] * vl))))
+        v6 = fma(lin[tb + L_B5 * W], k5, fma(lin[tb + L_B4 * W], k4, fma(lin[tb + L_B3 * W], k3,
+                 fma(lin[tb + L_B2 * W], k2, fma(lin[tb + L_B0 * W], kl, vl)))))
+        P, Q = corner(ftl[(j * 7 + 6) * W + l], side, st, ct)
+        Pr, Qr = rotate(P, Q, sl, cl)
+        k6 = accel_near(Pr, Qr, d6, v6, dmp)
+        x6 = xl + d6
+        s6, c6 = sincos_poly(x6)
+        f = max(max(max(abs(d1), abs(d2)), max(abs(d3), abs(d4))), max(abs(d5), abs(d6)))
+        far = max(f * (1.0 / NEAR_RANGE), abs(x6) * (1.0 / SINCOS_RANGE))
+        lout[(O_FAR) * W + l] = far
+        lout[(O_KV + 1) * W + l] = v1
+        lout[(O_KV + 2) * W + l] = v2
+        lout[(O_KV + 3) * W + l] = v3
+        lout[(O_KV + 4) * W + l] = v4
+        lout[(O_KV + 5) * W + l] = v5
+        lout[(O_KV + 6) * W + l] = v6
+        lout[(O_KA + 1) * W + l] = k1
+        lout[(O_KA + 2) * W + l] = k2
+        lout[(O_KA + 3) * W + l] = k3
+        lout[(O_KA + 4) * W + l] = k4
+        lout[(O_KA + 5) * W + l] = k5
+        lout[(O_KA + 6) * W + l] = k6
+        lout[(O_X) * W + l] = x6
+        lout[(O_V) * W + l] = v6
+        lout[(O_S) * W + l] = s6
+        lout[(O_C) * W + l] = c6
+        g0 = side * xl
+        g1 = side * x6
+        graze = (g0 > 0.0) & (side * vl < 0.0) & (side * v6 > 0.0)
+        fast = ((side != 0.0) & (far <= 1.0) & (g1 < lin[I_THOVER * W + l]) & (g1 >= 0.0)
+                & (not graze))
+        lout[O_FAST * W + l] = 1.0 if fast else 0.0
+        lin[I_X * W + l] = x6 if fast else xl
+        lin[I_V * W + l] = v6 if fast else vl
+        lin[I_K * W + l] = k6 if fast else kl
+        lin[I_S * W + l] = s6 if fast else sl
+        lin[I_C * W + l] = c6 if fast else cl
+
+
+# ---------------------------------------------------------------------------------------------
+# a grid's cells in lanes
+# ---------------------------------------------------------------------------------------------
+
+# layout of a lane's loop state: integers ``st`` and floats ``fs`` (the variables of
+# rockjit.integrate._loop)
+(S_STATUS, S_SIDE, S_NIMP, S_STEP, S_JPER, S_KPER, S_JQR, S_JREC, S_NCOL, S_NCOLWIN,
+ S_CELL) = range(11)
+N_ST = 11
+F_TT, F_MAXERR, F_TLIFT = range(3)
+N_FS = 3
+
+
+@jit(nrt=False)
+def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, prof, counts):
+    """One grid step of a lane on the scalar path: the body of the loop of
+    :func:`rockjit.integrate._loop` (closed-form forcing, no trajectory), its variables kept in
+    ``st`` and ``fs``. Used for every step the lanes' fast path does not take (an event, a rest
+    phase, a stage out of the polynomial's range), so that each lane runs exactly the
+    single-lane code there. ``pre``: the grid step's first Runge–Kutta step is in ``w``
+    already (``K[1:]``, ``ynew``, ``trig[2:4]``: the vector step's, which equals it when it
+    stayed in range), so it is not taken again. With ``prof``, ``counts[6:13]`` receive the
+    cycles spent in rest phases (:func:`rockjit.integrate.leave_rest`), in the steps after an
+    event (from the event to the grid point), in locating events
+    (:func:`rockjit.integrate.locate`), in impacts (:func:`rockjit.integrate.impact`), in
+    detection (:func:`rockjit.integrate.detect`),
+    in the grid step's first Runge–Kutta step where it was taken again (the vector step's left
+    the polynomials' range, or the block was at rest) and at the grid point
+    (:func:`rockjit.integrate.grid_point`)."""
+    EMBED4 = False
+    RECORD = False
+    NS = 2
+    NY = NS + (4 if TANGENT else 0)
+    n_per = ipar[ig.I_N]
+    win_step = ipar[ig.I_WINDOW] * n_per
+    h = par[ig.P_H]
+    y = w.y
+    K = w.K
+    status = st[S_STATUS]
+    side = st[S_SIDE]
+    n_imp = st[S_NIMP]
+    step = st[S_STEP]
+    j_per = st[S_JPER]
+    k_per = st[S_KPER]
+    j_qr = st[S_JQR]
+    j_rec = st[S_JREC]
+    n_col = st[S_NCOL]
+    n_col_win = st[S_NCOLWIN]
+    t = fs[F_TT]
+    max_err = fs[F_MAXERR]
+    t_lift = fs[F_TLIFT]
+    t_grid = (step + 1) * h
+    in_window = step >= win_step
+    fresh = True
+    hold = False
+    while True:
+        if side == 0:
+            c0 = cycles() if prof else 0
+            action, t, side = ig.leave_rest(EMBED4, t, t_grid, hold, y, side, par, w, out.iout)
+            counts[6] += (cycles() - c0) if prof else 0
+            if action == ig.REST_END:
+                status = ig.REST
+                break
+            if action == ig.REST_HOLD:
+                break
+            if action == ig.REST_LIFT:
+                t_lift = t
+                fresh = EMBED4 and fresh
+                continue
+        if fresh:
+            hh = h
+            if not pre:
+                c0 = cycles() if prof else 0
+                ig.rk_step(EMBED4, TANGENT, not EMBED4, 0.0, 0.0, y, K, side, par, w.ytmp,
+                           w.ynew, w.tab_h, w.fr if EMBED4 else w.ftab[j_per], w.jac, w.trig)
+                counts[11] += (cycles() - c0) if prof else 0
+            pre = False
+        else:
+            c0 = cycles() if prof else 0
+            hh = t_grid - t
+            psi = par[ig.P_OMEGA] * t + par[ig.P_PHI]
+            ig.step_table(par[ig.P_OMEGA], hh, w.tab)
+            ig.rk_step(EMBED4, TANGENT, False, math.sin(psi), math.cos(psi), y, K, side, par,
+                       w.ytmp, w.ynew, w.tab, w.fr, w.jac, w.trig)
+            counts[7] += (cycles() - c0) if prof else 0
+        out.iout[ig.O_RHS] += ig.N_STAGES
+        out.iout[ig.O_SUBSTEPS] += 1
+        c0 = cycles() if prof else 0
+        kind, lo, hi = ig.detect(y, w.ynew, hh, K, side, par)
+        counts[10] += (cycles() - c0) if prof else 0
+        if hold and kind == ig.EV_UPLIFT:
+            kind = ig.EV_NONE
+        if kind == ig.EV_NONE:
+            max_err = ig.accept(NS, NY, side, hh, max_err, w)
+            t = t_grid
+            break
+        if hi > lo:
+            c0 = cycles() if prof else 0
+            tau = ig.locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, w.ytmp,
+                            w.yev, out.iout, w.tab, w.fr, w.jac, w.trig)
+            counts[8] += (cycles() - c0) if prof else 0
+        else:
+            tau = 0.0
+            for m in range(NY):
+                w.yev[m] = y[m]
+            w.yev[1] = 0.0
+        t = t + tau
+        fresh = False
+        for m in range(NY):
+            y[m] = w.yev[m]
+        if kind == ig.EV_OVERTURN:
+            if ipar[ig.I_CONTINUE] == 0:
+                status = ig.OVERTURNED
+                break
+            out.fout[ig.F_TOVER] = t
+            par[ig.P_THOVER] = math.inf
+            ig.rhs(EMBED4, ig.forcing_at(t, par), y, side, par, K, w.jac, w.trig)
+            out.iout[ig.O_RHS] += 1
+            continue
+        if kind == ig.EV_UPLIFT:
+            y[0] = 0.0
+            y[1] = 0.0
+            side = 1 if y[2] > 0.0 else -1
+            t_lift = t
+            ig.rhs(EMBED4, ig.forcing_at(t, par), y, side, par, K, w.jac, w.trig)
+            out.iout[ig.O_RHS] += 1
+            continue
+        c0 = cycles() if prof else 0
+        side, n_imp, rests, held = ig.impact(EMBED4, TANGENT, t, t_lift, side, n_imp,
+                                             in_window, par, out, w)
+        counts[9] += (cycles() - c0) if prof else 0
+        if rests:
+            hold = hold or held
+            if TANGENT:
+                ig.reset_tangent(EMBED4, y)
+                n_col += 1
+                if in_window:
+                    n_col_win += 1
+        if n_imp >= ipar[ig.I_MAXIMP]:
+            status = ig.MAX_IMPACTS
+            break
+    if status == ig.RUNNING:
+        step += 1
+        if not (math.isfinite(y[0]) and math.isfinite(y[1])):
+            status = ig.NONFINITE
+        else:
+            c0 = cycles() if prof else 0
+            status, j_per, k_per, j_qr, j_rec, collapsed = ig.grid_point(
+                EMBED4, TANGENT, RECORD, t, step, side, n_imp, n_col, in_window, ipar, par,
+                out, w, j_per, k_per, j_qr, j_rec)
+            counts[12] += (cycles() - c0) if prof else 0
+            if collapsed:
+                n_col += 1
+                if in_window:
+                    n_col_win += 1
+    st[S_STATUS] = status
+    st[S_SIDE] = side
+    st[S_NIMP] = n_imp
+    st[S_STEP] = step
+    st[S_JPER] = j_per
+    st[S_KPER] = k_per
+    st[S_JQR] = j_qr
+    st[S_JREC] = j_rec
+    st[S_NCOL] = n_col
+    st[S_NCOLWIN] = n_col_win
+    fs[F_TT] = t
+    fs[F_MAXERR] = max_err
+    fs[F_TLIFT] = t_lift
+
+
+#: A block of lanes' arrays: each lane's loop state (``st``, ``fs``), parameters (``par``,
+#: ``N_PARW``), the lanes' step input and output (``lin``, ``lout``) and forcing table
+#: (``ftl``), and each lane's
+#: :data:`rockjit.integrate.Outputs` and :data:`rockjit.integrate.Work` arrays (first index:
+#: the lane).
+Bank = namedtuple("Bank", "st fs par lin lout ftl strobe half impacts traj lam_run per_imp iout "
+                          "fout K states lam tab_h tab fr jac trig ftab")
+
+
+def bank(periods, n_per, n_imp_pts):
+    """Fresh arrays for ``W`` lanes (a run's outputs as :func:`rockjit.kernel._grid` makes
+    them, the work arrays as :func:`rockjit.integrate._run`)."""
+    return _bank(periods, n_per, max(n_imp_pts, 1))
+
+
+@jit
+def _bank(periods, n_per, cap):
+    n_st = ig.N_STAGES + 1
+    return Bank(np.zeros((W, N_ST), dtype=np.int64), np.zeros((W, N_FS)),
+                np.zeros((W, ig.N_PARW)), np.zeros(N_LIN * W), np.zeros(N_LOUT * W),
+                np.zeros(n_per * n_st * W),
+                np.zeros((W, periods + 1, 4)), np.zeros((W, periods + 1, 4)),
+                np.zeros((W, cap, 3)), np.zeros((W, 1, 5)), np.zeros((W, 1, 3)),
+                np.zeros((W, periods + 1), dtype=np.int64),
+                np.zeros((W, ig.N_IOUT), dtype=np.int64), np.zeros((W, ig.N_FOUT)),
+                np.zeros((W, n_st, 2)), np.zeros((W, 4, 2)), np.zeros((W, 4)),
+                np.zeros((W, ig.N_TAB, n_st)), np.zeros((W, ig.N_TAB, n_st)),
+                np.zeros((W, n_st)), np.zeros((W, n_st)), np.zeros((W, 4)),
+                np.zeros((W, n_per, n_st)))
+
+
+@jit(nrt=False, inline=True)
+def lane_outputs(b, l):
+    return ig.Outputs(b.strobe[l], b.half[l], b.impacts[l], b.traj[l], b.lam_run[l],
+                      b.per_imp[l], b.iout[l], b.fout[l])
+
+
+@jit(nrt=False, inline=True)
+def lane_work(b, l):
+    s = b.states[l]
+    return ig.Work(b.K[l], s[0], s[1], s[2], s[3], b.lam[l], b.tab_h[l], b.tab[l], b.fr[l],
+                   b.jac[l], b.trig[l], b.ftab[l])
+
+
+@jit(nrt=False)
+def _zero(a):
+    f = a.reshape(a.size)
+    for m in range(f.size):
+        f[m] = 0
+
+
+@jit(nrt=False)
+def _load(l, i, y0s, pars, ipar, b):
+    """Start cell ``i`` in lane ``l`` (:func:`rockjit.integrate._run` and the start of its
+    loop, on fresh arrays). Returns whether it runs (False: it ended before its first step)."""
+    _zero(b.strobe[l])
+    _zero(b.half[l])
+    _zero(b.impacts[l])
+    _zero(b.traj[l])
+    _zero(b.lam_run[l])
+    _zero(b.fout[l])
+    _zero(b.K[l])
+    _zero(b.states[l])
+    _zero(b.lam[l])
+    _zero(b.tab_h[l])
+    _zero(b.tab[l])
+    _zero(b.fr[l])
+    _zero(b.jac[l])
+    _zero(b.trig[l])
+    _zero(b.ftab[l])
+    _zero(b.per_imp[l])
+    _zero(b.iout[l])
+    par = b.par[l]
+    for m in range(ig.N_PARW):
+        par[m] = 0.0
+    for m in range(ig.N_PAR):
+        par[m] = pars[i, m]
+    par[ig.P_STHC] = math.sin(pars[i, ig.P_THC])
+    par[ig.P_CTHC] = math.cos(pars[i, ig.P_THC])
+    out = lane_outputs(b, l)
+    w = lane_work(b, l)
+    y0 = y0s[i]
+    side0 = initial_side(y0[0], y0[1])
+    status = ig.start(False, False, False, y0, side0, par, ipar, out, w)
+    st = b.st[l]
+    fs = b.fs[l]
+    for m in range(N_ST):
+        st[m] = 0
+    st[S_STATUS] = status
+    st[S_SIDE] = side0
+    st[S_NCOL] = out.iout[ig.O_NCOL]
+    st[S_NCOLWIN] = st[S_NCOL] if ipar[ig.I_WINDOW] == 0 else 0
+    st[S_CELL] = i
+    fs[F_TT] = 0.0
+    fs[F_MAXERR] = 0.0
+    fs[F_TLIFT] = -math.inf
+    lane_tables(w.tab_h, b.lin, l)
+    for jj in range(ipar[ig.I_N]):
+        for s in range(ig.N_STAGES + 1):
+            b.ftl[(jj * (ig.N_STAGES + 1) + s) * W + l] = w.ftab[jj, s]
+    b.lin[I_STHC * W + l] = par[ig.P_STHC]
+    b.lin[I_CTHC * W + l] = par[ig.P_CTHC]
+    b.lin[I_XI * W + l] = par[ig.P_XI]
+    _refresh(l, b)
+    return status == ig.RUNNING and ipar[ig.I_N] * ipar[ig.I_PERIODS] > 0
+
+
+@jit(nrt=False, inline=True)
+def _refresh(l, b):
+    """The lane's step input from its state (after a load or a step)."""
+    s = b.states[l]
+    b.lin[I_X * W + l] = s[0, 0]
+    b.lin[I_V * W + l] = s[0, 1]
+    b.lin[I_K * W + l] = b.K[l, 0, 1]
+    b.lin[I_S * W + l] = b.trig[l, 0]
+    b.lin[I_C * W + l] = b.trig[l, 1]
+    b.lin[I_SG * W + l] = b.st[l, S_SIDE]
+    b.lin[I_THOVER * W + l] = b.par[l, ig.P_THOVER]
+
+
+@jit(nrt=False, inline=True)
+def _sync(l, b):
+    """The lane's single-lane state from its step input (the fast path keeps it there only)."""
+    s = b.states[l]
+    s[0, 0] = b.lin[I_X * W + l]
+    s[0, 1] = b.lin[I_V * W + l]
+    b.K[l, 0, 0] = b.lin[I_V * W + l]
+    b.K[l, 0, 1] = b.lin[I_K * W + l]
+    b.trig[l, 0] = b.lin[I_S * W + l]
+    b.trig[l, 1] = b.lin[I_C * W + l]
+
+
+@jit(nrt=False, inline=True)
+def _stages(l, b):
+    """The vector step's stages and end into the lane's work arrays, as
+    :func:`rockjit.integrate.rk_step` would leave them (no tangent)."""
+    K = b.K[l]
+    for i in range(1, ig.N_STAGES + 1):
+        K[i, 0] = b.lout[(O_KV + i) * W + l]
+        K[i, 1] = b.lout[(O_KA + i) * W + l]
+    s = b.states[l]
+    s[2, 0] = b.lout[O_X * W + l]  # ynew
+    s[2, 1] = b.lout[O_V * W + l]
+    b.trig[l, 2] = b.lout[O_S * W + l]
+    b.trig[l, 3] = b.lout[O_C * W + l]
+
+
+@jit(nrt=False)
+def _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b):
+    """Lane ``l``'s run has ended: its outputs (:func:`rockjit.integrate._loop`'s end), its
+    classification and samples (:func:`rockjit.kernel._grid`); the lane is free."""
+    st = b.st[l]
+    fs = b.fs[l]
+    par = b.par[l]
+    out = lane_outputs(b, l)
+    w = lane_work(b, l)
+    status = st[S_STATUS]
+    if status == ig.RUNNING:
+        status = ig.DONE
+    out.iout[ig.O_NCOL] = st[S_NCOL]
+    ig.finish(False, False, status, fs[F_TT], st[S_STEP], st[S_NIMP], st[S_NCOLWIN],
+              fs[F_MAXERR], ipar, par, out, w)
+    i = st[S_CELL]
+    kn._classify(False, status, ipar, cpar, out, res[i])
+    kn._collect(i, par[ig.P_H] * ipar[ig.I_N], n_pts, n_imp_pts, out, res, pts, imp_pts,
+                n_got, n_imp_got)
+    st[S_CELL] = -1
+
+
+@jit(nrt=False)
+def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts,
+              n_got, n_imp_got, b, prof, counts):
+    """Cells ``i0 .. i1 - 1`` through ``n_lanes <= W`` lanes (no tangent vectors), a freed
+    lane refilled from the next pending cell at the next period's start (all lanes then step
+    through the period together: one forcing row for all); outputs as
+    :func:`rockjit.kernel._grid`'s.
+
+    Each grid step: :func:`block_step_lanes` for all lanes at once, which accepts the step of
+    every lane in flight whose step has no event, stays in the polynomials' range; every other
+    lane's step (an event, a rest phase) is taken again by :func:`scalar_step`, the single-lane
+    code. A lane's arithmetic is the single-lane kernel's either way, so its results are bit for
+    bit those of :func:`rockjit.kernel._grid` (the running error estimate ``max_err`` is not
+    kept on the fast path: no grid output reads it). ``counts``: the fast and the scalar steps,
+    the vector steps taken, and with ``prof`` the cycles (``readcyclecounter``) spent in the
+    vector steps, in the scalar steps, and in all, then the parts of the scalar steps
+    (:func:`scalar_step`); without, the cycle counter is not read (its reads cost ~10 % of a
+    basin's time).
+    """
+    c_start = cycles() if prof else 0
+    n_per = ipar[ig.I_N]
+    total = n_per * ipar[ig.I_PERIODS]
+    half = n_per // 2
+    lin = b.lin
+    lout = b.lout
+    ftl = b.ftl
+    nxt = i0
+    for l in range(W):
+        b.st[l, S_CELL] = -1
+    j = 0  # the step's index in the period, the same in every lane
+    while True:
+        busy = 0
+        for l in range(n_lanes):
+            while j == 0 and b.st[l, S_CELL] < 0 and nxt < i1:
+                i = nxt
+                nxt += 1
+                if not _load(l, i, y0s, pars, ipar, b):
+                    b.st[l, S_CELL] = i
+                    _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got,
+                         n_imp_got, b)
+            if b.st[l, S_CELL] >= 0:
+                busy += 1
+        if busy == 0:
+            if nxt >= i1:
+                break
+            j = 0  # no lane busy: the next cells start now
+            continue
+        c0 = cycles() if prof else 0
+        # all W lanes, one vector, whatever n_lanes; the count is read from an array's shape
+        # so that LLVM does not know it: a known count of 8 unrolls the loop fully, and the
+        # unrolled code is not vectorised
+        block_step_lanes(b.st.shape[0], j, lin, lout, ftl)
+        c1 = cycles() if prof else 0
+        counts[2] += 1
+        counts[3] += c1 - c0
+        for l in range(n_lanes):
+            st = b.st[l]
+            if st[S_CELL] < 0:
+                continue
+            if lout[O_FAST * W + l] != 0.0:
+                counts[0] += 1
+                iout = b.iout[l]
+                iout[ig.O_RHS] += ig.N_STAGES
+                iout[ig.O_SUBSTEPS] += 1
+                step = st[S_STEP] + 1
+                st[S_STEP] = step
+                t = step * b.par[l, ig.P_H]
+                b.fs[l, F_TT] = t
+                if not (math.isfinite(lin[I_X * W + l]) and math.isfinite(lin[I_V * W + l])):
+                    st[S_STATUS] = ig.NONFINITE
+                elif j + 1 != n_per and j + 1 != half:
+                    st[S_JPER] = j + 1
+                else:
+                    _sync(l, b)
+                    status, j_per, k_per, j_qr, j_rec, collapsed = ig.grid_point(
+                        False, False, False, t, step, st[S_SIDE], st[S_NIMP], st[S_NCOL],
+                        step - 1 >= ipar[ig.I_WINDOW] * n_per, ipar, b.par[l],
+                        lane_outputs(b, l), lane_work(b, l), st[S_JPER], st[S_KPER],
+                        st[S_JQR], st[S_JREC])
+                    st[S_STATUS] = status
+                    st[S_JPER] = j_per
+                    st[S_KPER] = k_per
+                    st[S_JQR] = j_qr
+                    st[S_JREC] = j_rec
+            else:
+                counts[1] += 1
+                c0 = cycles() if prof else 0
+                _sync(l, b)
+                pre = st[S_SIDE] != 0 and lout[O_FAR * W + l] <= 1.0
+                if pre:
+                    _stages(l, b)
+                scalar_step(False, st, b.fs[l], b.par[l], ipar, lane_outputs(b, l),
+                            lane_work(b, l), pre, prof, counts)
+                _refresh(l, b)
+                counts[4] += (cycles() - c0) if prof else 0
+            if st[S_STATUS] != ig.RUNNING or st[S_STEP] >= total:
+                _sync(l, b)
+                _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b)
+        j += 1
+        if j == n_per:
+            j = 0
+    if prof:
+        counts[5] += cycles() - c_start
+
+
+#: Cells per block of lanes: a block is one task of the parallel loop, its cells run through
+#: one set of lanes (a freed lane takes the block's next pending cell).
+BLOCK = 256
+
+
+@jit(parallel=True)
+def grid_lanes(n_lanes, block, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts,
+               n_got, n_imp_got, prof, counts):
+    """:func:`rockjit.kernel._grid` without tangent vectors, ``n_lanes`` cells at a time per
+    thread: blocks of ``block`` cells, each through :func:`run_lanes` on fresh arrays. A cell's
+    results do not depend on its block, lane or thread. ``counts[g]`` receives block ``g``'s
+    step counts, and with ``prof`` its cycle counts (:func:`run_lanes`)."""
+    n = y0s.shape[0]
+    nb = (n + block - 1) // block
+    for g in prange(nb):
+        b = _bank(ipar[ig.I_PERIODS], ipar[ig.I_N], max(n_imp_pts, 1))
+        run_lanes(n_lanes, g * block, min(n, (g + 1) * block), y0s, pars, ipar, cpar, n_pts,
+                  n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b, prof, counts[g])

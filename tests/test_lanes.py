@@ -1,0 +1,180 @@
+"""Grids with several cells per thread in lockstep (issue 17): the same outputs, bit for bit.
+
+The reference is the single-lane grid kernel (``lanes=1``, :func:`rockjit.kernel._grid`, which
+runs every cell through :func:`rockjit.integrate._loop`): the lanes' vector step must equal the
+single-lane step in every lane, and every output array of a grid (labels, periods, end times,
+overturning instants, stroboscopic samples, impact sections, attractor ids) must be equal, on
+the study's four basins, full length and early-stopped, a sweep with per-cell parameters, a
+parameter plane (each cell its own step length) and the study's continue-past-overturning rule,
+for every lane count and thread count.
+"""
+
+import dataclasses
+import math
+
+import numba
+import numpy as np
+import pytest
+
+from rockjit import analysis as an
+from rockjit import integrate as ig
+from rockjit import kernel as kn
+from rockjit import lanes as ln
+from rockjit.model import Block
+
+#: The study's four basins (SPEC.md §7).
+BASINS = (
+    dict(hb=1.0, alpha=0.66, omega=1.3, law="housner"),
+    dict(hb=1.0, alpha=0.66, omega=1.3, law="mao"),
+    dict(hb=2.0, alpha=0.2, omega=1.6, law="housner"),
+    dict(hb=2.0, alpha=0.2, omega=1.6, law="mao"),
+)
+OUTPUTS = ("res", "pts", "imp", "n_got", "n_imp_got")
+
+
+def chunk(plan, lanes, threads=None):
+    return kn.run_chunk(plan.tangent, plan.y0s, plan.pars, plan.ipar, plan.cpar, plan.n_pts,
+                        plan.n_imp_pts, threads, lanes)
+
+
+def assert_same(a, b):
+    for k in OUTPUTS:
+        assert a[k].shape == b[k].shape, k
+        assert np.array_equal(a[k], b[k], equal_nan=True), k
+
+
+@pytest.mark.parametrize("early_stop", [True, False])
+@pytest.mark.parametrize("kw", BASINS, ids=lambda kw: f"hb{kw['hb']:g}-{kw['law']}")
+def test_study_basins_bit_for_bit(kw, early_stop):
+    plan = an.plan_basin(**kw, grid=12, periods=40, window=20, early_stop=early_stop)
+    ref = chunk(plan, 1)
+    assert len(np.unique(ref["res"][:, kn.R_LABEL])) >= 2  # the grid is not trivial
+    assert_same(ref, chunk(plan, 8))
+
+
+def test_lane_counts_and_threads():
+    plan = an.plan_basin(**BASINS[0], grid=10, periods=30, window=15, early_stop=False)
+    ref = chunk(plan, 1, threads=1)
+    for lanes in (2, 3, 4, 8):
+        assert_same(ref, chunk(plan, lanes, threads=1))
+    if numba.config.NUMBA_NUM_THREADS >= 2:
+        assert_same(ref, chunk(plan, 8, threads=2))
+
+
+def test_public_results_equal():
+    plan = an.plan_basin(**BASINS[2], grid=10, periods=40, window=20)
+    a = an.run(plan)
+    b = an.run(dataclasses.replace(plan, lanes=8))
+    for k in ("label", "period", "t_end", "attractor"):
+        assert np.array_equal(getattr(a, k), getattr(b, k), equal_nan=True), k
+
+
+def test_sweep_and_plane_per_cell_parameters():
+    # a sweep: each cell its own forcing amplitude (its own forcing table), impact sections
+    sw = an.plan_sweep(hb=1.0, alpha_range=(0.5, 1.0), alpha_step=0.02, omega=1.3,
+                       law="housner", periods=40, window=20, lyapunov=False)
+    assert sw.n_imp_pts > 0
+    assert_same(chunk(sw, 1), chunk(sw, 8))
+    # a plane: each cell its own period, so its own step length and step table
+    pl = an.plan_plane(hb=1.0, alpha_range=(0.4, 1.0), omega_range=(1.0, 2.0), grid=(5, 5),
+                       periods=30, window=15, lyapunov=False)
+    assert len(np.unique(pl.pars[:, ig.P_H])) > 1
+    assert_same(chunk(pl, 1), chunk(pl, 8))
+
+
+def test_continue_past_overturning():
+    plan = an.plan_basin(**BASINS[0], grid=8, periods=30, window=15, early_stop=False,
+                         stop_at_overturn=False)
+    ref = chunk(plan, 1)
+    assert np.isfinite(ref["res"][:, kn.R_TOVER]).any()  # some cells fell and went on
+    assert_same(ref, chunk(plan, 8))
+
+
+def test_tangent_grids_stay_single_lane():
+    sw = an.plan_sweep(hb=1.0, alpha_range=(0.6, 0.7), alpha_step=0.05, omega=1.3,
+                       law="housner", periods=20, window=10, lyapunov=True)
+    assert_same(chunk(sw, 1), chunk(sw, 8))
+
+
+@pytest.mark.parametrize("bad", [0, 9, 2.5, "four", True])
+def test_lanes_out_of_range(bad):
+    plan = an.plan_basin(**BASINS[0], grid=2, periods=2, window=1)
+    with pytest.raises(ValueError, match="lanes"):
+        chunk(plan, bad)
+
+
+def test_vector_step_equals_single_lane_step():
+    """block_step_lanes against integrate.block_step lane by lane, on random states (a few
+    outside the polynomials' range, some at rest, some crossing theta = 0)."""
+    rng = np.random.default_rng(17)
+    W = ln.W
+    block = Block(hb=1.0, alpha=0.66, omega=1.3)
+    n_per = 64
+    p = kn.pack(block, 0.3, n_per)
+    par = np.zeros(ig.N_PARW)
+    par[:ig.N_PAR] = p
+    par[ig.P_STHC] = math.sin(p[ig.P_THC])
+    par[ig.P_CTHC] = math.cos(p[ig.P_THC])
+    tab = np.zeros((ig.N_TAB, ig.N_STAGES + 1))
+    ig.step_table(par[ig.P_OMEGA], par[ig.P_H], tab)
+    ftl = rng.uniform(-1.0, 1.0, n_per * (ig.N_STAGES + 1) * W)
+    lin = np.zeros(ln.N_LIN * W)
+    lout = np.zeros(ln.N_LOUT * W)
+    n_far = n_fast = 0
+    for trial in range(40):
+        j = int(rng.integers(n_per))
+        x = rng.uniform(-0.6, 0.6, W)
+        v = rng.uniform(-3.0, 3.0, W)
+        side = rng.choice([-1, 1, 1, 0], W)
+        if trial % 5 == 0:
+            v[:2] = 12.0  # far from the start within the step
+        for l in range(W):
+            lin[ln.I_X * W + l] = x[l]
+            lin[ln.I_V * W + l] = v[l]
+            lin[ln.I_K * W + l] = rng.uniform(-2.0, 2.0)
+            lin[ln.I_S * W + l] = math.sin(x[l])
+            lin[ln.I_C * W + l] = math.cos(x[l])
+            lin[ln.I_SG * W + l] = side[l]
+            lin[ln.I_STHC * W + l] = par[ig.P_STHC]
+            lin[ln.I_CTHC * W + l] = par[ig.P_CTHC]
+            lin[ln.I_XI * W + l] = par[ig.P_XI]
+            lin[ln.I_THOVER * W + l] = par[ig.P_THOVER]
+            ln.lane_tables(tab, lin, l)
+        before = lin.copy()
+        ln.block_step_lanes(W, j, lin, lout, ftl)
+        for l in range(W):
+            K = np.zeros((ig.N_STAGES + 1, 2))
+            K[0, 1] = before[ln.I_K * W + l]
+            trig = np.array([before[ln.I_S * W + l], before[ln.I_C * W + l], 0.0, 0.0])
+            fr = np.array([ftl[(j * 7 + i) * W + l] for i in range(7)])
+            sd = int(side[l])
+            xe, ve, far = _block_step(x[l], v[l], fr, tab, sd if sd else 1, par, K, trig)
+            if sd == 0:  # the vector computes a corner of 0; only its flag matters
+                assert lout[ln.O_FAST * W + l] == 0.0
+                continue
+            assert lout[ln.O_X * W + l] == xe and lout[ln.O_V * W + l] == ve
+            assert lout[ln.O_FAR * W + l] == far
+            assert lout[ln.O_S * W + l] == trig[2] and lout[ln.O_C * W + l] == trig[3]
+            for i in range(1, 7):
+                assert lout[(ln.O_KV + i) * W + l] == K[i, 0]
+                assert lout[(ln.O_KA + i) * W + l] == K[i, 1]
+            # fast: in range and none of detect's events (written out from detect's tests)
+            g0, g1 = sd * x[l], sd * xe
+            event = g1 >= par[ig.P_THOVER] or g1 < 0.0 or (g0 > 0 and sd * v[l] < 0
+                                                           and sd * ve > 0)
+            fast = far <= 1.0 and not event
+            assert lout[ln.O_FAST * W + l] == (1.0 if fast else 0.0)
+            # a fast lane's state is advanced, any other left as it was
+            want = (xe, ve, K[6, 1], trig[2], trig[3]) if fast else \
+                tuple(before[r * W + l] for r in (ln.I_X, ln.I_V, ln.I_K, ln.I_S, ln.I_C))
+            got = tuple(lin[r * W + l] for r in (ln.I_X, ln.I_V, ln.I_K, ln.I_S, ln.I_C))
+            assert got == want
+            n_far += far > 1.0
+            n_fast += fast
+    assert n_far > 0 and 0 < n_fast < 40 * W  # every branch was seen
+
+
+@numba.njit(cache=False)
+def _block_step(x, v, fr, tab, side, par, K, trig):
+    jac = np.zeros(ig.N_STAGES + 1)
+    return ig.block_step(True, False, x, v, fr, tab, side, par, K, jac, trig)
