@@ -85,8 +85,7 @@ def _chunk_root(args):
     return chunk_root(args.out)
 
 
-def _client(args):
-    """A Dask client for ``--scheduler``, or None."""
+def _client(args):  # a Dask client for --scheduler, or None
     if not getattr(args, "scheduler", None):
         return None
     from dask.distributed import Client
@@ -473,7 +472,6 @@ def build_parser():
     p = sub.add_parser("compile", help="compile every kernel into numba's cache", description=
                        "Compile the kernel variants the commands use into numba's cache, in "
                        "parallel processes: later runs only load them (images, CI, Dask).")
-    p.add_argument("--all", action="store_true", help="every variant (the embedding too)")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
 
     p = _command(sub, "cor", _cor_plan, _cor_run, "restitution laws: figure 1 and the e-table",
@@ -529,9 +527,9 @@ def _internal_error(exc):
 
 
 def _compile(args):
-    """``rockjit compile [--all]``: the kernel variants into numba's cache, in parallel."""
-    from .kernel import COMMON, VARIANTS, compile_kernels
-    names, t0 = list(VARIANTS if args.all else COMMON), time.perf_counter()
+    """``rockjit compile``: every kernel variant into numba's cache, in parallel processes."""
+    from .kernel import COMMON as names, VARIANTS, compile_kernels
+    t0 = time.perf_counter()
     _say(args, f"compile: {len(names)} kernel variants (a minute or two cold on two cores)")
     try:
         compile_kernels(names, progress=lambda i, n, name, s: _say(
@@ -563,8 +561,10 @@ def main(argv=None):
     from ._jit import cached_kernels
     if args.command != "cor" and not cached_kernels():
         _say(args, "first run here: numba compiles rockjit's kernels into its cache, about "
-                   "20-40 s per kernel variant on two cores, once (`rockjit compile` does it "
+                   "15-25 s per kernel variant on two cores, once (`rockjit compile` does it "
                    "ahead of time)")
+        if args.command == "paper" and _compile(args):  # every variant, side by side
+            return 130
     import matplotlib
     matplotlib.use("Agg")
     out = OutputDir(args.out, command=args.command)

@@ -453,8 +453,8 @@ VARIANTS = {
     "grid": ("basins, erosion, fate", ("grid", False)),
     "grid+tangent": ("sweeps, planes (exponents)", ("grid", True)),
 }
-#: What ``rockjit compile`` compiles without ``--all``: every variant, since ``rockjit paper``
-#: (README's first command) uses each one.
+#: What ``rockjit compile`` (and a cold ``rockjit paper``) compiles: every variant, since
+#: ``rockjit paper`` (README's first command) uses each one.
 COMMON = tuple(VARIANTS)
 
 
