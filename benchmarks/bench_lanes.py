@@ -301,7 +301,9 @@ def main(argv=None):
     ax.set_ylabel(f"cycles per cell-step (at the nominal {mhz:.0f} MHz)")
     ax.legend(fontsize=8)
     ax.set_title("free-flight step, one thread")
-    b.report("lanes", markdown=md, data=dict(ns_per_cell_step={f"{k}|{L}": ns[(k, L)]
+    csv_cols = ["basin", "grid", "lanes", "cells_per_s", "ns_per_cell_step", "speedup_vs_1",
+                "scalar_steps", "time_vector", "time_scalar", "bound"]
+    b.report("lanes", markdown=md, csv=(csv_cols, [list(r[:10]) for r in grid_rows]), data=dict(ns_per_cell_step={f"{k}|{L}": ns[(k, L)]
                                                                for (k, L) in ns},
                                              mhz=mhz, raw=raw, cfg=cfg, grid_rows=grid_rows,
                                              grids=grid_data, threads=threads),

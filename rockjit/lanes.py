@@ -24,7 +24,7 @@ from numba import prange, types
 from numba.extending import intrinsic
 
 from . import integrate as ig
-from . import kernel as kn
+from . import cell
 from ._jit import fma, jit
 from .model import (NEAR_RANGE, SINCOS_RANGE, accel_near, corner, initial_side, rotate,
                     sincos_poly)
@@ -466,7 +466,7 @@ def _load(l, i, y0s, pars, ipar, b):
     w = lane_work(b, l)
     y0 = y0s[i]
     side0 = initial_side(y0[0], y0[1])
-    status = ig.start(False, False, False, y0, side0, par, ipar, out, w)
+    status = ig.start(False, False, y0, side0, par, ipar, out, w)
     st = b.st[l]
     fs = b.fs[l]
     for m in range(N_ST):
@@ -546,8 +546,8 @@ def _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b
     ig.finish(False, False, status, fs[F_TT], st[S_STEP], st[S_NIMP], st[S_NCOLWIN],
               fs[F_MAXERR], ipar, par, out, w)
     i = st[S_CELL]
-    kn._classify(False, status, ipar, cpar, out, res[i])
-    kn._collect(i, par[ig.P_H] * ipar[ig.I_N], n_pts, n_imp_pts, out, res, pts, imp_pts,
+    cell._classify(False, status, ipar, cpar, out, res[i])
+    cell._collect(i, par[ig.P_H] * ipar[ig.I_N], n_pts, n_imp_pts, out, res, pts, imp_pts,
                 n_got, n_imp_got)
     st[S_CELL] = -1
 

@@ -64,6 +64,9 @@ SCRIPTS = {
          "first_call_s", "compile_cpu_s", "compiles", "typing", "ir_inlining", "front_end_other",
          "lowering", "llvm_parse_link", "llvm_opt", "llvm_codegen", "cache", "other"],
         ["compile.png"]),
+    "bench_lanes.py": (["basin", "grid", "lanes", "cells_per_s", "ns_per_cell_step",
+                        "speedup_vs_1", "scalar_steps", "time_vector", "time_scalar", "bound"],
+                       ["lanes.png"]),
     "bench_stress.py": (
         ["id", "category", "hb", "alpha", "omega", "law", "e", "n_steps", "periods", "forcing",
          "status", "t", "n_impacts", "n_rhs", "work_bound", "wall_s", "failed_checks"],
