@@ -219,8 +219,17 @@ def test_keyboard_interrupt_inside_a_write_leaves_out_untouched(tmp_path, monkey
     assert _snapshot(tmp_path) == before_root  # no stage, no parent left behind
 
 
+@pytest.fixture
+def ctrl_c():
+    """Ctrl-C raises KeyboardInterrupt, as in a terminal: a shell starting the tests in the
+    background (``cmd &``) makes them ignore SIGINT, and a sent SIGINT would do nothing."""
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, old)
+
+
 @pytest.mark.parametrize("existing", [False, True])
-def test_signal_during_staging_leaves_out_untouched(tmp_path, existing):
+def test_signal_during_staging_leaves_out_untouched(tmp_path, existing, ctrl_c):
     out = tmp_path / "out"
     if existing:
         out.mkdir()
