@@ -147,7 +147,7 @@ NEWTON_ITERS = 8
 DELTA_EULER = 1e-8  # see locate
 
 
-def build(embed4: bool = False, tangent: bool = False, record: bool = False):
+def build(embed4: bool = False, tangent: bool = False):
     """Compile (once, then from numba's cache) the integrator for one set of switches.
 
     Parameters
@@ -157,16 +157,13 @@ def build(embed4: bool = False, tangent: bool = False, record: bool = False):
         the closed form ``r = sin(omega t + phi)``.
     tangent : bool
         Carry the 2×2 tangent matrix for Lyapunov exponents (SPEC.md §5).
-    record : bool
-        Whether the caller will record the dense trajectory every ``stride`` steps. Ignored:
-        recording is a run-time switch of the same compiled code (a ``traj`` of more than one
-        row, see :func:`_run`), which saves compiling a variant per switch (issue 15).
 
     Returns
     -------
     run : numba dispatcher
         ``run(y0, side0, par, ipar, out)`` with ``out`` an :data:`Outputs`; returns the status
-        code (see :func:`_loop`).
+        code (see :func:`_loop`). Recording is not a switch here: ``out.traj`` with more than
+        one row records the dense trajectory (see :func:`_run`; issue 15).
     """
     return _build(bool(embed4), bool(tangent))
 
@@ -724,7 +721,7 @@ def reset_tangent(EMBED4, y):
 
 
 @jit
-def _run(EMBED4, TANGENT, RECORD, y0, side0, par_in, ipar, out):
+def _run(EMBED4, TANGENT, y0, side0, par_in, ipar, out):
     """One run from ``y0`` on corner ``side0``: the parameters ``par_in`` (``N_PAR``) and
     settings ``ipar`` in, :data:`Outputs` ``out`` filled; returns the status code.
 
@@ -743,8 +740,8 @@ def _run(EMBED4, TANGENT, RECORD, y0, side0, par_in, ipar, out):
              np.zeros(N_STAGES + 1), np.zeros(N_STAGES + 1), np.zeros(4),
              np.zeros((ipar[I_N], N_STAGES + 1)))
     # Recording is a run-time switch (a trajectory array of more than one row), not a
-    # compile-time one: one compiled loop serves runs with and without it and the grids, which
-    # pass RECORD = False (ignored); its test costs nothing measurable per step (issue 15).
+    # compile-time one: one compiled loop serves runs with and without it and the grids; its
+    # test costs nothing measurable per step (issue 15).
     record = out.traj.shape[0] > 1
     return _loop(EMBED4, TANGENT, record, y0, side0, par, ipar, out, w)
 
@@ -904,7 +901,7 @@ def impact(EMBED4, TANGENT, t, t_lift, side, n_imp, in_window, par, out, w):
 
 
 @jit(nrt=False, inline=True)
-def grid_point(EMBED4, TANGENT, RECORD, t, step, side, n_imp, n_col, in_window, ipar, par,
+def grid_point(EMBED4, TANGENT, record, t, step, side, n_imp, n_col, in_window, ipar, par,
                out, w, j_per, k_per, j_qr, j_rec):
     """Bookkeeping at the end of grid step ``step`` (1-based count): the tangent vectors'
     renormalisation, the stroboscopic samples at ``kT`` and ``kT + T/2``, the early stop, the
@@ -945,7 +942,7 @@ def grid_point(EMBED4, TANGENT, RECORD, t, step, side, n_imp, n_col, in_window, 
     elif j_per == n_per // 2:
         sample(EMBED4, t, y, par, out.half[k_per])
         out.iout[O_NHALF] = k_per + 1
-    if RECORD and status == RUNNING:
+    if record and status == RUNNING:
         j_rec += 1
         if j_rec == ipar[I_STRIDE]:
             j_rec = 0
@@ -986,7 +983,7 @@ REST_END, REST_HOLD, REST_LIFT, REST_STEP = 0, 1, 2, 3
 
 
 @jit(nrt=False)
-def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, out, w):
+def _loop(EMBED4, TANGENT, record, y0, side0, par, ipar, out, w):
     """The integration: ``_run``'s arguments, the parameters with the derived constants
     (``N_PARW``), and the :data:`Work` arrays ``w``.
 
@@ -1113,7 +1110,7 @@ def _loop(EMBED4, TANGENT, RECORD, y0, side0, par, ipar, out, w):
             status = NONFINITE
             break
         status, j_per, k_per, j_qr, j_rec, collapsed = grid_point(
-            EMBED4, TANGENT, RECORD, t, step, side, n_imp, n_col, in_window, ipar, par, out, w,
+            EMBED4, TANGENT, record, t, step, side, n_imp, n_col, in_window, ipar, par, out, w,
             j_per, k_per, j_qr, j_rec)
         if collapsed:
             n_col += 1
@@ -1133,6 +1130,6 @@ def _build(EMBED4, TANGENT):
     # Recording is decided at run time (see _run).
     @jit
     def run(y0, side0, par, ipar, out):
-        return _run(EMBED4, TANGENT, False, y0, side0, par, ipar, out)
+        return _run(EMBED4, TANGENT, y0, side0, par, ipar, out)
 
     return run

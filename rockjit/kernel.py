@@ -138,7 +138,7 @@ def grid_bytes(n_cells, periods, n_steps, n_pts, n_imp_pts, tangent, chunk, thre
 def run_single(block, y0, phi, *, n_steps, periods, window, max_impacts, record_stride,
                embed4, lyapunov, qr_every, stop_at_overturn=True):
     """One compiled run (inputs validated by :func:`rockjit.simulate.plan`); a Result."""
-    run = ig.build(embed4=embed4, tangent=lyapunov, record=record_stride is not None)
+    run = ig.build(embed4=embed4, tangent=lyapunov)
     par = pack(block, phi, n_steps)
     ipar = settings(n_steps, periods, max_impacts, window, stride=record_stride or 1,
                     qr_every=qr_every, stop_at_overturn=stop_at_overturn,
@@ -203,7 +203,7 @@ def _impacts_in_order(ring, n_imp):
 @jit
 def _cell(TANGENT, y0, side0, par, ipar, cpar, out, res):
     """Run one cell and classify it; scalar results go to ``res`` (layout ``R_*``)."""
-    status = ig._run(False, TANGENT, False, y0, side0, par, ipar, out)
+    status = ig._run(False, TANGENT, y0, side0, par, ipar, out)
     _classify(TANGENT, status, ipar, cpar, out, res)
 
 

@@ -542,6 +542,14 @@ def _misc():
         Case("(no command)", "", {}, r"COMMAND|command", base=False),
         Case("frobnicate --out x", "frobnicate", {"--out": ["{out}"]}, r"frobnicate",
              base=False),
+        # rockjit compile takes only --quiet (issue 15): everything else is refused
+        Case("compile --all", "compile", {"--all": True}, r"--all", extra_ok=True, base=False),
+        Case("compile --out x", "compile", {"--out": ["{out}"]}, r"--out", extra_ok=True,
+             base=False),
+        Case("compile --threads 2", "compile", {"--threads": ["2"]}, r"--threads",
+             extra_ok=True, base=False),
+        Case("compile --quiet nan", "compile", {"--quiet": ["nan"]}, r"nan", extra_ok=True,
+             base=False),
     ]
 
 
