@@ -32,7 +32,9 @@ Writes lanes.{md,json} and lanes.png to benchmarks/results/ (quick/ with --quick
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import time
 
 import numba
 import numpy as np
@@ -49,10 +51,10 @@ from rockjit.analysis import GRID_N
 from rockjit.kernel import pack
 
 LS = (1, 2, 4, 8)
-FULL = dict(steps=2_000_000, reps=7, grid_full=100, periods_full=500, reps_full=1, grid_es=100,
-            reps_es=3)
-QUICK = dict(steps=40_000, reps=3, grid_full=12, periods_full=40, reps_full=2, grid_es=20,
-             reps_es=2)
+FULL = dict(grid_big=1000, steps=2_000_000, reps=7, grid_full=100, periods_full=500,
+            reps_full=1, grid_es=100, reps_es=3)
+QUICK = dict(grid_big=20, steps=40_000, reps=3, grid_full=12, periods_full=40, reps_full=2,
+             grid_es=20, reps_es=2)
 BASIN = dict(hb=1.0, alpha=0.66, omega=1.3, law="housner")  # the study's hb=1 basin
 
 #: Multiplies and FMAs of one block step (fast path, no slopes), from the source: per stage
@@ -243,6 +245,18 @@ def grids(cfg, threads):
 H_TSC_HZ = math.nan
 
 
+def big_basin(grid):
+    """Issue 17's second target: the study's hb=1 basin at ``grid`` x ``grid`` (500 periods,
+    early stop, attractors identified), once with one lane and once with eight; wall seconds."""
+    plan = an.plan_basin(hb=1.0, alpha=0.66, omega=1.3, law="housner", grid=grid)
+    out = {}
+    for L in (1, 8):
+        t0 = time.perf_counter()
+        an.run(dataclasses.replace(plan, lanes=L))
+        out[L] = time.perf_counter() - t0
+    return out
+
+
 def main(argv=None):
     global H_TSC_HZ
     b = H.Bench(__doc__, argv, options=_options)
@@ -255,6 +269,7 @@ def main(argv=None):
     mhz = cpu_mhz()
     H_TSC_HZ = mhz * 1e6
     grid_rows, grid_data, parts = grids(cfg, threads)
+    big = big_basin(cfg["grid_big"])
     numba.set_num_threads(1)
     ns, raw = measure(cfg)
     kinds = ("scalar", "lanes")
@@ -287,6 +302,9 @@ def main(argv=None):
           + "; ".join(f"{name}: " + ", ".join(f"{k} {v:.2f}" for k, v in p.items())
                       for (name, L), p in parts.items() if L == 8)
           + " (the rest: the lanes' bookkeeping and the cycle counter's own reads).\n\n"
+          + f"The study's hb=1 basin at {cfg['grid_big']}x{cfg['grid_big']} (500 periods, early "
+          f"stop, attractors identified; issue 17's target: 1000x1000 in under 60 s), one run "
+          f"each: {big[1]:.1f} s with one lane, {big[8]:.1f} s with eight.\n\n"
           + H.env_line(b.env) + "\n")
     plt = H.pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -303,10 +321,10 @@ def main(argv=None):
     ax.set_title("free-flight step, one thread")
     csv_cols = ["basin", "grid", "lanes", "cells_per_s", "ns_per_cell_step", "speedup_vs_1",
                 "scalar_steps", "time_vector", "time_scalar", "bound"]
-    b.report("lanes", markdown=md, csv=(csv_cols, [list(r[:10]) for r in grid_rows]), data=dict(ns_per_cell_step={f"{k}|{L}": ns[(k, L)]
-                                                               for (k, L) in ns},
-                                             mhz=mhz, raw=raw, cfg=cfg, grid_rows=grid_rows,
-                                             grids=grid_data, threads=threads),
+    b.report("lanes", markdown=md, csv=(csv_cols, [list(r[:10]) for r in grid_rows]),
+             data=dict(ns_per_cell_step={f"{k}|{L}": ns[(k, L)] for (k, L) in ns}, mhz=mhz,
+                       raw=raw, cfg=cfg, grid_rows=grid_rows, grids=grid_data, threads=threads,
+                       big_basin_s={str(k): v for k, v in big.items()}),
              figures=[("lanes.png", fig, 120)])
 
 
