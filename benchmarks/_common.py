@@ -80,6 +80,8 @@ class Bench:
     Attributes
     ----------
     args : argparse.Namespace
+    parser : argparse.ArgumentParser
+        For the script's own checks of its options (``bench.parser.error(...)``).
     quick : bool
         ``--quick`` was given.
     out_path : Path
@@ -95,6 +97,7 @@ class Bench:
         p = parser(doc.strip().splitlines()[0])
         if options is not None:
             options(p)
+        self.parser = p
         self.args = p.parse_args(argv)
         self.quick = bool(self.args.quick)
         if self.quick and self.args.out is not None and _same_path(self.args.out, RESULTS):

@@ -18,6 +18,7 @@ state and impact count of a run; the labels, periods, exponents and strobe point
 
     python benchmarks/bench_versions.py --base 4b22de6           # this checkout against 4b22de6
     python benchmarks/bench_versions.py --quick   # smoke: this checkout against itself, small
+    python benchmarks/bench_versions.py --base e16710d --cases run,run+lyapunov --out /tmp/b
 
 Without ``--base`` both workers import this checkout (a self-comparison: every case must come
 out identical, and the ratios near 1 show the method's noise).
@@ -107,6 +108,9 @@ def options(p):
     p.add_argument("--base", default=None,
                    help="the earlier commit (any git revision); default: this checkout itself")
     p.add_argument("--repeats", type=int, default=None, help="rounds (default 15; quick 3)")
+    p.add_argument("--cases", default=",".join(CASES),
+                   help=f"comma-separated subset of {', '.join(CASES)} (default: all), e.g. to "
+                        f"bisect one case's change quickly")
 
 
 def measure(bench, base_src, cases, repeats):
@@ -148,8 +152,12 @@ def main(argv=None):
     bench = H.Bench(__doc__, argv, options=options)
     a = bench.args
     repeats = a.repeats or (3 if bench.quick else 15)
+    chosen = [c.strip() for c in a.cases.split(",") if c.strip()]
+    unknown = sorted(set(chosen) - set(CASES))
+    if unknown or not chosen:
+        bench.parser.error(f"--cases: unknown {unknown}; choose from {', '.join(CASES)}")
     cases = {c: (fn, dict(kw, **(QUICK[c] if bench.quick else {})))
-             for c, (fn, kw) in CASES.items()}
+             for c, (fn, kw) in CASES.items() if c in chosen}
     if a.base is None:
         rev = "this checkout"
         rows, raw = measure(bench, H.ROOT, cases, repeats)
