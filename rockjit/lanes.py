@@ -306,7 +306,7 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, prof, counts):
         if hold and kind == ig.EV_UPLIFT:
             kind = ig.EV_NONE
         if kind == ig.EV_NONE:
-            max_err = ig.accept(NS, NY, side, hh, max_err, w)
+            max_err = ig.accept(EMBED4, TANGENT, side, hh, max_err, w)
             t = t_grid
             break
         if hi > lo:
