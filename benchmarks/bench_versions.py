@@ -108,33 +108,42 @@ def options(p):
     p.add_argument("--base", default=None,
                    help="the earlier commit (any git revision); default: this checkout itself")
     p.add_argument("--repeats", type=int, default=None, help="rounds (default 15; quick 3)")
+    p.add_argument("--processes", type=int, default=None,
+                   help="fresh worker pairs the rounds are shared out over (default 3; quick 1)")
     p.add_argument("--cases", default=",".join(CASES),
                    help=f"comma-separated subset of {', '.join(CASES)} (default: all), e.g. to "
                         f"bisect one case's change quickly")
 
 
-def measure(bench, base_src, cases, repeats):
-    """Every case in both versions, interleaved; rows and the raw times."""
+def measure(bench, base_src, cases, repeats, processes=1):
+    """Every case in both versions, interleaved; rows and the raw times.
+
+    The rounds are shared out over ``processes`` fresh pairs of workers, one pair after the
+    other: a process's own layout (where its arrays and code land) moves one version's time by
+    up to 10 % for the life of that process on this machine, so one pair alone can show a
+    difference that is not the code's."""
     here = H.ROOT
-    workers = {"base": Worker(base_src), "this": Worker(here)}
-    try:
-        for name, (fn, kw) in cases.items():  # warm: compile or load every variant once
+    raw = {(c, v): [] for c in cases for v in ("base", "this")}
+    cpu = {(c, v): [] for c in cases for v in ("base", "this")}
+    last = {}
+    per = [repeats // processes + (k < repeats % processes) for k in range(processes)]
+    for k, rounds in enumerate(per):
+        workers = {"base": Worker(base_src), "this": Worker(here)}
+        try:
+            for name, (fn, kw) in cases.items():  # warm: compile or load every variant once
+                for w in workers.values():
+                    w(fn, kw)
+            order = list(workers) if k % 2 else list(workers)[::-1]
+            for rep in range(rounds):
+                for c, (fn, kw) in cases.items():
+                    for v in (order if rep % 2 else order[::-1]):
+                        r = workers[v](fn, kw)
+                        raw[c, v].append(r["wall"])
+                        cpu[c, v].append(r["cpu"])
+                        last[c, v] = r
+        finally:
             for w in workers.values():
-                w(fn, kw)
-        order = list(workers)
-        raw = {(c, v): [] for c in cases for v in workers}
-        cpu = {(c, v): [] for c in cases for v in workers}
-        last = {}
-        for rep in range(repeats):
-            for c, (fn, kw) in cases.items():
-                for v in (order if rep % 2 else order[::-1]):
-                    r = workers[v](fn, kw)
-                    raw[c, v].append(r["wall"])
-                    cpu[c, v].append(r["cpu"])
-                    last[c, v] = r
-    finally:
-        for w in workers.values():
-            w.close()
+                w.close()
     rows = []
     for c in cases:
         b, t = H.median(raw[c, "base"]), H.median(raw[c, "this"])
@@ -152,6 +161,10 @@ def main(argv=None):
     bench = H.Bench(__doc__, argv, options=options)
     a = bench.args
     repeats = a.repeats or (3 if bench.quick else 15)
+    processes = a.processes or (1 if bench.quick else 3)
+    if not 1 <= processes <= repeats:
+        bench.parser.error(f"--processes must be in [1, --repeats = {repeats}] "
+                           f"(got {processes})")
     chosen = [c.strip() for c in a.cases.split(",") if c.strip()]
     unknown = sorted(set(chosen) - set(CASES))
     if unknown or not chosen:
@@ -160,7 +173,7 @@ def main(argv=None):
              for c, (fn, kw) in CASES.items() if c in chosen}
     if a.base is None:
         rev = "this checkout"
-        rows, raw = measure(bench, H.ROOT, cases, repeats)
+        rows, raw = measure(bench, H.ROOT, cases, repeats, processes)
     else:
         rev = subprocess.run(["git", "-C", str(H.ROOT), "rev-parse", "--short", a.base],
                              capture_output=True, text=True, check=True).stdout.strip()
@@ -169,14 +182,15 @@ def main(argv=None):
             subprocess.run(["git", "-C", str(H.ROOT), "worktree", "add", "--detach", "--quiet",
                             str(src), rev], check=True)
             try:
-                rows, raw = measure(bench, src, cases, repeats)
+                rows, raw = measure(bench, src, cases, repeats, processes)
             finally:
                 subprocess.run(["git", "-C", str(H.ROOT), "worktree", "remove", "--force",
                                 str(src)], check=False)
     this = bench.env.get("commit", "this checkout")
     lines = [f"#### Two versions side by side: {rev} (base) and {this} (this)", "",
-             f"Medians of {repeats} rounds, each case run in both versions back to back (order "
-             f"alternating), after one warm-up call each; `this/base` compares wall times, `CPU "
+             f"Medians of {repeats} rounds over {processes} fresh pairs of worker processes, each "
+             f"case run in both versions back to back (order alternating), after one warm-up "
+             f"call per process; `this/base` compares wall times, `CPU "
              f"this/base` the process CPU times (all threads; less sensitive to other work on a "
              f"shared machine); `identical`: both returned the same numbers bit for bit.", "",
              "| case | base | this | this/base | CPU this/base | ns/step base | ns/step this "
