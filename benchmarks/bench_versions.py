@@ -199,7 +199,8 @@ def main(argv=None):
         ns = ("", "") if r["base_ns_step"] is None else (f"{r['base_ns_step']:.0f}",
                                                         f"{r['this_ns_step']:.0f}")
         lines.append(f"| {r['case']} | {r['base_s']:.4g} s | {r['this_s']:.4g} s | "
-                     f"{r['ratio']:.3f} | {r['cpu_ratio']:.3f} | {ns[0]} | {ns[1]} | {'yes' if r['identical'] else 'no'} |")
+                     f"{r['ratio']:.3f} | {r['cpu_ratio']:.3f} | {ns[0]} | {ns[1]} | "
+                     f"{'yes' if r['identical'] else 'no'} |")
     markdown = "\n".join(lines) + "\n"
     plt = H.pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.2))
