@@ -498,3 +498,39 @@ def test_continuing_past_overturn_matches_the_scipy_path(alpha):
 def an_classify(result):
     from rockjit.analysis import classify_result
     return classify_result(result)
+
+
+@pytest.mark.parametrize("want_max", [True, False])
+def test_turning_point_is_the_derivatives_root(want_max):
+    """The extension's turning point (an apex, or the bottom of a grazing dip) is the root of its
+    derivative, a cubic, that the step's ends bracket: checked against numpy's polynomial roots
+    on random bracketing cubics, and against plain bisection when the ends do not bracket."""
+    rng = np.random.default_rng(17)
+    checked = 0
+    for _ in range(2000):
+        q = rng.normal(size=4) * 10.0 ** rng.uniform(-3, 3, size=4)
+        sgn = rng.choice([-1.0, 1.0])
+        coeffs = sgn * np.array([q[0], 2 * q[1], 3 * q[2], 4 * q[3]])  # d(x), ascending powers
+        d0, d1 = coeffs[0], coeffs.sum()
+        x = ig.turning_point(q[0], q[1], q[2], q[3], sgn, want_max)
+        assert 0.0 <= x <= 1.0
+        if ((d0 >= 0) == want_max) and ((d1 >= 0) != want_max):
+            roots = np.roots(coeffs[::-1])
+            real = roots[(abs(roots.imag) < 1e-9) & (roots.real >= 0) & (roots.real <= 1)].real
+            scale = np.abs(coeffs).sum()
+            # a root where the derivative crosses the wanted way, to round-off
+            slope = np.polyval(np.polyder(coeffs[::-1]), x)
+            assert abs(np.polyval(coeffs[::-1], x)) <= 1e-12 * scale or \
+                np.min(abs(real - x)) <= 1e-9, (q, sgn, x, real)
+            assert (slope <= 0) == want_max or abs(slope) <= 1e-9 * scale
+            checked += 1
+        else:
+            lo, hi = 0.0, 1.0
+            for _ in range(ig.BISECT_ITERS):
+                mid = 0.5 * (lo + hi)
+                if (np.polyval(coeffs[::-1], mid) >= 0) == want_max:
+                    lo = mid
+                else:
+                    hi = mid
+            assert abs(x - 0.5 * (lo + hi)) <= 1e-12
+    assert checked > 200  # about a fifth of random cubics are bracketed
