@@ -119,13 +119,15 @@ def measure(bench, base_src, cases, repeats, processes=1):
     """Every case in both versions, interleaved; rows and the raw times.
 
     The rounds are shared out over ``processes`` fresh pairs of workers, one pair after the
-    other: a process's own layout (where its arrays and code land) moves one version's time by
-    up to 10 % for the life of that process on this machine, so one pair alone can show a
-    difference that is not the code's."""
+    other: a process's own layout (where its arrays and code land, which core it gets) moves
+    one version's time by 10-20 % for the life of that process on this machine, so one pair
+    alone can show a difference that is not the code's. Each pair's own ratio (of its medians)
+    is kept too: their spread is the measurement's noise."""
     here = H.ROOT
     raw = {(c, v): [] for c in cases for v in ("base", "this")}
     cpu = {(c, v): [] for c in cases for v in ("base", "this")}
     last = {}
+    pair = {c: [] for c in cases}  # each pair's ratio of medians
     per = [repeats // processes + (k < repeats % processes) for k in range(processes)]
     for k, rounds in enumerate(per):
         workers = {"base": Worker(base_src), "this": Worker(here)}
@@ -141,6 +143,9 @@ def measure(bench, base_src, cases, repeats, processes=1):
                         raw[c, v].append(r["wall"])
                         cpu[c, v].append(r["cpu"])
                         last[c, v] = r
+            for c in cases:
+                pair[c].append(H.median(raw[c, "this"][-rounds:]) /
+                               H.median(raw[c, "base"][-rounds:]))
         finally:
             for w in workers.values():
                 w.close()
@@ -150,6 +155,7 @@ def measure(bench, base_src, cases, repeats, processes=1):
         steps = last[c, "this"]["steps"]
         cb, ct = H.median(cpu[c, "base"]), H.median(cpu[c, "this"])
         rows.append(dict(case=c, base_s=b, this_s=t, ratio=t / b, cpu_ratio=ct / cb,
+                         pair_min=min(pair[c]), pair_max=max(pair[c]),
                          base_ns_step=b / steps * 1e9 if steps else None,
                          this_ns_step=t / steps * 1e9 if steps else None,
                          identical=last[c, "base"]["digest"] == last[c, "this"]["digest"]))
@@ -190,23 +196,27 @@ def main(argv=None):
     lines = [f"#### Two versions side by side: {rev} (base) and {this} (this)", "",
              f"Medians of {repeats} rounds over {processes} fresh pairs of worker processes, each "
              f"case run in both versions back to back (order alternating), after one warm-up "
-             f"call per process; `this/base` compares wall times, `CPU "
+             f"call per process; `this/base` compares wall times (`pairs`: the lowest and highest "
+             f"ratio of one pair of processes alone, the measurement's noise), `CPU "
              f"this/base` the process CPU times (all threads; less sensitive to other work on a "
              f"shared machine); `identical`: both returned the same numbers bit for bit.", "",
-             "| case | base | this | this/base | CPU this/base | ns/step base | ns/step this "
-             "| identical |", "|---|---|---|---|---|---|---|---|"]
+             "| case | base | this | this/base | pairs | CPU this/base | ns/step base "
+             "| ns/step this | identical |", "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         ns = ("", "") if r["base_ns_step"] is None else (f"{r['base_ns_step']:.0f}",
                                                         f"{r['this_ns_step']:.0f}")
         lines.append(f"| {r['case']} | {r['base_s']:.4g} s | {r['this_s']:.4g} s | "
-                     f"{r['ratio']:.3f} | {r['cpu_ratio']:.3f} | {ns[0]} | {ns[1]} | "
+                     f"{r['ratio']:.3f} | {r['pair_min']:.2f}-{r['pair_max']:.2f} | "
+                     f"{r['cpu_ratio']:.3f} | {ns[0]} | {ns[1]} | "
                      f"{'yes' if r['identical'] else 'no'} |")
     markdown = "\n".join(lines) + "\n"
     plt = H.pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.2))
-    ax.barh([r["case"] for r in rows], [r["ratio"] for r in rows], color="tab:blue")
+    ax.barh([r["case"] for r in rows], [r["ratio"] for r in rows], color="tab:blue",
+            xerr=[[max(r["ratio"] - r["pair_min"], 0.0) for r in rows],
+                  [max(r["pair_max"] - r["ratio"], 0.0) for r in rows]], capsize=3)
     ax.axvline(1.0, color="k", lw=0.8)
-    ax.set_xlabel(f"wall time, this / base ({rev})")
+    ax.set_xlabel(f"wall time, this / base ({rev}); bars: single pairs of processes")
     ax.invert_yaxis()
     fig.tight_layout()
     keys = list(rows[0])
