@@ -71,6 +71,21 @@ def fma(typingctx, a, b, c):
     return sig, codegen
 
 
+@intrinsic
+def cycles(typingctx):
+    """The CPU's cycle counter (LLVM's ``readcyclecounter``: ``rdtsc`` on x86-64), for the
+    lanes' own accounting of where their time goes (read only when profiling: each read costs
+    tens of cycles)."""
+    sig = types.int64()
+
+    def codegen(context, builder, signature, args):
+        fn = builder.module.declare_intrinsic("llvm.readcyclecounter", fnty=ir.FunctionType(
+            ir.IntType(64), []))
+        return builder.call(fn, [])
+
+    return sig, codegen
+
+
 # ---- keeping numba's on-disk cache honest ------------------------------------------------------
 # numba invalidates a cached function only when its own source file changes; the kernels inline
 # code from other modules (model.py, _jit.py), and an edit there would leave stale machine code

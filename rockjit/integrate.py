@@ -50,7 +50,7 @@ from fractions import Fraction
 
 import numpy as np
 
-from ._jit import fma, jit
+from ._jit import cycles, fma, jit
 from .classify import orbit_scale, repeats
 from .result import STATUSES
 from .model import (NEAR_RANGE, SINCOS_RANGE, accel_near, accel_pq, corner, forcing_closed, jump,
@@ -1014,23 +1014,165 @@ def finish(EMBED4, TANGENT, status, t, step, n_imp, n_col_win, max_err, ipar, pa
 REST_END, REST_HOLD, REST_LIFT, REST_STEP = 0, 1, 2, 3
 
 
-@jit(nrt=False)
-def _loop(EMBED4, TANGENT, record, y0, side0, par, ipar, out, w):
-    """The integration: ``_run``'s arguments, the parameters with the derived constants
-    (``N_PARW``), and the :data:`Work` arrays ``w``.
+@jit(nrt=False, inline=True)
+def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k_per, j_qr,
+              j_rec, n_col, n_col_win, t_lift, max_err, par, ipar, out, w, counts):
+    """One grid step, from ``t`` (the grid point ``step h``, or the block still at rest) to the
+    next grid point (SPEC.md §4): a step of the current corner, or of rest; an event in it is
+    located, the state taken there (impact: :func:`impact`; uplift; overturning ends the run),
+    and the step finished from the event to the grid point; then :func:`grid_point`.
 
-    Grid step by grid step (SPEC.md §4): a step of the current corner, or of rest; an event in
-    it is located, the state taken there (impact: :func:`impact`; uplift; overturning ends the
-    run), and the step finished from the event to the grid point; then :func:`grid_point`.
+    The loop's state goes in and comes back out: ``(status, t, side, n_imp, step, j_per, k_per,
+    j_qr, j_rec, n_col, n_col_win, t_lift, max_err)``. The one step of the single-lane loop
+    (:func:`_loop`) and of a lane taken out of the lanes' lockstep (:mod:`rockjit.lanes`): with
+    ``pre`` the grid step's first Runge–Kutta step is already in ``K``, ``w.ynew``, ``w.jac``
+    and ``w.trig``. With ``PROF``, ``counts[6:13]`` receive the cycles spent in rest phases,
+    in the steps after an event, in locating, in impacts, in detection, in the first step and
+    at the grid point (the lanes' accounting; the single-lane loop passes ``PROF = False``).
     """
     NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
     NY = NS + (4 if TANGENT else 0)  # plus the tangent matrix, column-major
-    n_per = ipar[I_N]
-    total = n_per * ipar[I_PERIODS]
-    win_step = ipar[I_WINDOW] * n_per
     h = par[P_H]
     y = w.y
     K = w.K
+    status = RUNNING
+    j = j_per
+    t_grid = (step + 1) * h
+    in_window = step >= ipar[I_WINDOW] * ipar[I_N]
+    fresh = True  # no event yet in this grid step
+    # Held at rest until the grid point: set when a flight that began at an uplift ends at
+    # rest within rounding of that instant (forcing a hair above the uplift threshold, where
+    # the acceleration rounds to zero); otherwise the uplift would be found again at the
+    # same instant forever (found by the stress suite).
+    hold = False
+    while True:
+        if side == 0:
+            c0 = cycles() if PROF else 0
+            action, t, side = leave_rest(EMBED4, t, t_grid, hold, y, side, par, w, out.iout)
+            if PROF:
+                counts[6] += cycles() - c0
+            if action == REST_END:
+                status = REST
+                break
+            if action == REST_HOLD:
+                break
+            if action == REST_LIFT:
+                t_lift = t
+                fresh = EMBED4 and fresh
+                continue
+        if fresh:
+            # a whole grid step: the forcing phase there is phi + 2 pi j / N exactly
+            hh = h
+            if not pre:
+                c0 = cycles() if PROF else 0
+                rk_step(EMBED4, TANGENT, not EMBED4, 0.0, 0.0, y, K, side, par, w.ytmp, w.ynew,
+                        w.tab_h, w.fr if EMBED4 else w.ftab[j], w.jac, w.trig)
+                if PROF:
+                    counts[11] += cycles() - c0
+            pre = False
+        else:
+            c0 = cycles() if PROF else 0
+            hh = t_grid - t
+            psi = par[P_OMEGA] * t + par[P_PHI]
+            step_table(par[P_OMEGA], hh, w.tab)
+            rk_step(EMBED4, TANGENT, False, math.sin(psi), math.cos(psi), y, K, side, par,
+                    w.ytmp, w.ynew, w.tab, w.fr, w.jac, w.trig)
+            if PROF:
+                counts[7] += cycles() - c0
+        out.iout[O_RHS] += N_STAGES
+        out.iout[O_SUBSTEPS] += 1
+        c0 = cycles() if PROF else 0
+        kind, lo, hi = detect(y, w.ynew, hh, K, side, par)
+        if PROF:
+            counts[10] += cycles() - c0
+        if hold and kind == EV_UPLIFT:
+            kind = EV_NONE
+        if kind == EV_NONE:
+            max_err = accept(EMBED4, TANGENT, side, hh, max_err, w)
+            t = t_grid
+            break
+        c0 = cycles() if PROF else 0
+        if hi > lo:
+            tau = locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, w.ytmp,
+                         w.yev, out.iout, w.tab, w.fr, w.jac, w.trig)
+        else:
+            # an unresolvably small flight: take it as ending at rest where it started
+            tau = 0.0
+            for m in range(NY):
+                w.yev[m] = y[m]
+            w.yev[1] = 0.0
+        if PROF:
+            counts[8] += cycles() - c0
+        t = t + tau
+        fresh = False
+        for m in range(NY):
+            y[m] = w.yev[m]
+        if kind == EV_OVERTURN:
+            if ipar[I_CONTINUE] == 0:
+                status = OVERTURNED
+                break
+            # the study's way: note the first crossing and integrate on (the same field;
+            # the threshold is lifted so that the crossing is not found again)
+            out.fout[F_TOVER] = t
+            par[P_THOVER] = math.inf
+            rhs(EMBED4, forcing_at(t, par), y, side, par, K, w.jac, w.trig)
+            out.iout[O_RHS] += 1
+            continue
+        if kind == EV_UPLIFT:
+            y[0] = 0.0
+            y[1] = 0.0
+            side = 1 if y[2] > 0.0 else -1
+            t_lift = t
+            rhs(EMBED4, forcing_at(t, par), y, side, par, K, w.jac, w.trig)
+            out.iout[O_RHS] += 1
+            continue
+        c0 = cycles() if PROF else 0
+        side, n_imp, rests, held = impact(EMBED4, TANGENT, t, t_lift, side, n_imp,
+                                          in_window, par, out, w)
+        if PROF:
+            counts[9] += cycles() - c0
+        if rests:
+            hold = hold or held
+            if TANGENT:
+                # A rest phase ends every perturbation: a nearby state reaches rest too (its
+                # Zeno cascade ends a little earlier or later), and the block leaves rest
+                # when the forcing alone says. The flow's Jacobian across it is zero, and
+                # the exponents of a stretch holding one are -inf (SPEC.md §5). (Banking the
+                # vectors' growth instead counted the cascade's saltation entries, ~1/theta'
+                # at the last impacts, as growth: exponents that depended on rest_speed.)
+                reset_tangent(EMBED4, y)
+                n_col += 1
+                if in_window:
+                    n_col_win += 1
+        if n_imp >= ipar[I_MAXIMP]:
+            status = MAX_IMPACTS
+            break
+    if status == RUNNING:
+        step += 1
+        if not (math.isfinite(y[0]) and math.isfinite(y[1])):
+            status = NONFINITE
+        else:
+            c0 = cycles() if PROF else 0
+            status, j_per, k_per, j_qr, j_rec, collapsed = grid_point(
+                EMBED4, TANGENT, record, t, step, side, n_imp, n_col, in_window, ipar, par,
+                out, w, j_per, k_per, j_qr, j_rec)
+            if PROF:
+                counts[12] += cycles() - c0
+            if collapsed:
+                n_col += 1
+                if in_window:
+                    n_col_win += 1
+    return (status, t, side, n_imp, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win, t_lift,
+            max_err)
+
+
+@jit(nrt=False)
+def _loop(EMBED4, TANGENT, record, y0, side0, par, ipar, out, w):
+    """The integration: ``_run``'s arguments, the parameters with the derived constants
+    (``N_PARW``), and the :data:`Work` arrays ``w``; grid step by grid step
+    (:func:`grid_step`) to the end, then :func:`finish`."""
+    n_per = ipar[I_N]
+    total = n_per * ipar[I_PERIODS]
     status = start(EMBED4, TANGENT, y0, side0, par, ipar, out, w)
     side = side0
     t = 0.0
@@ -1045,109 +1187,10 @@ def _loop(EMBED4, TANGENT, record, y0, side0, par, ipar, out, w):
     n_col_win = n_col if ipar[I_WINDOW] == 0 else 0
     t_lift = -math.inf  # instant of the latest uplift
     while step < total and status == RUNNING:
-        t_grid = (step + 1) * h
-        in_window = step >= win_step
-        fresh = True  # no event yet in this grid step
-        # Held at rest until the grid point: set when a flight that began at an uplift ends at
-        # rest within rounding of that instant (forcing a hair above the uplift threshold, where
-        # the acceleration rounds to zero); otherwise the uplift would be found again at the
-        # same instant forever (found by the stress suite).
-        hold = False
-        while True:
-            if side == 0:
-                action, t, side = leave_rest(EMBED4, t, t_grid, hold, y, side, par, w, out.iout)
-                if action == REST_END:
-                    status = REST
-                    break
-                if action == REST_HOLD:
-                    break
-                if action == REST_LIFT:
-                    t_lift = t
-                    fresh = EMBED4 and fresh
-                    continue
-            if fresh:
-                # a whole grid step: the forcing phase there is phi + 2 pi j / N exactly
-                hh = h
-                rk_step(EMBED4, TANGENT, not EMBED4, 0.0, 0.0, y, K, side, par, w.ytmp, w.ynew,
-                        w.tab_h, w.fr if EMBED4 else w.ftab[j_per], w.jac, w.trig)
-            else:
-                hh = t_grid - t
-                psi = par[P_OMEGA] * t + par[P_PHI]
-                step_table(par[P_OMEGA], hh, w.tab)
-                rk_step(EMBED4, TANGENT, False, math.sin(psi), math.cos(psi), y, K, side, par,
-                        w.ytmp, w.ynew, w.tab, w.fr, w.jac, w.trig)
-            out.iout[O_RHS] += N_STAGES
-            out.iout[O_SUBSTEPS] += 1
-            kind, lo, hi = detect(y, w.ynew, hh, K, side, par)
-            if hold and kind == EV_UPLIFT:
-                kind = EV_NONE
-            if kind == EV_NONE:
-                max_err = accept(EMBED4, TANGENT, side, hh, max_err, w)
-                t = t_grid
-                break
-            if hi > lo:
-                tau = locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, w.ytmp,
-                             w.yev, out.iout, w.tab, w.fr, w.jac, w.trig)
-            else:
-                # an unresolvably small flight: take it as ending at rest where it started
-                tau = 0.0
-                for m in range(NY):
-                    w.yev[m] = y[m]
-                w.yev[1] = 0.0
-            t = t + tau
-            fresh = False
-            for m in range(NY):
-                y[m] = w.yev[m]
-            if kind == EV_OVERTURN:
-                if ipar[I_CONTINUE] == 0:
-                    status = OVERTURNED
-                    break
-                # the study's way: note the first crossing and integrate on (the same field;
-                # the threshold is lifted so that the crossing is not found again)
-                out.fout[F_TOVER] = t
-                par[P_THOVER] = math.inf
-                rhs(EMBED4, forcing_at(t, par), y, side, par, K, w.jac, w.trig)
-                out.iout[O_RHS] += 1
-                continue
-            if kind == EV_UPLIFT:
-                y[0] = 0.0
-                y[1] = 0.0
-                side = 1 if y[2] > 0.0 else -1
-                t_lift = t
-                rhs(EMBED4, forcing_at(t, par), y, side, par, K, w.jac, w.trig)
-                out.iout[O_RHS] += 1
-                continue
-            side, n_imp, rests, held = impact(EMBED4, TANGENT, t, t_lift, side, n_imp,
-                                              in_window, par, out, w)
-            if rests:
-                hold = hold or held
-                if TANGENT:
-                    # A rest phase ends every perturbation: a nearby state reaches rest too (its
-                    # Zeno cascade ends a little earlier or later), and the block leaves rest
-                    # when the forcing alone says. The flow's Jacobian across it is zero, and
-                    # the exponents of a stretch holding one are -inf (SPEC.md §5). (Banking the
-                    # vectors' growth instead counted the cascade's saltation entries, ~1/theta'
-                    # at the last impacts, as growth: exponents that depended on rest_speed.)
-                    reset_tangent(EMBED4, y)
-                    n_col += 1
-                    if in_window:
-                        n_col_win += 1
-            if n_imp >= ipar[I_MAXIMP]:
-                status = MAX_IMPACTS
-                break
-        if status != RUNNING:
-            break
-        step += 1
-        if not (math.isfinite(y[0]) and math.isfinite(y[1])):
-            status = NONFINITE
-            break
-        status, j_per, k_per, j_qr, j_rec, collapsed = grid_point(
-            EMBED4, TANGENT, record, t, step, side, n_imp, n_col, in_window, ipar, par, out, w,
-            j_per, k_per, j_qr, j_rec)
-        if collapsed:
-            n_col += 1
-            if in_window:
-                n_col_win += 1
+        (status, t, side, n_imp, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win, t_lift,
+         max_err) = grid_step(EMBED4, TANGENT, record, False, False, t, side, n_imp, step,
+                              j_per, k_per, j_qr, j_rec, n_col, n_col_win, t_lift, max_err,
+                              par, ipar, out, w, out.iout)
     if status == RUNNING:
         status = DONE
     out.iout[O_NCOL] = n_col

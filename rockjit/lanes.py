@@ -19,13 +19,11 @@ import math
 from collections import namedtuple
 
 import numpy as np
-from llvmlite import ir
-from numba import prange, types
-from numba.extending import intrinsic
+from numba import prange
 
 from . import integrate as ig
 from . import cell
-from ._jit import fma, jit
+from ._jit import cycles, fma, jit
 from .model import (NEAR_RANGE, SINCOS_RANGE, accel_near, corner, initial_side, rotate,
                     sincos_poly)
 
@@ -69,20 +67,6 @@ def lane_tables(tab, lin, lane):
 #: Lanes at most (the row length of the lanes' arrays: a compile-time constant, so that the
 #: vectoriser knows rows apart)
 W = 8
-
-
-@intrinsic
-def cycles(typingctx):
-    """The CPU's cycle counter (LLVM's ``readcyclecounter``: ``rdtsc`` on x86-64), for the
-    lanes' own accounting of where their time goes."""
-    sig = types.int64()
-
-    def codegen(context, builder, signature, args):
-        fn = builder.module.declare_intrinsic("llvm.readcyclecounter", fnty=ir.FunctionType(
-            ir.IntType(64), []))
-        return builder.call(fn, [])
-
-    return sig, codegen
 
 
 # rows of the lanes' input ``lin`` and output ``lout`` (:func:`block_step_lanes`)
@@ -228,146 +212,19 @@ N_FS = 3
 
 @jit(nrt=False)
 def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, prof, counts):
-    """One grid step of a lane on the scalar path: the body of the loop of
-    :func:`rockjit.integrate._loop` (closed-form forcing, no trajectory), its variables kept in
-    ``st`` and ``fs``. Used for every step the lanes' fast path does not take (an event, a rest
-    phase, a stage out of the polynomial's range), so that each lane runs exactly the
-    single-lane code there. ``pre``: the grid step's first Runge–Kutta step is in ``w``
-    already (``K[1:]``, ``ynew``, ``trig[2:4]``: the vector step's, which equals it when it
+    """One grid step of a lane on the scalar path: :func:`rockjit.integrate.grid_step`, the
+    single-lane loop's own step (closed-form forcing, no trajectory), with the lane's loop
+    variables kept in ``st`` and ``fs``. Used for every step the lanes' fast path does not take
+    (an event, a rest phase, a stage out of the polynomial's range), so that each lane runs
+    exactly the single-lane code there. ``pre``: the grid step's first Runge–Kutta step is in
+    ``w`` already (``K[1:]``, ``ynew``, ``trig[2:4]``: the vector step's, which equals it when it
     stayed in range), so it is not taken again. With ``prof``, ``counts[6:13]`` receive the
-    cycles spent in rest phases (:func:`rockjit.integrate.leave_rest`), in the steps after an
-    event (from the event to the grid point), in locating events
-    (:func:`rockjit.integrate.locate`), in impacts (:func:`rockjit.integrate.impact`), in
-    detection (:func:`rockjit.integrate.detect`),
-    in the grid step's first Runge–Kutta step where it was taken again (the vector step's left
-    the polynomials' range, or the block was at rest) and at the grid point
-    (:func:`rockjit.integrate.grid_point`)."""
-    EMBED4 = False
-    RECORD = False
-    NS = 2
-    NY = NS + (4 if TANGENT else 0)
-    n_per = ipar[ig.I_N]
-    win_step = ipar[ig.I_WINDOW] * n_per
-    h = par[ig.P_H]
-    y = w.y
-    K = w.K
-    status = st[S_STATUS]
-    side = st[S_SIDE]
-    n_imp = st[S_NIMP]
-    step = st[S_STEP]
-    j_per = st[S_JPER]
-    k_per = st[S_KPER]
-    j_qr = st[S_JQR]
-    j_rec = st[S_JREC]
-    n_col = st[S_NCOL]
-    n_col_win = st[S_NCOLWIN]
-    t = fs[F_TT]
-    max_err = fs[F_MAXERR]
-    t_lift = fs[F_TLIFT]
-    t_grid = (step + 1) * h
-    in_window = step >= win_step
-    fresh = True
-    hold = False
-    while True:
-        if side == 0:
-            c0 = cycles() if prof else 0
-            action, t, side = ig.leave_rest(EMBED4, t, t_grid, hold, y, side, par, w, out.iout)
-            counts[6] += (cycles() - c0) if prof else 0
-            if action == ig.REST_END:
-                status = ig.REST
-                break
-            if action == ig.REST_HOLD:
-                break
-            if action == ig.REST_LIFT:
-                t_lift = t
-                fresh = EMBED4 and fresh
-                continue
-        if fresh:
-            hh = h
-            if not pre:
-                c0 = cycles() if prof else 0
-                ig.rk_step(EMBED4, TANGENT, not EMBED4, 0.0, 0.0, y, K, side, par, w.ytmp,
-                           w.ynew, w.tab_h, w.fr if EMBED4 else w.ftab[j_per], w.jac, w.trig)
-                counts[11] += (cycles() - c0) if prof else 0
-            pre = False
-        else:
-            c0 = cycles() if prof else 0
-            hh = t_grid - t
-            psi = par[ig.P_OMEGA] * t + par[ig.P_PHI]
-            ig.step_table(par[ig.P_OMEGA], hh, w.tab)
-            ig.rk_step(EMBED4, TANGENT, False, math.sin(psi), math.cos(psi), y, K, side, par,
-                       w.ytmp, w.ynew, w.tab, w.fr, w.jac, w.trig)
-            counts[7] += (cycles() - c0) if prof else 0
-        out.iout[ig.O_RHS] += ig.N_STAGES
-        out.iout[ig.O_SUBSTEPS] += 1
-        c0 = cycles() if prof else 0
-        kind, lo, hi = ig.detect(y, w.ynew, hh, K, side, par)
-        counts[10] += (cycles() - c0) if prof else 0
-        if hold and kind == ig.EV_UPLIFT:
-            kind = ig.EV_NONE
-        if kind == ig.EV_NONE:
-            max_err = ig.accept(EMBED4, TANGENT, side, hh, max_err, w)
-            t = t_grid
-            break
-        if hi > lo:
-            c0 = cycles() if prof else 0
-            tau = ig.locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, w.ytmp,
-                            w.yev, out.iout, w.tab, w.fr, w.jac, w.trig)
-            counts[8] += (cycles() - c0) if prof else 0
-        else:
-            tau = 0.0
-            for m in range(NY):
-                w.yev[m] = y[m]
-            w.yev[1] = 0.0
-        t = t + tau
-        fresh = False
-        for m in range(NY):
-            y[m] = w.yev[m]
-        if kind == ig.EV_OVERTURN:
-            if ipar[ig.I_CONTINUE] == 0:
-                status = ig.OVERTURNED
-                break
-            out.fout[ig.F_TOVER] = t
-            par[ig.P_THOVER] = math.inf
-            ig.rhs(EMBED4, ig.forcing_at(t, par), y, side, par, K, w.jac, w.trig)
-            out.iout[ig.O_RHS] += 1
-            continue
-        if kind == ig.EV_UPLIFT:
-            y[0] = 0.0
-            y[1] = 0.0
-            side = 1 if y[2] > 0.0 else -1
-            t_lift = t
-            ig.rhs(EMBED4, ig.forcing_at(t, par), y, side, par, K, w.jac, w.trig)
-            out.iout[ig.O_RHS] += 1
-            continue
-        c0 = cycles() if prof else 0
-        side, n_imp, rests, held = ig.impact(EMBED4, TANGENT, t, t_lift, side, n_imp,
-                                             in_window, par, out, w)
-        counts[9] += (cycles() - c0) if prof else 0
-        if rests:
-            hold = hold or held
-            if TANGENT:
-                ig.reset_tangent(EMBED4, y)
-                n_col += 1
-                if in_window:
-                    n_col_win += 1
-        if n_imp >= ipar[ig.I_MAXIMP]:
-            status = ig.MAX_IMPACTS
-            break
-    if status == ig.RUNNING:
-        step += 1
-        if not (math.isfinite(y[0]) and math.isfinite(y[1])):
-            status = ig.NONFINITE
-        else:
-            c0 = cycles() if prof else 0
-            status, j_per, k_per, j_qr, j_rec, collapsed = ig.grid_point(
-                EMBED4, TANGENT, RECORD, t, step, side, n_imp, n_col, in_window, ipar, par,
-                out, w, j_per, k_per, j_qr, j_rec)
-            counts[12] += (cycles() - c0) if prof else 0
-            if collapsed:
-                n_col += 1
-                if in_window:
-                    n_col_win += 1
+    cycles of its parts (see :func:`rockjit.integrate.grid_step`)."""
+    (status, t, side, n_imp, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win, t_lift,
+     max_err) = ig.grid_step(False, TANGENT, False, prof, pre, fs[F_TT], st[S_SIDE], st[S_NIMP],
+                             st[S_STEP], st[S_JPER], st[S_KPER], st[S_JQR], st[S_JREC],
+                             st[S_NCOL], st[S_NCOLWIN], fs[F_TLIFT], fs[F_MAXERR], par, ipar,
+                             out, w, counts)
     st[S_STATUS] = status
     st[S_SIDE] = side
     st[S_NIMP] = n_imp
