@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -184,12 +185,15 @@ class Block:
         else:
             object.__setattr__(self, "e", None)
 
-    @property
+    # thc and the restitution are computed once per block (numpy on scalars: a microsecond
+    # each, a run's fixed cost); cached_property writes the instance's __dict__ directly, which
+    # a frozen dataclass allows
+    @cached_property
     def thc(self) -> float:
         """``arctan(hb)``."""
         return float(thc_from_hb(self.hb))
 
-    @property
+    @cached_property
     def restitution(self) -> float:
         """The coefficient of restitution of this block under its law."""
         if self.law == "constant":

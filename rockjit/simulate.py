@@ -172,14 +172,31 @@ def check_theta0(theta0, block, name="theta0"):
     return theta0
 
 
+#: Blocks made from plain numbers, by their arguments: a Block is immutable and validated once
+#: (its checks were a sixth of a short run's fixed cost, issue 16).
+_BLOCKS = {}
+_PLAIN = (float, int, str, type(None))
+
+
 def make_block(hb, alpha, omega, law=None, e=None, xi=None, theta_over=0.5 * math.pi,
                rest_speed=1e-6):
     """A :class:`Block` from the API's keyword arguments (``xi=None``: the study's value)."""
+    key = (hb, alpha, omega, law, e, xi, theta_over, rest_speed)
+    plain = all(type(v) in _PLAIN for v in key)
+    if plain:
+        block = _BLOCKS.get(key)
+        if block is not None:
+            return block
     kw = dict(hb=hb, alpha=alpha, omega=omega, law=law, e=e, theta_over=theta_over,
               rest_speed=rest_speed)
     if xi is not None:
         kw["xi"] = xi
-    return Block(**kw)
+    block = Block(**kw)
+    if plain:
+        if len(_BLOCKS) >= 1024:
+            _BLOCKS.clear()
+        _BLOCKS[key] = block
+    return block
 
 
 @dataclass(frozen=True)

@@ -38,12 +38,15 @@ def _range_text(lo, hi, lo_open, hi_open):
 
 def real(name, value, lo=None, hi=None, *, lo_open=False, hi_open=False):
     """A finite real number in the given range (``None``: unbounded on that side)."""
-    if isinstance(value, (bool, np.bool_)) or isinstance(value, str) and not value.strip():
-        raise ValueError(f"{name} must be a real number (got {value!r})")
-    try:
-        v = float(value)
-    except (TypeError, ValueError, OverflowError):
-        raise ValueError(f"{name} must be a real number (got {value!r})") from None
+    if type(value) is float:  # the common case, checked first (a run's fixed cost)
+        v = value
+    else:
+        if isinstance(value, (bool, np.bool_)) or isinstance(value, str) and not value.strip():
+            raise ValueError(f"{name} must be a real number (got {value!r})")
+        try:
+            v = float(value)
+        except (TypeError, ValueError, OverflowError):
+            raise ValueError(f"{name} must be a real number (got {value!r})") from None
     if not math.isfinite(v):
         raise ValueError(f"{name} must be finite (got {v})")
     bad = (lo is not None and (v < lo or (lo_open and v == lo))) or \

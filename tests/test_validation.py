@@ -187,3 +187,21 @@ def test_memory_estimate_names_the_need_and_the_limit():
     with pytest.raises(ValueError, match=r"x would need 1\.0 GiB; at most 800\.0 MiB fits"):
         memory("x", 2.0**30, limit=1000 * 2.0**20)
     memory("x", 2.0**20, limit=1000 * 2.0**20)  # fits: no error
+
+
+def test_blocks_made_once_and_refusals_never_remembered():
+    """simulate.make_block keeps the blocks it made from plain numbers (a run's fixed cost): the
+    same arguments give the same block, other arguments another, and a refused block is refused
+    again (nothing invalid is kept)."""
+    from rockjit.simulate import make_block
+    a = make_block(1.0, 0.6, 1.3, "housner")
+    assert make_block(1.0, 0.6, 1.3, "housner") is a
+    b = make_block(1.0, 0.6, 1.3, "mao")
+    assert b is not a and b.restitution != a.restitution
+    assert make_block(np.float64(1.0), 0.6, 1.3, "housner") == a  # not kept, still equal
+    for _ in range(2):
+        with pytest.raises(ValueError, match="alpha"):
+            make_block(1.0, -0.6, 1.3, "housner")
+    with pytest.raises(ValueError, match="hb"):
+        make_block(0.5, 0.6, 1.3, "housner")  # below 1/sqrt(2) for Housner's law
+    assert make_block(0.5, 0.6, 1.3, "mao").hb == 0.5
