@@ -40,7 +40,7 @@ Several package roots can be measured side by side (``--root NAME=DIR``, a folde
 ``rockjit`` package; default: this checkout), e.g. the code as it is and a patched copy: that is
 how the levers of issue 15 are compared (benchmarks/README.md).
 
-    flock /work/timing.lock python benchmarks/bench_compile.py          # full (~15 min)
+    python benchmarks/bench_compile.py          # full (~15 min)
     python benchmarks/bench_compile.py --quick    # smoke (seconds): one small function
     python benchmarks/bench_compile.py --root base=. --root new=/tmp/patched --parts speed
 

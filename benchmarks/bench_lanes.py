@@ -23,9 +23,9 @@ share of the time in the vector steps and in the steps taken by the single-lane 
 rest phases), with the speed-up that remains possible if those keep their cost (Amdahl: the L=1
 time over the time of the scalar steps).
 
-    flock /work/timing.lock python benchmarks/bench_lanes.py           # ~10 min
-    flock /work/timing.lock python benchmarks/bench_lanes.py --quick
-    flock /work/timing.lock python benchmarks/bench_lanes.py --grid-full 40 --periods-full 200
+    python benchmarks/bench_lanes.py           # ~10 min
+    python benchmarks/bench_lanes.py --quick
+    python benchmarks/bench_lanes.py --grid-full 40 --periods-full 200
 
 Writes lanes.{md,json} and lanes.png to benchmarks/results/ (quick/ with --quick, or --out).
 """

@@ -80,7 +80,8 @@ class GridPlan:
     attractors: bool = False  # identify the attractors (rockjit.attractors)
     phi: float = 0.0          # the forcing phase (basins: of every cell)
     uncertainty: float | None = None  # flag the cells whose outcome moves with eps
-    lanes: int = 1            # cells per thread in lockstep (rockjit.lanes; same results)
+    lanes: int | None = None  # cells per thread in lockstep (rockjit.lanes; same results;
+    #                           None: kernel.DEFAULT_LANES)
 
 
 def _classification(tol, pmax, lam_tol, settle_tol, settle_reps):
