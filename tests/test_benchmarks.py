@@ -57,8 +57,9 @@ SCRIPTS = {
                             ["attractors.png"]),
     "bench_orbits.py": (["measurement", "value", "unit", "target"],
                         ["orbits.png", "orbits_branches.png"]),
-    "bench_versions.py": (["case", "base_s", "this_s", "ratio", "cpu_ratio", "base_ns_step",
-                           "this_ns_step", "identical"], ["versions.png"]),
+    "bench_versions.py": (["case", "base_s", "this_s", "ratio", "cpu_ratio", "pair_min",
+                           "pair_max", "base_ns_step", "this_ns_step", "identical"],
+                          ["versions.png"]),
     "bench_compile.py": (
         ["root", "group", "item", "mode", "n", "wall_s", "wall_min_s", "wall_max_s", "cpu_s",
          "first_call_s", "compile_cpu_s", "compiles", "typing", "ir_inlining", "front_end_other",
