@@ -665,14 +665,14 @@ def detect(y, ynew, hh, K, side, par):
             return EV_IMPACT, 0.0, hh
         # started on theta = 0 (just after an impact or an uplift): bracket from the apex
         q0, q1, q2, q3 = dense_coeffs(K, 0)
-        x = turning_point(q0, q1, q2, q3, side, True)
+        x = turning_point(q0, q1, q2, q3, float(side), True)
         if dense_event(EV_IMPACT, y[0], hh, q0, q1, q2, q3, side, par, x) > 0.0:
             return EV_IMPACT, x * hh, hh
         return EV_IMPACT, 0.0, 0.0  # a flight too small to resolve: lo == hi marks it
     if g0 > 0.0 and d0 < 0.0 and d1 > 0.0:
         # grazing: theta may dip through 0 and come back within the step
         q0, q1, q2, q3 = dense_coeffs(K, 0)
-        x = turning_point(q0, q1, q2, q3, side, False)
+        x = turning_point(q0, q1, q2, q3, float(side), False)
         if dense_event(EV_IMPACT, y[0], hh, q0, q1, q2, q3, side, par, x) < 0.0:
             return EV_IMPACT, 0.0, x * hh
     return EV_NONE, 0.0, 0.0
@@ -1044,7 +1044,7 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
     # rest within rounding of that instant (forcing a hair above the uplift threshold, where
     # the acceleration rounds to zero); otherwise the uplift would be found again at the
     # same instant forever (found by the stress suite).
-    hold = False
+    hold = step < 0  # False, typed bool rather than the literal (one compilation of leave_rest)
     while True:
         if side == 0:
             c0 = cycles() if PROF else 0
@@ -1177,12 +1177,14 @@ def _loop(EMBED4, TANGENT, record, y0, side0, par, ipar, out, w):
     side = side0
     t = 0.0
     max_err = 0.0
-    n_imp = 0
-    step = 0
-    j_per = 0   # grid steps into the current period
-    k_per = 0   # completed periods
-    j_qr = 0
-    j_rec = 0
+    # the counters start as int64, not as the literal 0: numba would type (and compile) every
+    # piece they are passed to once more for the literal (issue 15)
+    n_imp = np.int64(0)
+    step = np.int64(0)
+    j_per = np.int64(0)  # grid steps into the current period
+    k_per = np.int64(0)  # completed periods
+    j_qr = np.int64(0)
+    j_rec = np.int64(0)
     n_col = out.iout[O_NCOL]  # collapses of the tangent vectors (start at rest; see below)
     n_col_win = n_col if ipar[I_WINDOW] == 0 else 0
     t_lift = -math.inf  # instant of the latest uplift

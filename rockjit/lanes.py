@@ -438,7 +438,8 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
     nxt = i0
     for l in range(W):
         b.st[l, S_CELL] = -1
-    j = 0  # the step's index in the period, the same in every lane
+    j = np.int64(0)  # the step's index in the period, the same in every lane (int64, not the
+    # literal 0: block_step_lanes would be compiled once more for the literal)
     while True:
         busy = 0
         for l in range(n_lanes):
