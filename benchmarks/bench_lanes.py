@@ -88,7 +88,7 @@ def kernels():
     def restart(l, y, K, par, jac, trig):
         y[l, 0] = 0.2 + 0.01 * l
         y[l, 1] = 0.0
-        rhs(False, 0.0, y[l], 1, par, K[l], jac[l], trig[l])
+        rhs(None, 0.0, y[l], 1, par, K[l], jac[l], trig[l])
 
     @numba.njit(cache=False, _nrt=False)
     def scalar(n, L, y, K, par, ytmp, ynew, tab, ftab, jac, trig, lin, lout, ftl, nv):
@@ -99,7 +99,7 @@ def kernels():
         for _ in range(n):
             for l in range(L):
                 Kl = K[l]
-                rk_step(False, False, True, 0.0, 1.0, y[l], Kl, 1, par, ytmp[l], ynew[l], tab,
+                rk_step(None, None, True, 0.0, 1.0, y[l], Kl, 1, par, ytmp[l], ynew[l], tab,
                         ftab[j], jac[l], trig[l])
                 if ynew[l, 0] < 0.0:
                     restart(l, y, K, par, jac, trig)

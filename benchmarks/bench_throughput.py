@@ -109,9 +109,9 @@ def step_internals():
 
     @numba.njit(cache=False, _nrt=False)  # as the kernel's loop: no reference counting
     def dp_steps(n, y, K, par, ytmp, ynew, tab, fr, jac, trig):
-        rhs(False, 0.0, y, 1, par, K, jac, trig)
+        rhs(None, 0.0, y, 1, par, K, jac, trig)
         for _ in range(n):
-            rk_step(False, False, False, 0.0, 1.0, y, K, 1, par, ytmp, ynew, tab, fr, jac, trig)
+            rk_step(None, None, False, 0.0, 1.0, y, K, 1, par, ytmp, ynew, tab, fr, jac, trig)
             y[0] = ynew[0]
             y[1] = ynew[1]
             K[0, 0] = K[n_stages, 0]
@@ -122,7 +122,7 @@ def step_internals():
             if y[0] < -0.3:  # keep the free fall within range (rare)
                 y[0] = 0.2
                 y[1] = 0.0
-                rhs(False, 0.0, y, 1, par, K, jac, trig)
+                rhs(None, 0.0, y, 1, par, K, jac, trig)
         return y[0]
 
     blk = rockjit.Block(hb=1.0, alpha=0.0, omega=1.3)

@@ -35,7 +35,7 @@ def _classify(TANGENT, status, ipar, cpar, out, res):
         k0 = ipar[ig.I_WINDOW]
     lam1 = math.nan
     lam2 = math.nan
-    if TANGENT:
+    if TANGENT is not None:
         la, lb = lam_between(out.lam_run, k0, k1)
         lam1 = max(la, lb)  # sorted: lambda1 >= lambda2 (see run_single)
         lam2 = min(la, lb)
@@ -48,7 +48,7 @@ def _classify(TANGENT, status, ipar, cpar, out, res):
         lam1 = -math.inf
         lam2 = -math.inf
     elif status == ig.DONE or status == ig.SETTLED:
-        label, period = classify(out.strobe, out.half, out.per_imp, k0, k1, lam1, TANGENT,
+        label, period = classify(out.strobe, out.half, out.per_imp, k0, k1, lam1, TANGENT is not None,
                                  cpar[C_TOL], ipar[ig.I_PMAX], cpar[C_LAMTOL])
     res[R_MOTION] = label
     t_over = out.fout[ig.F_TOVER]

@@ -27,7 +27,12 @@ counting.
 The state lives in one array ``y``: ``theta, theta'``, then ``r, s`` when the oscillator
 embedding is integrated, then the 2×2 tangent matrix (column-major) when Lyapunov exponents are
 asked for. Which of these exist is decided at compile time by :func:`build`; a run that does not
-ask for tangent vectors compiles without them (STYLE.md 3). Recording a trajectory is the one
+ask for tangent vectors compiles without them (STYLE.md 3). The compile-time switches
+``EMBED4``, ``TANGENT`` (and ``block_step``'s ``SLOPE``) are ``True`` or ``None``, never
+``False``, and are tested as ``is not None``: numba prunes a branch before typing it only when
+it compares an argument with ``None`` (``numba.core.analysis.dead_branch_prune``), so a run
+without tangent vectors or embedding never types, lowers or optimises their code (a cold first
+run 11.7 -> 10.2 s, issue 15). ``False`` would read as on. Recording a trajectory is the one
 run-time switch (one test per grid step, in :func:`grid_point`): measured side by side it costs
 nothing distinguishable per step, and it halves the variants to compile (issue 15,
 benchmarks/README.md, "Cold start").
@@ -165,7 +170,7 @@ def build(embed4: bool = False, tangent: bool = False):
         code (see :func:`_loop`). Recording is not a switch here: ``out.traj`` with more than
         one row records the dense trajectory (see :func:`_run`; issue 15).
     """
-    return _build(bool(embed4), bool(tangent))
+    return _build(True if embed4 else None, True if tangent else None)
 
 
 @jit(nrt=False)
@@ -253,7 +258,7 @@ def block_stage(FAST, SLOPE, x0, d, v, f, side, par, s0, c0):
     if FAST:
         Pr, Qr = rotate(P, Q, s0, c0)
         a = accel_near(Pr, Qr, d, v, par[P_XI])
-        if not SLOPE:
+        if SLOPE is None:
             return a, 0.0
         sn, cn = near_poly(d)
         return a, slope_pq(Pr, Qr, d * sn, cn)
@@ -267,7 +272,7 @@ def rhs(EMBED4, r, y, side, par, K, jac, trig):
     cosine of theta into ``trig[0:2]``; ``r`` is the closed-form forcing value (ignored with the
     embedding, which reads ``r`` from y). The tangent rows of ``K[0]`` are filled by
     :func:`tangent_step` itself."""
-    if EMBED4:
+    if EMBED4 is not None:
         r = y[2]
         dr, ds = oscillator(r, y[3], par[P_OMEGA])
         K[0, 2] = dr
@@ -343,7 +348,7 @@ def block_step(FAST, SLOPE, x0, v0, fr, tab, side, par, K, jac, trig):
     K[4, 1] = k4
     K[5, 1] = k5
     K[6, 1] = k6
-    if SLOPE:
+    if SLOPE is not None:
         jac[1] = j1
         jac[2] = j2
         jac[3] = j3
@@ -440,8 +445,8 @@ def rk_step(EMBED4, TANGENT, tabulated, sp, cp, y, K, side, par, ytmp, ynew, tab
     phase ``omega t + phi`` at the step's start, and the closed-form forcing at each stage is
     that pair rotated by the table's phase advances (both are ignored with the embedding).
     """
-    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
-    if EMBED4:
+    NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
+    if EMBED4 is not None:
         osc_step(y, K, ytmp, ynew, tab, par, fr)
     elif not tabulated:
         aw2 = par[P_AW2]
@@ -460,7 +465,7 @@ def rk_step(EMBED4, TANGENT, tabulated, sp, cp, y, K, side, par, ytmp, ynew, tab
             x, v, far = block_step(False, TANGENT, y[0], y[1], fr, tab, side, par, K, jac, trig)
         ynew[0] = x
         ynew[1] = v
-    if TANGENT:
+    if TANGENT is not None:
         tangent_step(NS, y, K, ynew, tab, par, jac)
 
 
@@ -680,7 +685,7 @@ def detect(y, ynew, hh, K, side, par):
 
 @jit(nrt=False)
 def forcing_now(EMBED4, t, y, par):
-    if EMBED4:
+    if EMBED4 is not None:
         return y[2]
     return forcing_closed(t, par[P_OMEGA], par[P_PHI])
 
@@ -689,7 +694,7 @@ def forcing_now(EMBED4, t, y, par):
 def sample(EMBED4, t, y, par, out):
     out[0] = y[0]
     out[1] = y[1]
-    if EMBED4:
+    if EMBED4 is not None:
         out[2] = y[2]
         out[3] = y[3]
     else:
@@ -707,7 +712,7 @@ def qr_renormalise(EMBED4, y, lam_sum, in_window, lam_win):
     not added, the vectors restart as the identity, and the caller counts the collapse (the
     exponents over a stretch with a collapse are ``-inf``).
     """
-    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
+    NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
     v00 = y[NS]
     v10 = y[NS + 1]
     v01 = y[NS + 2]
@@ -739,7 +744,7 @@ def qr_renormalise(EMBED4, y, lam_sum, in_window, lam_win):
 
 @jit(nrt=False)
 def reset_tangent(EMBED4, y):
-    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
+    NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
     y[NS] = 1.0
     y[NS + 1] = 0.0
     y[NS + 2] = 0.0
@@ -753,8 +758,8 @@ def _run(EMBED4, TANGENT, y0, side0, par_in, ipar, out):
 
     The work arrays are made here, and the loop itself is compiled without numba's reference
     counting (its helpers are inlined into it, and each inlined array would be counted)."""
-    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
-    NY = NS + (4 if TANGENT else 0)  # plus the tangent matrix, column-major
+    NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
+    NY = NS + (4 if TANGENT is not None else 0)  # plus the tangent matrix, column-major
     par = np.zeros(N_PARW)  # the parameters and constants derived from them
     for m in range(N_PAR):
         par[m] = par_in[m]
@@ -776,12 +781,12 @@ def _run(EMBED4, TANGENT, y0, side0, par_in, ipar, out):
 def start(EMBED4, TANGENT, y0, side0, par, ipar, out, w):
     """Before the first step: the step tables, the initial state and its samples, the field at
     the start. Returns the status (overturned already, or running)."""
-    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
+    NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
     n_per = ipar[I_N]
     step_table(par[P_OMEGA], par[P_H], w.tab_h)
     # The forcing acceleration at the stages of the grid steps of a period (the grid repeats):
     # phase phi + 2 pi (j + c_i) / N at stage i of step j, sines made once per run.
-    if not EMBED4:
+    if EMBED4 is None:
         for j in range(n_per):
             for i in range(N_STAGES + 1):
                 c = C[i] if i < N_STAGES else 1.0
@@ -790,7 +795,7 @@ def start(EMBED4, TANGENT, y0, side0, par, ipar, out, w):
     y = w.y
     for m in range(NS):
         y[m] = y0[m]
-    if TANGENT:
+    if TANGENT is not None:
         reset_tangent(EMBED4, y)
     for m in range(N_IOUT):
         out.iout[m] = 0
@@ -800,7 +805,7 @@ def start(EMBED4, TANGENT, y0, side0, par, ipar, out, w):
     out.traj[0, 0] = 0.0
     sample(EMBED4, 0.0, y, par, out.traj[0, 1:])
     out.iout[O_NTRAJ] = 1
-    if TANGENT:
+    if TANGENT is not None:
         for c in range(3):
             out.lam_run[0, c] = 0.0
     out.per_imp[0] = 0
@@ -808,7 +813,7 @@ def start(EMBED4, TANGENT, y0, side0, par, ipar, out, w):
     status = RUNNING
     if side0 != 0 and side0 * y[0] >= par[P_THOVER]:
         status = OVERTURNED
-    if TANGENT and side0 == 0:
+    if TANGENT is not None and side0 == 0:
         # at rest from the start: every perturbation small enough dies in a Zeno cascade, and
         # the block leaves rest when the forcing alone says (see _loop, rest phases)
         out.iout[O_NCOL] = 1
@@ -826,7 +831,7 @@ def leave_rest(EMBED4, t, t_grid, hold, y, side, par, w, iout):
     ``REST_LIFT`` (lifted at the returned ``t`` onto ``side``, field refreshed), or
     ``REST_STEP`` (embedding: take a step at rest and watch the forcing).
     """
-    if not EMBED4:
+    if EMBED4 is None:
         t_up = uplift_time(t, par[P_AW2], par[P_COT], par[P_OMEGA], par[P_PHI])
         if t_up == math.inf:
             return REST_END, t, side
@@ -858,8 +863,8 @@ def accept(EMBED4, TANGENT, side, hh, max_err, w):
     It takes the compile-time switches, not the state's sizes: compiled on its own with sizes
     unknown, LLVM vectorised its copies behind run-time overlap checks before inlining it, and
     a run with exponents took 9 % longer a step (found bisecting issue 11's promise)."""
-    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
-    NY = NS + (4 if TANGENT else 0)  # plus the tangent matrix, column-major
+    NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
+    NY = NS + (4 if TANGENT is not None else 0)  # plus the tangent matrix, column-major
     K = w.K
     if side != 0:
         e0 = 0.0
@@ -889,12 +894,12 @@ def impact(EMBED4, TANGENT, t, t_lift, side, n_imp, in_window, par, out, w):
     impact count, whether a rest phase began, and whether it began within rounding of the
     latest uplift (then it is held to the grid point, see :func:`_loop`).
     """
-    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
+    NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
     y = w.y
     e = par[P_E]
     dth_m = y[1]
     dth_p = jump(dth_m, e)
-    if TANGENT:
+    if TANGENT is not None:
         if dth_m != 0.0:
             s10 = saltation(dth_m, par[P_AW2] * forcing_now(EMBED4, t, y, par), side,
                             par[P_THC], par[P_XI], e)
@@ -946,7 +951,7 @@ def grid_point(EMBED4, TANGENT, record, t, step, side, n_imp, n_col, in_window, 
     n_per = ipar[I_N]
     status = RUNNING
     collapsed = False
-    if TANGENT:
+    if TANGENT is not None:
         j_qr += 1
         if j_qr == ipar[I_QR]:
             j_qr = 0
@@ -960,7 +965,7 @@ def grid_point(EMBED4, TANGENT, record, t, step, side, n_imp, n_col, in_window, 
         sample(EMBED4, t, y, par, out.strobe[k_per])
         out.iout[O_NSTROBE] = k_per + 1
         out.per_imp[k_per] = n_imp
-        if TANGENT:
+        if TANGENT is not None:
             n_now = n_col + (1 if collapsed else 0)
             out.lam_run[k_per, 0] = w.lam[0] / t
             out.lam_run[k_per, 1] = w.lam[1] / t
@@ -988,7 +993,7 @@ def grid_point(EMBED4, TANGENT, record, t, step, side, n_imp, n_col, in_window, 
 @jit(nrt=False, inline=True)
 def finish(EMBED4, TANGENT, status, t, step, n_imp, n_col_win, max_err, ipar, par, out, w):
     """The scalar outputs at the end of a run (layouts ``O_*`` and ``F_*``)."""
-    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
+    NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
     iout = out.iout
     fout = out.fout
     iout[O_STATUS] = status
@@ -997,7 +1002,7 @@ def finish(EMBED4, TANGENT, status, t, step, n_imp, n_col_win, max_err, ipar, pa
     fout[F_T] = t
     sample(EMBED4, t, w.y, par, fout[F_TH:F_S + 1])
     fout[F_MAXERR] = max_err
-    if TANGENT:
+    if TANGENT is not None:
         for m in range(4):
             fout[F_V + m] = w.y[NS + m]
         wt = t - ipar[I_WINDOW] * ipar[I_N] * par[P_H]
@@ -1030,8 +1035,8 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
     in the steps after an event, in locating, in impacts, in detection, in the first step and
     at the grid point (the lanes' accounting; the single-lane loop passes ``PROF = False``).
     """
-    NS = 4 if EMBED4 else 2  # state: theta, theta' (, r, s)
-    NY = NS + (4 if TANGENT else 0)  # plus the tangent matrix, column-major
+    NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
+    NY = NS + (4 if TANGENT is not None else 0)  # plus the tangent matrix, column-major
     h = par[P_H]
     y = w.y
     K = w.K
@@ -1058,15 +1063,15 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
                 break
             if action == REST_LIFT:
                 t_lift = t
-                fresh = EMBED4 and fresh
+                fresh = EMBED4 is not None and fresh
                 continue
         if fresh:
             # a whole grid step: the forcing phase there is phi + 2 pi j / N exactly
             hh = h
             if not pre:
                 c0 = cycles() if PROF else 0
-                rk_step(EMBED4, TANGENT, not EMBED4, 0.0, 0.0, y, K, side, par, w.ytmp, w.ynew,
-                        w.tab_h, w.fr if EMBED4 else w.ftab[j], w.jac, w.trig)
+                rk_step(EMBED4, TANGENT, EMBED4 is None, 0.0, 0.0, y, K, side, par, w.ytmp, w.ynew,
+                        w.tab_h, w.fr if EMBED4 is not None else w.ftab[j], w.jac, w.trig)
                 if PROF:
                     counts[11] += cycles() - c0
             pre = False
@@ -1133,7 +1138,7 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
             counts[9] += cycles() - c0
         if rests:
             hold = hold or held
-            if TANGENT:
+            if TANGENT is not None:
                 # A rest phase ends every perturbation: a nearby state reaches rest too (its
                 # Zeno cascade ends a little earlier or later), and the block leaves rest
                 # when the forcing alone says. The flow's Jacobian across it is zero, and

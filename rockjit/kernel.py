@@ -203,7 +203,7 @@ def _impacts_in_order(ring, n_imp):
 @jit
 def _cell(TANGENT, y0, side0, par, ipar, cpar, out, res):
     """Run one cell and classify it; scalar results go to ``res`` (layout ``R_*``)."""
-    status = ig._run(False, TANGENT, y0, side0, par, ipar, out)
+    status = ig._run(None, TANGENT, y0, side0, par, ipar, out)
     _classify(TANGENT, status, ipar, cpar, out, res)
 
 
@@ -224,7 +224,7 @@ def _grid(TANGENT, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n
         T = par[ig.P_H] * ipar[ig.I_N]
         out = ig.Outputs(np.zeros((periods + 1, 4)), np.zeros((periods + 1, 4)),
                          np.zeros((cap, 3)), np.zeros((1, 5)),
-                         np.zeros((periods + 1 if TANGENT else 1, 3)),
+                         np.zeros((periods + 1 if TANGENT is not None else 1, 3)),
                          np.zeros(periods + 1, dtype=np.int64),
                          np.zeros(ig.N_IOUT, dtype=np.int64), np.zeros(ig.N_FOUT))
         y0 = y0s[i]
@@ -236,7 +236,7 @@ def _grid(TANGENT, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n
 def _kernel(tangent):
     """The grid kernel with or without tangent vectors (a thin closure forwarding the flag as a
     compile-time literal, so that the module-level kernels are specialised and cached)."""
-    TANGENT = bool(tangent)
+    TANGENT = True if tangent else None
 
     @jit
     def grid(y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got):

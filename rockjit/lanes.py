@@ -221,7 +221,7 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, prof, counts):
     stayed in range), so it is not taken again. With ``prof``, ``counts[6:13]`` receive the
     cycles of its parts (see :func:`rockjit.integrate.grid_step`)."""
     (status, t, side, n_imp, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win, t_lift,
-     max_err) = ig.grid_step(False, TANGENT, False, prof, pre, fs[F_TT], st[S_SIDE], st[S_NIMP],
+     max_err) = ig.grid_step(None, TANGENT, False, prof, pre, fs[F_TT], st[S_SIDE], st[S_NIMP],
                              st[S_STEP], st[S_JPER], st[S_KPER], st[S_JQR], st[S_JREC],
                              st[S_NCOL], st[S_NCOLWIN], fs[F_TLIFT], fs[F_MAXERR], par, ipar,
                              out, w, counts)
@@ -323,7 +323,7 @@ def _load(l, i, y0s, pars, ipar, b):
     w = lane_work(b, l)
     y0 = y0s[i]
     side0 = initial_side(y0[0], y0[1])
-    status = ig.start(False, False, y0, side0, par, ipar, out, w)
+    status = ig.start(None, None, y0, side0, par, ipar, out, w)
     st = b.st[l]
     fs = b.fs[l]
     for m in range(N_ST):
@@ -400,10 +400,10 @@ def _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b
     if status == ig.RUNNING:
         status = ig.DONE
     out.iout[ig.O_NCOL] = st[S_NCOL]
-    ig.finish(False, False, status, fs[F_TT], st[S_STEP], st[S_NIMP], st[S_NCOLWIN],
+    ig.finish(None, None, status, fs[F_TT], st[S_STEP], st[S_NIMP], st[S_NCOLWIN],
               fs[F_MAXERR], ipar, par, out, w)
     i = st[S_CELL]
-    cell._classify(False, status, ipar, cpar, out, res[i])
+    cell._classify(None, status, ipar, cpar, out, res[i])
     cell._collect(i, par[ig.P_H] * ipar[ig.I_N], n_pts, n_imp_pts, out, res, pts, imp_pts,
                 n_got, n_imp_got)
     st[S_CELL] = -1
@@ -485,7 +485,7 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
                 else:
                     _sync(l, b)
                     status, j_per, k_per, j_qr, j_rec, collapsed = ig.grid_point(
-                        False, False, False, t, step, st[S_SIDE], st[S_NIMP], st[S_NCOL],
+                        None, None, False, t, step, st[S_SIDE], st[S_NIMP], st[S_NCOL],
                         step - 1 >= ipar[ig.I_WINDOW] * n_per, ipar, b.par[l],
                         lane_outputs(b, l), lane_work(b, l), st[S_JPER], st[S_KPER],
                         st[S_JQR], st[S_JREC])
@@ -501,7 +501,7 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
                 pre = st[S_SIDE] != 0 and lout[O_FAR * W + l] <= 1.0
                 if pre:
                     _stages(l, b)
-                scalar_step(False, st, b.fs[l], b.par[l], ipar, lane_outputs(b, l),
+                scalar_step(None, st, b.fs[l], b.par[l], ipar, lane_outputs(b, l),
                             lane_work(b, l), pre, prof, counts)
                 _refresh(l, b)
                 counts[4] += (cycles() - c0) if prof else 0

@@ -213,8 +213,8 @@ def test_one_step_matches_a_plain_reference_step(spec, theta0, dtheta0, n):
     ytmp, ynew = np.zeros(2), np.zeros(2)
     ig.step_table(omega, h, tab)
     trig = np.zeros(4)
-    ig.rhs(False, math.sin(phi), y, side, par, K, jac, trig)
-    ig.rk_step(False, False, False, math.sin(phi), math.cos(phi), y, K, side, par, ytmp, ynew,
+    ig.rhs(None, math.sin(phi), y, side, par, K, jac, trig)
+    ig.rk_step(None, None, False, math.sin(phi), math.cos(phi), y, K, side, par, ytmp, ynew,
                tab, fr, jac, trig)
     want = _reference_dp5_step(spec, 0.0, y, h, side, hb, alpha * omega**2, omega, phi, xi)
     # the cases test what they say: the fast path, a stage far from the start, beyond 1.75

@@ -178,4 +178,4 @@ def test_vector_step_equals_single_lane_step():
 @numba.njit(cache=False)
 def _block_step(x, v, fr, tab, side, par, K, trig):
     jac = np.zeros(ig.N_STAGES + 1)
-    return ig.block_step(True, False, x, v, fr, tab, side, par, K, jac, trig)
+    return ig.block_step(True, None, x, v, fr, tab, side, par, K, jac, trig)
