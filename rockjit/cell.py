@@ -48,8 +48,9 @@ def _classify(TANGENT, status, ipar, cpar, out, res):
         lam1 = -math.inf
         lam2 = -math.inf
     elif status == ig.DONE or status == ig.SETTLED:
-        label, period = classify(out.strobe, out.half, out.per_imp, k0, k1, lam1, TANGENT is not None,
-                                 cpar[C_TOL], ipar[ig.I_PMAX], cpar[C_LAMTOL])
+        label, period = classify(out.strobe, out.half, out.per_imp, k0, k1, lam1,
+                                 TANGENT is not None, cpar[C_TOL], ipar[ig.I_PMAX],
+                                 cpar[C_LAMTOL])
     res[R_MOTION] = label
     t_over = out.fout[ig.F_TOVER]
     if t_over == t_over:  # fell once and went on: overturn, the study's rule

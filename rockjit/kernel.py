@@ -316,8 +316,7 @@ LANES_MAX = 8
 #: fates; the grids with exponents run one cell at a time). Measured (benchmarks/bench_lanes.py,
 #: the study's basin, 2 threads): 8 lanes 1.18x the cells per second of one full length, 1.40x
 #: early-stopped; 2 lanes lose, 4 about even. The same outputs bit for bit whatever the count.
-#: The lanes' kernel replaces the single-lane one in the ``grid`` variant (a cold compile 25 s
-#: against 21.5 s).
+#: The lanes' kernel replaces the single-lane one in the ``grid`` variant (a cold compile ~20 s).
 DEFAULT_LANES = 8
 
 
@@ -377,7 +376,7 @@ VARIANTS = {
 #: What ``rockjit compile`` (and a cold ``rockjit paper``) compiles: every variant, since
 #: ``rockjit paper`` (README's first command) uses each one; the longest first (the lanes'
 #: grid kernel, ~20 s, compiles the step again inside its own loop), so that the others share
-#: the second core meanwhile (measured on 2 cores: 35 s, against 48 s with it last).
+#: the second core meanwhile (measured on 2 cores when adopted: 35 s, against 48 s with it last).
 COMMON = ("grid", "run", "run+tangent", "embedded", "embedded+tangent", "grid+tangent")
 assert sorted(COMMON) == sorted(VARIANTS)
 

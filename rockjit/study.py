@@ -7,8 +7,9 @@ gallery, the basins. :func:`plan_paper` validates a paper's settings (nothing co
 (:class:`rockjit.io.OutputDir` on the command line): figures 1-6 of the study, and beyond it
 the branches of periodic orbits over its bifurcation diagrams with their located bifurcations
 (figure 5's ``fig5_branches_*``, ``bifurcation_table``), the attractor maps of its basins with
-their entropy and integrity (figure 7) and the erosion profiles of both laws (figure 8). Its grids run on the chunk store, so an interrupted paper
-resumes, and on a Dask cluster when a client is given.
+their entropy and integrity (figure 7) and the erosion profiles of both laws (figure 8). Its
+grids run on the chunk store, so an interrupted paper resumes, and on a Dask cluster when a
+client is given.
 """
 
 from __future__ import annotations
