@@ -561,7 +561,7 @@ def main(argv=None):
     from ._jit import cached_kernels
     if args.command != "cor" and not cached_kernels():
         _say(args, "first run here: numba compiles rockjit's kernels into its cache, about "
-                   "15-25 s per kernel variant on two cores, once (`rockjit compile` does it "
+                   "10-20 s per kernel variant on two cores, once (`rockjit compile` does it "
                    "ahead of time)")
         if args.command == "paper" and _compile(args):  # every variant, side by side
             return 130
