@@ -186,6 +186,7 @@ def test_peers_quick_mode_checks_before_it_times(tmp_path):
         assert row["n_impacts"] == row["ref_n_impacts"] > 0, row
     with open(out / "peers.csv", newline="", encoding="utf-8") as f:
         rows = list(csv.reader(f))
+    # the CSV's column names (its timings are the benchmark's, never checked here)
     assert rows[0] == ["scene", "method", "setting", "wall_median_s", "error", "status",
                        "n_impacts", "flag"]
     assert len(rows) > 1 and all(len(r) == len(rows[0]) for r in rows[1:])

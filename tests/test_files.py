@@ -658,9 +658,11 @@ def test_progress_in_a_log_file_is_plain_throttled_lines(tmp_path, monkeypatch, 
     # chunks end at 2, 4, 6, 8, 10 s: a line once 5 s have passed since the last (6 s), then
     # the last one (10 s)
     assert [line.split(",")[0] for line in lines] == ["basin: 15/23 cells", "basin: 23/23 cells"]
-    # the clock is the fake one above: the line's arithmetic, not a timing (8 cells left at
-    # 15 cells per 6 s)
-    assert lines[0] == f"basin: 15/23 cells, {6.0:.1f} s elapsed, ~{6.0 * 8 / 15:.1f} s left"
+    # the clock is the fake one above, so this checks the line's arithmetic and format, not a
+    # timing: the fake clock read 6 s at that line, and 8 cells were left at 15 cells per 6 s
+    fake_now, done, left = 3 * 2.0, 15, 23 - 15
+    assert lines[0] == (f"basin: {done}/23 cells, {fake_now:.1f} s elapsed, "
+                        f"~{fake_now * left / done:.1f} s left")
 
 
 def test_progress_on_a_terminal_rewrites_one_line(monkeypatch):
