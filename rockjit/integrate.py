@@ -1020,6 +1020,23 @@ REST_END, REST_HOLD, REST_LIFT, REST_STEP = 0, 1, 2, 3
 
 
 @jit(nrt=False, inline=True)
+def tick(PROF):
+    """The cycle counter when profiling (``PROF`` true), else 0. ``PROF`` is ``None`` in the
+    single-lane loop, so that numba prunes the read before typing it (see the module's note on
+    switches); the lanes pass a run-time bool (they profile only when asked)."""
+    if PROF is not None and PROF:
+        return cycles()
+    return 0
+
+
+@jit(nrt=False, inline=True)
+def tock(PROF, counts, k, c0):
+    """Add the cycles since ``c0`` (:func:`tick`) to ``counts[k]`` when profiling."""
+    if PROF is not None and PROF:
+        counts[k] += cycles() - c0
+
+
+@jit(nrt=False, inline=True)
 def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k_per, j_qr,
               j_rec, n_col, n_col_win, t_lift, max_err, par, ipar, out, w, counts):
     """One grid step, from ``t`` (the grid point ``step h``, or the block still at rest) to the
@@ -1033,7 +1050,8 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
     ``pre`` the grid step's first Runge–Kutta step is already in ``K``, ``w.ynew``, ``w.jac``
     and ``w.trig``. With ``PROF``, ``counts[6:13]`` receive the cycles spent in rest phases,
     in the steps after an event, in locating, in impacts, in detection, in the first step and
-    at the grid point (the lanes' accounting; the single-lane loop passes ``PROF = False``).
+    at the grid point (the lanes' accounting, a run-time bool; the single-lane loop passes
+    ``PROF = None``: :func:`tick`).
     """
     NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
     NY = NS + (4 if TANGENT is not None else 0)  # plus the tangent matrix, column-major
@@ -1052,10 +1070,9 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
     hold = step < 0  # False, typed bool rather than the literal (one compilation of leave_rest)
     while True:
         if side == 0:
-            c0 = cycles() if PROF else 0
+            c0 = tick(PROF)
             action, t, side = leave_rest(EMBED4, t, t_grid, hold, y, side, par, w, out.iout)
-            if PROF:
-                counts[6] += cycles() - c0
+            tock(PROF, counts, 6, c0)
             if action == REST_END:
                 status = REST
                 break
@@ -1069,34 +1086,31 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
             # a whole grid step: the forcing phase there is phi + 2 pi j / N exactly
             hh = h
             if not pre:
-                c0 = cycles() if PROF else 0
+                c0 = tick(PROF)
                 rk_step(EMBED4, TANGENT, EMBED4 is None, 0.0, 0.0, y, K, side, par, w.ytmp, w.ynew,
                         w.tab_h, w.fr if EMBED4 is not None else w.ftab[j], w.jac, w.trig)
-                if PROF:
-                    counts[11] += cycles() - c0
+                tock(PROF, counts, 11, c0)
             pre = False
         else:
-            c0 = cycles() if PROF else 0
+            c0 = tick(PROF)
             hh = t_grid - t
             psi = par[P_OMEGA] * t + par[P_PHI]
             step_table(par[P_OMEGA], hh, w.tab)
             rk_step(EMBED4, TANGENT, False, math.sin(psi), math.cos(psi), y, K, side, par,
                     w.ytmp, w.ynew, w.tab, w.fr, w.jac, w.trig)
-            if PROF:
-                counts[7] += cycles() - c0
+            tock(PROF, counts, 7, c0)
         out.iout[O_RHS] += N_STAGES
         out.iout[O_SUBSTEPS] += 1
-        c0 = cycles() if PROF else 0
+        c0 = tick(PROF)
         kind, lo, hi = detect(y, w.ynew, hh, K, side, par)
-        if PROF:
-            counts[10] += cycles() - c0
+        tock(PROF, counts, 10, c0)
         if hold and kind == EV_UPLIFT:
             kind = EV_NONE
         if kind == EV_NONE:
             max_err = accept(EMBED4, TANGENT, side, hh, max_err, w)
             t = t_grid
             break
-        c0 = cycles() if PROF else 0
+        c0 = tick(PROF)
         if hi > lo:
             tau = locate(EMBED4, TANGENT, kind, t, y, hh, lo, hi, K, side, par, w.ytmp,
                          w.yev, out.iout, w.tab, w.fr, w.jac, w.trig)
@@ -1106,8 +1120,7 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
             for m in range(NY):
                 w.yev[m] = y[m]
             w.yev[1] = 0.0
-        if PROF:
-            counts[8] += cycles() - c0
+        tock(PROF, counts, 8, c0)
         t = t + tau
         fresh = False
         for m in range(NY):
@@ -1131,11 +1144,10 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
             rhs(EMBED4, forcing_at(t, par), y, side, par, K, w.jac, w.trig)
             out.iout[O_RHS] += 1
             continue
-        c0 = cycles() if PROF else 0
+        c0 = tick(PROF)
         side, n_imp, rests, held = impact(EMBED4, TANGENT, t, t_lift, side, n_imp,
                                           in_window, par, out, w)
-        if PROF:
-            counts[9] += cycles() - c0
+        tock(PROF, counts, 9, c0)
         if rests:
             hold = hold or held
             if TANGENT is not None:
@@ -1157,12 +1169,11 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
         if not (math.isfinite(y[0]) and math.isfinite(y[1])):
             status = NONFINITE
         else:
-            c0 = cycles() if PROF else 0
+            c0 = tick(PROF)
             status, j_per, k_per, j_qr, j_rec, collapsed = grid_point(
                 EMBED4, TANGENT, record, t, step, side, n_imp, n_col, in_window, ipar, par,
                 out, w, j_per, k_per, j_qr, j_rec)
-            if PROF:
-                counts[12] += cycles() - c0
+            tock(PROF, counts, 12, c0)
             if collapsed:
                 n_col += 1
                 if in_window:
@@ -1195,7 +1206,7 @@ def _loop(EMBED4, TANGENT, record, y0, side0, par, ipar, out, w):
     t_lift = -math.inf  # instant of the latest uplift
     while step < total and status == RUNNING:
         (status, t, side, n_imp, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win, t_lift,
-         max_err) = grid_step(EMBED4, TANGENT, record, False, False, t, side, n_imp, step,
+         max_err) = grid_step(EMBED4, TANGENT, record, None, False, t, side, n_imp, step,
                               j_per, k_per, j_qr, j_rec, n_col, n_col_win, t_lift, max_err,
                               par, ipar, out, w, out.iout)
     if status == RUNNING:
