@@ -28,8 +28,13 @@ What is measured
   events, ``NUMBA_LLVM_PASS_TIMINGS`` and ``NUMBA_CHROME_TRACE``.)
 - **commands**, as a user runs them first, in-process (``rockjit.cli.main``, same breakdown):
   ``rockjit trajectory --hb 1 --alpha 0.6 --omega 1.3`` with and without ``--lyapunov``, a tiny
-  basin, a tiny sweep and ``rockjit compile`` (its worker processes compile; the parent's
-  breakdown is empty). The install of the package is not measured.
+  basin, a tiny sweep, ``rockjit compile`` (its worker processes compile; the parent's
+  breakdown is empty) and ``rockjit paper``, the README's first command;
+- **the install** (part ``install``): ``python -m venv`` and ``pip install -e ROOT`` into a
+  fresh folder, per root, with whatever index and wheel cache pip is configured to use;
+- **issue 15's targets**, from the above: a cold ``rockjit trajectory`` at most 4x its warm
+  time, and the README's first command (install + cold ``rockjit paper``) under 45 s. (The third,
+  the test suite cold under 100 s, is what ``.ci/run`` on a fresh clone measures.)
 - **warm speed**, the guard of any change made to cut compile time: the per-step time of the
   reference run (``simulate(1, 0.6, 1.3, periods=5000)`` over its ``n_grid_steps``), with and
   without exponents, a basin of the study (hb 1, alpha 0.66, omega 1.3, ``r0, s0 = 0, 1``) and
@@ -77,6 +82,7 @@ COMMANDS = {
                                      "0.6", "0.62", "--alpha-step", "0.01", "--periods", "40",
                                      "--out", "OUT", "--quiet"],
     "compile": ["compile", "--quiet"],
+    "paper": ["paper", "--out", "OUT", "--quiet"],
 }
 #: Kernel sequences compiled in one process: what the second costs after the first.
 SEQUENCES = (("run", "grid"), ("run+tangent", "grid+tangent"))
@@ -616,6 +622,44 @@ def markdown(b, args, rows, summary, spd, quick):
     return "\n".join(md) + "\n"
 
 
+def install(roots, tmp):
+    """Seconds to make a virtual environment and ``pip install -e`` each root into it."""
+    out = {}
+    for name, root in roots.items():
+        venv = Path(tempfile.mkdtemp(prefix="venv-", dir=tmp))
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
+        subprocess.run([str(venv / "bin" / "python"), "-m", "pip", "install", "--quiet", "-e",
+                        str(root)], check=True, capture_output=True)
+        out[name] = time.perf_counter() - t0
+        print(f"  {name:>10} install {out[name]:7.2f} s", flush=True)
+        shutil.rmtree(venv, ignore_errors=True)
+    return out
+
+
+def targets(summary, inst):
+    """Issue 15's two command targets, per root, from the commands measured (Markdown)."""
+    by = {(s["root"], s["item"], s["mode"]): s["wall_s"] for s in summary}
+    lines = []
+    for root in dict.fromkeys(s["root"] for s in summary):
+        cold, warm = by.get((root, "rockjit trajectory", "cold")), by.get(
+            (root, "rockjit trajectory", "warm"))
+        if cold and warm:
+            ok = "met" if cold <= 4 * warm else "not met"
+            lines.append(f"| {root} | cold `rockjit trajectory` / warm | {cold:.1f} s / "
+                         f"{warm:.2f} s = {cold / warm:.1f}x | <= 4x | {ok} |")
+        paper = by.get((root, "rockjit paper", "cold"))
+        if paper and root in inst:
+            total = paper + inst[root]
+            ok = "met" if total <= 45.0 else "not met"
+            lines.append(f"| {root} | install + cold `rockjit paper` | {inst[root]:.1f} s + "
+                         f"{paper:.1f} s = {total:.1f} s | <= 45 s | {ok} |")
+    if not lines:
+        return ""
+    return ("\n#### Issue 15's targets\n\n| root | what | measured | target | |\n"
+            "|---|---|---|---|---|\n" + "\n".join(lines) + "\n")
+
+
 def csv_rows(summary, spd):
     rows = [[s.get(c) for c in CSV_COLUMNS] for s in summary]
     if spd:
@@ -669,9 +713,9 @@ def options(p):
     p.add_argument("--root", action="append", default=[], metavar="NAME=DIR",
                    help="a folder holding a rockjit package to measure (repeatable; default "
                         "this checkout)")
-    p.add_argument("--parts", default="kernels,commands,speed",
-                   help="comma-separated: kernels, commands, speed (default all; --quick: one "
-                        "small function only)")
+    p.add_argument("--parts", default="kernels,commands,install,speed",
+                   help="comma-separated: kernels, commands, install, speed (default all; "
+                        "--quick: one small function only)")
     p.add_argument("--all", action="store_true", help="every kernel variant, not only the "
                    "common ones (rockjit.kernel.COMMON)")
     p.add_argument("--variants", default=None,
@@ -716,13 +760,14 @@ def main(argv=None):
         rows = measure(args, roots, tmp, quick) if quick or args.parts & {"kernels",
                                                                           "commands"} else []
         spd = speed(args, roots, tmp) if "speed" in args.parts and not quick else None
+        inst = install(roots, tmp) if "install" in args.parts and not quick else {}
     b.env["load_end"] = H.load_text()
     summary = summarise(rows)
-    md = markdown(b, args, rows, summary, spd, quick)
+    md = markdown(b, args, rows, summary, spd, quick) + targets(summary, inst)
     settings = {k: sorted(v) if isinstance(v, set) else v for k, v in vars(args).items()}
     b.report("compile", markdown=md, csv=(CSV_COLUMNS, csv_rows(summary, spd)),
              data=dict(environment=b.env, settings=settings, roots=roots, summary=summary,
-                       runs=rows, speed=spd),
+                       runs=rows, speed=spd, install_s=inst),
              figures=[("compile.png", plot(summary), 120)])
     return 0
 
