@@ -234,8 +234,9 @@ def _grid(TANGENT, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n
 
 @functools.lru_cache(maxsize=None)
 def _kernel(tangent):
-    """The grid kernel with or without tangent vectors (a thin closure forwarding the flag as a
-    compile-time literal, so that the module-level kernels are specialised and cached)."""
+    """The grid kernel with or without tangent vectors (a thin closure forwarding the switch,
+    ``True`` or ``None`` as :mod:`rockjit.integrate` wants them, so that the module-level
+    kernels are specialised and cached)."""
     TANGENT = True if tangent else None
 
     @jit
