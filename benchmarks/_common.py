@@ -7,7 +7,7 @@ module is all they share:
 - :class:`Bench` parses the common options (``--quick``, ``--out DIR``), records what the numbers
   were measured on, and writes the report: the Markdown table (``.md``, also pasted into its block
   of benchmarks/README.md by a full run), the ``.csv``, the ``.json`` and the plots, every file
-  through :mod:`rockjit.io`'s atomic writers (so the JSON is strict, with non-finite floats
+  through :mod:`rockjit.storage.files`'s atomic writers (so the JSON is strict, with non-finite floats
   written as the strings ``"nan"``, ``"inf"``, ``"-inf"``, rockjit's one convention);
 - :func:`side_by_side` times cases interleaved in rotating order (medians of repeats, every ratio
   taken within one process: the machine is shared and noisy);
@@ -160,8 +160,8 @@ class Bench:
 
 
 def _io():
-    import rockjit.io
-    return rockjit.io
+    import rockjit.storage.files
+    return rockjit.storage.files
 
 
 def update_block(path, key: str, text: str) -> bool:
@@ -263,7 +263,7 @@ _PROBE = textwrap.dedent("""
     spec = json.loads(sys.argv[1])
     t0 = time.perf_counter()
     import rockjit
-    from rockjit import analysis
+    from rockjit.grids import grids as analysis
     t1 = time.perf_counter()
     fn = dict(simulate=rockjit.simulate, basin=analysis.basin, sweep=analysis.sweep,
               plane=analysis.plane)[spec["kind"]]
@@ -301,7 +301,7 @@ def compile_times(kind: str, kwargs: dict, *, sessions=("cold", "cached"),
     Parameters
     ----------
     kind : {"simulate", "basin", "sweep", "plane"}
-        ``rockjit.simulate`` or the ``rockjit.analysis`` function called.
+        ``rockjit.simulate`` or the ``rockjit.grids.grids`` function called.
     kwargs : dict
         Its keyword arguments (JSON-serialisable).
 

@@ -26,7 +26,9 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import _common as H  # noqa: E402
 
-from rockjit import analysis, erosion, kernel  # noqa: E402
+from rockjit._engine import kernel  # noqa: E402
+from rockjit.basins import erosion  # noqa: E402
+from rockjit.grids import grids as analysis  # noqa: E402
 
 BASINS = ((1.0, 0.66, 1.3), (2.0, 0.2, 1.6))
 FULL = dict(grid=100, repeats=5, erosion=dict(hb=1.0, omega=1.3, alpha_range=(0.3, 1.0),

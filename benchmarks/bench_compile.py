@@ -10,8 +10,8 @@ less than wall time.
 
 What is measured
 
-- **kernel variants** (:data:`rockjit.kernel.VARIANTS`): the first call of each, through
-  :func:`rockjit.kernel.compile_variant` (what ``rockjit compile`` runs), each alone on an empty
+- **kernel variants** (:data:`rockjit._engine.kernel.VARIANTS`): the first call of each, through
+  :func:`rockjit._engine.kernel.compile_variant` (what ``rockjit compile`` runs), each alone on an empty
   cache; and two sequences in one process, ``run`` then ``grid`` and ``run+tangent`` then
   ``grid+tangent``, which show what a grid kernel costs once the single-run kernel it calls is
   compiled (the grid kernels call the same ``integrate._run`` specialisation).
@@ -212,7 +212,7 @@ def _piece():
     """The quick mode's item: one small compiled function of the package, called once."""
     import numpy as np
 
-    from rockjit import integrate as ig
+    from rockjit._engine import integrate as ig
     s = np.zeros((5, 4))
     ig.settled_period(s, s, np.zeros(5, dtype=np.int64), 3, 1, 1, 1e-9)
 
@@ -230,7 +230,7 @@ def _child(spec):
     import rockjit  # noqa: F401
     out["import_s"] = time.perf_counter() - t0
     if kind in ("kernel", "piece"):
-        from rockjit import kernel
+        from rockjit._engine import kernel as kernel
         steps = []
         for name in spec["names"]:
             before = report()
@@ -252,7 +252,7 @@ def _child(spec):
         out["first_s"] = sum(s["first_s"] for s in steps)
         out["rc"] = 0
     else:
-        from rockjit import cli
+        from rockjit.cli.main import main as cli
         argv = [a if a != "OUT" else spec["out"] for a in spec["argv"]]
         t1 = time.perf_counter()
         out["rc"] = int(cli.main(argv) or 0)
@@ -369,7 +369,7 @@ def _items(args, quick):
     if quick:
         return [("kernel", "piece: integrate.settled_period",
                  dict(kind="piece", names=["settled_period"]))]
-    from rockjit.kernel import COMMON, VARIANTS
+    from rockjit._engine.kernel import COMMON, VARIANTS
     items = []
     if "kernels" in args.parts:
         names = (args.variants.split(",") if args.variants else VARIANTS if args.all
@@ -717,7 +717,7 @@ def options(p):
                    help="comma-separated: kernels, commands, install, speed (default all; "
                         "--quick: one small function only)")
     p.add_argument("--all", action="store_true", help="every kernel variant, not only the "
-                   "common ones (rockjit.kernel.COMMON)")
+                   "common ones (rockjit._engine.kernel.COMMON)")
     p.add_argument("--variants", default=None,
                    help="comma-separated kernel variants to measure (then no sequences)")
     p.add_argument("--commands", default=None,

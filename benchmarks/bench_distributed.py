@@ -23,7 +23,7 @@ import numpy as np
 
 import _common as H
 
-from rockjit import analysis as an
+from rockjit.grids import grids as an
 
 FULL = dict(grid=(60, 60), periods=500, repeats=3, chunk_divisors=(4, 16, 64))
 QUICK = dict(grid=(16, 16), periods=100, repeats=1, chunk_divisors=(4, 16))

@@ -39,8 +39,8 @@ import numpy as np
 import _common as H
 
 import rockjit
-from rockjit.analysis import BEHAVIOURS, GRID_N, basin, sweep
-from rockjit.plotting import agreement
+from rockjit.grids.grids import BEHAVIOURS, GRID_N, basin, sweep
+from rockjit.plotting.figures import agreement
 
 #: The study's four basins (SPEC.md §7, figure 6).
 BASINS = (
@@ -495,7 +495,7 @@ def plot_timing(m):
 def _label_image(ax, b, label):
     from matplotlib.colors import BoundaryNorm, ListedColormap
 
-    from rockjit.plotting import BEHAVIOUR_COLOURS
+    from rockjit.plotting.figures import BEHAVIOUR_COLOURS
     cmap = ListedColormap([BEHAVIOUR_COLOURS[n] for n in BEHAVIOURS])
     norm = BoundaryNorm(np.arange(len(BEHAVIOURS) + 1) - 0.5, cmap.N)
     th, dth = b.theta0, b.dtheta0
@@ -510,7 +510,7 @@ def plot_agreement(m):
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
-    from rockjit.plotting import BEHAVIOUR_COLOURS
+    from rockjit.plotting.figures import BEHAVIOUR_COLOURS
     t5, full, item4, item5 = m["t5"], m["full"], m["item4"], m["item5"]
     plt = H.pyplot()
     fig, axes = plt.subplots(2, len(BASINS), figsize=(4.0 * len(BASINS), 8.4),

@@ -4,9 +4,9 @@ Measured side by side in one process, on one thread, the block's free-flight ste
 forcing tabulated per period, no tangent, no events; a lane leaving the polynomial's range is
 put back to its start, rarely):
 
-- ``scalar``: today's step (:func:`rockjit.integrate.rk_step`) for each of L independent cells in
+- ``scalar``: today's step (:func:`rockjit._engine.integrate.rk_step`) for each of L independent cells in
   turn, then the step's acceptance; the out-of-order core may overlap neighbouring cells' chains;
-- ``lanes``: :func:`rockjit.lanes.block_step_lanes`, the same arithmetic written as one loop over
+- ``lanes``: :func:`rockjit._engine.lanes.block_step_lanes`, the same arithmetic written as one loop over
   lanes, vectorised (it always computes all ``W`` = 8 lanes, one AVX-512 vector; L of them
   count), which also accepts the step.
 
@@ -15,7 +15,7 @@ bound drawn in the plot is :data:`FLOPS_PER_STEP` floating-point instructions (c
 source, below) at :data:`FP_PER_CYCLE` per cycle (two FMA/multiply pipes), scalar and at the
 vector width.
 
-Then the grid kernel itself (:func:`rockjit.kernel.run_chunk_counted`, ``lanes`` = 1, 2, 4, 8,
+Then the grid kernel itself (:func:`rockjit._engine.kernel.run_chunk_counted`, ``lanes`` = 1, 2, 4, 8,
 side by side, outputs checked equal to ``lanes=1``'s): cells per second and wall ns per
 cell-step on the study's hb=1 Housner basin, full length and early-stopped, on the same threads,
 and from the lanes' own cycle counters (one more run per L with ``profile=True``, not timed) the
@@ -43,12 +43,12 @@ import _common as H
 from bench_throughput import cpu_mhz
 
 import rockjit
-from rockjit import integrate as ig
-from rockjit import lanes as ln
-from rockjit import analysis as an
-from rockjit import kernel as kn
-from rockjit.analysis import GRID_N
-from rockjit.kernel import pack
+from rockjit._engine import integrate as ig
+from rockjit._engine import lanes as ln
+from rockjit.grids import grids as an
+from rockjit._engine import kernel as kn
+from rockjit.grids.grids import GRID_N
+from rockjit._engine.kernel import pack
 
 LS = (1, 2, 4, 8)
 FULL = dict(grid_big=1000, steps=2_000_000, reps=7, grid_full=100, periods_full=500,

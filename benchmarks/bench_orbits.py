@@ -2,7 +2,7 @@
 
 On the study's case (hb=1, Housner, omega=1.3, alpha in [0.5, 1.0]):
 
-1. one Newton solve of a period-1 orbit (``rockjit.orbits.periodic_orbit``, alpha = 0.8, the
+1. one Newton solve of a period-1 orbit (``rockjit.orbits.orbits.periodic_orbit``, alpha = 0.8, the
    asymmetric orbit, seeded from the sweep cell's stroboscopic point): median of repeats, warm
    (target 5 ms);
 2. ``continue_branches`` over [0.5, 1.0] from the study's sweep (step 0.001), every branch of
@@ -24,7 +24,7 @@ On the study's case (hb=1, Housner, omega=1.3, alpha in [0.5, 1.0]):
     python benchmarks/bench_orbits.py --quick    # smoke mode (coarser sweep, fewer repeats)
 
 Writes orbits.{md,csv,json,png} and orbits_branches.png to benchmarks/results/
-(benchmarks/results/quick/ with --quick, or --out DIR), through rockjit.io's atomic writers.
+(benchmarks/results/quick/ with --quick, or --out DIR), through rockjit.storage.files's atomic writers.
 """
 
 from __future__ import annotations
@@ -45,7 +45,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import _common as C  # noqa: E402
 
 import rockjit  # noqa: E402
-from rockjit import analysis, orbits, plotting  # noqa: E402
+from rockjit.grids import grids as analysis  # noqa: E402
+from rockjit.orbits import orbits  # noqa: E402
+from rockjit.plotting import figures as plotting  # noqa: E402
 
 CASE = dict(hb=1.0, law="housner", omega=1.3)
 RANGE = (0.5, 1.0)
@@ -58,7 +60,8 @@ _PROBE = textwrap.dedent("""
     import json, statistics, sys, time
     t0 = time.perf_counter()
     import numpy as np
-    from rockjit import Block, orbits
+    from rockjit import Block
+    from rockjit.orbits import orbits
     t1 = time.perf_counter()
     a = json.loads(sys.argv[1])
     b = Block(hb=a["hb"], alpha=a["alpha"], omega=a["omega"], law=a["law"])
@@ -88,7 +91,7 @@ def probe(args: dict, cache_dir: str | None) -> dict:
 
 
 class Timer:
-    """Wraps ``rockjit.orbits.simulate`` to count its calls and the time spent in them."""
+    """Wraps ``rockjit.orbits.orbits.simulate`` to count its calls and the time spent in them."""
 
     def __init__(self):
         self.calls = 0

@@ -33,7 +33,7 @@ from pathlib import Path
 import _common as H
 
 from rockjit import DEFAULT_N
-from rockjit.analysis import GRID_N
+from rockjit.grids.grids import GRID_N
 
 TARGET_S = 60.0
 SECTION = H.RESULTS / "grids_section.md"

@@ -31,7 +31,7 @@ import numpy as np
 import _common as H
 
 import rockjit
-from rockjit import stress as S
+from rockjit.testing import stress as S
 
 #: n_runs: the stress cases of the study's ranges; n_extreme: issue 10's cases beyond them
 FULL = dict(n_runs=3000, n_extreme=3900, max_periods=200, long_periods=20_000, n_energy=300,
@@ -54,7 +54,7 @@ def warm_up():
             for stride in (None, 4):
                 rockjit.simulate(**base, forcing=forcing, lyapunov=lyap, record_stride=stride)
     for lyap in (False, True):
-        rockjit.analysis.basin(1.0, 0.6, 1.3, grid=2, periods=2, lyapunov=lyap, threads=1)
+        rockjit.grids.grids.basin(1.0, 0.6, 1.3, grid=2, periods=2, lyapunov=lyap, threads=1)
     return time.perf_counter() - t0
 
 

@@ -38,7 +38,7 @@ import numpy as np
 import _common as H
 
 import rockjit
-from rockjit import analysis as an
+from rockjit.grids import grids as an
 
 REF = dict(H.REFERENCE_RUN, z0=rockjit.Z0_STUDY)
 BASIN = dict(hb=1.0, alpha=0.66, omega=1.3, law="housner")  # the study's hb=1 basin
@@ -72,10 +72,10 @@ def step_internals():
 
     Uses exactly these private names (today's layout):
 
-    - ``rockjit.integrate``: ``rk_step``, ``rhs``, ``step_table``; the constants ``N_STAGES``,
+    - ``rockjit._engine.integrate``: ``rk_step``, ``rhs``, ``step_table``; the constants ``N_STAGES``,
       ``N_TAB``, ``N_PAR``, ``N_PARW`` and the parameter-vector indices ``P_THC``, ``P_OMEGA``,
       ``P_H``, ``P_STHC``, ``P_CTHC``;
-    - ``rockjit.kernel.pack`` (the float parameter vector);
+    - ``rockjit._engine.kernel.pack`` (the float parameter vector);
     - ``rockjit.model.sincos_poly`` (the stepper's sine and cosine).
 
     Returns
@@ -86,9 +86,9 @@ def step_internals():
         ``"bare DP5 step"`` (n Dormand–Prince steps chained through the state, no event
         detection), each compiled and called once already.
     """
-    from rockjit import integrate as ig
+    from rockjit._engine import integrate as ig
     from rockjit.model import sincos_poly
-    from rockjit.kernel import pack
+    from rockjit._engine.kernel import pack
 
     rk_step, rhs, n_stages = ig.rk_step, ig.rhs, ig.N_STAGES
 
@@ -338,7 +338,7 @@ _MEM = textwrap.dedent("""
     import json, resource, sys, time, tracemalloc
     spec = json.loads(sys.argv[1])
     import numpy as np
-    from rockjit import analysis
+    from rockjit.grids import grids as analysis
     kw = spec["kw"]
     analysis.basin(kw["hb"], kw["alpha"], kw["omega"], grid=2, periods=5)  # load the kernel
     base_kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss

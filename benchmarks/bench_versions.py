@@ -56,7 +56,7 @@ _WORKER = textwrap.dedent("""
     import hashlib, inspect, json, sys, time
     import numpy as np
     import rockjit
-    from rockjit import analysis
+    from rockjit.grids import grids as analysis
     FN = dict(simulate=rockjit.simulate, basin=analysis.basin, sweep=analysis.sweep)
 
     def digest(res):

@@ -6,7 +6,7 @@ A Numba-compiled fixed-step Dormand–Prince integrator with located impacts, re
 
 from .model import Block, delta_e_percent, e_housner, e_mao, thc_from_hb
 from .result import Result
-from .simulate import DEFAULT_N, Z0_STUDY, simulate
+from .single import DEFAULT_N, Z0_STUDY, simulate
 
 __all__ = [
     "Block", "DEFAULT_N", "Result", "Z0_STUDY", "delta_e_percent", "e_housner", "e_mao",

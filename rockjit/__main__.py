@@ -1,5 +1,5 @@
-"""``python -m rockjit``: the command line (see :mod:`rockjit.cli`)."""
+"""``python -m rockjit``: the command line (see :mod:`rockjit.cli.main`)."""
 
-from .cli import main
+from .cli.main import main
 
 raise SystemExit(main())

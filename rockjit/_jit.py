@@ -104,23 +104,29 @@ def cycles(typingctx):
 # or ".<n>.nbc" (the data). Only files of that form whose <module> is a module of the package
 # are deleted, and only in those folders: nothing else under NUMBA_CACHE_DIR is touched.
 
-_SOURCES = ("_jit.py", "model.py", "integrate.py", "analysis.py")
+_SOURCES = ("_jit.py", "model.py")
 STAMP = "rockjit-sources.sha256"
+_IMPORTS_JIT = re.compile(rb"^\s*from\s+(\.+|rockjit\.)_jit\s+import\b", re.M)
 
 
 def _compiled_sources(pkg):
-    """The package's modules whose code numba compiles: those named in ``_SOURCES`` and every
-    module that imports this one (the only way to reach the project's ``jit``)."""
+    """The package's modules whose code numba compiles, as paths relative to ``pkg``: those
+    named in ``_SOURCES`` and every module, in any subpackage, that imports this one (the only
+    way to reach the project's ``jit``)."""
     names = set(_SOURCES)
-    for f in pkg.glob("*.py"):
+    for f in pkg.rglob("*.py"):
         try:
             text = f.read_bytes()
         except OSError:
             continue
-        if re.search(rb"^\s*from\s+(\.|rockjit)\s*(\._jit\s+)?import\s+.*\b_jit\b"
-                     rb"|^\s*from\s+(\.|rockjit\.)_jit\s+import\b", text, re.M):
-            names.add(f.name)
+        if _IMPORTS_JIT.search(text):
+            names.add(f.relative_to(pkg).as_posix())
     return sorted(names)
+
+
+def _compiled_folders(pkg):
+    """The folders of the package that hold compiled modules: numba keeps a cache per folder."""
+    return sorted({(pkg / name).parent for name in _compiled_sources(pkg)})
 
 
 def _subpath(pkg_dir):
@@ -185,9 +191,16 @@ def check_cache(pkg=None):
         except OSError:
             continue  # a module listed in _SOURCES that no longer exists
     digest = h.hexdigest()
-    pattern = _cache_file_pattern(f.stem for f in pkg.glob("*.py"))
+    for folder in _compiled_folders(pkg):
+        _stamp_folder(folder, digest)
+
+
+def _stamp_folder(folder, digest):
+    """Make ``folder``'s cache folders carry ``digest``, deleting the cache files of its modules
+    where they carry another."""
+    pattern = _cache_file_pattern(f.stem for f in folder.glob("*.py"))
     settled = False  # a folder numba will use has been stamped
-    for home in _cache_dirs(pkg):
+    for home in _cache_dirs(folder):
         if settled and not home.is_dir():
             continue
         try:
@@ -213,6 +226,7 @@ def cached_kernels(pkg=None):
     """Whether numba's cache already holds compiled kernels of the package (any cache file of
     ``integrate.py``, where every kernel's loop lives): a cold first run compiles for a minute."""
     pkg = Path(__file__).parent if pkg is None else Path(pkg)
+    pkg = pkg / "_engine"
     pattern = _cache_file_pattern(["integrate", "kernel"])
     root = os.environ.get("NUMBA_CACHE_DIR")
     for home in _cache_dirs(pkg):

@@ -2,7 +2,7 @@
 
 Everything that knows the equations of motion lives here: the restitution laws, the angular
 acceleration on either corner and its Jacobian, the forcing oscillator, the impact (jump) map and
-the saltation matrix. The compiled integrator (:mod:`rockjit.integrate`) and the scipy reference
+the saltation matrix. The compiled integrator (:mod:`rockjit._engine.integrate`) and the scipy reference
 path call these same functions; nothing else writes an equation of motion.
 
 Conventions (SPEC.md §1–2). State ``(theta, dtheta)``; ``side = +1`` rocks on the corner reached

@@ -62,7 +62,7 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
                    max_impacts=100_000, stop_at_overturn=True):
     """Reference run through ``scipy.integrate.solve_ivp``; returns a :class:`Result`.
 
-    Called by :func:`rockjit.simulate.run` with ``method="scipy[:METHOD]"`` on a validated
+    Called by :func:`rockjit.single.run` with ``method="scipy[:METHOD]"`` on a validated
     plan. Samples are taken at the compiled path's grid points (``T/2`` for the stroboscopic
     sections, ``record_stride`` steps for the trajectory) from the solver's own output.
     """

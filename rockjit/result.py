@@ -23,7 +23,7 @@ BEHAVIOURS = ("overturn", "rest", "symmetric", "asymmetric", "multiperiodic", "c
               "aperiodic", "unresolved")
 OVERTURN, REST, SYMMETRIC, ASYMMETRIC, MULTIPERIODIC, CHAOTIC, APERIODIC, UNRESOLVED = range(8)
 
-#: Statuses of a run, in the order of the kernels' status codes (rockjit.integrate).
+#: Statuses of a run, in the order of the kernels' status codes (rockjit._engine.integrate).
 STATUSES = ("done", "overturned", "rest", "max_impacts", "nonfinite", "settled")
 
 STATUS_MESSAGES = {
@@ -38,7 +38,7 @@ STATUS_MESSAGES = {
 
 
 #: Separation, relative to the orbit's size, at which two runs count as different (the
-#: predictability horizon's tolerance, rockjit.fate).
+#: predictability horizon's tolerance, rockjit.basins.fate).
 HORIZON_TOL = 1e-2
 #: Rounding, relative: the perturbation every run carries.
 ROUNDING = float(np.finfo(float).eps)
@@ -89,7 +89,7 @@ class Result:
         The same at ``t = T/2, 3T/2, ...``.
     impacts : ndarray, shape (m, 3)
         ``(t, theta'-, theta'+)`` of the impacts, in order: all of them, or the latest
-        :data:`rockjit.kernel.IMPACT_RECORD` when there were more (``n_impacts`` counts all).
+        :data:`rockjit._engine.kernel.IMPACT_RECORD` when there were more (``n_impacts`` counts all).
     n_impacts, n_grid_steps, n_rhs : int
         Counts of impacts, grid steps completed, right-hand-side evaluations.
     max_error_estimate : float
@@ -187,7 +187,7 @@ class Result:
     @property
     def beyond_horizon(self) -> bool:
         """True when the run ended beyond its own horizon: its outcome is one sample of what
-        rounding can make of it, not a result (rockjit.fate gives the probabilities)."""
+        rounding can make of it, not a result (rockjit.basins.fate gives the probabilities)."""
         return self.t > self.horizon
 
     @property
@@ -212,7 +212,7 @@ class Result:
             out.append(f"the run ended at t = {self.t:.4g}, beyond its predictability horizon "
                        f"t* = {self.horizon:.4g} (rounding grown to 1 % at lambda1 = "
                        f"{self.lyapunov_running[-1, 0]:.3g}): its outcome is one sample; "
-                       + ("`rockjit fate`" if cli else "rockjit.fate") + " gives the "
+                       + ("`rockjit fate`" if cli else "rockjit.basins.fate") + " gives the "
                        "probabilities")
         return out
 
@@ -236,12 +236,12 @@ class GridResult:
     settings: dict = field(default_factory=dict)
     names: np.ndarray = field(default_factory=_names_array)
     #: Outcome id of each cell (same shape as ``label``): ``>= 0`` the attractor it reaches,
-    #: ``-1`` overturn, ``-2`` unresolved (rockjit.attractors); None when not identified.
+    #: ``-1`` overturn, ``-2`` unresolved (rockjit.basins.identity); None when not identified.
     attractor: np.ndarray | None = None
-    #: The attractors (rockjit.attractors.Attractor), by id.
+    #: The attractors (rockjit.basins.identity.Attractor), by id.
     attractors: list = field(default_factory=list)
     #: Cells whose outcome changes when their initial state moves by ``settings["uncertainty"]``
-    #: (rockjit.analysis.uncertain_cells); None when not asked for.
+    #: (rockjit.grids.grids.uncertain_cells); None when not asked for.
     uncertain: np.ndarray | None = None
 
     def fractions(self):
@@ -328,11 +328,11 @@ class BasinResult(GridResult):
         return out
 
     def measures(self, box=5, eps_cells=(1, 2, 3, 4, 6, 8)):
-        """Measures of the attractor map (rockjit.measures): basin entropy ``Sb`` and
+        """Measures of the attractor map (rockjit.basins.measures): basin entropy ``Sb`` and
         boundary basin entropy ``Sbb`` on ``box x box`` boxes, the uncertainty exponent of the
         boundary from the fraction of cells whose outcome differs ``eps`` cells away, and the
         dynamical integrity (GIM, IF, and LIM of each bounded attractor). JSON-ready."""
-        from . import measures as M
+        from .basins import measures as M
         ids = self.attractor
         if min(ids.shape) >= 2:
             out = M.basin_entropy(ids, box=min(box, *ids.shape)).to_dict()

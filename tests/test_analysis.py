@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import rockjit
-from rockjit import analysis as an
+from rockjit.grids import grids as an
 
 PERIODS = 200
 

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 import rockjit
-from rockjit import analysis as an
-from rockjit.attractors import cycle_distance, identify, match_attractors
+from rockjit.grids import grids as an
+from rockjit.basins.identity import cycle_distance, identify, match_attractors
 
 BASIN = dict(hb=1.0, alpha=0.66, omega=1.3, law="housner")  # the study's hb=1 basin
 SMALL = dict(grid=7, periods=300, n_steps=64, early_stop=False)

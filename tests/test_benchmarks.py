@@ -168,7 +168,7 @@ def test_peers_quick_mode_checks_before_it_times(tmp_path):
     installed (``pip install -e ".[peers]"``; CI installs ".[test]" and skips this). Besides
     the files, the quick run's own correctness checks must hold for every peer: the reference
     run's impact count and times (against rockjit at N = 8192) and the basin's labels (against
-    ``rockjit.analysis.basin``) on its subgrid, each peer's model written independently."""
+    ``rockjit.grids.grids.basin``) on its subgrid, each peer's model written independently."""
     for module in ("jax", "diffrax", "optimistix", "sksundae", "nbkode"):
         pytest.importorskip(module)
     before = _fingerprint()

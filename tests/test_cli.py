@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 import rockjit
-from rockjit import analysis
-from rockjit import io as rio
-from rockjit.analysis import BEHAVIOURS
-from rockjit.cli import main
+from rockjit.grids import grids as analysis
+from rockjit.storage import files as rio
+from rockjit.grids.grids import BEHAVIOURS
+from rockjit.cli.main import main
 
 TINY = ["--periods", "20", "--n-steps", "64", "--quiet"]
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -440,7 +440,7 @@ def test_compile_fills_a_cold_cache_and_says_so(tmp_path):
     code = (
         "import sys\n"
         "from rockjit._jit import cached_kernels\n"
-        "from rockjit.kernel import compile_kernels\n"
+        "from rockjit._engine.kernel import compile_kernels\n"
         "assert not cached_kernels(), 'cache not cold'\n"
         "compiled = compile_kernels(['grid'], processes=1)\n"
         "assert set(compiled) == {'grid'}  # the variants it compiled (their times unread)\n"
@@ -453,6 +453,6 @@ def test_compile_fills_a_cold_cache_and_says_so(tmp_path):
 
 
 def test_compile_refuses_an_unknown_variant():
-    from rockjit.kernel import compile_kernels
+    from rockjit._engine.kernel import compile_kernels
     with pytest.raises(ValueError, match="kernel variant must be one of"):
         compile_kernels(["warp-drive"])

@@ -49,7 +49,7 @@ from functools import lru_cache
 import numba
 import pytest
 
-from rockjit.cli import build_parser, main
+from rockjit.cli.main import build_parser, main
 
 # ---------------------------------------------------------------------------------------------
 # The entry points of real work: reaching one means the input was not refused before work.
@@ -59,29 +59,29 @@ from rockjit.cli import build_parser, main
 # ---------------------------------------------------------------------------------------------
 
 GUARDED = (
-    "rockjit.simulate:simulate",
-    "rockjit.analysis:sweep",
-    "rockjit.analysis:basin",
-    "rockjit.analysis:plane",
-    "rockjit.analysis:run",
-    "rockjit.kernel:run_chunk",
-    "rockjit.integrate:build",
-    "rockjit.study:write_e_table",  # the work of `cor` (and of `paper`'s first part)
-    "rockjit.study:paper",
-    "rockjit.io:atomic_open",       # every file the CLI writes goes through these
-    "rockjit.io:write_json",
-    "rockjit.io:write_npz",
-    "rockjit.io:write_csv",
-    "rockjit.io:write_text",
-    "rockjit.io:save_figure",
+    "rockjit.single:simulate",
+    "rockjit.grids.grids:sweep",
+    "rockjit.grids.grids:basin",
+    "rockjit.grids.grids:plane",
+    "rockjit.grids.grids:run",
+    "rockjit._engine.kernel:run_chunk",
+    "rockjit._engine.integrate:build",
+    "rockjit.study.paper:write_e_table",  # the work of `cor` (and of `paper`'s first part)
+    "rockjit.study.paper:paper",
+    "rockjit.storage.files:atomic_open",       # every file the CLI writes goes through these
+    "rockjit.storage.files:write_json",
+    "rockjit.storage.files:write_npz",
+    "rockjit.storage.files:write_csv",
+    "rockjit.storage.files:write_text",
+    "rockjit.storage.files:save_figure",
 )
 #: Patched as well where they exist (names of a refactor in progress); absent ones are ignored.
 GUARDED_IF_PRESENT = (
-    "rockjit.simulate:run",
-    "rockjit.kernel:run_single",
-    "rockjit.kernel:run_grid",
-    "rockjit.kernel:run_chunk",
-    "rockjit.analysis:run",
+    "rockjit.single:run",
+    "rockjit._engine.kernel:run_single",
+    "rockjit.grids.runner:run_grid",
+    "rockjit._engine.kernel:run_chunk",
+    "rockjit.grids.grids:run",
 )
 
 SEED = int(os.environ.get("ROCKJIT_FUZZ_SEED", "20240610"))
@@ -652,8 +652,8 @@ def reached():
     calls = []
     # import every module the CLI may import lazily first: one imported while the patches are
     # in place would keep a sentinel under its own name for the rest of the session
-    for name in ("analysis", "attractors", "erosion", "fate", "orbits", "outputs", "plotting",
-                 "study"):
+    for name in ("grids.grids", "basins.identity", "basins.erosion", "basins.fate",
+                 "orbits.orbits", "cli.outputs", "plotting.figures", "study.paper"):
         importlib.import_module(f"rockjit.{name}")
     mp = pytest.MonkeyPatch()
     for target in GUARDED + GUARDED_IF_PRESENT:

@@ -13,9 +13,11 @@ import dask.distributed as distributed
 import numpy as np
 import pytest
 
-from rockjit import analysis as an
-from rockjit import chunks, kernel
-from rockjit.cli import main
+from rockjit.grids import runner as grid_runner
+from rockjit.grids import grids as an
+from rockjit.storage import chunkstore as chunks
+from rockjit._engine import kernel
+from rockjit.cli.main import main
 
 
 PLANE = dict(hb=1, alpha_range=(0.4, 1.0), omega_range=(0.9, 1.8), grid=(8, 6), periods=120)
@@ -92,7 +94,7 @@ def test_interrupted_run_resumes(tmp_path, local_plane, monkeypatch):
         an.plane(**PLANE, chunk=6, store=store)
     done = sorted(store.glob("cells-*.npz"))
     assert len(done) == 3
-    assert not list(store.glob(".*.tmp"))  # nothing half-written (rockjit.io names)
+    assert not list(store.glob(".*.tmp"))  # nothing half-written (rockjit.storage.files names)
     assert not (store / "lock.json").exists()  # the interrupted run released the store
     counted = []
 
@@ -138,7 +140,7 @@ def test_plane_command_resumes_and_cleans_up(tmp_path, monkeypatch, capsys):
         return real(*a)
 
     monkeypatch.setattr(kernel, "run_chunk", interrupt_once)
-    monkeypatch.setattr(kernel, "run_grid", _small_chunks(kernel.run_grid))
+    monkeypatch.setattr(grid_runner, "run_grid", _small_chunks(grid_runner.run_grid))
     assert main(args) == 130
     assert not out.exists()  # --out is written only once everything is computed
     assert list((tmp_path / "plane.chunks" / "plane").glob("cells-*.npz"))

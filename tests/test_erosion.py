@@ -1,12 +1,12 @@
 """Erosion profiles (issue 12 §4): the stacked computation against separate basins, the
-measures against rockjit.measures on each basin, and the continued branches' bookkeeping."""
+measures against rockjit.basins.measures on each basin, and the continued branches' bookkeeping."""
 
 import numpy as np
 import pytest
 
-from rockjit import analysis as an
-from rockjit import erosion as er
-from rockjit import measures as M
+from rockjit.grids import grids as an
+from rockjit.basins import erosion as er
+from rockjit.basins import measures as M
 
 KW = dict(hb=1.0, omega=1.3, law="housner", alpha_range=(0.60, 0.72), alpha_step=0.04, grid=16,
           periods=200)

@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 
 import rockjit
-from rockjit import analysis as an
-from rockjit import fate as F
-from rockjit.simulate import Z0_STUDY
+from rockjit.grids import grids as an
+from rockjit.basins import fate as F
+from rockjit.single import Z0_STUDY
 
 CHAOTIC = dict(hb=1.0, alpha=0.955, omega=1.3, law="housner")  # tests/test_lyapunov.py
 

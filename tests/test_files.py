@@ -20,8 +20,10 @@ import numpy as np
 import pytest
 from numba.core.caching import _CacheLocator
 
-from rockjit import _jit, chunks
-from rockjit import io as rio
+from rockjit import _jit
+from rockjit.grids import runner as grid_runner
+from rockjit.storage import chunkstore as chunks
+from rockjit.storage import files as rio
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -273,7 +275,7 @@ def test_signal_during_publish_is_deferred(tmp_path, monkeypatch, existing):
 
 CHILD_PUBLISH = """
     import os, signal, sys, time
-    from rockjit import io as rio
+    from rockjit.storage import files as rio
     out = rio.OutputDir(sys.argv[1], command="basin")
     out.text("a.txt", "new a")
     out.text("summary.json", "new summary")
@@ -438,7 +440,7 @@ def _outputs():
 def _run(store, calls=None, **kw):
     x = np.arange(N, dtype=float)
     out = _outputs()
-    chunks.run_chunks(lambda xs: _runner(xs, calls), (x,), N, CHUNK, out, store=store, **kw)
+    grid_runner.run_chunks(lambda xs: _runner(xs, calls), (x,), N, CHUNK, out, store=store, **kw)
     return out
 
 
@@ -544,7 +546,7 @@ def test_lock_released_when_the_run_raises(tmp_path):
 
     s = _open(store)
     with pytest.raises(KeyboardInterrupt):
-        chunks.run_chunks(runner, (np.arange(N, dtype=float),), N, CHUNK, _outputs(), store=s)
+        grid_runner.run_chunks(runner, (np.arange(N, dtype=float),), N, CHUNK, _outputs(), store=s)
     assert not s.locked and not (store / "lock.json").exists()
     calls = []
     _same(_run(_open(store), calls), _direct())  # resumes: only the missing chunks
@@ -565,7 +567,8 @@ CHILD_RUN = """
     import sys
     from pathlib import Path
     import numpy as np
-    from rockjit import chunks
+    from rockjit.grids import runner as grid_runner
+    from rockjit.storage import chunkstore as chunks
     def runner(x):
         if x[0] == 5:  # the second chunk: wait for the parent
             print("computing", flush=True)
@@ -574,7 +577,7 @@ CHILD_RUN = """
     x = np.arange(23.0)
     out = {"y": np.zeros(23)}
     store = chunks.ChunkStore(sys.argv[1], chunks.fingerprint((x,), {}), 23, 5)
-    chunks.run_chunks(runner, (x,), 23, 5, out, store=store)
+    grid_runner.run_chunks(runner, (x,), 23, 5, out, store=store)
     gone = chunks.remove_stores(Path(sys.argv[1]).parent)  # as the command line does
     print("removed" if gone else "kept", flush=True)
 """
@@ -639,7 +642,7 @@ def test_remove_store_deletes_only_rockjits_files(tmp_path):
 
 def _fake_clock(monkeypatch):
     now = [0.0]
-    monkeypatch.setattr(chunks.time, "perf_counter", lambda: now[0])
+    monkeypatch.setattr(grid_runner.time, "perf_counter", lambda: now[0])
     return now
 
 
@@ -651,7 +654,7 @@ def test_progress_in_a_log_file_is_plain_throttled_lines(tmp_path, monkeypatch, 
         now[0] += 2.0  # each chunk takes 2 s
         return _runner(xs)
 
-    chunks.run_chunks(runner, (x,), N, CHUNK, _outputs(), progress=True, label="basin")
+    grid_runner.run_chunks(runner, (x,), N, CHUNK, _outputs(), progress=True, label="basin")
     err = capsys.readouterr().err
     assert "\r" not in err
     lines = err.splitlines()
@@ -674,7 +677,7 @@ def test_progress_on_a_terminal_rewrites_one_line(monkeypatch):
 
     tty = Tty()
     monkeypatch.setattr(sys, "stderr", tty)
-    chunks.run_chunks(_runner, (np.arange(N, dtype=float),), N, CHUNK, _outputs(),
+    grid_runner.run_chunks(_runner, (np.arange(N, dtype=float),), N, CHUNK, _outputs(),
                       progress=True)
     text = tty.getvalue()
     assert text.count("\r") == len(BOUNDS) and text.count("\n") == 1 and text.endswith("\n")
@@ -689,6 +692,8 @@ def _package(tmp_path, extra=()):
     pkg.mkdir(parents=True)
     for name in _jit._SOURCES + ("cli.py",) + tuple(extra):
         (pkg / name).write_text(f"# {name}\n")
+    for name in ("integrate.py", "analysis.py"):  # modules that compile import the policy
+        (pkg / name).write_text("from ._jit import jit\n")
     return pkg
 
 

@@ -1,4 +1,4 @@
-"""The compiled integrator (rockjit.integrate) against things that do not come from it.
+"""The compiled integrator (rockjit._engine.integrate) against things that do not come from it.
 
 - the Dormand–Prince tableau against the Runge–Kutta order conditions, generated here from the
   rooted trees (Butcher), for the 5th-order weights, the embedded 4th-order weights and the
@@ -21,8 +21,8 @@ import numpy as np
 import pytest
 
 import rockjit
-from rockjit import integrate as ig
-from rockjit.kernel import pack
+from rockjit._engine import integrate as ig
+from rockjit._engine.kernel import pack
 
 DOP = dict(method="scipy:DOP853", rtol=1e-12, atol=1e-12)
 
@@ -467,7 +467,7 @@ def test_default_impact_bound_scales_with_the_periods():
 
 
 def test_impact_record_keeps_the_latest_impacts_in_order(monkeypatch):
-    from rockjit import kernel
+    from rockjit._engine import kernel as kernel
     full = rockjit.simulate(1.0, 0.6, 1.3, "housner", periods=40)
     assert full.n_impacts > 57
     monkeypatch.setattr(kernel, "IMPACT_RECORD", 57)  # a ring of 57 rows
@@ -496,7 +496,7 @@ def test_continuing_past_overturn_matches_the_scipy_path(alpha):
 
 
 def an_classify(result):
-    from rockjit.analysis import classify_result
+    from rockjit.grids.grids import classify_result
     return classify_result(result)
 
 

@@ -29,6 +29,7 @@ def _fake_package(tmp_path):
     cache.mkdir(parents=True)
     for name in _jit._SOURCES:
         (pkg / name).write_text(f"# {name}\n")
+    (pkg / "integrate.py").write_text("from ._jit import jit\n")  # compiles: imports the policy
     for name in ("integrate._run-1.py311.nbi", "integrate._run-1.py311.1.nbc"):
         (cache / name).write_text("stale")
     (cache / "simulate.cpython-311.pyc").write_text("keep")
@@ -66,6 +67,26 @@ def test_cache_dir_elsewhere_survives_a_cold_start(tmp_path, monkeypatch):
     (compiled / "integrate._run-1.py311.nbi").write_text("fresh")
     _jit.check_cache(pkg)  # a second process, sources unchanged
     assert (compiled / "integrate._run-1.py311.nbi").exists()
-    (pkg / "integrate.py").write_text("# integrate.py, edited\n")
+    (pkg / "integrate.py").write_text("from ._jit import jit  # integrate.py, edited\n")
     _jit.check_cache(pkg)
     assert not list(compiled.glob("*.nb[ic]"))
+
+
+def test_a_subpackage_that_compiles_has_its_cache_checked(tmp_path, monkeypatch):
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.setattr(_jit, "_user_wide_dir", lambda: tmp_path / "user-wide")
+    pkg, _ = _fake_package(tmp_path)
+    engine = pkg / "_engine"
+    (engine / "__pycache__").mkdir(parents=True)
+    (engine / "kernel.py").write_text("from .._jit import jit\n")
+    (engine / "notes.py").write_text("# compiles nothing\n")
+    _jit.check_cache(pkg)
+    cache = engine / "__pycache__"
+    assert (cache / _jit.STAMP).exists()
+    (cache / "kernel._grid-1.py311.nbi").write_text("fresh")
+    (cache / "notes.f-1.py311.nbi").write_text("fresh")
+    _jit.check_cache(pkg)
+    assert (cache / "kernel._grid-1.py311.nbi").exists()
+    (pkg / "model.py").write_text("# model.py, edited\n")  # the engine inlines the model
+    _jit.check_cache(pkg)
+    assert not (cache / "kernel._grid-1.py311.nbi").exists()

@@ -1,7 +1,7 @@
 """Grids with several cells per thread in lockstep (issue 17): the same outputs, bit for bit.
 
-The reference is the single-lane grid kernel (``lanes=1``, :func:`rockjit.kernel._grid`, which
-runs every cell through :func:`rockjit.integrate._loop`): the lanes' vector step must equal the
+The reference is the single-lane grid kernel (``lanes=1``, :func:`rockjit._engine.kernel._grid`, which
+runs every cell through :func:`rockjit._engine.integrate._loop`): the lanes' vector step must equal the
 single-lane step in every lane, and every output array of a grid (labels, periods, end times,
 overturning instants, stroboscopic samples, impact sections, attractor ids) must be equal, on
 the study's four basins, full length and early-stopped, a sweep with per-cell parameters, a
@@ -16,10 +16,10 @@ import numba
 import numpy as np
 import pytest
 
-from rockjit import analysis as an
-from rockjit import integrate as ig
-from rockjit import kernel as kn
-from rockjit import lanes as ln
+from rockjit.grids import grids as an
+from rockjit._engine import integrate as ig
+from rockjit._engine import kernel as kn
+from rockjit._engine import lanes as ln
 from rockjit.model import Block
 
 #: The study's four basins (SPEC.md §7).

@@ -1,4 +1,4 @@
-"""Periodic orbits (rockjit.orbits): shooting, continuation and bifurcations against independent
+"""Periodic orbits (rockjit.orbits.orbits): shooting, continuation and bifurcations against independent
 references: plain and scipy runs, finite differences, Lyapunov exponents, brute-force sweeps."""
 
 import math
@@ -7,8 +7,10 @@ import numpy as np
 import pytest
 
 import rockjit
-from rockjit import Block, analysis, orbits
-from rockjit.orbits import OrbitRefused
+from rockjit import Block
+from rockjit.grids import grids as analysis
+from rockjit.orbits import orbits
+from rockjit.orbits.orbits import OrbitRefused
 
 HB, OMEGA = 1.0, 1.3
 T = 2 * math.pi / OMEGA
@@ -353,7 +355,7 @@ def test_continuation_in_omega_uses_the_same_code(asym08):
 
 
 def test_summary_and_arrays_round_trip(study, tmp_path):
-    from rockjit import io
+    from rockjit.storage import files as io
     _, cont = study
     summary, arrays = cont.to_summary()
     io.write_json(tmp_path / "summary.json", summary)
@@ -373,7 +375,7 @@ def test_summary_and_arrays_round_trip(study, tmp_path):
 
 
 def test_fig_branches(study):
-    from rockjit import plotting
+    from rockjit.plotting import figures as plotting
     sw, cont = study
     fig = plotting.fig_branches(cont, sw)
     ax = fig.axes[0]
@@ -389,7 +391,7 @@ def test_fig_branches(study):
 def test_branches_and_bifurcations_stay_inside_the_range():
     # the asymmetric branch switched onto at Mao hb=1's symmetry breaking (alpha = 0.7876) was
     # followed to alpha = 1.93 and a grazing reported there, outside the requested (0.3, 0.8)
-    from rockjit import analysis as an
+    from rockjit.grids import grids as an
     sw = an.sweep(1.0, 1.3, law="mao", alpha_range=(0.3, 0.8), alpha_step=0.004, periods=300)
     c = orbits.continue_branches(1.0, "mao", 1.3, (0.3, 0.8), sweep=sw)
     assert c.bifurcations and all(0.3 <= b.alpha <= 0.8 for b in c.bifurcations)

@@ -11,9 +11,9 @@ matplotlib.use("Agg")
 from matplotlib.colors import to_hex  # noqa: E402
 
 import rockjit  # noqa: E402
-from rockjit import plotting as P  # noqa: E402
-from rockjit.analysis import BEHAVIOURS, BasinResult, SweepResult, fractions  # noqa: E402
-from rockjit.io import save_figure  # noqa: E402
+from rockjit.plotting import figures as P  # noqa: E402
+from rockjit.grids.grids import BEHAVIOURS, BasinResult, SweepResult, fractions  # noqa: E402
+from rockjit.storage.files import save_figure  # noqa: E402
 
 RUN = dict(periods=20, n_steps=64, record_stride=4, lyapunov=True)  # one compiled variant
 

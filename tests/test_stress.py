@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import rockjit
-from rockjit import stress as S
+from rockjit.testing import stress as S
 
 SEED = 0
 N_CASES = 60
@@ -158,7 +158,7 @@ def test_threads_check_catches_a_difference():
     one = S.run_threads_case(case, 1)
     assert S.check_threads(one, one) == []
     label = one.label.copy()
-    label.flat[0] = (label.flat[0] + 1) % len(rockjit.analysis.BEHAVIOURS)
+    label.flat[0] = (label.flat[0] + 1) % len(rockjit.grids.grids.BEHAVIOURS)
     assert S.check_threads(one, dataclasses.replace(one, label=label))
 
 

@@ -1,4 +1,4 @@
-"""Input checking of ``rockjit.simulate``: every invalid input is a ValueError naming the parameter.
+"""Input checking of ``rockjit.single``: every invalid input is a ValueError naming the parameter.
 
 Checked against SPEC.md's ranges (§1-3) and STYLE.md 12, on both the compiled and the scipy path
 (the wrapper validates before it dispatches, so no integration runs in these tests).
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import rockjit
-from rockjit.simulate import MAX_STEP
+from rockjit.single import MAX_STEP
 
 BASE = dict(hb=1.0, alpha=0.6, omega=1.3, periods=1)
 NAN = math.nan
@@ -193,7 +193,7 @@ def test_blocks_made_once_and_refusals_never_remembered():
     """simulate.make_block keeps the blocks it made from plain numbers (a run's fixed cost): the
     same arguments give the same block, other arguments another, and a refused block is refused
     again (nothing invalid is kept)."""
-    from rockjit.simulate import make_block
+    from rockjit.single import make_block
     a = make_block(1.0, 0.6, 1.3, "housner")
     assert make_block(1.0, 0.6, 1.3, "housner") is a
     b = make_block(1.0, 0.6, 1.3, "mao")

@@ -8,7 +8,7 @@ best scipy method of ``bench_work_precision.py`` (DOP853) through rockjit's scip
    z0 = Z0_STUDY, 500 periods): each peer at tight tolerances against rockjit at N = 8192
    (impact count, impact times, final state, label). The hb=1 Housner basin (alpha=0.66,
    omega=1.3, (r0, s0) = (0, 1), 500 periods, rockjit's classification): labels against
-   ``rockjit.analysis.basin(...).label`` on a ``--basin-sub`` x ``--basin-sub`` subgrid of the
+   ``rockjit.grids.grids.basin(...).label`` on a ``--basin-sub`` x ``--basin-sub`` subgrid of the
    100 x 100 lattice (every peer), and on the whole lattice for peers whose estimated time is
    under ``--full-basin-cap`` seconds.
 2. **Work–precision** on bench_work_precision.py's periodic and chaotic scenes (same
@@ -54,7 +54,7 @@ sys.path.insert(0, str(HERE.parent))
 import _common as H  # noqa: E402
 
 import rockjit  # noqa: E402
-from rockjit import analysis  # noqa: E402
+from rockjit.grids import grids as analysis  # noqa: E402
 from rockjit.result import BEHAVIOURS  # noqa: E402
 
 N_REF = 8192
@@ -221,8 +221,8 @@ def scene_runs(peers, name, scene, quick, repeats):
 def call_floor(peers, n=41):
     """The fixed cost of one call: a one-period run of the chaotic scene's block at the
     loosest settings, median of ``n``; for rockjit also its two halves, validating the inputs
-    (``rockjit.simulate.plan``) and running the plan (``rockjit.simulate.run``)."""
-    sim = importlib.import_module("rockjit.simulate")
+    (``rockjit.single.plan``) and running the plan (``rockjit.single.run``)."""
+    sim = importlib.import_module("rockjit.single")
     sc = C.SCENES["chaotic"]
     kw = dict(hb=sc["hb"], alpha=sc["alpha"], omega=sc["omega"])
     z = rockjit.Z0_STUDY

@@ -12,7 +12,7 @@ block leaves on the side of the forcing's sign. The forcing is rockjit's closed 
 
 Every peer returns a :class:`PeerRun`: samples ``(theta, theta')`` at ``t = j T/2`` (``strobe``
 at ``kT``, ``half`` at ``kT + T/2``) and the count of impacts up to each ``kT``, which is what
-:func:`rockjit.classify.classify` (the classifier behind :func:`rockjit.analysis.classify_result`
+:func:`rockjit._engine.classify.classify` (the classifier behind :func:`rockjit.grids.grids.classify_result`
 and the basin kernels) reads; :func:`label` calls it on them exactly as ``classify_result``
 does, over the window ``[round(0.8 P) T, P T]``.
 """
@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 import rockjit
-from rockjit.classify import classify
+from rockjit._engine.classify import classify
 from rockjit.model import Block, e_housner, e_mao
 from rockjit.result import BEHAVIOURS, OVERTURN, REST, UNRESOLVED
 
@@ -35,7 +35,7 @@ DONE, OVERTURNED, RESTED, MAX_IMPACTS = "done", "overturned", "rest", "max_impac
 FAILED = "failed"
 STATUS_CODES = (DONE, OVERTURNED, RESTED, MAX_IMPACTS, FAILED)
 
-#: rockjit's classification defaults (rockjit.analysis.TOL, PMAX, LAM_TOL).
+#: rockjit's classification defaults (rockjit.grids.grids.TOL, PMAX, LAM_TOL).
 TOL, PMAX, LAM_TOL = 1e-6, 16, 1e-2
 
 #: The work–precision scenes of benchmarks/bench_work_precision.py (same parameters, same
@@ -146,8 +146,8 @@ def samples_from(n_samples, values, n_got):
 
 def label_code(status, strobe, half, per_imp, periods, *, tol=TOL, pmax=PMAX):
     """Behaviour code of a run (an index of ``rockjit.result.BEHAVIOURS``), as
-    :func:`rockjit.analysis.classify_result` finds it: overturn, rest (for good), unresolved
-    (impact bound), else :func:`rockjit.classify.classify` on the samples ``k0..k1`` with
+    :func:`rockjit.grids.grids.classify_result` finds it: overturn, rest (for good), unresolved
+    (impact bound), else :func:`rockjit._engine.classify.classify` on the samples ``k0..k1`` with
     ``k0 = round(0.8 periods)`` and no Lyapunov exponent (as a basin without ``lyapunov``)."""
     if status == OVERTURNED:
         return OVERTURN

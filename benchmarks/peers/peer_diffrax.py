@@ -212,7 +212,7 @@ def compiled_basin(method, periods):
 
 def basin(p: C.Params, theta0s, dtheta0s, periods, rtol, atol, method="Tsit5", chunk=2500):
     """Labels ``(len(theta0s), len(dtheta0s))``: the run under ``jax.vmap``, ``chunk`` cells
-    at a time; each cell classified by ``rockjit.classify`` (:func:`common.label_code`)."""
+    at a time; each cell classified by ``rockjit._engine.classify`` (:func:`common.label_code`)."""
     TH, DTH = np.meshgrid(theta0s, dtheta0s, indexing="ij")
     th, dth = TH.ravel(), DTH.ravel()
     f = compiled_basin(method, int(periods))

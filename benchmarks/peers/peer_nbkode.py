@@ -13,7 +13,7 @@ Illinois' rule), takes the state there from the dense output, applies the jump a
 stepper (a fresh buffer: the FSAL derivative is stale after the jump), keeping the step size.
 Samples at ``j T/2`` come from the dense output. The basin runs every cell in a
 ``numba.prange`` loop and classifies it in the same compiled code with
-``rockjit.classify.classify``.
+``rockjit._engine.classify.classify``.
 
 This is a user's code, not rockjit's: it uses ``numba.njit`` as nbkode does (rockjit's own
 kernels go through ``rockjit._jit``).
@@ -31,7 +31,7 @@ from nbkode.runge_kutta import dop853_coefficients as _d853
 from nbkode.runge_kutta.explicit import (DOP853, DOP853Interpolator, RkInterpolator,
                                          RungeKutta45)
 
-from rockjit.classify import classify
+from rockjit._engine.classify import classify
 
 import common as C
 

@@ -10,11 +10,11 @@ to ``1e-10``) and reports each outcome's probability, the finite-time exponent o
 and the horizon. The ensemble is one grid of the compiled kernels (closed-form forcing) or
 ``K`` single runs (the embedding), so it is independent of the number of threads.
 
-Grids can flag their *uncertain* cells (:func:`rockjit.analysis.uncertain_cells`, the
+Grids can flag their *uncertain* cells (:func:`rockjit.grids.grids.uncertain_cells`, the
 ``uncertainty`` setting of the grids): those whose outcome changes when the initial state is
 perturbed by ``eps``; the fraction of uncertain cells against ``eps`` gives the boundary's
 uncertainty exponent (Grebogi, McDonald, Ott & Yorke 1983,
-:func:`rockjit.measures.uncertainty_exponent`).
+:func:`rockjit.basins.measures.uncertainty_exponent`).
 """
 
 from __future__ import annotations
@@ -24,12 +24,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import analysis, kernel
-from .attractors import identify
-from .result import BEHAVIOURS, HORIZON_TOL, ROUNDING, horizon
-from .simulate import plan as plan_run
-from .simulate import run as run_one
-from .validate import integer, memory, pair
+from ..grids import grids as analysis
+from ..grids import runner
+
+from .._engine import kernel
+from .identity import identify
+from ..result import BEHAVIOURS, HORIZON_TOL, ROUNDING, horizon
+from ..single import plan as plan_run
+from ..single import run as run_one
+from ..validate import integer, memory, pair
 
 __all__ = ["DEFAULT_SPREAD", "HORIZON_TOL", "FatePlan", "FateResult", "fate", "horizon",
            "perturb", "plan_fate", "run"]
@@ -193,7 +196,7 @@ def _members_on_a_grid(p, starts, threads, progress):
                            pmax=analysis.PMAX, stop_at_overturn=p.stop_at_overturn)
     cpar = np.array([analysis.TOL, analysis.LAM_TOL])
     y0s = np.column_stack([starts, np.full(n, p.y0[2]), np.full(n, p.y0[3])])
-    out = kernel.run_grid(y0s, np.tile(par, (n, 1)), ipar, cpar, tangent=False,
+    out = runner.run_grid(y0s, np.tile(par, (n, 1)), ipar, cpar, tangent=False,
                           n_pts=analysis.PMAX, n_imp_pts=0, threads=threads,
                           progress=progress, label="fate")
     res = out["res"]
@@ -204,7 +207,7 @@ def _members_on_a_grid(p, starts, threads, progress):
 def _members_one_by_one(p, starts):
     from dataclasses import replace
 
-    from .analysis import classify_result
+    from ..grids.grids import classify_result
     n = starts.shape[0]
     m = analysis.PMAX
     label = np.zeros(n, dtype=np.int64)

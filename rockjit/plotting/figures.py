@@ -1,9 +1,9 @@
 """The study's figures (SPEC.md §7), one function each; matplotlib is imported lazily.
 
-Every function takes result objects (:class:`rockjit.Result`, :class:`rockjit.analysis.SweepResult`,
-:class:`rockjit.analysis.BasinResult`) and returns a :class:`matplotlib.figure.Figure` built
+Every function takes result objects (:class:`rockjit.Result`, :class:`rockjit.grids.grids.SweepResult`,
+:class:`rockjit.grids.grids.BasinResult`) and returns a :class:`matplotlib.figure.Figure` built
 without :mod:`matplotlib.pyplot`, so no GUI backend is needed and nothing is kept in pyplot's
-figure registry; save it with :func:`rockjit.io.save_figure` or ``fig.savefig``.
+figure registry; save it with :func:`rockjit.storage.files.save_figure` or ``fig.savefig``.
 
 Behaviours have one colour everywhere: :data:`BEHAVIOUR_COLOURS`.
 """
@@ -14,9 +14,9 @@ import math
 
 import numpy as np
 
-from .analysis import classify_result
-from .result import BEHAVIOURS, fractions
-from .model import delta_e_percent, e_housner, e_mao, thc_from_hb
+from ..grids.grids import classify_result
+from ..result import BEHAVIOURS, fractions
+from ..model import delta_e_percent, e_housner, e_mao, thc_from_hb
 
 __all__ = ["BEHAVIOUR_COLOURS", "LAW_COLOURS", "agreement", "fig_attractors", "fig_basin",
            "fig_basin_compare", "fig_bifurcation", "fig_erosion", "fig_fate", "fig_gallery",
@@ -708,7 +708,7 @@ def fig_plane(plane_result, state=0, title=None):
 
 
 # ---------------------------------------------------------------------------------------------
-# Periodic-orbit branches (rockjit.orbits) over a sweep
+# Periodic-orbit branches (rockjit.orbits.orbits) over a sweep
 # ---------------------------------------------------------------------------------------------
 
 #: Marker of each bifurcation type in :func:`fig_branches`.
@@ -750,8 +750,8 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
 
     Parameters
     ----------
-    continuation : rockjit.orbits.Continuation
-        From :func:`rockjit.orbits.continue_branches` (or :func:`~rockjit.orbits.continuation`).
+    continuation : rockjit.orbits.orbits.Continuation
+        From :func:`rockjit.orbits.orbits.continue_branches` (or :func:`~rockjit.orbits.orbits.continuation`).
     sweep : SweepResult, optional
         Its stroboscopic points are drawn as dots coloured by behaviour; it must be sampled at
         the continuation's forcing phase (``continue_branches`` uses the sweep's).

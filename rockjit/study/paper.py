@@ -4,7 +4,7 @@ The constants are the study's parameters: the slenderness ratios with their forc
 and amplitude ranges, the sweeps' step, the zoom, the initial states of the single runs, the
 gallery, the basins. :func:`plan_paper` validates a paper's settings (nothing computed) and
 :func:`paper` computes every figure and table and writes them into an output directory object
-(:class:`rockjit.io.OutputDir` on the command line): figures 1-6 of the study, and beyond it
+(:class:`rockjit.storage.files.OutputDir` on the command line): figures 1-6 of the study, and beyond it
 the branches of periodic orbits over its bifurcation diagrams with their located bifurcations
 (figure 5's ``fig5_branches_*``, ``bifurcation_table``), the attractor maps of its basins with
 their entropy and integrity (figure 7) and the erosion profiles of both laws (figure 8). Its
@@ -20,22 +20,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import analysis
-from . import erosion
-from .analysis import BEHAVIOURS, classify_result
-from .model import delta_e_percent, e_housner, e_mao, thc_from_hb
-from .simulate import DEFAULT_N, Z0_STUDY, simulate
-from .erosion import plan_erosion
-from .fate import fate
-from .simulate import plan as plan_run
-from .validate import integer, pair, real
+from ..grids import grids as analysis
+from ..basins import erosion
+from ..grids.grids import BEHAVIOURS, classify_result
+from ..model import delta_e_percent, e_housner, e_mao, thc_from_hb
+from ..single import DEFAULT_N, Z0_STUDY, simulate
+from ..basins.erosion import plan_erosion
+from ..basins.fate import fate
+from ..single import plan as plan_run
+from ..validate import integer, pair, real
 
 __all__ = ["ALPHA_STEP", "BASIN_CASES", "BASIN_GRID", "EROSION", "EROSION_GRID", "EROSION_STEP",
            "GALLERY", "LAWS_IC", "LAWS_RUN", "PERIODS", "REFERENCE_RUN", "STUDY", "Z0", "ZOOM",
            "PaperPlan", "after_the_fall", "e_table", "paper", "plan_paper"]
 
 #: The initial state of the single runs and sweeps, ``(theta, theta', r, s)``. (Defined in
-#: rockjit.simulate, whose default it is.)
+#: rockjit.single, whose default it is.)
 Z0 = Z0_STUDY
 
 #: Per slenderness ratio: the forcing frequency and the amplitude range of each law's sweep.
@@ -106,7 +106,7 @@ def e_table(hb_values):
 
 def write_e_table(out, hb_values, hb_max, fig_name, table_stem):
     """Figure 1 and the e-table into ``out``; returns the table as dicts."""
-    from .plotting import fig_restitution
+    from ..plotting.figures import fig_restitution
     rows = e_table(hb_values)
     out.figure(fig_name, fig_restitution((1 / math.sqrt(2), hb_max)))
     out.table(table_stem, E_HEADER, rows, E_FMT)
@@ -190,7 +190,7 @@ def after_the_fall(sw):
     """What a sweep integrated past overturning plots where the block fell: the share of its
     amplitudes whose points and exponent come from motion after the fall, and that motion's
     behaviours, exponent signs and distinct attractors (continued along the amplitudes)."""
-    from .attractors import identify_along
+    from ..basins.identity import identify_along
     fell = np.isfinite(sw.t_overturn)
     plotted = fell & np.isin(sw.motion, [BEHAVIOURS.index(b) for b in
                                          ("symmetric", "asymmetric", "multiperiodic",
@@ -217,7 +217,7 @@ def paper(out, plan=None, *, progress=False, client=None, store=None, say=None, 
 
     Parameters
     ----------
-    out : rockjit.io.OutputDir
+    out : rockjit.storage.files.OutputDir
         Where the files go (``json``, ``npz``, ``figure``, ``table`` methods); the caller
         publishes it.
     plan : PaperPlan, optional
@@ -235,9 +235,9 @@ def paper(out, plan=None, *, progress=False, client=None, store=None, say=None, 
     """
     from pathlib import Path
 
-    from .attractors import attractor_agreement
-    from .orbits import continue_branches
-    from .plotting import (agreement, fig_attractors, fig_basin_compare, fig_bifurcation,
+    from ..basins.identity import attractor_agreement
+    from ..orbits.orbits import continue_branches
+    from ..plotting.figures import (agreement, fig_attractors, fig_basin_compare, fig_bifurcation,
                            fig_branches, fig_erosion, fig_gallery, fig_laws_timeseries,
                            fig_trajectory)
 

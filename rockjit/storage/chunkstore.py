@@ -1,13 +1,8 @@
-"""Chunked, resumable execution of grid computations, in-process or on a Dask cluster.
+"""The store of finished grid chunks: resumable grid computations, one run at a time.
 
 A grid (the cells of a sweep, a basin or a parameter plane) is cut into chunks of consecutive
-cells. Each chunk is one call of a runner function (``rockjit.analysis.run_chunk``: the compiled
-parallel kernel on those cells), in this process or as a task on a ``dask.distributed.Client``,
-whose workers run the same compiled kernels. Results are placed into the full output arrays as
-chunks arrive.
-
-With a store directory (:class:`ChunkStore`), every finished chunk is written there atomically
-(:func:`rockjit.io.atomic_open`, with the user's umask) beside a manifest holding a fingerprint
+cells (:mod:`rockjit.grids.runner`). With a store directory (:class:`ChunkStore`), every finished chunk is written there atomically
+(:func:`rockjit.storage.files.atomic_open`, with the user's umask) beside a manifest holding a fingerprint
 of the whole computation (inputs, settings, chunking, rockjit's version). Running the same
 computation again with the same directory loads the finished chunks and computes only the
 missing ones, so an interrupted run, or one that lost workers, resumes; the result equals an
@@ -19,10 +14,9 @@ missing or of the wrong shape or type) is discarded and computed again, and the 
 A store is used by one run at a time: a lock file (``lock.json``: the owner's pid and host)
 makes a second run on the same store refuse with a ``ValueError`` naming the owner while it is
 alive; the lock of a process that no longer exists on this host is taken over (and the run
-says so). :func:`run_chunks` releases the lock when it returns or raises; :func:`remove_stores`
+says so). :func:`rockjit.grids.runner.run_chunks` releases the lock when it returns or raises; :func:`remove_stores`
 deletes a store only when it can hold the lock, and only the files rockjit wrote there.
 
-Dask is optional and imported only when a client is given.
 """
 
 from __future__ import annotations
@@ -41,14 +35,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .io import atomic_open, create_temp, host_name, pid_alive, write_text
+from .files import atomic_open, create_temp, host_name, pid_alive, write_text
 
-__all__ = ["ChunkStore", "DamagedChunk", "fingerprint", "remove_stores", "run_chunks"]
+__all__ = ["ChunkStore", "DamagedChunk", "fingerprint", "remove_stores"]
 
 
 def fingerprint(arrays, settings):
     """SHA-256 over the arrays' bytes (with dtype and shape) and the settings as JSON."""
-    from . import __version__
+    from .. import __version__
 
     h = hashlib.sha256()
     for a in arrays:
@@ -373,7 +367,7 @@ class ChunkStore:
         return out
 
     def save(self, a, b, out):
-        """Write chunk ``a:b`` atomically (:func:`rockjit.io.atomic_open`)."""
+        """Write chunk ``a:b`` atomically (:func:`rockjit.storage.files.atomic_open`)."""
         with atomic_open(self._path(a, b), "wb") as fh:
             np.savez(fh, **out)
 
@@ -434,143 +428,3 @@ def remove_stores(directory, *, message=None, _lock=None):
         with contextlib.suppress(OSError):
             d.rmdir()
     return not os.path.lexists(d)
-
-
-class _Progress:
-    """Progress on stderr: one line rewritten with ``\\r`` on a terminal; otherwise plain lines,
-    at most one every :attr:`EVERY` seconds plus the last, so that a log file stays readable."""
-
-    EVERY = 5.0
-
-    def __init__(self, total, label, enabled, done=0, stream=None):
-        self.total, self.label, self.enabled = total, label, enabled
-        self.stream = sys.stderr if stream is None else stream
-        try:
-            self.tty = bool(self.stream.isatty())
-        except (AttributeError, ValueError):
-            self.tty = False
-        self.t0 = self.last = time.perf_counter()
-        self.done = self.start = done
-        self.shown = False
-        self.pending = False
-
-    def _line(self, width):
-        el = time.perf_counter() - self.t0
-        fresh = self.done - self.start
-        eta = el / fresh * (self.total - self.done) if fresh else float("nan")
-        if width:
-            return (f"{self.label}: {self.done}/{self.total} cells, {el:6.1f} s elapsed, "
-                    f"~{eta:5.1f} s left ")
-        return (f"{self.label}: {self.done}/{self.total} cells, {el:.1f} s elapsed, "
-                f"~{eta:.1f} s left")
-
-    def update(self, n):
-        self.done += n
-        if not self.enabled:
-            return
-        if self.tty:
-            self.stream.write("\r" + self._line(True))
-        elif time.perf_counter() - self.last >= self.EVERY or self.done >= self.total:
-            self.stream.write(self._line(False) + "\n")
-            self.last = time.perf_counter()
-            self.pending = False
-        else:
-            self.pending = True
-            return
-        self.shown = True
-        self.stream.flush()
-
-    def close(self):
-        if not self.enabled:
-            return
-        if self.tty and self.shown:
-            self.stream.write("\n")
-        elif self.pending:
-            self.stream.write(self._line(False) + "\n")
-            self.pending = False
-        self.stream.flush()
-
-
-def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, progress=False,
-               label="cells", task_prefix="rockjit"):
-    """Run ``runner`` over chunks of ``n`` cells and fill ``outputs`` in place.
-
-    Parameters
-    ----------
-    runner : callable
-        ``runner(*inputs_of_chunk) -> dict name -> array`` for cells ``a:b``; module-level, so
-        that Dask can send it to workers.
-    inputs : tuple
-        Arguments of ``runner``; arrays whose first axis has length ``n`` are sliced per chunk,
-        everything else is passed whole.
-    outputs : dict name -> ndarray
-        Preallocated results, first axis ``n``; chunk ``a:b`` is written to ``[a:b]``.
-    client : dask.distributed.Client, optional
-        Run the chunks as tasks on this cluster (retried if a worker is lost).
-    store : ChunkStore, optional
-        Load finished chunks from it and save new ones to it. A stored chunk that cannot be
-        read back whole is discarded, reported through ``store.message`` ("discarded damaged
-        chunk cells-...; recomputing") and computed again. The store's lock is taken for the
-        run (if :meth:`ChunkStore.close` gave it back) and released when this function
-        returns or raises.
-    progress : bool
-        Report progress on stderr (a rewritten line on a terminal, else throttled lines).
-    """
-    if store is not None:
-        store.acquire()
-    try:
-        return _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, label,
-                           task_prefix)
-    finally:
-        if store is not None:
-            store.close()
-
-
-def _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, label,
-                task_prefix):
-    bounds = [(a, min(n, a + chunk)) for a in range(0, n, chunk)]
-    todo = []
-    for a, b in bounds:
-        if store is not None and store.has(a, b):
-            try:
-                loaded = store.load(a, b, like=outputs)
-            except DamagedChunk as exc:
-                store.discard(a, b)
-                store.message(f"discarded damaged chunk {exc.name} ({exc.reason}); "
-                              f"recomputing")
-                todo.append((a, b))
-                continue
-            for k, v in loaded.items():
-                outputs[k][a:b] = v
-        else:
-            todo.append((a, b))
-    bar = _Progress(n, label, progress, done=n - sum(b - a for a, b in todo))
-
-    def args(a, b):
-        return tuple(x[a:b] if isinstance(x, np.ndarray) and x.ndim and x.shape[0] == n else x
-                     for x in inputs)
-
-    def place(a, b, out):
-        if store is not None:
-            store.save(a, b, out)
-        for k, v in out.items():
-            outputs[k][a:b] = v
-        bar.update(b - a)
-
-    try:
-        if client is None:
-            for a, b in todo:
-                place(a, b, runner(*args(a, b)))
-        else:
-            from dask.distributed import as_completed
-
-            futures = {}
-            for a, b in todo:
-                fut = client.submit(runner, *args(a, b), key=f"{task_prefix}-{a}-{b}",
-                                    retries=3, pure=False)
-                futures[fut] = (a, b)
-            for fut in as_completed(futures):
-                place(*futures[fut], fut.result())
-    finally:
-        bar.close()
-    return outputs

@@ -1,16 +1,16 @@
 """The ``rockjit`` command line: argparse and file output over the library's plans and runs.
 
-Every command parses its options into the library's own plan (:func:`rockjit.simulate.plan`,
-:func:`rockjit.analysis.plan_sweep` and the others), which validates everything before any work:
+Every command parses its options into the library's own plan (:func:`rockjit.single.plan`,
+:func:`rockjit.grids.grids.plan_sweep` and the others), which validates everything before any work:
 a bad value ends the command with one line ``rockjit: error: ...`` on stderr and exit status 2,
 having written nothing. Then it computes and writes its data, its figure(s) and
 ``summary.json`` into a hidden staging directory, published into ``--out`` as one unit at the
-end (:class:`rockjit.io.OutputDir`). An interrupted command (Ctrl-C: exit status 130) leaves
+end (:class:`rockjit.storage.files.OutputDir`). An interrupted command (Ctrl-C: exit status 130) leaves
 ``--out`` as it was; the finished chunks of its grids wait in ``<out>.chunks`` so that running
 the same command again resumes.
 
 JSON files write non-finite numbers as the strings ``"nan"``, ``"inf"``, ``"-inf"``
-(:mod:`rockjit.io`).
+(:mod:`rockjit.storage.files`).
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
+from .. import __version__
 
 __all__ = ["build_parser", "main"]
 
@@ -66,22 +66,22 @@ def _warn(msg):
 
 def _check_run(args):
     """``--threads`` fits numba's; ``--scheduler`` needs dask; ``--out`` can be written
-    (:func:`rockjit.io.check_out`)."""
+    (:func:`rockjit.storage.files.check_out`)."""
     if getattr(args, "threads", None) is not None:
         import numba
-        from .validate import integer
+        from ..validate import integer
         integer("threads", args.threads, 1, numba.config.NUMBA_NUM_THREADS)
     if getattr(args, "scheduler", None):
         try:
             import dask.distributed  # noqa: F401
         except ImportError:
             raise UsageError("--scheduler needs dask: pip install 'rockjit[dask]'") from None
-    from .io import check_out
+    from ..storage.files import check_out
     check_out(args.out, name="--out")
 
 
 def _chunk_root(args):
-    from .io import chunk_root
+    from ..storage.files import chunk_root
     return chunk_root(args.out)
 
 
@@ -112,7 +112,7 @@ def _grid_kw(args):
 
 
 def _z0(args):
-    from .simulate import closed_form_z0
+    from ..single import closed_form_z0
     return closed_form_z0(args.theta0, args.dtheta0, args.r0, args.s0, args.phase)
 
 
@@ -121,8 +121,8 @@ def _z0(args):
 # ---------------------------------------------------------------------------------------------
 
 def _trajectory_plan(args):
-    from .simulate import plan
-    from .validate import integer
+    from ..single import plan
+    from ..validate import integer
     integer("max-points", args.max_points, 2)
     kw = dict(**_block_kw(args), **_state_kw(args), periods=args.periods,
               n_steps=args.n_steps, forcing=args.forcing, method=args.method, rtol=args.rtol,
@@ -135,7 +135,7 @@ def _trajectory_plan(args):
 
 def _trajectory_run(args, p, out):
     from . import outputs
-    from .simulate import run
+    from ..single import run
     _say(args, f"trajectory: {p.periods} periods, {p.method}")
     t0 = time.perf_counter()
     res, wall = run(p), time.perf_counter() - t0
@@ -145,7 +145,7 @@ def _trajectory_run(args, p, out):
 
 
 def _sweep_plan(args):
-    from .analysis import plan_sweep
+    from ..grids.grids import plan_sweep
     return plan_sweep(args.hb, args.omega, **_block_kw(args), alpha_range=args.alpha_range,
                       alpha_step=args.alpha_step, z0=_z0(args), lyapunov=not args.no_lyapunov,
                       **_grid_kw(args))
@@ -160,7 +160,7 @@ def _laws(args):
 
 
 def _basin_plan(args):
-    from .analysis import plan_basin
+    from ..grids.grids import plan_basin
     return {law: plan_basin(args.hb, args.alpha, args.omega, law=law, e=args.e, xi=args.xi,
                             grid=args.grid, theta_range=args.theta_range,
                             dtheta_range=args.dtheta_range, r0=args.r0, s0=args.s0,
@@ -169,14 +169,14 @@ def _basin_plan(args):
 
 
 def _plane_plan(args):
-    from .analysis import plan_plane
+    from ..grids.grids import plan_plane
     return plan_plane(args.hb, args.alpha_range, args.omega_range, grid=args.grid,
                       **_block_kw(args), z0=_z0(args), lyapunov=not args.no_lyapunov,
                       **_grid_kw(args))
 
 
 def _erosion_plan(args):
-    from .erosion import plan_erosion
+    from ..basins.erosion import plan_erosion
     kw = _grid_kw(args)
     kw.pop("uncertainty")
     return {law: plan_erosion(args.hb, args.omega, law=law, e=args.e, xi=args.xi,
@@ -189,7 +189,10 @@ def _grid_run(writer, name):
     """The run of a grid command: its plan (or one plan per law) computed with the command
     line's progress, Dask client and chunk store, then written by ``outputs.<writer>``."""
     def run_it(args, plans, out):
-        from . import analysis, erosion, orbits, outputs
+        from ..grids import grids as analysis
+        from ..basins import erosion
+        from ..orbits import orbits
+        from . import outputs
         run = dict(erosion=erosion.run, orbits=orbits.run).get(writer, analysis.run)
         t0 = time.perf_counter()
         if isinstance(plans, dict):
@@ -203,14 +206,14 @@ def _grid_run(writer, name):
 
 
 def _orbits_plan(args):
-    from .orbits import plan_orbits
+    from ..orbits.orbits import plan_orbits
     return plan_orbits(args.hb, args.law, args.omega, args.alpha_range, e=args.e, xi=args.xi,
                        sweep_step=args.alpha_step, periods=args.periods, threads=args.threads,
                        max_period=args.max_period)
 
 
 def _fate_plan(args):
-    from .fate import plan_fate
+    from ..basins.fate import plan_fate
     return plan_fate(args.hb, args.alpha, args.omega, **_block_kw(args), **_state_kw(args),
                      ensemble=args.ensemble, spread=args.spread, seed=args.seed,
                      periods=args.periods, n_steps=args.n_steps, forcing=args.forcing,
@@ -220,7 +223,7 @@ def _fate_plan(args):
 
 def _fate_run(args, p, out):
     from . import outputs
-    from .fate import run
+    from ..basins.fate import run
     t0 = time.perf_counter()
     fr = run(p, progress=not args.quiet)
     wall = time.perf_counter() - t0
@@ -229,21 +232,21 @@ def _fate_run(args, p, out):
 
 
 def _cor_plan(args):
-    from .model import Block
-    from .validate import real
+    from ..model import Block
+    from ..validate import real
     [Block(hb=hb, alpha=0.0, omega=1.0, law="housner") for hb in args.hb_values]
     real("hb_max", args.hb_max, 1 / math.sqrt(2), 100.0, lo_open=True)
 
 
 def _cor_run(args, _, out):
-    from .study import write_e_table
+    from ..study.paper import write_e_table
     t0 = time.perf_counter()
     table = write_e_table(out, args.hb_values, args.hb_max, "restitution.png", "e_table")
     return time.perf_counter() - t0, dict(table=table)
 
 
 def _paper_plan(args):
-    from .study import plan_paper
+    from ..study.paper import plan_paper
     return plan_paper(grid=args.grid, periods=args.periods, n_steps=args.n_steps,
                       alpha_step=args.alpha_step, zoom=args.zoom, zoom_step=args.zoom_step,
                       erosion_step=args.erosion_step, erosion_grid=args.erosion_grid,
@@ -251,7 +254,7 @@ def _paper_plan(args):
 
 
 def _paper_run(args, p, out):
-    from .study import paper
+    from ..study.paper import paper
     t0 = time.perf_counter()
     results = _grid(args, functools.partial(paper, out, say=lambda m: _say(args, m)), p, None)
     return time.perf_counter() - t0, results
@@ -289,8 +292,8 @@ def _add_block(p, alpha=True, omega=True, laws="housner, mao or constant"):
 
 
 def _add_run(p, periods=500, grid=False):
-    from .analysis import GRID_N
-    from .simulate import DEFAULT_N, MAX_STEP
+    from ..grids.grids import GRID_N
+    from ..single import DEFAULT_N, MAX_STEP
     p.add_argument("--periods", type=int, default=periods,
                    help=f"forcing periods to integrate (default {periods})")
     p.add_argument("--n-steps", type=int, default=None,
@@ -369,7 +372,7 @@ def _command(sub, name, plan, run, help, description):
 
 def build_parser():
     """The argument parser (its ``error`` raises :class:`UsageError`)."""
-    from .study import E_FIGURE_HB_MAX, E_TABLE_HB, ZOOM
+    from ..study.paper import E_FIGURE_HB_MAX, E_TABLE_HB, ZOOM
     parser = _Parser(prog=PROG, description="The harmonically forced rigid rocking block "
                      "(Housner's model): single runs, bifurcation sweeps, basins, figures.")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
@@ -528,7 +531,7 @@ def _internal_error(exc):
 
 def _compile(args):
     """``rockjit compile``: every kernel variant into numba's cache, in parallel processes."""
-    from .kernel import COMMON as names, VARIANTS, compile_kernels
+    from .._engine.kernel import COMMON as names, VARIANTS, compile_kernels
     t0 = time.perf_counter()
     _say(args, f"compile: {len(names)} kernel variants (a minute or two cold on two cores)")
     try:
@@ -544,7 +547,7 @@ def _compile(args):
 def main(argv=None):
     """Run the command line; returns the exit status (0, 2 bad input, 130 interrupted)."""
     from . import outputs
-    from .io import OutputDir, sigterm_interrupts
+    from ..storage.files import OutputDir, sigterm_interrupts
     try:
         args = build_parser().parse_args(argv)
     except UsageError as exc:
@@ -558,7 +561,7 @@ def main(argv=None):
         _check_run(args)
     except (UsageError, ValueError) as exc:
         return _error(exc)
-    from ._jit import cached_kernels
+    from .._jit import cached_kernels
     if args.command != "cor" and not cached_kernels():
         _say(args, "first run here: numba compiles rockjit's kernels into its cache, about "
                    "10-20 s per kernel variant on two cores, once (`rockjit compile` does it "
@@ -592,7 +595,7 @@ def main(argv=None):
     try:
         if note:
             _warn(note)
-        from .chunks import remove_stores
+        from ..storage.chunkstore import remove_stores
         remove_stores(_chunk_root(args), message=lambda m: _say(args, m))
         _say(args, f"{args.command}: wrote {args.out}")
     except KeyboardInterrupt:

@@ -1,4 +1,4 @@
-"""The numerical stress suite: seeded extreme cases for ``rockjit.simulate`` and the checks
+"""The numerical stress suite: seeded extreme cases for ``rockjit.single`` and the checks
 every run must pass.
 
 What it is for: finding inputs on which the compiled integrator misbehaves (a NaN, a wrong
@@ -119,8 +119,8 @@ import numpy as np
 
 import rockjit
 
-from . import analysis as an
-from .simulate import default_max_impacts, steps_per_period
+from ..grids import grids as an
+from ..single import default_max_impacts, steps_per_period
 
 RANGES = dict(hb=(0.75, 20.0), alpha=(0.0, 3.0), omega=(0.05, 20.0), e=(0.0, 1.0))
 CATEGORIES = ("random", "near_zero", "grazing", "near_overturn", "long_horizon",

@@ -103,9 +103,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .model import Block
-from .simulate import simulate
-from .validate import integer, pair, real
+from ..model import Block
+from ..single import simulate
+from ..validate import integer, pair, real
 
 __all__ = ["BIFURCATION_TYPES", "N_ORBIT", "Bifurcation", "Branch", "Continuation",
            "OrbitRefused", "PeriodicOrbit", "continuation", "continue_branches",
@@ -405,8 +405,8 @@ class Continuation:
     """Branches and bifurcations from :func:`continuation` or :func:`continue_branches`.
 
     ``to_summary()`` gives ``(summary, arrays)``: JSON-ready dicts (write them with
-    :func:`rockjit.io.write_json`, which handles non-finite floats) and arrays for
-    :func:`rockjit.io.write_npz`.
+    :func:`rockjit.storage.files.write_json`, which handles non-finite floats) and arrays for
+    :func:`rockjit.storage.files.write_npz`.
     """
 
     parameter: str
@@ -1675,7 +1675,7 @@ def continue_branches(hb, law, omega, alpha_range, seeds=None, sweep=None, *, e=
         Forcing phase of the section: the sweep's if a sweep is given, else 0.
     sweep_step : float
         With neither seeds nor a sweep, a sweep of this step over ``alpha_range`` from the
-        study's ``z0`` is run first (:func:`rockjit.analysis.sweep`).
+        study's ``z0`` is run first (:func:`rockjit.grids.grids.sweep`).
     n_steps, switch, **options
         As in :func:`continuation`.
 
@@ -1685,7 +1685,7 @@ def continue_branches(hb, law, omega, alpha_range, seeds=None, sweep=None, *, e=
         Branches in the order found (seeds by period, then alpha; switched branches right
         after their parent) and every located bifurcation.
     """
-    from . import analysis
+    from ..grids import grids as analysis
 
     a0, a1 = _range("alpha_range", alpha_range, 0.0)
     kw = dict(hb=hb, alpha=a0, omega=omega, law=law, e=e)
@@ -1742,7 +1742,7 @@ def plan_orbits(hb, law, omega, alpha_range, *, e=None, xi=None, sweep_step=0.00
                 n_steps=N_ORBIT, periods=500, threads=None, **options) -> OrbitsPlan:
     """Validate :func:`continue_branches` seeded by a sweep of step ``sweep_step`` from the
     study's ``z0`` (same parameters); nothing is run."""
-    from . import analysis
+    from ..grids import grids as analysis
     a0, a1 = _range("alpha_range", alpha_range, 0.0)
     sp = analysis.plan_sweep(hb, omega, law=law, e=e, xi=xi, alpha_range=(a0, a1),
                              alpha_step=sweep_step, periods=periods, threads=threads)
@@ -1756,7 +1756,7 @@ def plan_orbits(hb, law, omega, alpha_range, *, e=None, xi=None, sweep_step=0.00
 def run(plan: OrbitsPlan, *, progress=False, client=None, store=None, message=None):
     """Execute an :class:`OrbitsPlan`: the sweep, then the branches from its periodic
     attractors. Returns ``(Continuation, SweepResult)``."""
-    from . import analysis
+    from ..grids import grids as analysis
     sw = analysis.run(plan.sweep_plan, progress=progress, client=client, store=store,
                       message=message)
     b = sw.block

@@ -1,15 +1,15 @@
 """One grid cell's results: a finished run classified into its row of scalars, and its samples
-collected into the grid's arrays. Shared by the grid kernel (:mod:`rockjit.kernel`) and the
-lockstep lanes (:mod:`rockjit.lanes`), so that neither imports the other."""
+collected into the grid's arrays. Shared by the grid kernel (:mod:`rockjit._engine.kernel`) and the
+lockstep lanes (:mod:`rockjit._engine.lanes`), so that neither imports the other."""
 
 from __future__ import annotations
 
 import math
 
 from . import integrate as ig
-from ._jit import jit
+from .._jit import jit
 from .classify import classify, lam_between
-from .result import OVERTURN, REST, UNRESOLVED
+from ..result import OVERTURN, REST, UNRESOLVED
 
 # layout of the classification settings ``cpar`` (float)
 C_TOL, C_LAMTOL = range(2)

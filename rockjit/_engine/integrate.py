@@ -37,7 +37,7 @@ run-time switch (one test per grid step, in :func:`grid_point`): measured side b
 nothing distinguishable per step, and it halves the variants to compile (issue 15,
 benchmarks/README.md, "Cold start").
 
-Kernels never raise; they return the status codes below, which :mod:`rockjit.simulate` turns into
+Kernels never raise; they return the status codes below, which :mod:`rockjit.single` turns into
 messages.
 
 Notes
@@ -55,10 +55,10 @@ from fractions import Fraction
 
 import numpy as np
 
-from ._jit import cycles, fma, jit
+from .._jit import cycles, fma, jit
 from .classify import orbit_scale, repeats
-from .result import STATUSES
-from .model import (NEAR_RANGE, SINCOS_RANGE, accel_near, accel_pq, corner, forcing_closed, jump,
+from ..result import STATUSES
+from ..model import (NEAR_RANGE, SINCOS_RANGE, accel_near, accel_pq, corner, forcing_closed, jump,
                     near_poly, oscillator, rotate, saltation, sincos, sincos_poly, slope_pq,
                     uplift_time)
 
@@ -99,7 +99,7 @@ SETTLED = 5       # stopped early: the stroboscopic orbit settled (see analysis)
 STATUS_NAMES = dict(enumerate(STATUSES))  # code -> name (rockjit.result.STATUSES)
 
 # ---- the kernel's arguments ---------------------------------------------------------------------
-# rockjit.kernel is the one module that packs these and reads them back; the layouts below are
+# rockjit._engine.kernel is the one module that packs these and reads them back; the layouts below are
 # the contract between it and the compiled code.
 
 #: What a run writes: stroboscopic samples at kT and kT + T/2 (rows theta, theta', r, s), the
@@ -177,7 +177,7 @@ def build(embed4: bool = False, tangent: bool = False):
 def settled_period(strobe, half, per_imp, k, reps, pmax, tol):
     """Smallest period p <= pmax that the last ``reps * p`` periods repeat, else 0.
 
-    The period test of :func:`rockjit.classify.repeats` on periods ``k - reps p + 1 .. k``,
+    The period test of :func:`rockjit._engine.classify.repeats` on periods ``k - reps p + 1 .. k``,
     relative to the size of the samples from ``k - (reps + 1) p`` on. It also requires the same
     number of impacts in each compared period, so that a transient which happens to be at rest
     at the sampling instants is not taken for a periodic orbit.
@@ -1046,7 +1046,7 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
 
     The loop's state goes in and comes back out: ``(status, t, side, n_imp, step, j_per, k_per,
     j_qr, j_rec, n_col, n_col_win, t_lift, max_err)``. The one step of the single-lane loop
-    (:func:`_loop`) and of a lane taken out of the lanes' lockstep (:mod:`rockjit.lanes`): with
+    (:func:`_loop`) and of a lane taken out of the lanes' lockstep (:mod:`rockjit._engine.lanes`): with
     ``pre`` the grid step's first Runge–Kutta step is already in ``K``, ``w.ynew``, ``w.jac``
     and ``w.trig``. With ``PROF``, ``counts[6:13]`` receive the cycles spent in rest phases,
     in the steps after an event, in locating, in impacts, in detection, in the first step and

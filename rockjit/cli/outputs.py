@@ -1,7 +1,7 @@
 """What each command leaves on disk: its data (``.npz``), its figures and its summary.
 
 One function per kind of result writes it into an output directory object
-(:class:`rockjit.io.OutputDir`, or anything with its ``npz`` and ``figure`` methods) and returns
+(:class:`rockjit.storage.files.OutputDir`, or anything with its ``npz`` and ``figure`` methods) and returns
 the JSON-ready part of ``summary.json`` that describes it. The command line and the paper
 (:func:`rockjit.study.paper`) both write through these, so a sweep or a basin has the same files
 wherever it was computed.
@@ -17,17 +17,17 @@ __all__ = ["basins", "erosion", "fate", "orbits", "plane", "sweep", "trajectory"
 def summary(out, command, inputs, wall, **results):
     """``summary.json``'s content: the command and its inputs, rockjit's version, the wall
     time, the behaviour names, every file written, and the command's ``results``."""
-    from . import __version__
-    from .result import BEHAVIOURS
+    from .. import __version__
+    from ..result import BEHAVIOURS
     return dict(command=command, rockjit_version=__version__, inputs=inputs, wall_s=wall,
                 behaviours=list(BEHAVIOURS), files=sorted(out.written + ["summary.json"]),
                 **results)
 
 
 def trajectory(out, res, *, npz="trajectory.npz", png="trajectory.png"):
-    """One run: its arrays (``Result.arrays``) and :func:`rockjit.plotting.fig_trajectory`."""
-    from .analysis import classify_result
-    from .plotting import fig_trajectory
+    """One run: its arrays (``Result.arrays``) and :func:`rockjit.plotting.figures.fig_trajectory`."""
+    from ..grids.grids import classify_result
+    from ..plotting.figures import fig_trajectory
     name, period = classify_result(res)
     out.npz(npz, **res.arrays())
     out.figure(png, fig_trajectory(res))
@@ -36,7 +36,7 @@ def trajectory(out, res, *, npz="trajectory.npz", png="trajectory.png"):
 
 def sweep(out, sw, *, npz="sweep.npz", png="bifurcation.png"):
     """A sweep: its arrays and its bifurcation diagram."""
-    from .plotting import fig_bifurcation
+    from ..plotting.figures import fig_bifurcation
     out.npz(npz, **sw.arrays())
     if png:
         out.figure(png, fig_bifurcation(sw))
@@ -51,8 +51,8 @@ def basins(out, res, *, npz="basin.npz", png="basin.png", attractors_png="attrac
     """One basin, or two laws' (a dict ``law: BasinResult``): the labels, attractor maps and
     (when computed) exponents and uncertain cells, per law when there are two; the behaviour
     map (with the two laws' agreement) and the attractor map with its measures."""
-    from .attractors import attractor_agreement
-    from .plotting import agreement, fig_attractors, fig_basin, fig_basin_compare
+    from ..basins.identity import attractor_agreement
+    from ..plotting.figures import agreement, fig_attractors, fig_basin, fig_basin_compare
     if not isinstance(res, dict):
         res = {res.block.law: res}
     first = next(iter(res.values()))
@@ -93,7 +93,7 @@ def basins(out, res, *, npz="basin.npz", png="basin.png", attractors_png="attrac
 
 def plane(out, pl, *, npz="plane.npz", png="plane.png"):
     """A plane from its first initial state: its arrays and its map."""
-    from .plotting import fig_plane
+    from ..plotting.figures import fig_plane
     arrays = dict(alpha=pl.alpha, omega=pl.omega, z0=pl.z0, label=pl.label[0],
                   period=pl.period[0], lambda_max=pl.lambda_max[0], t_end=pl.t_end[0],
                   names=np.asarray(pl.names, dtype=str))
@@ -112,7 +112,7 @@ def plane(out, pl, *, npz="plane.npz", png="plane.png"):
 def erosion(out, res, *, npz="erosion.npz", png="erosion.png"):
     """Erosion profiles (a dict ``law: ErosionResult``): per law, the profile's arrays, and the
     profile figure."""
-    from .plotting import fig_erosion
+    from ..plotting.figures import fig_erosion
     first = next(iter(res.values()))
     out.npz(npz, alpha=first.alpha, theta0=first.theta0, dtheta0=first.dtheta0,
             **{k: v for law, r in res.items() for k, v in r.arrays(f"_{law}").items()})
@@ -123,7 +123,7 @@ def erosion(out, res, *, npz="erosion.npz", png="erosion.png"):
 def fate(out, fr, *, npz="fate.npz", png="fate.png"):
     """An ensemble's outcomes: the members' initial states, outcomes and end times, and a
     figure of the outcome probabilities and the end times against the horizon."""
-    from .plotting import fig_fate
+    from ..plotting.figures import fig_fate
     out.npz(npz, initial=fr.initial, outcome=fr.outcome, t_end=fr.t_end)
     out.figure(png, fig_fate(fr))
     return fr.to_summary()
@@ -133,7 +133,7 @@ def orbits(out, res, *, npz="orbits.npz", png="orbits.png"):
     """Branches of periodic orbits (``(Continuation, SweepResult)``): the branches' and
     bifurcations' arrays, the diagram with the branches over the sweep's dots, and the summary
     (``"bifurcations"``: type, alpha, period, multipliers, state)."""
-    from .plotting import fig_branches
+    from ..plotting.figures import fig_branches
     cont, sw = res
     summary, arrays = cont.to_summary()
     out.npz(npz, **arrays)

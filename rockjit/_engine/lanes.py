@@ -7,7 +7,7 @@ each waiting for the last (its cost is latency, not arithmetic); ``L`` independe
 by side let the core overlap them, and written as one loop over lanes with no branch in it,
 LLVM turns the lanes into SIMD vectors.
 
-:func:`block_step_lanes` is :func:`rockjit.integrate.block_step` (fast path, no slopes) for
+:func:`block_step_lanes` is :func:`rockjit._engine.integrate.block_step` (fast path, no slopes) for
 ``L`` lanes with the lane as the innermost, contiguous index of every array: the same
 operations in the same order, fused multiply-adds included, so each lane's result is bit for
 bit the single-lane step's (a vector FMA rounds once, as the scalar one).
@@ -23,8 +23,8 @@ from numba import prange
 
 from . import integrate as ig
 from . import cell
-from ._jit import cycles, fma, jit
-from .model import (NEAR_RANGE, SINCOS_RANGE, accel_near, corner, initial_side, rotate,
+from .._jit import cycles, fma, jit
+from ..model import (NEAR_RANGE, SINCOS_RANGE, accel_near, corner, initial_side, rotate,
                     sincos_poly)
 
 __all__ = ["W", "bank", "block_step_lanes", "lane_tables", "run_lanes", "scalar_step"]
@@ -97,11 +97,11 @@ def block_step_lanes(n, j, lin, lout, ftl):
         A lane whose step is *fast* (below) has its state advanced to the step's end here.
     lout : ndarray, (N_LOUT * W,)
         Receives the stages' velocities and accelerations (``O_KV + i``, ``O_KA + i``, rows
-        ``i = 1..6``: ``K[i, 0]`` and ``K[i, 1]`` of :func:`rockjit.integrate.block_step`), the
+        ``i = 1..6``: ``K[i, 0]`` and ``K[i, 1]`` of :func:`rockjit._engine.integrate.block_step`), the
         angle and velocity at the step's end, the sine and cosine of that angle, ``far``
         (``> 1``: the step left the polynomials' range) and ``O_FAST``: 1 when the step is
         accepted as it is (in flight, in range, and none of the events that
-        :func:`rockjit.integrate.detect` looks for), else 0 (the lane's state is left as it was,
+        :func:`rockjit._engine.integrate.detect` looks for), else 0 (the lane's state is left as it was,
         for the single-lane code to take the step).
     ftl : ndarray, (N * 7 * W,)
         Each lane's forcing acceleration at stage ``i`` of step ``j`` at ``(7 j + i) W + l``.
@@ -202,7 +202,7 @@ def block_step_lanes(n, j, lin, lout, ftl):
 # ---------------------------------------------------------------------------------------------
 
 # layout of a lane's loop state: integers ``st`` and floats ``fs`` (the variables of
-# rockjit.integrate._loop)
+# rockjit._engine.integrate._loop)
 (S_STATUS, S_SIDE, S_NIMP, S_STEP, S_JPER, S_KPER, S_JQR, S_JREC, S_NCOL, S_NCOLWIN,
  S_CELL) = range(11)
 N_ST = 11
@@ -212,14 +212,14 @@ N_FS = 3
 
 @jit(nrt=False)
 def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, prof, counts):
-    """One grid step of a lane on the scalar path: :func:`rockjit.integrate.grid_step`, the
+    """One grid step of a lane on the scalar path: :func:`rockjit._engine.integrate.grid_step`, the
     single-lane loop's own step (closed-form forcing, no trajectory), with the lane's loop
     variables kept in ``st`` and ``fs``. Used for every step the lanes' fast path does not take
     (an event, a rest phase, a stage out of the polynomial's range), so that each lane runs
     exactly the single-lane code there. ``pre``: the grid step's first Runge–Kutta step is in
     ``w`` already (``K[1:]``, ``ynew``, ``trig[2:4]``: the vector step's, which equals it when it
     stayed in range), so it is not taken again. With ``prof``, ``counts[6:13]`` receive the
-    cycles of its parts (see :func:`rockjit.integrate.grid_step`)."""
+    cycles of its parts (see :func:`rockjit._engine.integrate.grid_step`)."""
     (status, t, side, n_imp, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win, t_lift,
      max_err) = ig.grid_step(None, TANGENT, False, prof, pre, fs[F_TT], st[S_SIDE], st[S_NIMP],
                              st[S_STEP], st[S_JPER], st[S_KPER], st[S_JQR], st[S_JREC],
@@ -243,15 +243,15 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, prof, counts):
 #: A block of lanes' arrays: each lane's loop state (``st``, ``fs``), parameters (``par``,
 #: ``N_PARW``), the lanes' step input and output (``lin``, ``lout``) and forcing table
 #: (``ftl``), and each lane's
-#: :data:`rockjit.integrate.Outputs` and :data:`rockjit.integrate.Work` arrays (first index:
+#: :data:`rockjit._engine.integrate.Outputs` and :data:`rockjit._engine.integrate.Work` arrays (first index:
 #: the lane).
 Bank = namedtuple("Bank", "st fs par lin lout ftl strobe half impacts traj lam_run per_imp iout "
                           "fout K states lam tab_h tab fr jac trig ftab")
 
 
 def bank(periods, n_per, n_imp_pts):
-    """Fresh arrays for ``W`` lanes (a run's outputs as :func:`rockjit.kernel._grid` makes
-    them, the work arrays as :func:`rockjit.integrate._run`)."""
+    """Fresh arrays for ``W`` lanes (a run's outputs as :func:`rockjit._engine.kernel._grid` makes
+    them, the work arrays as :func:`rockjit._engine.integrate._run`)."""
     return _bank(periods, n_per, max(n_imp_pts, 1))
 
 
@@ -293,7 +293,7 @@ def _zero(a):
 
 @jit(nrt=False)
 def _load(l, i, y0s, pars, ipar, b):
-    """Start cell ``i`` in lane ``l`` (:func:`rockjit.integrate._run` and the start of its
+    """Start cell ``i`` in lane ``l`` (:func:`rockjit._engine.integrate._run` and the start of its
     loop, on fresh arrays). Returns whether it runs (False: it ended before its first step)."""
     _zero(b.strobe[l])
     _zero(b.half[l])
@@ -375,7 +375,7 @@ def _sync(l, b):
 @jit(nrt=False, inline=True)
 def _stages(l, b):
     """The vector step's stages and end into the lane's work arrays, as
-    :func:`rockjit.integrate.rk_step` would leave them (no tangent)."""
+    :func:`rockjit._engine.integrate.rk_step` would leave them (no tangent)."""
     K = b.K[l]
     for i in range(1, ig.N_STAGES + 1):
         K[i, 0] = b.lout[(O_KV + i) * W + l]
@@ -389,8 +389,8 @@ def _stages(l, b):
 
 @jit(nrt=False)
 def _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b):
-    """Lane ``l``'s run has ended: its outputs (:func:`rockjit.integrate._loop`'s end), its
-    classification and samples (:func:`rockjit.kernel._grid`); the lane is free."""
+    """Lane ``l``'s run has ended: its outputs (:func:`rockjit._engine.integrate._loop`'s end), its
+    classification and samples (:func:`rockjit._engine.kernel._grid`); the lane is free."""
     st = b.st[l]
     fs = b.fs[l]
     par = b.par[l]
@@ -415,13 +415,13 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
     """Cells ``i0 .. i1 - 1`` through ``n_lanes <= W`` lanes (no tangent vectors), a freed
     lane refilled from the next pending cell at the next period's start (all lanes then step
     through the period together: one forcing row for all); outputs as
-    :func:`rockjit.kernel._grid`'s.
+    :func:`rockjit._engine.kernel._grid`'s.
 
     Each grid step: :func:`block_step_lanes` for all lanes at once, which accepts the step of
     every lane in flight whose step has no event, stays in the polynomials' range; every other
     lane's step (an event, a rest phase) is taken again by :func:`scalar_step`, the single-lane
     code. A lane's arithmetic is the single-lane kernel's either way, so its results are bit for
-    bit those of :func:`rockjit.kernel._grid` (the running error estimate ``max_err`` is not
+    bit those of :func:`rockjit._engine.kernel._grid` (the running error estimate ``max_err`` is not
     kept on the fast path: no grid output reads it). ``counts``: the fast and the scalar steps,
     the vector steps taken, and with ``prof`` the cycles (``readcyclecounter``) spent in the
     vector steps, in the scalar steps, and in all, then the parts of the scalar steps
@@ -523,7 +523,7 @@ BLOCK = 256
 @jit(parallel=True)
 def grid_lanes(n_lanes, block, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts,
                n_got, n_imp_got, prof, counts):
-    """:func:`rockjit.kernel._grid` without tangent vectors, ``n_lanes`` cells at a time per
+    """:func:`rockjit._engine.kernel._grid` without tangent vectors, ``n_lanes`` cells at a time per
     thread: blocks of ``block`` cells, each through :func:`run_lanes` on fresh arrays. A cell's
     results do not depend on its block, lane or thread. ``counts[g]`` receives block ``g``'s
     step counts, and with ``prof`` its cycle counts (:func:`run_lanes`)."""

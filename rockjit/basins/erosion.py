@@ -4,8 +4,8 @@ continued from one amplitude to the next (global continuation, as in Attractors.
 :func:`plan_erosion` makes one grid of every basin's cells (``n_alpha`` stacked basins, each on
 the same ``(theta0, theta0')`` lattice at the same forcing phase), so the whole profile runs as
 one computation: chunk by chunk with progress, resumable from a chunk store, on Dask when asked.
-:func:`run` then, at each amplitude, identifies the attractors (:func:`rockjit.attractors.identify`)
-and measures the basin (:mod:`rockjit.measures`: GIM, IF, basin entropy), and links each
+:func:`run` then, at each amplitude, identifies the attractors (:func:`rockjit.basins.identity.identify`)
+and measures the basin (:mod:`rockjit.basins.measures`: GIM, IF, basin entropy), and links each
 amplitude's attractors to the previous amplitude's (same behaviour and period, cycles within
 ``cont_tol`` of the orbit's size, the nearest one): a *branch* is an attractor followed across
 amplitudes, and its basin fraction against the amplitude is the stacked panel of the profile.
@@ -21,11 +21,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import analysis
-from . import integrate as ig
-from . import kernel
+from ..grids import grids as analysis
+from ..grids import runner
+from .._engine import integrate as ig
+from .._engine import kernel
 from . import measures as M
-from .attractors import cycle_distance, floquet, identify
+from .identity import cycle_distance, floquet, identify
 
 __all__ = ["LINK_TOL", "ErosionResult", "erosion", "plan_erosion", "run"]
 
@@ -37,7 +38,7 @@ LINK_TOL = 0.35
 
 @dataclass(frozen=True)
 class ErosionPlan:
-    """The stacked basins of an erosion profile: a :class:`rockjit.analysis.GridPlan` of all
+    """The stacked basins of an erosion profile: a :class:`rockjit.grids.grids.GridPlan` of all
     cells (amplitude-major) and the amplitudes."""
 
     grid_plan: analysis.GridPlan
@@ -54,7 +55,7 @@ class ErosionResult:
     ----------
     alpha : ndarray, shape (na,)
     GIM, IF : ndarray, shape (na,)
-        Global integrity measure and integrity factor of each basin (rockjit.measures).
+        Global integrity measure and integrity factor of each basin (rockjit.basins.measures).
     basin_entropy, boundary_basin_entropy : ndarray, shape (na,)
     overturn : ndarray, shape (na,)
         Percent of cells that overturn.
@@ -171,7 +172,7 @@ def run(plan: ErosionPlan, *, progress=False, client=None, store=None, message=N
         cont_tol=LINK_TOL):
     """Execute an :class:`ErosionPlan`; returns an :class:`ErosionResult`."""
     gp = plan.grid_plan
-    out = kernel.run_grid(gp.y0s, gp.pars, gp.ipar, gp.cpar, tangent=False, n_pts=gp.n_pts,
+    out = runner.run_grid(gp.y0s, gp.pars, gp.ipar, gp.cpar, tangent=False, n_pts=gp.n_pts,
                           n_imp_pts=0, threads=gp.threads, progress=progress, label="erosion",
                           chunk=gp.chunk, client=client, store=store, message=message)
     res = out["res"]
@@ -239,13 +240,13 @@ def erosion(hb, omega, *, law=None, alpha_range, alpha_step=0.01, grid=100, prog
         Slenderness and forcing frequency.
     law : str, optional
         Restitution law (``e``, ``xi`` and the other block parameters as in
-        :func:`rockjit.analysis.basin`).
+        :func:`rockjit.grids.grids.basin`).
     alpha_range : pair of float
         Amplitudes from start to end (included), every ``alpha_step``.
     grid : int
         Cells per side of each basin.
     progress, client, store :
-        As in :func:`rockjit.analysis.sweep` (the whole stack of basins is one computation).
+        As in :func:`rockjit.grids.grids.sweep` (the whole stack of basins is one computation).
     cont_tol : float
         Continuation tolerance of the attractors from one amplitude to the next, relative to
         the orbit's size.

@@ -4,16 +4,16 @@ Each grid computation has a plan and a runner. :func:`plan_sweep`, :func:`plan_b
 :func:`plan_plane` validate every input (ranges, classification settings, the grid's stability,
 the memory it would allocate) into a :class:`GridPlan` of packed kernel inputs; :func:`run`
 executes a plan chunk by chunk (progress between chunks, in this process or on a Dask cluster,
-resumable from a chunk store, :mod:`rockjit.kernel` and :mod:`rockjit.chunks`) and wraps the
+resumable from a chunk store, :mod:`rockjit._engine.kernel` and :mod:`rockjit.storage.chunkstore`) and wraps the
 arrays into a result (:mod:`rockjit.result`). :func:`sweep`, :func:`basin` and :func:`plane` are
 the two steps in one call; the command line calls them separately, so it refuses bad input
 before any work, with the library's own messages.
 
-Cells are classified by the behaviour rules of :mod:`rockjit.classify` (SPEC.md §6), on the
+Cells are classified by the behaviour rules of :mod:`rockjit._engine.classify` (SPEC.md §6), on the
 stroboscopic samples over the asymptotic window or, with early stopping (on by default), on the
 stretch that showed a bounded run had settled: a run stops as soon as its last
 ``settle_reps * p`` periods repeat to ``settle_tol`` (much tighter than ``tol``), see
-:func:`rockjit.integrate.settled_period`. The full-length mode stays available with
+:func:`rockjit._engine.integrate.settled_period`. The full-length mode stays available with
 ``early_stop=False``.
 """
 
@@ -25,16 +25,17 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from . import integrate as ig
-from . import kernel
-from .attractors import (cycles_differ, floquet, identify, identify_along,
+from .._engine import integrate as ig
+from .._engine import kernel
+from . import runner
+from ..basins.identity import (cycles_differ, floquet, identify, identify_along,
                          match_attractors)
-from .classify import classify
-from .model import ALPHA_MAX, OMEGA_RANGE, Block
-from .result import (BEHAVIOURS, BasinResult, PlaneResult, SweepResult, fractions)
-from .simulate import (Z0_STUDY, check_step, check_theta0, forcing_phase, make_block,
+from .._engine.classify import classify
+from ..model import ALPHA_MAX, OMEGA_RANGE, Block
+from ..result import (BEHAVIOURS, BasinResult, PlaneResult, SweepResult, fractions)
+from ..single import (Z0_STUDY, check_step, check_theta0, forcing_phase, make_block,
                        run_settings)
-from .validate import integer, memory, pair, real
+from ..validate import integer, memory, pair, real
 
 __all__ = ["BEHAVIOURS", "GRID_N", "BasinResult", "GridPlan", "PlaneResult", "SweepResult",
            "alpha_grid", "basin", "classify_result", "fractions", "plan_basin", "plan_plane",
@@ -46,7 +47,7 @@ __all__ = ["BEHAVIOURS", "GRID_N", "BasinResult", "GridPlan", "PlaneResult", "Sw
 #: when the forcing is slow (MAX_STEP) or the damping strong.
 GRID_N = 64
 
-#: Defaults of the classification (documented in rockjit.classify and the README).
+#: Defaults of the classification (documented in rockjit._engine.classify and the README).
 TOL = 1e-6
 PMAX = 16
 LAM_TOL = 1e-2
@@ -77,10 +78,10 @@ class GridPlan:
     shape: tuple              # the result arrays' shape
     settings: dict = field(default_factory=dict)
     memory_bytes: float = 0.0
-    attractors: bool = False  # identify the attractors (rockjit.attractors)
+    attractors: bool = False  # identify the attractors (rockjit.basins.identity)
     phi: float = 0.0          # the forcing phase (basins: of every cell)
     uncertainty: float | None = None  # flag the cells whose outcome moves with eps
-    lanes: int | None = None  # cells per thread in lockstep (rockjit.lanes; same results;
+    lanes: int | None = None  # cells per thread in lockstep (rockjit._engine.lanes; same results;
     #                           None: kernel.DEFAULT_LANES)
 
 
@@ -340,7 +341,7 @@ def run(plan: GridPlan, *, progress=False, client=None, store=None, message=None
     progress : bool
         Show progress on stderr.
     client : dask.distributed.Client, optional
-        Run the chunks of cells on this cluster (:mod:`rockjit.chunks`).
+        Run the chunks of cells on this cluster (:mod:`rockjit.storage.chunkstore`).
     store : path, optional
         Directory for finished chunks: a rerun with the same inputs computes only what is
         missing.
@@ -349,7 +350,7 @@ def run(plan: GridPlan, *, progress=False, client=None, store=None, message=None
         recomputed); default a line on stderr.
     """
     p = plan
-    out = kernel.run_grid(p.y0s, p.pars, p.ipar, p.cpar, tangent=p.tangent, n_pts=p.n_pts,
+    out = runner.run_grid(p.y0s, p.pars, p.ipar, p.cpar, tangent=p.tangent, n_pts=p.n_pts,
                           n_imp_pts=p.n_imp_pts, threads=p.threads, progress=progress,
                           label=p.kind, chunk=p.chunk, client=client, store=store,
                           message=message, lanes=p.lanes)
@@ -382,12 +383,12 @@ def run(plan: GridPlan, *, progress=False, client=None, store=None, message=None
 
 def uncertain_cells(plan, result, eps, *, seed=0, progress=False, client=None):
     """Which cells of a grid change outcome when their initial state moves by ``eps``
-    (Grebogi, McDonald, Ott & Yorke 1983; rockjit.fate).
+    (Grebogi, McDonald, Ott & Yorke 1983; rockjit.basins.fate).
 
     Each cell's ``(theta0, theta0')`` is moved by ``eps`` times its size (absolute where 0) in
     a seeded random direction and run again with the same plan; a cell is uncertain when the
     moved run reaches another outcome: another behaviour or period, or another attractor (the
-    two maps' attractors matched by their cycles, rockjit.attractors). Returns a boolean array
+    two maps' attractors matched by their cycles, rockjit.basins.identity). Returns a boolean array
     shaped like the labels.
     """
     from dataclasses import replace
@@ -414,7 +415,7 @@ def uncertain_cells(plan, result, eps, *, seed=0, progress=False, client=None):
 
 def _identify(p, res, pts, n_got):
     """Attractor ids (shaped like the labels) and attractors of a plan's cells, with the
-    Floquet multipliers of the periodic ones (rockjit.attractors)."""
+    Floquet multipliers of the periodic ones (rockjit.basins.identity)."""
     label = res[:, kernel.R_LABEL].astype(np.int64)
     period = res[:, kernel.R_PERIOD].astype(np.int64)
     lam = res[:, [kernel.R_LAM1, kernel.R_LAM2]] if p.tangent else None
@@ -482,7 +483,7 @@ def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None
     progress : bool
         Show progress on stderr.
     tol, pmax, lam_tol, settle_tol, settle_reps :
-        Classification settings (:mod:`rockjit.classify`).
+        Classification settings (:mod:`rockjit._engine.classify`).
     n_points : int, optional
         Stroboscopic samples kept per alpha (default the window length).
     n_impact_points : int
@@ -495,10 +496,10 @@ def sweep(hb, omega, alphas=None, *, law=None, e=None, xi=None, alpha_range=None
         a cell keeps the label overturn (``t_overturn`` its first crossing) and its samples and
         exponents describe the motion after the fall (``motion``, its behaviour).
     attractors : bool
-        Identify the attractors (:mod:`rockjit.attractors`): ``result.attractor`` (ids) and
+        Identify the attractors (:mod:`rockjit.basins.identity`): ``result.attractor`` (ids) and
         ``result.attractors``; along a sweep or plane by continuation between neighbours.
     client : dask.distributed.Client, optional
-        Run the chunks of cells on this cluster (:mod:`rockjit.chunks`).
+        Run the chunks of cells on this cluster (:mod:`rockjit.storage.chunkstore`).
     store : path, optional
         Directory for finished chunks: a rerun with the same inputs computes only what is
         missing.

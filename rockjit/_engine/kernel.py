@@ -1,18 +1,18 @@
 """The one owner of the compiled kernels' inputs and outputs: packing, allocating, unpacking.
 
-The kernels (:mod:`rockjit.integrate` for one run, :func:`_grid` here for grids of runs) read a
+The kernels (:mod:`rockjit._engine.integrate` for one run, :func:`_grid` here for grids of runs) read a
 float parameter vector ``par`` and integer settings ``ipar`` and fill an
-:data:`rockjit.integrate.Outputs`; their layouts are declared in :mod:`rockjit.integrate`. This
+:data:`rockjit._engine.integrate.Outputs`; their layouts are declared in :mod:`rockjit._engine.integrate`. This
 module is the only one that packs those vectors (:func:`pack`, :func:`settings`), allocates the
 outputs (:func:`outputs`), estimates their memory before anything is allocated
 (:func:`run_bytes`, :func:`grid_bytes`), and reads them back into the result types of
 :mod:`rockjit.result` (:func:`run_single`, :func:`run_grid`).
 
 Grids (three tiers, STYLE.md 1): :func:`_cell`, a serial compiled worker, runs one cell and
-classifies it (:mod:`rockjit.classify`); :func:`_grid`, ``parallel=True``, runs a chunk of cells
+classifies it (:mod:`rockjit._engine.classify`); :func:`_grid`, ``parallel=True``, runs a chunk of cells
 with ``prange``, each iteration with private scratch writing only its own row of the outputs,
 so results do not depend on the number of threads; :func:`run_chunk` is the unit of work of
-:mod:`rockjit.chunks` (in this process or on a Dask worker) and :func:`run_grid` runs all chunks.
+:mod:`rockjit.storage.chunkstore` (in this process or on a Dask worker) and :func:`run_grid` runs all chunks.
 """
 
 from __future__ import annotations
@@ -25,17 +25,16 @@ import numba
 import numpy as np
 from numba import prange
 
-from . import chunks
 from . import integrate as ig
 from .cell import (C_LAMTOL, C_TOL, N_RES, R_K0, R_K1, R_LABEL, R_LAM1, R_LAM2,  # noqa: F401
                    R_MOTION, R_NIMP, R_PERIOD, R_STATUS, R_T, R_TOVER, _classify, _collect)
-from ._jit import jit
-from .model import initial_side
-from .result import Result
-from .validate import integer
+from .._jit import jit
+from ..model import initial_side
+from ..result import Result
+from ..validate import integer
 
 __all__ = ["IMPACT_RECORD", "LANES_MAX", "N_RES", "grid_bytes", "outputs", "pack", "run_bytes",
-           "run_chunk", "run_chunk_counted", "run_grid", "run_single", "settings"]
+           "run_chunk", "run_chunk_counted", "run_single", "settings"]
 
 #: Rows of the impact record of a single run: beyond this many impacts only the latest are kept
 #: (``Result.n_impacts`` counts all of them).
@@ -47,7 +46,7 @@ IMPACT_RECORD = 1_000_000
 
 def pack(block, phi, n_steps, settle_tol=0.0):
     """The float parameter vector ``par`` of a block at forcing phase ``phi`` with ``n_steps``
-    steps per period (layout ``P_*`` in :mod:`rockjit.integrate`)."""
+    steps per period (layout ``P_*`` in :mod:`rockjit._engine.integrate`)."""
     par = np.zeros(ig.N_PAR)
     par[ig.P_THC] = block.thc
     par[ig.P_XI] = block.xi
@@ -85,7 +84,7 @@ def default_qr_every(n_steps, h, xi):
 
 def settings(n_steps, periods, max_impacts, window, *, stride=1, settle_reps=0, qr_every=None,
              pmax=1, stop_at_overturn=True, h=0.0, xi=0.0):
-    """The integer settings ``ipar`` (layout ``I_*`` in :mod:`rockjit.integrate`);
+    """The integer settings ``ipar`` (layout ``I_*`` in :mod:`rockjit._engine.integrate`);
     ``qr_every`` defaults to :func:`default_qr_every` (``h`` the largest step, ``xi`` the
     damping)."""
     ipar = np.zeros(ig.N_IPAR, dtype=np.int64)
@@ -106,7 +105,7 @@ def _impact_rows(max_impacts):
 
 
 def outputs(periods, max_impacts, n_traj, tangent):
-    """Fresh :data:`rockjit.integrate.Outputs` for one run."""
+    """Fresh :data:`rockjit._engine.integrate.Outputs` for one run."""
     return ig.Outputs(
         strobe=np.zeros((periods + 1, 4)), half=np.zeros((periods, 4)),
         impacts=np.empty((_impact_rows(max_impacts), 3)),  # rows filled are all that is read
@@ -137,7 +136,7 @@ def grid_bytes(n_cells, periods, n_steps, n_pts, n_imp_pts, tangent, chunk, thre
 
 def run_single(block, y0, phi, *, n_steps, periods, window, max_impacts, record_stride,
                embed4, lyapunov, qr_every, stop_at_overturn=True):
-    """One compiled run (inputs validated by :func:`rockjit.simulate.plan`); a Result."""
+    """One compiled run (inputs validated by :func:`rockjit.single.plan`); a Result."""
     run = ig.build(embed4=embed4, tangent=lyapunov)
     par = pack(block, phi, n_steps)
     ipar = settings(n_steps, periods, max_impacts, window, stride=record_stride or 1,
@@ -235,7 +234,7 @@ def _grid(TANGENT, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n
 @functools.lru_cache(maxsize=None)
 def _kernel(tangent):
     """The grid kernel with or without tangent vectors (a thin closure forwarding the switch,
-    ``True`` or ``None`` as :mod:`rockjit.integrate` wants them, so that the module-level
+    ``True`` or ``None`` as :mod:`rockjit._engine.integrate` wants them, so that the module-level
     kernels are specialised and cached)."""
     TANGENT = True if tangent else None
 
@@ -263,7 +262,7 @@ def _threads(threads):
         numba.set_num_threads(old)
 
 
-def _grid_outputs(n, n_pts, n_imp_pts):
+def grid_outputs(n, n_pts, n_imp_pts):
     return dict(res=np.zeros((n, N_RES)), pts=np.full((n, max(n_pts, 1), 2), np.nan),
                 imp=np.full((n, max(n_imp_pts, 1), 2), np.nan),
                 n_got=np.zeros(n, dtype=np.int64), n_imp_got=np.zeros(n, dtype=np.int64))
@@ -272,8 +271,8 @@ def _grid_outputs(n, n_pts, n_imp_pts):
 def run_chunk(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=None, lanes=None):
     """Run the grid kernel on one chunk of cells; returns its outputs by name.
 
-    The unit of work of :func:`rockjit.chunks.run_chunks`, in this process or on a Dask worker.
-    ``lanes > 1`` runs that many cells per thread in lockstep (:mod:`rockjit.lanes`; without
+    The unit of work of :func:`rockjit.storage.chunkstore.run_chunks`, in this process or on a Dask worker.
+    ``lanes > 1`` runs that many cells per thread in lockstep (:mod:`rockjit._engine.lanes`; without
     tangent vectors only, the same outputs bit for bit); default :data:`DEFAULT_LANES`.
     """
     return run_chunk_counted(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads,
@@ -288,7 +287,7 @@ def run_chunk_counted(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=
     lanes = DEFAULT_LANES if lanes is None else integer("lanes", lanes, 1, LANES_MAX)
     y0s = np.ascontiguousarray(y0s)
     pars = np.ascontiguousarray(pars)
-    out = _grid_outputs(y0s.shape[0], n_pts, n_imp_pts)
+    out = grid_outputs(y0s.shape[0], n_pts, n_imp_pts)
     counts = None
     with _threads(threads):
         if lanes > 1 and not tangent:
@@ -305,13 +304,13 @@ def run_chunk_counted(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=
     return out, counts
 
 
-#: The lanes' counters per block (:func:`rockjit.lanes.run_lanes`): fast steps, scalar steps,
+#: The lanes' counters per block (:func:`rockjit._engine.lanes.run_lanes`): fast steps, scalar steps,
 #: vector steps; cycles in vector steps, in scalar steps, in all; within the scalar steps, cycles
 #: in rest phases, in the steps after events, in locating events, in impacts, in detection, in
-#: first steps taken again, at grid points (:func:`rockjit.lanes.scalar_step`).
+#: first steps taken again, at grid points (:func:`rockjit._engine.lanes.scalar_step`).
 N_LANE_COUNTS = 13
 
-#: Cells per thread in lockstep at most (:data:`rockjit.lanes.W`, the vector's width).
+#: Cells per thread in lockstep at most (:data:`rockjit._engine.lanes.W`, the vector's width).
 LANES_MAX = 8
 #: Cells per thread in lockstep by default, for grids without tangent vectors (basins, erosion,
 #: fates; the grids with exponents run one cell at a time). Measured (benchmarks/bench_lanes.py,
@@ -330,29 +329,6 @@ def lane_block(n, threads):
 def default_chunk(n):
     """Cells per chunk when none is given: about a twentieth of the grid, at least 64."""
     return max(64, -(-n // 20))
-
-
-def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, threads, progress, label,
-             chunk=None, client=None, store=None, message=None, lanes=None):
-    """All cells through :func:`run_chunk`, chunk by chunk (progress between chunks).
-
-    Returns the outputs by name: ``res`` (rows in the ``R_*`` layout), ``pts``, ``imp``,
-    ``n_got``, ``n_imp_got``. ``message(text)`` hears what the chunk store has to say (default
-    a line on stderr). ``lanes``: cells per thread in lockstep (:func:`run_chunk`; default
-    :data:`DEFAULT_LANES`).
-    """
-    n = y0s.shape[0]
-    chunk = default_chunk(n) if chunk is None else chunk
-    outputs_ = _grid_outputs(n, n_pts, n_imp_pts)
-    cs = None
-    if store is not None:
-        key = chunks.fingerprint((y0s, pars, ipar, cpar),
-                                 dict(tangent=bool(tangent), n_pts=n_pts, n_imp_pts=n_imp_pts))
-        cs = chunks.ChunkStore(store, key, n, chunk, message=message)
-    chunks.run_chunks(run_chunk, (bool(tangent), y0s, pars, ipar, cpar, n_pts, n_imp_pts,
-                                  threads, lanes), n, chunk, outputs_, client=client, store=cs,
-                      progress=progress, label=label)
-    return outputs_
 
 
 # ---------------------------------------------------------------------------------------------
@@ -387,7 +363,7 @@ def compile_variant(name):
     a tiny input; returns the seconds it took. Module-level, so worker processes can run it."""
     import time as _time
 
-    from .model import Block
+    from ..model import Block
     t0 = _time.perf_counter()
     spec = VARIANTS[name][1]
     block = Block(hb=1.0, alpha=0.6, omega=1.3)

@@ -1,6 +1,6 @@
 """Attractor identity: which attractor each cell of a grid reaches, and what each attractor is.
 
-The grid kernels classify a cell by its behaviour (:mod:`rockjit.classify`); this module names
+The grid kernels classify a cell by its behaviour (:mod:`rockjit._engine.classify`); this module names
 the *attractor*: two cells of a basin reach the same attractor when their settled stroboscopic
 cycles coincide (SPEC.md §8). Outcome ids: ``>= 0`` attractors (numbered by decreasing basin
 size; rest for good is one), ``-1`` overturn, ``-2`` unresolved.
@@ -40,7 +40,7 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from .result import (APERIODIC, ASYMMETRIC, BEHAVIOURS, CHAOTIC, MULTIPERIODIC, OVERTURN,
+from ..result import (APERIODIC, ASYMMETRIC, BEHAVIOURS, CHAOTIC, MULTIPERIODIC, OVERTURN,
                      REST, SYMMETRIC, UNRESOLVED)
 
 __all__ = ["CLOUD_GRID", "CONT_TOL", "MATCH_TOL", "OVERTURN_ID", "UNRESOLVED_ID", "Attractor",
@@ -340,7 +340,7 @@ def floquet(block, phi, n_steps, point, period):
     instant of phase ``phi``): the eigenvalues of the tangent over ``period`` periods, saltation
     at every impact (zero when the cycle passes through rest). Returns ``(mu, lam)`` with
     ``lam = ln|mu| / (period T)``, sorted decreasing."""
-    from .simulate import simulate
+    from ..single import simulate
     r = simulate(block.hb, block.alpha, block.omega, block.law, e=block.e, xi=block.xi,
                  theta0=float(point[0]), dtheta0=float(point[1]), phase=phi,
                  periods=int(period), n_steps=n_steps, lyapunov=True, qr_every=0,

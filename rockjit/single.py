@@ -1,8 +1,8 @@
-"""``rockjit.simulate``: one run of the forced rocking block, compiled or through scipy.
+"""``rockjit.single``: one run of the forced rocking block, compiled or through scipy.
 
 :func:`plan` validates every input of a run (ranges, the grid's stability, the memory the run
 would allocate) and returns a :class:`RunPlan`; :func:`run` executes it on the compiled path
-(:mod:`rockjit.kernel`) or the scipy reference path (:mod:`rockjit.reference`). The command
+(:mod:`rockjit._engine.kernel`) or the scipy reference path (:mod:`rockjit.reference`). The command
 line builds the same plan, so the API and the CLI accept and refuse exactly the same inputs.
 """
 
@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import kernel
+from ._engine import kernel
 from .model import Block
 from .result import Result
 from .validate import choice, integer, memory, real
@@ -24,7 +24,7 @@ __all__ = ["DAMPING_STEP", "DEFAULT_N", "IVP_METHODS", "MAX_STEP", "RunPlan", "S
 
 #: The study's initial state ``(theta, theta', r, s)`` of its single runs and sweeps (SPEC.md
 #: §7), which :func:`simulate` starts from when no initial state is given. (Every other constant
-#: of the study is in :mod:`rockjit.study`, which lists this one too.)
+#: of the study is in :mod:`rockjit.study.paper`, which lists this one too.)
 Z0_STUDY = (-0.2254, -0.1597, -0.7778, 0.6284)
 
 #: Default number of steps per forcing period of single runs. Impact times over 20 periods are
@@ -370,14 +370,14 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
         block at rest.
     qr_every : int, optional
         Grid steps between Gram–Schmidt renormalisations of the tangent vectors; default
-        twice a period, or more often under strong damping (:func:`rockjit.kernel.
+        twice a period, or more often under strong damping (:func:`rockjit._engine.kernel.
         default_qr_every`); 0 never renormalises, so that ``result.extra["tangent"]`` is the
         Jacobian of the whole flow (zero across a rest phase; short runs, tests).
     stop_at_overturn : bool
         Stop when ``|theta|`` reaches ``theta_over`` (the physical rule, default). ``False``
         integrates on through the threshold with the same equations, as the study's own code
         did; ``result.t_overturn`` records the first crossing and the run counts as overturned
-        (:func:`rockjit.analysis.classify_result`).
+        (:func:`rockjit.grids.grids.classify_result`).
 
     Returns
     -------
@@ -385,7 +385,7 @@ def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta
 
     See Also
     --------
-    rockjit.fate.fate : ``K`` runs from nearby initial states, the same keywords: each
+    rockjit.basins.fate.fate : ``K`` runs from nearby initial states, the same keywords: each
         outcome's probability and the predictability horizon.
 
     Raises

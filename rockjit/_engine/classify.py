@@ -3,7 +3,7 @@ a stretch of periods.
 
 Everything here reads a run's stroboscopic samples ``x_k = (theta, theta')`` at ``kT``
 (``strobe[k]``) and at ``kT + T/2`` (``half[k]``), and ``per_imp[k]``, the number of impacts
-before ``kT``. The integrator's early stop (:func:`rockjit.integrate.settled_period`) and the
+before ``kT``. The integrator's early stop (:func:`rockjit._engine.integrate.settled_period`) and the
 classification of a finished run (:func:`find_period`) apply the same test,
 :func:`repeats`, to different stretches.
 
@@ -24,8 +24,8 @@ from __future__ import annotations
 
 import math
 
-from ._jit import jit
-from .result import APERIODIC, ASYMMETRIC, CHAOTIC, MULTIPERIODIC, SYMMETRIC
+from .._jit import jit
+from ..result import APERIODIC, ASYMMETRIC, CHAOTIC, MULTIPERIODIC, SYMMETRIC
 
 __all__ = ["classify", "find_period", "lam_between", "orbit_scale", "repeats"]
 

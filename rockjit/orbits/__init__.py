@@ -1,0 +1,1 @@
+"""Periodic orbits of the stroboscopic map: shooting, continuation and located bifurcations."""

@@ -1,0 +1,1 @@
+"""Figures: matplotlib drawings of results (imported lazily by the commands)."""

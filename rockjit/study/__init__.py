@@ -1,0 +1,1 @@
+"""The study rockjit reproduces: its constants and its pipeline, :func:`paper`."""

@@ -1,0 +1,1 @@
+"""Tools for testing rockjit itself: the seeded stress suite (:mod:`.stress`)."""
