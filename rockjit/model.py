@@ -30,6 +30,7 @@ from .validate import choice, real
 
 __all__ = [
     "LAWS",
+    "XI_STUDY",
     "Block",
     "accel",
     "accel_jac",
@@ -96,54 +97,45 @@ def delta_e_percent(e1, e2):
 
 
 # --------------------------------------------------------------------------------------------
-# Validated parameters
+# The block
 # --------------------------------------------------------------------------------------------
 
-#: Allowed ranges of the block's parameters. They are wide (the study's values are hb 1-2,
-#: alpha <= 1, omega ~ 1, xi ~ 2e-4) and keep every product the integrator forms finite.
+#: Allowed range of the slenderness: wide (the study's values are 1 and 2) and keeping every
+#: product the integrator forms finite.
 HB_RANGE = (1e-2, 1e2)
-ALPHA_MAX = 1e9
-OMEGA_RANGE = (1e-4, 1e4)
-#: Largest forcing acceleration ``alpha omega^2`` (in units of g): slow forcing may take a
-#: large amplitude alpha, what the block feels is the acceleration.
-ACCEL_MAX = 1e8
 XI_MAX = 1e4
-REST_SPEED_MAX = 0.1
+#: The study's damping ``c_b / (M R^2 Omega0)``: M = 2e4 kg, c_b = 101 N s m, R = 3.764 m,
+#: g = 9.81 m/s^2 (docs/theory/model.md).
+XI_STUDY = 101.0 / (2e4 * 3.764**2 * math.sqrt(9.81 / 3.764))
 
 
 @dataclass(frozen=True)
 class Block:
-    """A validated parameter set of the forced rocking block.
+    """A rigid block rocking on a rigid base: its slenderness, restitution law and damping.
 
     Parameters
     ----------
     hb : float
         Slenderness ``h/b`` in ``[0.01, 100]`` (``>= 1/sqrt(2)`` for the Housner law).
-    alpha : float
-        Forcing amplitude ``A/R`` in ``[0, 1e9]``, with ``alpha omega^2 <= 1e8``.
-    omega : float
-        Forcing frequency ``Omega/Omega0`` in ``[1e-4, 1e4]``.
     law : {"housner", "mao", "constant"}, optional
         Restitution law; default ``"housner"``, or ``"constant"`` when ``e`` is given.
     e : float, optional
         Coefficient of restitution in ``[0, 1]``, only with the constant law.
     xi : float
-        Viscous damping in ``[0, 1e4]``; default the study's value (SPEC.md §1).
-    theta_over : float
-        Overturning threshold on ``|theta|``, in ``(0, pi/2]``; default ``pi/2``.
-    rest_speed : float
-        Impact speed ``|theta'|`` after the jump below which the block is put to rest (the Zeno
-        cut-off, SPEC.md §3), in ``(0, 0.1]``; default ``1e-6``.
+        Viscous damping in ``[0, 1e4]``; default the study's, :data:`XI_STUDY`.
+
+    Examples
+    --------
+    >>> from rockjit import Block
+    >>> b = Block(hb=1, law="mao")
+    >>> round(b.restitution, 3), round(b.thc, 4)
+    (0.582, 0.7854)
     """
 
     hb: float
-    alpha: float
-    omega: float
     law: str | None = None
     e: float | None = None
-    xi: float = 101.0 / (2e4 * 3.764**2 * math.sqrt(9.81 / 3.764))
-    theta_over: float = 0.5 * math.pi
-    rest_speed: float = 1e-6
+    xi: float = XI_STUDY
 
     def __post_init__(self):
         hb = real("hb", self.hb, *HB_RANGE)
@@ -162,28 +154,10 @@ class Block:
                 f"hb must be >= 1/sqrt(2) = {HB_MIN_HOUSNER:.6f} for the Housner law "
                 f"(got {hb}); e_H would be negative"
             )
-        alpha = real("alpha", self.alpha, 0.0, ALPHA_MAX)
-        omega = real("omega", self.omega, *OMEGA_RANGE)
-        if alpha * omega**2 > ACCEL_MAX:
-            raise ValueError(f"the forcing acceleration alpha * omega**2 must be <= "
-                             f"{ACCEL_MAX:g} (got alpha = {alpha:g}, omega = {omega:g}: "
-                             f"{alpha * omega**2:.3g})")
-        xi = real("xi", self.xi, 0.0, XI_MAX)
-        theta_over = real("theta_over", self.theta_over, 0.0, 0.5 * math.pi, lo_open=True)
-        if isinstance(self.rest_speed, (int, float)) and self.rest_speed == 0:
-            raise ValueError(
-                "rest_speed must be > 0 (got 0): with e < 1 the impacts of a Zeno cascade "
-                "accumulate in finite time, and without a cut-off a run would pile impacts at "
-                "one instant until max_impacts")
-        rest_speed = real("rest_speed", self.rest_speed, 0.0, REST_SPEED_MAX, lo_open=True)
-        for name, value in (("hb", hb), ("alpha", alpha), ("omega", omega), ("xi", xi),
-                            ("theta_over", theta_over), ("rest_speed", rest_speed),
-                            ("law", law)):
-            object.__setattr__(self, name, value)
-        if law == "constant":
-            object.__setattr__(self, "e", float(self.e))
-        else:
-            object.__setattr__(self, "e", None)
+        object.__setattr__(self, "hb", hb)
+        object.__setattr__(self, "law", law)
+        object.__setattr__(self, "xi", real("xi", self.xi, 0.0, XI_MAX))
+        object.__setattr__(self, "e", e if law == "constant" else None)
 
     # thc and the restitution are computed once per block (numpy on scalars: a microsecond
     # each, a run's fixed cost); cached_property writes the instance's __dict__ directly, which
@@ -207,15 +181,10 @@ class Block:
         """Uplift threshold ``cot(thc) = b/h`` on ``|f|``."""
         return 1.0 / self.hb
 
-    @property
-    def period(self) -> float:
-        """Forcing period ``2 pi / omega``."""
-        return 2.0 * math.pi / self.omega
-
     def replace(self, **changes) -> "Block":
-        """A copy with some fields changed (validated again)."""
-        fields = dict(hb=self.hb, alpha=self.alpha, omega=self.omega, law=self.law, e=self.e,
-                      xi=self.xi, theta_over=self.theta_over, rest_speed=self.rest_speed)
+        """A copy with some fields changed (validated again); a new ``law`` drops ``e`` and a
+        new ``e`` selects the constant law, unless both are given."""
+        fields = dict(hb=self.hb, law=self.law, e=self.e, xi=self.xi)
         fields.update(changes)
         if "law" in changes and "e" not in changes:
             fields["e"] = None

@@ -25,8 +25,8 @@ from .result import Result
 _TINY = np.finfo(float).tiny
 
 
-def _fields(block: Block, phi: float, embed4: bool):
-    thc, xi, aw2, omega = block.thc, block.xi, block.alpha * block.omega**2, block.omega
+def _fields(block: Block, forcing, phi: float, embed4: bool):
+    thc, xi, aw2, omega = block.thc, block.xi, forcing.alpha * forcing.omega**2, forcing.omega
 
     def forcing(t, z):
         return z[2] if embed4 else forcing_closed(t, omega, phi)
@@ -57,22 +57,26 @@ def _fields(block: Block, phi: float, embed4: bool):
     return fun, jac, forcing
 
 
-def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, forcing,
-                   ivp_method="BDF", rtol=1e-6, atol=1e-9, record_stride=None,
-                   max_impacts=100_000, stop_at_overturn=True):
-    """Reference run through ``scipy.integrate.solve_ivp``; returns a :class:`Result`.
+def simulate_scipy(p):
+    """Reference run of a :class:`rockjit.single.RunPlan` through ``scipy.integrate.solve_ivp``
+    (its method and tolerances in ``p.method``, a :class:`rockjit.Scipy`); returns a
+    :class:`Result`.
 
-    Called by :func:`rockjit.single.run` with ``method="scipy[:METHOD]"`` on a validated
-    plan. Samples are taken at the compiled path's grid points (``T/2`` for the stroboscopic
+    Samples are taken at the compiled path's grid points (``T/2`` for the stroboscopic
     sections, ``record_stride`` steps for the trajectory) from the solver's own output.
     """
-    embed4 = forcing == "embedded"
-    fun, jac, forc = _fields(block, phi, embed4)
-    T = block.period
+    block, forcing, phi, n_steps = p.block, p.forcing, p.phi, p.n_steps
+    theta0, dtheta0, r0, s0 = p.y0
+    periods, record_stride, max_impacts = p.periods, p.record_stride, p.max_impacts
+    ivp_method, rtol, atol = p.method.method, p.method.rtol, p.method.atol
+    stop_at_overturn = p.integration.stop_at_overturn
+    embed4 = forcing.embedded
+    fun, jac, forc = _fields(block, forcing, phi, embed4)
+    T = forcing.period
     h = T / n_steps
     t_end = periods * T
-    aw2, cot, omega, thover, e = (block.alpha * block.omega**2, block.cot, block.omega,
-                                  block.theta_over, block.restitution)
+    aw2, cot, omega, thover, e = (forcing.alpha * forcing.omega**2, block.cot, forcing.omega,
+                                  p.integration.theta_over, block.restitution)
     # sample times: the half-period grid, and the trajectory grid if asked
     t_half = np.arange(2 * periods + 1) * (T / 2)
     t_samp = t_half
@@ -230,7 +234,7 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
         side = -side
         z[0] = side * _TINY
         z[1] = dth_p
-        if abs(dth_p) < block.rest_speed or dth_p == 0.0:
+        if abs(dth_p) < p.integration.rest_speed or dth_p == 0.0:
             z[0] = 0.0
             z[1] = 0.0
             side = 0
@@ -279,7 +283,8 @@ def simulate_scipy(block, theta0, dtheta0, phi, r0, s0, *, periods, n_steps, for
                          if np.isclose(tk / (h * record_stride),
                                        round(tk / (h * record_stride)), rtol=0, atol=1e-6)])
     return Result(
-        block=block, method=f"scipy:{ivp_method}", status=status, t=float(t), state=state,
+        block=block, forcing=forcing, integration=p.integration, method=f"scipy:{ivp_method}",
+        status=status, t=float(t), state=state,
         period=T, n_steps=n_steps, periods=periods,
         strobe=np.array(strobe).reshape(-1, 4), strobe_half=np.array(strobe_half).reshape(-1, 4),
         impacts=np.array(impacts).reshape(-1, 3), n_impacts=len(impacts),

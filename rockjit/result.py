@@ -12,7 +12,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .excitation import Excitation
 from .model import Block
+from .settings import Integration
 
 __all__ = ["BEHAVIOURS", "HORIZON_TOL", "ROUNDING", "BasinResult", "GridResult",
            "PlaneResult", "Result", "STATUSES", "STATUS_MESSAGES", "SweepResult", "fractions",
@@ -68,7 +70,11 @@ class Result:
     Attributes
     ----------
     block : Block
-        The validated parameters.
+        The block.
+    forcing : Harmonic
+        The excitation.
+    integration : Integration
+        The integration settings as given (``n_steps`` is the one used).
     method : str
         ``"rockjit"`` or ``"scipy:<solve_ivp method>"``.
     status : str
@@ -117,6 +123,8 @@ class Result:
     """
 
     block: Block
+    forcing: Excitation
+    integration: Integration
     method: str
     status: str
     t: float
@@ -196,13 +204,12 @@ class Result:
         physics (the impact bound, a non-finite number)."""
         return self.status in ("max_impacts", "nonfinite")
 
-    def caveats(self, *, cli=False):
+    def caveats(self):
         """What a reader of this run must be told, as sentences: a stop before the requested
-        end, exponents with no averaging window, an outcome beyond the predictability horizon
-        (``cli``: options named as the command line spells them)."""
+        end, exponents with no averaging window, an outcome beyond the predictability horizon."""
         out = []
         if self.stopped_early:
-            raise_ = "; raise " + ("--max-impacts" if cli else "max_impacts")
+            raise_ = "; raise Integration.max_impacts"
             out.append(f"the run stopped at t = {self.t:.6g} of {self.periods * self.period:.6g}: "
                        f"{self.message}"
                        + (raise_ if self.status == "max_impacts" else ""))
@@ -212,14 +219,13 @@ class Result:
             out.append(f"the run ended at t = {self.t:.4g}, beyond its predictability horizon "
                        f"t* = {self.horizon:.4g} (rounding grown to 1 % at lambda1 = "
                        f"{self.lyapunov_running[-1, 0]:.3g}): its outcome is one sample; "
-                       + ("`rockjit fate`" if cli else "rockjit.basins.fate") + " gives the "
-                       "probabilities")
+                       "rockjit.fate gives the probabilities")
         return out
 
     def __repr__(self) -> str:
-        b = self.block
-        return (f"Result({self.method}, hb={b.hb}, alpha={b.alpha}, omega={b.omega}, "
-                f"law={b.law}, status={self.status!r}, t={self.t:.6g}, "
+        b, f = self.block, self.forcing
+        return (f"Result({self.method}, hb={b.hb}, law={b.law}, alpha={f.alpha}, "
+                f"omega={f.omega}, status={self.status!r}, t={self.t:.6g}, "
                 f"impacts={self.n_impacts})")
 
 
@@ -229,10 +235,11 @@ def _names_array():
 
 @dataclass(kw_only=True)
 class GridResult:
-    """What every grid result has: the block (at the grid's first point), the settings it was
-    computed with, and the behaviour names that its ``label`` codes index."""
+    """What every grid result has: the block, the excitation (without what the grid sweeps), the
+    settings it was computed with, and the behaviour names that its ``label`` codes index."""
 
     block: Block
+    forcing: Excitation | None = None
     settings: dict = field(default_factory=dict)
     names: np.ndarray = field(default_factory=_names_array)
     #: Outcome id of each cell (same shape as ``label``): ``>= 0`` the attractor it reaches,

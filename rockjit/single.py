@@ -1,9 +1,12 @@
-"""``rockjit.single``: one run of the forced rocking block, compiled or through scipy.
+"""One run of the forced rocking block: validated, then integrated compiled or through scipy.
 
-:func:`plan` validates every input of a run (ranges, the grid's stability, the memory the run
-would allocate) and returns a :class:`RunPlan`; :func:`run` executes it on the compiled path
-(:mod:`rockjit._engine.kernel`) or the scipy reference path (:mod:`rockjit.reference`). The command
-line builds the same plan, so the API and the CLI accept and refuse exactly the same inputs.
+:func:`simulate` is the entry point. Its inputs are the block (:class:`rockjit.Block`), the
+excitation (:class:`rockjit.Harmonic`), the initial state and the integration settings
+(:class:`rockjit.Integration`); :func:`plan` checks what depends on them together (the step's
+stability, the memory the run would allocate) into a :class:`RunPlan`, and :func:`run` executes
+it on the compiled path (:mod:`rockjit._engine.kernel`) or the scipy reference path
+(:mod:`rockjit.reference`). The command line builds the same plan, so the API and the CLI accept
+and refuse exactly the same inputs.
 """
 
 from __future__ import annotations
@@ -14,23 +17,28 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._engine import kernel
+from .excitation import STUDY_PHASE, Harmonic
 from .model import Block
 from .result import Result
-from .validate import choice, integer, memory, real
+from ._engine.classify import classify
+from .result import BEHAVIOURS
+from .settings import Classification, Integration
+from .validate import boolean, choice, integer, memory, real
 
 __all__ = ["DAMPING_STEP", "DEFAULT_N", "IVP_METHODS", "MAX_STEP", "RunPlan", "STABLE_DAMPING",
-           "STEP_LIMIT", "Z0_STUDY", "check_step", "default_max_impacts", "forcing_phase",
-           "plan", "run", "simulate", "steps_per_period"]
+           "STEP_LIMIT", "Scipy", "Z0_STUDY", "check_step", "classify_result", "plan", "run",
+           "simulate",
+           "steps_per_period"]
 
-#: The study's initial state ``(theta, theta', r, s)`` of its single runs and sweeps (SPEC.md
-#: §7), which :func:`simulate` starts from when no initial state is given. (Every other constant
-#: of the study is in :mod:`rockjit.study.paper`, which lists this one too.)
-Z0_STUDY = (-0.2254, -0.1597, -0.7778, 0.6284)
+#: The study's initial state ``(theta, theta', r, s)`` of its single runs and sweeps
+#: (docs/theory/study.md): a run from the default state starts here, at the study's forcing
+#: phase unless the excitation gives another.
+Z0_STUDY = (-0.2254, -0.1597) + STUDY_PHASE
 
 #: Default number of steps per forcing period of single runs. Impact times over 20 periods are
 #: within 1e-10 of a converged solution (N = 2048) on the study's orbits from N = 160 on; the
 #: most demanding of them, the asymmetric orbit (hb=1, alpha=0.8), needs it: 2.1e-10 at N = 128,
-#: 6.5e-11 at N = 160 (benchmarks/README.md, "Work against precision").
+#: 6.5e-11 at N = 160 (benchmarks/results/work_precision.md).
 DEFAULT_N = 160
 
 #: Largest step (in units of 1/Omega0) a default N may give: at slow forcing, N steps per period
@@ -52,18 +60,46 @@ DAMPING_STEP = 1.0
 #: ``solve_ivp`` methods of the reference path.
 IVP_METHODS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
 
-#: Largest number of periods, and of steps per period, a run may ask for: bounds that keep the
-#: kernels' step counter in 64 bits. The memory check refuses most large requests first, with
-#: the memory they would need.
-MAX_PERIODS = 10**15
-MAX_N = 10**12
+
+@dataclass(frozen=True)
+class Scipy:
+    """The scipy reference path: ``scipy.integrate.solve_ivp`` with this method and these
+    tolerances, restarted at every impact (docs/theory/integrator.md). The study's was BDF at
+    ``rtol=1e-6, atol=1e-9``.
+
+    Examples
+    --------
+    >>> from rockjit import Scipy
+    >>> Scipy("DOP853", rtol=1e-12, atol=1e-12).name
+    'scipy:DOP853'
+    """
+
+    method: str = "BDF"
+    rtol: float = 1e-6
+    atol: float = 1e-9
+
+    def __post_init__(self):
+        choice("method", self.method, IVP_METHODS)
+        object.__setattr__(self, "rtol", real("rtol", self.rtol, 0.0, 1.0, lo_open=True,
+                                              hi_open=True))
+        object.__setattr__(self, "atol", real("atol", self.atol, 0.0, None, lo_open=True))
+
+    @property
+    def name(self):
+        """``"scipy:<METHOD>"``, as results record it."""
+        return f"scipy:{self.method}"
 
 
-def default_max_impacts(periods):
-    """The default impact bound: 10,000 impacts per period, at least 100,000. A Zeno cascade
-    from ``|theta'| ~ 1`` to the cut-off ``1e-6`` has ``ln(1e-6) / ln(e)`` impacts: ~10 for
-    ``e = 0.25``, ~75 for ``e = 0.83``, ~1,400 for ``e = 0.99``, at most two a period."""
-    return max(100_000, 10_000 * int(periods))
+def _method(method):
+    """``"rockjit"`` or a :class:`Scipy`, from what :func:`simulate` was given."""
+    if method == "rockjit" or isinstance(method, Scipy):
+        return method
+    if isinstance(method, str) and (method == "scipy" or method.startswith("scipy:")):
+        name = method.split(":", 1)[1] if ":" in method else "BDF"
+        if name in IVP_METHODS:
+            return Scipy(name)
+    raise ValueError(f"method must be 'rockjit', 'scipy', 'scipy:<one of "
+                     f"{', '.join(IVP_METHODS)}>' or a rockjit.Scipy (got {method!r})")
 
 
 def check_step(period, n_steps, forcing="closed", radius=1.0, xi=0.0):
@@ -104,99 +140,48 @@ def steps_per_period(period, default, xi=0.0):
     return n
 
 
-def forcing_phase(phase=None, r0=None, s0=None, forcing="closed", *, embedded_hint=True):
-    """Resolve the forcing's initial condition into ``(phi, r0, s0)``.
-
-    Give either ``phase`` (``r = sin(omega t + phase)``) or ``(r0, s0)``; the default is
-    ``(r0, s0) = (0, 1)``. With the closed form, ``(r0, s0)`` must lie on the unit circle (to
-    1e-3): off it only the embedding is meaningful (SPEC.md §1); ``embedded_hint`` says so in
-    the message (callers without an embedding turn it off).
-    """
-    choice("forcing", forcing, ("closed", "embedded"))
-    if phase is not None:
-        if r0 is not None or s0 is not None:
-            raise ValueError("give either phase or (r0, s0), not both")
-        phi = real("phase", phase)
-        return phi, math.sin(phi), math.cos(phi)
-    if (r0 is None) != (s0 is None):
-        raise ValueError("r0 and s0 go together: give both or neither")
-    if r0 is None:
-        r0, s0 = 0.0, 1.0
-    r0 = real("r0", r0, -1e3, 1e3)
-    s0 = real("s0", s0, -1e3, 1e3)
-    rad = math.hypot(r0, s0)
-    if rad == 0.0:
-        raise ValueError("(r0, s0) must not be (0, 0): the forcing oscillator has no phase there")
-    if forcing == "closed" and abs(rad - 1.0) > 1e-3:
-        hint = "; use forcing='embedded' for a start off the circle" if embedded_hint else \
-            "; give a point on the circle, or a phase"
-        raise ValueError(f"(r0, s0) must lie on the unit circle for the closed-form forcing "
-                         f"(|(r0, s0)| = {rad:.6g}){hint}")
-    return math.atan2(r0, s0), r0, s0
+def settings_for(block, forcing, integration, default_n):
+    """The integration settings resolved for this block and forcing: ``(n_steps, window,
+    max_impacts)``. ``n_steps`` defaults to ``default_n``, raised for slow forcing and strong
+    damping; an explicit one is checked for stability (:func:`check_step`)."""
+    period = forcing.period
+    if integration.n_steps is None:
+        n_steps = steps_per_period(period, default_n, block.xi)
+    else:
+        n_steps = integration.n_steps
+    return n_steps, integration.window_start(), integration.impact_bound()
 
 
-def initial_state(theta0=None, dtheta0=None, z0=None, r0=None, s0=None, phase=None):
-    """``(theta0, dtheta0, r0, s0)`` from the ways a user may give them: ``z0`` at once, or
-    separately (missing angles are 0), or nothing at all (the study's ``Z0_STUDY``).
-    ``r0, s0`` may be ``None`` (resolved by :func:`forcing_phase`)."""
-    if z0 is not None:
-        if theta0 is not None or dtheta0 is not None or r0 is not None or s0 is not None:
-            raise ValueError("give z0 or (theta0, dtheta0, r0, s0), not both")
-        try:
-            z = np.asarray(z0, dtype=float).ravel()
-        except (TypeError, ValueError):
-            raise ValueError(f"z0 must be 4 numbers (theta, theta', r, s) (got {z0!r})") \
-                from None
-        if z.shape != (4,):
-            raise ValueError(f"z0 must have 4 entries (theta, theta', r, s) (got {z.size})")
-        theta0, dtheta0, r0, s0 = (float(v) for v in z)
-    elif theta0 is None and dtheta0 is None and r0 is None and s0 is None and phase is None:
-        theta0, dtheta0, r0, s0 = Z0_STUDY
-    return (0.0 if theta0 is None else theta0), (0.0 if dtheta0 is None else dtheta0), r0, s0
-
-
-def closed_form_z0(theta0=None, dtheta0=None, r0=None, s0=None, phase=None):
-    """A whole initial state ``(theta0, dtheta0, r0, s0)`` for the closed-form forcing, by
-    :func:`simulate`'s rule: the study's ``z0`` when nothing is given, else the angles given (0
-    where not) and the forcing at its phase (default ``(r0, s0) = (0, 1)``)."""
-    th, dth, r0, s0 = initial_state(theta0, dtheta0, None, r0, s0, phase)
-    return (th, dth) + forcing_phase(phase, r0, s0, "closed", embedded_hint=False)[1:]
-
-
-def check_theta0(theta0, block, name="theta0"):
+def check_theta0(theta0, integration, name="theta0"):
     """An initial angle inside the bounded region ``|theta0| < theta_over``."""
     theta0 = real(name, theta0)
-    if abs(theta0) >= block.theta_over:
-        raise ValueError(f"{name} must satisfy |{name}| < theta_over = {block.theta_over:.6g} "
-                         f"(got {theta0:g}): the block would start overturned")
+    if abs(theta0) >= integration.theta_over:
+        raise ValueError(f"{name} must satisfy |{name}| < theta_over = "
+                         f"{integration.theta_over:.6g} (got {theta0:g}): the block would start "
+                         f"overturned")
     return theta0
 
 
-#: Blocks made from plain numbers, by their arguments: a Block is immutable and validated once
-#: (its checks were a sixth of a short run's fixed cost, issue 16).
-_BLOCKS = {}
-_PLAIN = (float, int, str, type(None))
-
-
-def make_block(hb, alpha, omega, law=None, e=None, xi=None, theta_over=0.5 * math.pi,
-               rest_speed=1e-6):
-    """A :class:`Block` from the API's keyword arguments (``xi=None``: the study's value)."""
-    key = (hb, alpha, omega, law, e, xi, theta_over, rest_speed)
-    plain = all(type(v) in _PLAIN for v in key)
-    if plain:
-        block = _BLOCKS.get(key)
-        if block is not None:
-            return block
-    kw = dict(hb=hb, alpha=alpha, omega=omega, law=law, e=e, theta_over=theta_over,
-              rest_speed=rest_speed)
-    if xi is not None:
-        kw["xi"] = xi
-    block = Block(**kw)
-    if plain:
-        if len(_BLOCKS) >= 1024:
-            _BLOCKS.clear()
-        _BLOCKS[key] = block
-    return block
+def initial_state(state, forcing, integration):
+    """``(theta0, theta0', phi, r0, s0)`` from a run's ``state`` (``(theta0, theta0')``, or
+    ``None``: the study's) and its excitation's phase (not given: the study's forcing point
+    for the study's state, ``(0, 1)`` otherwise)."""
+    if state is None:
+        th, dth = Z0_STUDY[:2]
+        default = STUDY_PHASE
+    else:
+        try:
+            z = np.asarray(state, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"state must be two numbers (theta0, theta0') (got {state!r})") \
+                from None
+        if z.shape != (2,) or np.iscomplexobj(state):
+            raise ValueError(f"state must be two numbers (theta0, theta0') (got {state!r})")
+        th, dth = float(z[0]), float(z[1])
+        default = (0.0, 1.0)
+    th = check_theta0(th, integration, "state[0] (theta0)")
+    dth = real("state[1] (theta0')", dth, -1e6, 1e6)
+    return (th, dth) + forcing.start(default)
 
 
 @dataclass(frozen=True)
@@ -204,199 +189,155 @@ class RunPlan:
     """A validated single run: everything :func:`run` needs, nothing left to check."""
 
     block: Block
+    forcing: Harmonic
+    integration: Integration
     y0: tuple            # (theta0, dtheta0, r0, s0)
     phi: float
-    forcing: str
-    method: str          # "rockjit" or "scipy:<METHOD>"
-    rtol: float
-    atol: float
-    periods: int
+    method: object       # "rockjit" or a Scipy
     n_steps: int
     window: int
     max_impacts: int
     record_stride: int | None
     lyapunov: bool
-    qr_every: int | None
     memory_bytes: float
-    stop_at_overturn: bool = True
+
+    @property
+    def periods(self):
+        return self.integration.periods
 
 
-def _method(method):
-    if method == "rockjit":
-        return method
-    if isinstance(method, str) and (method == "scipy" or method.startswith("scipy:")):
-        name = method.split(":", 1)[1] if ":" in method else "BDF"
-        if name not in IVP_METHODS:
-            raise ValueError(f"method must be 'rockjit', 'scipy' or 'scipy:<one of "
-                             f"{', '.join(IVP_METHODS)}>' (got {method!r})")
-        return f"scipy:{name}"
-    raise ValueError(f"method must be 'rockjit', 'scipy' or 'scipy:<one of "
-                     f"{', '.join(IVP_METHODS)}>' (got {method!r})")
-
-
-def run_settings(block, periods, n_steps, default_n, max_impacts, window):
-    """The settings every run and grid shares, validated: ``(periods, n_steps, max_impacts,
-    window)``. ``n_steps=None`` gives ``default_n``, raised for slow forcing and strong
-    damping; an explicit one must be even, at least 8, and stable (:func:`check_step`)."""
-    periods = integer("periods", periods, 1, MAX_PERIODS)
-    if n_steps is None:
-        n_steps = steps_per_period(block.period, default_n, block.xi)
-    else:
-        n_steps = integer("n_steps", n_steps, 8, MAX_N)
-        if n_steps % 2:
-            raise ValueError(f"n_steps must be even, so that t = kT + T/2 is on the grid "
-                             f"(got {n_steps})")
-    max_impacts = default_max_impacts(periods) if max_impacts is None else \
-        integer("max_impacts", max_impacts, 1, 2**62)
-    w0 = int(round(0.8 * periods)) if window is None else \
-        integer("window", window, 0, periods - 1)
-    return periods, n_steps, max_impacts, w0
-
-
-def plan(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta0=None, z0=None,
-         phase=None, r0=None, s0=None, periods=500, n_steps=None, forcing="closed",
-         method="rockjit", rtol=1e-6, atol=1e-9, lyapunov=False, window=None,
-         record_stride=None, max_impacts=None, theta_over=0.5 * math.pi, rest_speed=1e-6,
-         qr_every=None, stop_at_overturn=True) -> RunPlan:
-    """Validate the inputs of :func:`simulate` (same parameters) into a :class:`RunPlan`.
-
-    Raises ``ValueError`` naming the parameter for anything out of range, for a grid too coarse
-    to integrate stably, and for a run whose arrays would not fit in memory.
-    """
-    theta0, dtheta0, r0, s0 = initial_state(theta0, dtheta0, z0, r0, s0, phase)
-    dtheta0 = real("dtheta0", dtheta0, -1e6, 1e6)
-    block = make_block(hb, alpha, omega, law, e, xi, theta_over, rest_speed)
-    theta0 = check_theta0(theta0, block)
-    phi, r0, s0 = forcing_phase(phase, r0, s0, forcing)
+def plan(block, forcing, state=None, *, integration=None, lyapunov=False, record_stride=None,
+         method="rockjit") -> RunPlan:
+    """Check the inputs of :func:`simulate` together (same parameters) into a
+    :class:`RunPlan`: the step's stability for this block and forcing, and the memory the
+    run would allocate. Each object was validated when it was made."""
+    if not isinstance(block, Block):
+        raise ValueError(f"block must be a rockjit.Block (got {type(block).__name__})")
+    if not isinstance(forcing, Harmonic):
+        raise ValueError(f"forcing must be a rockjit excitation such as Harmonic "
+                         f"(got {type(forcing).__name__})")
+    forcing.require("alpha", "omega", why="a single run")
+    integration = Integration() if integration is None else integration
+    if not isinstance(integration, Integration):
+        raise ValueError(f"integration must be a rockjit.Integration "
+                         f"(got {type(integration).__name__})")
+    theta0, dtheta0, phi, r0, s0 = initial_state(state, forcing, integration)
     method = _method(method)
-    periods, n_steps, max_impacts, w0 = run_settings(block, periods, n_steps, DEFAULT_N,
-                                                     max_impacts, window)
-    check_step(block.period, n_steps, forcing, math.hypot(r0, s0), block.xi)
+    n_steps, window, max_impacts = settings_for(block, forcing, integration, DEFAULT_N)
+    check_step(forcing.period, n_steps, "embedded" if forcing.embedded else "closed",
+               math.hypot(r0, s0), block.xi)
     if record_stride is not None:
         record_stride = integer("record_stride", record_stride, 1, 2**62)
-    if qr_every is not None:
-        qr_every = integer("qr_every", qr_every, 0, 2**62)
-    lyapunov = bool(lyapunov)
-    if method != "rockjit":
-        if lyapunov:
-            raise ValueError("lyapunov=True is only available with method='rockjit'")
-        rtol = real("rtol", rtol, 0.0, 1.0, lo_open=True, hi_open=True)
-        atol = real("atol", atol, 0.0, None, lo_open=True)
+    lyapunov = boolean("lyapunov", lyapunov)
+    if method != "rockjit" and lyapunov:
+        raise ValueError("lyapunov=True is only available with method='rockjit'")
+    periods = integration.periods
+    if periods * n_steps > 2**62:
+        raise ValueError(f"periods * n_steps must be <= 2**62 (got {periods} * {n_steps})")
     n_traj = periods * n_steps // record_stride + 1 if record_stride else 1
     nbytes = kernel.run_bytes(periods, n_steps, max_impacts, n_traj, lyapunov)
     memory(f"periods = {periods} at n_steps = {n_steps}", nbytes)
-    if periods * n_steps > 2**62:
-        raise ValueError(f"periods * n_steps must be <= 2**62 (got {periods} * {n_steps})")
-    return RunPlan(block=block, y0=(theta0, dtheta0, r0, s0), phi=phi, forcing=forcing,
-                   method=method, rtol=float(rtol), atol=float(atol), periods=periods,
-                   n_steps=n_steps, window=w0, max_impacts=max_impacts,
-                   record_stride=record_stride, lyapunov=lyapunov, qr_every=qr_every,
-                   memory_bytes=nbytes, stop_at_overturn=bool(stop_at_overturn))
+    return RunPlan(block=block, forcing=forcing, integration=integration,
+                   y0=(theta0, dtheta0, r0, s0), phi=phi, method=method, n_steps=n_steps,
+                   window=window, max_impacts=max_impacts, record_stride=record_stride,
+                   lyapunov=lyapunov, memory_bytes=nbytes)
 
 
 def run(p: RunPlan) -> Result:
     """Execute a :class:`RunPlan` on its path (compiled or scipy)."""
-    theta0, dtheta0, r0, s0 = p.y0
     if p.method != "rockjit":
         from .reference import simulate_scipy  # scipy.integrate only when asked for
-        return simulate_scipy(p.block, theta0, dtheta0, p.phi, r0, s0, periods=p.periods,
-                              n_steps=p.n_steps, forcing=p.forcing,
-                              ivp_method=p.method.split(":", 1)[1], rtol=p.rtol, atol=p.atol,
-                              record_stride=p.record_stride, max_impacts=p.max_impacts,
-                              stop_at_overturn=p.stop_at_overturn)
-    return kernel.run_single(p.block, (theta0, dtheta0, r0, s0), p.phi, n_steps=p.n_steps,
-                             periods=p.periods, window=p.window, max_impacts=p.max_impacts,
-                             record_stride=p.record_stride, embed4=p.forcing == "embedded",
-                             lyapunov=p.lyapunov, qr_every=p.qr_every,
-                             stop_at_overturn=p.stop_at_overturn)
+        return simulate_scipy(p)
+    return kernel.run_single(p)
 
 
-def simulate(hb, alpha, omega, law=None, *, e=None, xi=None, theta0=None, dtheta0=None,
-             z0=None, phase=None, r0=None, s0=None, periods=500, n_steps=None,
-             forcing="closed", method="rockjit", rtol=1e-6, atol=1e-9, lyapunov=False,
-             window=None, record_stride=None, max_impacts=None,
-             theta_over=0.5 * math.pi, rest_speed=1e-6, qr_every=None,
-             stop_at_overturn=True) -> Result:
-    """Simulate the harmonically forced rocking block.
+def simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
+             record_stride=None, method="rockjit") -> Result:
+    """Simulate the rocking block under an excitation.
 
     Parameters
     ----------
-    hb, alpha, omega : float
-        Slenderness, forcing amplitude and frequency (SPEC.md §1); see :class:`Block`.
-    law : {"housner", "mao", "constant"}, optional
-        Restitution law; ``e`` alone implies ``"constant"``.
-    e : float, optional
-        Constant coefficient of restitution in ``[0, 1]``.
-    xi : float, optional
-        Damping in ``[0, 1e4]``; default the study's ``2.208e-4``.
-    theta0, dtheta0 : float, optional
-        Initial angle (``|theta0| < theta_over``) and angular velocity. Default: the study's
-        ``z0`` (SPEC.md §7).
-    z0 : sequence of 4 floats, optional
-        ``(theta0, dtheta0, r0, s0)`` at once, instead of the four separately.
-    phase : float, optional
-        Forcing phase ``phi`` in ``r = sin(omega t + phi)``; or give ``(r0, s0)``.
-    r0, s0 : float, optional
-        Initial point of the forcing oscillator; default ``(0, 1)``.
-    periods : int
-        Number of forcing periods to integrate (``>= 1``), default 500.
-    n_steps : int, optional
-        Steps per period ``N`` (even, ``>= 8``); default :data:`DEFAULT_N`, raised for slow
-        forcing so that the step ``T/N`` stays below :data:`MAX_STEP`, and for strong damping
-        so that ``3/4 xi T/N <= DAMPING_STEP``. An explicit N beyond the step's stability
-        (:func:`check_step`) is refused, naming the N needed.
-    forcing : {"closed", "embedded"}
-        Closed-form forcing, or the 4-D oscillator embedding integrated with the block.
-    method : str
-        ``"rockjit"`` (compiled, fixed step) or ``"scipy"`` / ``"scipy:<METHOD>"`` for the
-        reference path through ``scipy.integrate.solve_ivp`` (default BDF, the study's).
-    rtol, atol : float
-        Tolerances of the scipy path (ignored by the compiled one); ``0 < rtol < 1``,
-        ``atol > 0``.
+    block : Block
+        The block: slenderness, restitution law, damping.
+    forcing : Harmonic
+        The excitation, with its amplitude ``alpha`` and frequency ``omega`` (and phase, or
+        the study's).
+    state : pair of float, optional
+        The initial ``(theta0, theta0')``, ``|theta0| < theta_over``. Default: the study's
+        ``z0`` (docs/theory/study.md), at the study's forcing phase unless ``forcing`` gives one.
+    integration : Integration, optional
+        Steps per period, periods, window, impact bound, Zeno cut-off, overturning threshold
+        (:class:`rockjit.Integration`; default N here is :data:`DEFAULT_N`).
     lyapunov : bool
-        Compute the block's Lyapunov exponents (SPEC.md §5); compiled path only.
-    window : int, optional
-        First period of the averaging window ``[window T, periods T]``; default 80 % of the run
-        (the study's ``[400T, 500T]`` for 500 periods).
+        Compute the block's Lyapunov exponents (docs/theory/exponents.md); compiled path only.
     record_stride : int, optional
         Record ``(t, theta, theta', r, s)`` every this many grid steps.
-    max_impacts : int, optional
-        Bound on the number of impacts; reaching it ends the run with status ``max_impacts``.
-        Default :func:`default_max_impacts` (10,000 per period, at least 100,000).
-    theta_over : float
-        Overturning threshold on ``|theta|``, default ``pi/2``.
-    rest_speed : float
-        Zeno cut-off in ``(0, 0.1]``: an impact leaving with ``|theta'| < rest_speed`` puts the
-        block at rest.
-    qr_every : int, optional
-        Grid steps between Gram–Schmidt renormalisations of the tangent vectors; default
-        twice a period, or more often under strong damping (:func:`rockjit._engine.kernel.
-        default_qr_every`); 0 never renormalises, so that ``result.extra["tangent"]`` is the
-        Jacobian of the whole flow (zero across a rest phase; short runs, tests).
-    stop_at_overturn : bool
-        Stop when ``|theta|`` reaches ``theta_over`` (the physical rule, default). ``False``
-        integrates on through the threshold with the same equations, as the study's own code
-        did; ``result.t_overturn`` records the first crossing and the run counts as overturned
-        (:func:`rockjit.grids.grids.classify_result`).
+    method : {"rockjit", "scipy", "scipy:<METHOD>"} or Scipy
+        The compiled path (default), or the reference path through
+        ``scipy.integrate.solve_ivp`` (default BDF at the study's tolerances; a
+        :class:`rockjit.Scipy` chooses the method and tolerances).
 
     Returns
     -------
     Result
-
-    See Also
-    --------
-    rockjit.basins.fate.fate : ``K`` runs from nearby initial states, the same keywords: each
-        outcome's probability and the predictability horizon.
+        The run's samples, impacts, exponents and status.
 
     Raises
     ------
     ValueError
-        For any parameter out of its range; the message names the parameter, the allowed range
-        and the value given. Also for a run whose arrays would not fit in memory.
+        For any parameter out of its range (the message names it, the allowed range and the
+        value given), a step too coarse to be stable, or a run whose arrays would not fit in
+        memory.
+
+    See Also
+    --------
+    rockjit.fate : runs from nearby initial states: each outcome's probability and the
+        predictability horizon.
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> from rockjit import Block, Harmonic
+    >>> res = rockjit.simulate(Block(hb=1), Harmonic(alpha=0.6, omega=1.3), lyapunov=True)
+    >>> res.status, rockjit.classify_result(res)
+    ('done', ('symmetric', 1))
     """
-    return run(plan(hb, alpha, omega, law, e=e, xi=xi, theta0=theta0, dtheta0=dtheta0, z0=z0,
-                    phase=phase, r0=r0, s0=s0, periods=periods, n_steps=n_steps,
-                    forcing=forcing, method=method, rtol=rtol, atol=atol, lyapunov=lyapunov,
-                    window=window, record_stride=record_stride, max_impacts=max_impacts,
-                    theta_over=theta_over, rest_speed=rest_speed, qr_every=qr_every,
-                    stop_at_overturn=stop_at_overturn))
+    return run(plan(block, forcing, state, integration=integration, lyapunov=lyapunov,
+                    record_stride=record_stride, method=method))
+
+
+def classify_result(result, classification=None):
+    """Behaviour name and period of a :class:`rockjit.Result` (the run's window).
+
+    Uses the same compiled classifier as the sweeps and basins on the result's stroboscopic
+    samples from ``window`` on, with the tolerances of ``classification`` (a
+    :class:`rockjit.Classification`; its defaults when not given). Returns ``(name, period)``.
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> from rockjit import Block, Harmonic
+    >>> rockjit.classify_result(rockjit.simulate(Block(hb=1), Harmonic(alpha=0.8, omega=1.3)))
+    ('asymmetric', 1)
+    """
+    cl = Classification() if classification is None else classification
+    if result.status == "overturned" or math.isfinite(result.t_overturn):
+        return "overturn", 0
+    if result.status == "rest":
+        return "rest", 0
+    if result.status not in ("done", "settled"):
+        return "unresolved", 0
+    k1 = result.strobe.shape[0] - 1
+    k0 = int(round(result.window[0] / result.period)) if result.window else \
+        int(round(0.8 * result.periods))
+    k0 = min(k0, k1)
+    per_imp = np.zeros(k1 + 1, dtype=np.int64)
+    t_imp = result.impacts[:, 0]
+    for k in range(k1 + 1):
+        per_imp[k] = np.count_nonzero(t_imp <= k * result.period * (1 + 1e-12))
+    half = np.zeros((k1 + 1, 4))
+    half[:result.strobe_half.shape[0]] = result.strobe_half[:k1 + 1]
+    lam = result.lambda_max
+    code, p = classify(result.strobe, half, per_imp, k0, k1, lam, not math.isnan(lam),
+                       float(cl.tol), int(cl.pmax), float(cl.lam_tol))
+    return BEHAVIOURS[code], int(p)

@@ -18,7 +18,8 @@ import time
 
 import numpy as np
 
-__all__ = ["available_memory", "choice", "integer", "memory", "pair", "real", "size_text"]
+__all__ = ["available_memory", "boolean", "choice", "integer", "memory", "pair", "real",
+           "size_text"]
 
 
 def _fmt(v):
@@ -74,6 +75,14 @@ def integer(name, value, lo=None, hi=None):
     if (lo is not None and v < lo) or (hi is not None and v > hi):
         raise ValueError(f"{name} must be {_range_text(lo, hi, False, False)} (got {v})")
     return v
+
+
+def boolean(name, value):
+    """``True`` or ``False`` (numpy's booleans too); anything else, ``'no'`` or ``1`` included,
+    is refused rather than read by its truth."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise ValueError(f"{name} must be True or False (got {value!r})")
 
 
 def choice(name, value, options):

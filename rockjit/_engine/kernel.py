@@ -44,22 +44,61 @@ IMPACT_RECORD = 1_000_000
 # packing
 # ---------------------------------------------------------------------------------------------
 
-def pack(block, phi, n_steps, settle_tol=0.0):
-    """The float parameter vector ``par`` of a block at forcing phase ``phi`` with ``n_steps``
-    steps per period (layout ``P_*`` in :mod:`rockjit._engine.integrate`)."""
+def pack(block, forcing, phi, integration, n_steps, settle_tol=0.0):
+    """The float parameter vector ``par`` of a block under a harmonic forcing at phase ``phi``
+    with ``n_steps`` steps per period (layout ``P_*`` in :mod:`.integrate`)."""
     par = np.zeros(ig.N_PAR)
     par[ig.P_THC] = block.thc
     par[ig.P_XI] = block.xi
     par[ig.P_E] = block.restitution
-    par[ig.P_AW2] = block.alpha * block.omega**2
-    par[ig.P_OMEGA] = block.omega
+    par[ig.P_AW2] = forcing.alpha * forcing.omega**2
+    par[ig.P_OMEGA] = forcing.omega
     par[ig.P_PHI] = phi
     par[ig.P_COT] = block.cot
-    par[ig.P_THOVER] = block.theta_over
-    par[ig.P_REST] = block.rest_speed
-    par[ig.P_H] = block.period / n_steps
+    par[ig.P_THOVER] = integration.theta_over
+    par[ig.P_REST] = integration.rest_speed
+    par[ig.P_H] = forcing.period / n_steps
     par[ig.P_SETTLE_TOL] = settle_tol
     return par
+
+
+def vary(pars, *, alpha=None, omega=None, phi=None, n_steps=None):
+    """Rows of ``pars`` (shape ``(n, N_PAR)``, changed in place and returned) with the forcing
+    varied per row: amplitudes ``alpha`` at the rows' frequencies, or frequencies ``omega``
+    (with ``alpha``, the step ``T/n_steps`` follows), or phases ``phi``."""
+    if omega is not None:
+        pars[:, ig.P_OMEGA] = omega
+        pars[:, ig.P_AW2] = alpha * omega ** 2
+        pars[:, ig.P_H] = 2.0 * math.pi / omega / n_steps
+    elif alpha is not None:
+        pars[:, ig.P_AW2] = alpha * pars[0, ig.P_OMEGA] ** 2
+    if phi is not None:
+        pars[:, ig.P_PHI] = phi
+    return pars
+
+
+def forcing_of(par):
+    """``(alpha, omega, phi)`` of a parameter row."""
+    return par[ig.P_AW2] / par[ig.P_OMEGA] ** 2, par[ig.P_OMEGA], par[ig.P_PHI]
+
+
+def grid_results(out):
+    """A grid's scalar results by name from the kernels' rows (layout ``R_*``): ``label``,
+    ``period``, ``motion`` (int64); ``lam1``, ``lam2``, ``t_end``, ``t_overturn``."""
+    res = out["res"]
+    return dict(label=res[:, R_LABEL].astype(np.int64),
+                period=res[:, R_PERIOD].astype(np.int64),
+                motion=res[:, R_MOTION].astype(np.int64),
+                lam1=res[:, R_LAM1], lam2=res[:, R_LAM2], t_end=res[:, R_T],
+                t_overturn=res[:, R_TOVER])
+
+
+def classification_vector(classification):
+    """The classification's float settings ``cpar`` (layout ``C_*``)."""
+    cpar = np.zeros(2)
+    cpar[C_TOL] = classification.tol
+    cpar[C_LAMTOL] = classification.lam_tol
+    return cpar
 
 
 #: Between two renormalisations the second tangent vector may lose at most exp(-QR_CONTRACTION)
@@ -134,25 +173,28 @@ def grid_bytes(n_cells, periods, n_steps, n_pts, n_imp_pts, tangent, chunk, thre
 # one run
 # ---------------------------------------------------------------------------------------------
 
-def run_single(block, y0, phi, *, n_steps, periods, window, max_impacts, record_stride,
-               embed4, lyapunov, qr_every, stop_at_overturn=True):
-    """One compiled run (inputs validated by :func:`rockjit.single.plan`); a Result."""
-    run = ig.build(embed4=embed4, tangent=lyapunov)
-    par = pack(block, phi, n_steps)
-    ipar = settings(n_steps, periods, max_impacts, window, stride=record_stride or 1,
-                    qr_every=qr_every, stop_at_overturn=stop_at_overturn,
-                    h=block.period / n_steps, xi=block.xi)
+def run_single(p):
+    """One compiled run of a :class:`rockjit.single.RunPlan` (validated); a Result."""
+    block, forcing, n_steps, periods = p.block, p.forcing, p.n_steps, p.periods
+    lyapunov, record_stride, window = p.lyapunov, p.record_stride, p.window
+    qr_every = p.integration.qr_every
+    run = ig.build(embed4=forcing.embedded, tangent=lyapunov)
+    par = pack(block, forcing, p.phi, p.integration, n_steps)
+    ipar = settings(n_steps, periods, p.max_impacts, window, stride=record_stride or 1,
+                    qr_every=qr_every, stop_at_overturn=p.integration.stop_at_overturn,
+                    h=forcing.period / n_steps, xi=block.xi)
     n_traj = periods * n_steps // record_stride + 1 if record_stride else 1
-    out = outputs(periods, max_impacts, n_traj, lyapunov)
-    y0 = np.asarray(y0, dtype=float)
+    out = outputs(periods, p.max_impacts, n_traj, lyapunov)
+    y0 = np.asarray(p.y0, dtype=float)
     code = run(y0, initial_side(y0[0], y0[1]), par, ipar, out)
     iout, fout = out.iout, out.fout
     status = ig.STATUS_NAMES[int(code)]
     n_imp = int(iout[ig.O_IMPACTS])
     ns = int(iout[ig.O_NSTROBE])
     res = Result(
-        block=block, method="rockjit", status=status, t=float(fout[ig.F_T]),
-        state=fout[ig.F_TH:ig.F_S + 1].copy(), period=block.period, n_steps=n_steps,
+        block=block, forcing=forcing, integration=p.integration, method="rockjit",
+        status=status, t=float(fout[ig.F_T]),
+        state=fout[ig.F_TH:ig.F_S + 1].copy(), period=forcing.period, n_steps=n_steps,
         periods=periods, strobe=out.strobe[:ns], strobe_half=out.half[:int(iout[ig.O_NHALF])],
         impacts=_impacts_in_order(out.impacts, n_imp), n_impacts=n_imp,
         n_grid_steps=int(iout[ig.O_STEPS]), n_rhs=int(iout[ig.O_RHS]),
@@ -172,7 +214,7 @@ def run_single(block, y0, phi, *, n_steps, periods, window, max_impacts, record_
         if qr_every == 0 and iout[ig.O_NCOL] > 0:
             tangent[:] = 0.0
         res.extra["tangent"] = tangent
-        res.window = (window * block.period, res.t)
+        res.window = (window * forcing.period, res.t)
         lam_run = out.lam_run[:ns]
         running = np.where(lam_run[:, 2:3] > 0, -math.inf, lam_run[:, :2])
         if status == "rest":
@@ -363,17 +405,24 @@ def compile_variant(name):
     a tiny input; returns the seconds it took. Module-level, so worker processes can run it."""
     import time as _time
 
+    from types import SimpleNamespace
+
+    from ..excitation import Harmonic
     from ..model import Block
+    from ..settings import Integration
     t0 = _time.perf_counter()
     spec = VARIANTS[name][1]
-    block = Block(hb=1.0, alpha=0.6, omega=1.3)
+    block, integration = Block(hb=1.0), Integration(n_steps=8, periods=2, window=1,
+                                                    max_impacts=100)
     if spec[0] == "run":
         _, embed4, tangent = spec
-        run_single(block, (0.1, 0.0, 0.0, 1.0), 0.0, n_steps=8, periods=2, window=1,
-                   max_impacts=100, record_stride=1, embed4=embed4,
-                   lyapunov=tangent, qr_every=None)
+        forcing = Harmonic(alpha=0.6, omega=1.3, embedded=embed4)
+        run_single(SimpleNamespace(block=block, forcing=forcing, integration=integration,
+                                   n_steps=8, periods=2, window=1, max_impacts=100,
+                                   record_stride=1, lyapunov=tangent, phi=0.0,
+                                   y0=(0.1, 0.0, 0.0, 1.0)))
     else:
-        par = pack(block, 0.0, 8, 1e-9)
+        par = pack(block, Harmonic(alpha=0.6, omega=1.3), 0.0, integration, 8, 1e-9)
         ipar = settings(8, 2, 100, 1, pmax=1)
         run_chunk(spec[1], np.array([[0.1, 0.0, 0.0, 1.0]]), par[None, :], ipar,
                   np.array([1e-6, 1e-2]), 1, 1)

@@ -1,10 +1,10 @@
 """Erosion profiles: basins along a forcing parameter, their integrity, and their attractors
 continued from one amplitude to the next (global continuation, as in Attractors.jl).
 
-:func:`plan_erosion` makes one grid of every basin's cells (``n_alpha`` stacked basins, each on
+:func:`erosion` plans one grid of every basin's cells (``n_alpha`` stacked basins, each on
 the same ``(theta0, theta0')`` lattice at the same forcing phase), so the whole profile runs as
 one computation: chunk by chunk with progress, resumable from a chunk store, on Dask when asked.
-:func:`run` then, at each amplitude, identifies the attractors (:func:`rockjit.basins.identity.identify`)
+and then, at each amplitude, identifies the attractors (:func:`rockjit.basins.identity.identify`)
 and measures the basin (:mod:`rockjit.basins.measures`: GIM, IF, basin entropy), and links each
 amplitude's attractors to the previous amplitude's (same behaviour and period, cycles within
 ``cont_tol`` of the orbit's size, the nearest one): a *branch* is an attractor followed across
@@ -21,14 +21,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..grids import grids as analysis
-from ..grids import runner
-from .._engine import integrate as ig
 from .._engine import kernel
+from ..excitation import check_acceleration
+from ..grids import basin_grid as grid_basin
+from ..grids import plan as gp
+from ..grids import runner
+from ..settings import Integration
+from ..validate import real
 from . import measures as M
 from .identity import cycle_distance, floquet, identify
 
-__all__ = ["LINK_TOL", "ErosionResult", "erosion", "plan_erosion", "run"]
+__all__ = ["LINK_TOL", "ErosionResult", "erosion"]
 
 #: Continuation tolerance from one amplitude to the next, relative to the orbit's size: an
 #: amplitude step of a few hundredths moves a cycle by up to a fifth of its size, while two
@@ -38,13 +41,14 @@ LINK_TOL = 0.35
 
 @dataclass(frozen=True)
 class ErosionPlan:
-    """The stacked basins of an erosion profile: a :class:`rockjit.grids.grids.GridPlan` of all
+    """The stacked basins of an erosion profile: a :class:`rockjit.grids.plan.GridPlan` of all
     cells (amplitude-major) and the amplitudes."""
 
-    grid_plan: analysis.GridPlan
+    grid_plan: gp.GridPlan
     alpha: np.ndarray
     grid: int
     floquet: bool
+    cont_tol: float
 
 
 @dataclass
@@ -69,7 +73,8 @@ class ErosionResult:
         The behaviour map of each basin.
     theta0, dtheta0 : ndarray, shape (grid,)
     block : Block
-        The block at the first amplitude.
+    forcing : Harmonic
+        The excitation (without the amplitude the profile sweeps).
     settings : dict
     """
 
@@ -85,6 +90,7 @@ class ErosionResult:
     theta0: np.ndarray
     dtheta0: np.ndarray
     block: object
+    forcing: object = None
     settings: dict = field(default_factory=dict)
 
     def fractions(self):
@@ -106,38 +112,6 @@ class ErosionResult:
                     branches=[{k: v for k, v in b.items()} for b in self.branches],
                     law=self.block.law, restitution=self.block.restitution,
                     settings=self.settings)
-
-
-def plan_erosion(hb, omega, *, law=None, e=None, xi=None, alpha_range, alpha_step=0.01,
-                 grid=100, theta_range=(-1.0, 1.0), dtheta_range=(-1.0, 1.0), r0=None, s0=None,
-                 phase=None, periods=500, n_steps=None, early_stop=True, threads=None,
-                 max_impacts=None, floquet=True, stop_at_overturn=True,
-                 chunk=None) -> ErosionPlan:
-    """Validate an erosion profile: a basin at each amplitude of ``alpha_range`` (ends included,
-    step ``alpha_step``), every basin planned and memory-checked as one grid."""
-    alphas = analysis.alpha_grid(alpha_range, alpha_step)
-    kw = dict(law=law, e=e, xi=xi, grid=grid, theta_range=theta_range,
-              dtheta_range=dtheta_range, r0=r0, s0=s0, phase=phase, periods=periods,
-              n_steps=n_steps, early_stop=early_stop, threads=threads,
-              max_impacts=max_impacts, stop_at_overturn=stop_at_overturn, chunk=chunk)
-    first = analysis.plan_basin(hb, float(alphas[0]), omega, **kw)
-    if alphas.size > 1:  # the largest amplitude's block, and the whole stack's memory
-        analysis.plan_basin(hb, float(alphas[-1]), omega, **kw)
-        analysis.grid_memory(f"grid = {grid} at {alphas.size} amplitudes",
-                             float(first.y0s.shape[0]) * alphas.size, first.settings,
-                             first.threads, first.chunk, first.n_pts)
-    n = first.y0s.shape[0]
-    y0s = np.tile(first.y0s, (alphas.size, 1))
-    pars = np.tile(first.pars, (alphas.size, 1))
-    pars[:, ig.P_AW2] = np.repeat(alphas, n) * first.block.omega ** 2
-    gp = analysis.GridPlan(kind="erosion", block=first.block, y0s=y0s, pars=pars,
-                           ipar=first.ipar, cpar=first.cpar, tangent=False, n_pts=first.n_pts,
-                           n_imp_pts=0, threads=first.threads, chunk=first.chunk,
-                           axes=dict(alpha=alphas, **first.axes),
-                           shape=(alphas.size,) + first.shape, settings=dict(first.settings),
-                           memory_bytes=first.memory_bytes * alphas.size, attractors=True,
-                           phi=first.phi)
-    return ErosionPlan(grid_plan=gp, alpha=alphas, grid=first.shape[0], floquet=bool(floquet))
 
 
 def _link(prev, cur, tol, floor):
@@ -168,19 +142,22 @@ def _link(prev, cur, tol, floor):
     return links
 
 
-def run(plan: ErosionPlan, *, progress=False, client=None, store=None, message=None,
-        cont_tol=LINK_TOL):
+def run(plan: ErosionPlan, execution=None):
     """Execute an :class:`ErosionPlan`; returns an :class:`ErosionResult`."""
-    gp = plan.grid_plan
-    out = runner.run_grid(gp.y0s, gp.pars, gp.ipar, gp.cpar, tangent=False, n_pts=gp.n_pts,
-                          n_imp_pts=0, threads=gp.threads, progress=progress, label="erosion",
-                          chunk=gp.chunk, client=client, store=store, message=message)
-    res = out["res"]
+    from ..settings import Execution
+    execution = Execution() if execution is None else execution
+    cont_tol = plan.cont_tol
+    g_plan = plan.grid_plan
+    out = runner.run_grid(g_plan.y0s, g_plan.pars, g_plan.ipar, g_plan.cpar, tangent=False,
+                          n_pts=g_plan.n_pts, n_imp_pts=0, label="erosion",
+                          execution=execution)
+    r = kernel.grid_results(out)
     na, g = plan.alpha.size, plan.grid
     n = g * g
-    label = res[:, kernel.R_LABEL].astype(np.int64)
-    period = res[:, kernel.R_PERIOD].astype(np.int64)
-    th, dth = gp.axes["theta0"], gp.axes["dtheta0"]
+    label, period = r["label"], r["period"]
+    th, dth = g_plan.axes["theta0"], g_plan.axes["dtheta0"]
+    integration = Integration(theta_over=g_plan.settings["theta_over"],
+                              rest_speed=g_plan.settings["rest_speed"])
     # the size below which orbits count as small: a tenth of the sampled region's half-width
     floor = 0.1 * max(th[-1] - th[0], dth[-1] - dth[0]) / 2 or 0.1
     gim, if_, sb, sbb, over = (np.zeros(na) for _ in range(5))
@@ -190,11 +167,12 @@ def run(plan: ErosionPlan, *, progress=False, client=None, store=None, message=N
     for k in range(na):
         sl = slice(k * n, (k + 1) * n)
         ids, found = identify(label[sl], period[sl], out["pts"][sl], out["n_got"][sl])
-        block = gp.block.replace(alpha=float(plan.alpha[k]))
+        forcing = g_plan.forcing.replace(alpha=float(plan.alpha[k]))
         if plan.floquet:
             for a in found:
                 if a.period:
-                    a.multipliers, a.lam = floquet(block, gp.phi, gp.settings["n_steps"],
+                    a.multipliers, a.lam = floquet(g_plan.block, forcing, g_plan.phi,
+                                                   integration, g_plan.settings["n_steps"],
                                                    a.points[0], a.period)
         links = _link(prev, found, cont_tol, floor)
         branch_of = {}
@@ -222,39 +200,79 @@ def run(plan: ErosionPlan, *, progress=False, client=None, store=None, message=N
         gim[k], if_[k], sb[k], sbb[k] = integ.GIM, integ.IF, ent.Sb, ent.Sbb
         over[k] = 100.0 * np.mean(ids2 == -1)
         prev, prev_branch = found, branch_of
-    settings = dict(gp.settings, grid=g, alpha_step=float(plan.alpha[1] - plan.alpha[0])
+    settings = dict(g_plan.settings, grid=g, alpha_step=float(plan.alpha[1] - plan.alpha[0])
                     if na > 1 else 0.0, cont_tol=cont_tol)
     return ErosionResult(alpha=plan.alpha, GIM=gim, IF=if_, basin_entropy=sb,
                          boundary_basin_entropy=sbb, overturn=over, branches=branches,
                          attractor=amap, label=label.reshape(na, g, g), theta0=th, dtheta0=dth,
-                         block=gp.block, settings=settings)
+                         block=g_plan.block, forcing=g_plan.forcing.replace(alpha=None),
+                         settings=settings)
 
 
-def erosion(hb, omega, *, law=None, alpha_range, alpha_step=0.01, grid=100, progress=False,
-            client=None, store=None, cont_tol=LINK_TOL, **kw) -> ErosionResult:
+@gp.entry_point(run)
+def erosion(block, forcing, alphas, grid=100, *, integration=None, classification=None,
+            floquet=True, cont_tol=LINK_TOL, execution=None) -> ErosionResult:
     """Erosion profile of the basin over ``(theta0, theta0')`` along the forcing amplitude.
 
     Parameters
     ----------
-    hb, omega : float
-        Slenderness and forcing frequency.
-    law : str, optional
-        Restitution law (``e``, ``xi`` and the other block parameters as in
-        :func:`rockjit.grids.grids.basin`).
-    alpha_range : pair of float
-        Amplitudes from start to end (included), every ``alpha_step``.
-    grid : int
-        Cells per side of each basin.
-    progress, client, store :
-        As in :func:`rockjit.grids.grids.sweep` (the whole stack of basins is one computation).
+    block : Block
+        The block.
+    forcing : Harmonic
+        The excitation with its ``omega`` and no ``alpha`` (the profile's own); its phase is
+        every cell's (default ``(r0, s0) = (0, 1)``).
+    alphas : array_like, shape (na,)
+        The amplitudes, increasing (:func:`rockjit.alpha_grid` makes an evenly spaced range).
+    grid : int or Lattice
+        Each basin's lattice (as in :func:`rockjit.basin`).
+    integration, classification, execution :
+        As in :func:`rockjit.sweep`; the whole stack of basins is one computation.
+    floquet : bool
+        Compute the Floquet multipliers of every periodic attractor.
     cont_tol : float
         Continuation tolerance of the attractors from one amplitude to the next, relative to
         the orbit's size.
-    **kw :
-        Further basin settings: ``theta_range``, ``dtheta_range``, ``r0``, ``s0``, ``phase``,
-        ``periods``, ``n_steps``, ``early_stop``, ``threads``, ``max_impacts``, ``floquet``,
-        ``chunk``, ``e``, ``xi``.
+
+    Returns
+    -------
+    ErosionResult
+        GIM, IF and basin entropy per amplitude, and the attractors as branches with their
+        basin fractions.
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> from rockjit import Block, Harmonic
+    >>> prof = rockjit.erosion(Block(hb=1), Harmonic(omega=1.3), [0.6, 0.7], grid=10)
+    >>> prof.GIM.shape
+    (2,)
     """
-    p = plan_erosion(hb, omega, law=law, alpha_range=alpha_range, alpha_step=alpha_step,
-                     grid=grid, **kw)
-    return run(p, progress=progress, client=client, store=store, cont_tol=cont_tol)
+    forcing = gp.harmonic(forcing, "omega", "-alpha", why="an erosion profile")
+    alphas = gp.alphas_array(alphas)
+    if np.any(np.diff(alphas) <= 0):
+        raise ValueError("alphas must increase")
+    check_acceleration(float(alphas[-1]), forcing.omega)
+    cont_tol = real("cont_tol", cont_tol, 0.0, None, lo_open=True)
+    integration, classification, execution = gp.objects(block, integration, classification,
+                                                        execution)
+    classification = classification.replace(attractors=True, uncertainty=None)
+    lat = grid_basin.lattice(grid)
+    # the whole stack's memory first, before any basin's arrays are made
+    first_forcing = forcing.replace(alpha=float(alphas[0]))
+    _, _, _, settings = gp.common(block, first_forcing, 0.0, integration, classification)
+    gp.grid_memory(f"grid = {lat.grid} at {alphas.size} amplitudes",
+                   float(lat.cells) * alphas.size, settings, execution, settings["pmax"])
+    first = grid_basin.basin.plan(block, first_forcing, lat, integration=integration,
+                                  classification=classification, execution=execution)
+    n = first.y0s.shape[0]
+    y0s = np.tile(first.y0s, (alphas.size, 1))
+    pars = np.tile(first.pars, (alphas.size, 1))
+    kernel.vary(pars, alpha=np.repeat(alphas, n))
+    g_plan = gp.GridPlan(kind="erosion", block=block, forcing=first.forcing, y0s=y0s,
+                         pars=pars, ipar=first.ipar, cpar=first.cpar, tangent=False,
+                         n_pts=first.n_pts, n_imp_pts=0, axes=dict(alpha=alphas, **first.axes),
+                         shape=(alphas.size,) + first.shape, settings=dict(first.settings),
+                         memory_bytes=first.memory_bytes * alphas.size, attractors=True,
+                         phi=first.phi)
+    return ErosionPlan(grid_plan=g_plan, alpha=alphas, grid=first.shape[0],
+                       floquet=bool(floquet), cont_tol=cont_tol)

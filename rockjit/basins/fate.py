@@ -24,18 +24,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..grids import grids as analysis
+from ..grids import plan as gp
 from ..grids import runner
 
 from .._engine import kernel
 from .identity import identify
 from ..result import BEHAVIOURS, HORIZON_TOL, ROUNDING, horizon
+from ..settings import Classification, Execution
+from ..single import classify_result
 from ..single import plan as plan_run
 from ..single import run as run_one
 from ..validate import integer, memory, pair
 
-__all__ = ["DEFAULT_SPREAD", "HORIZON_TOL", "FatePlan", "FateResult", "fate", "horizon",
-           "perturb", "plan_fate", "run"]
+__all__ = ["DEFAULT_SPREAD", "HORIZON_TOL", "FateResult", "fate", "horizon", "perturb"]
 
 #: Relative perturbations of the ensemble's initial states: four units in the last place to
 #: 1e-10 (log-uniform).
@@ -91,6 +92,7 @@ class FateResult:
     horizon_rounding: float
     nominal: object
     block: object
+    forcing: object = None
     settings: dict = field(default_factory=dict)
 
     def to_summary(self):
@@ -110,38 +112,15 @@ class FatePlan:
     ensemble: int
     spread: tuple
     seed: int
-    threads: int | None
 
 
-def plan_fate(hb, alpha, omega, law=None, *, ensemble=64, spread=None, seed=0, threads=None,
-              **run_kw) -> FatePlan:
-    """Validate an ensemble (the parameters of :func:`fate`); nothing is run."""
-    import numba
-    ensemble = integer("ensemble", ensemble, 2, 10**6)
-    spread = DEFAULT_SPREAD if spread is None else pair("spread", spread, 0.0, 1e-2,
-                                                          lo_open=True)
-    seed = integer("seed", seed, 0, 2**63 - 1)
-    if threads is not None:
-        threads = integer("threads", threads, 1, numba.config.NUMBA_NUM_THREADS)
-    run_kw.pop("lyapunov", None)
-    p = plan_run(hb, alpha, omega, law, lyapunov=True, **run_kw)
-    memory(f"ensemble = {ensemble}", kernel.grid_bytes(ensemble, p.periods, p.n_steps,
-                                                       analysis.PMAX, 0, False, ensemble, 1))
-    starts = perturb(p.y0[:2], ensemble, spread, seed)
-    if np.abs(starts[:, 0]).max() >= p.block.theta_over:
-        raise ValueError(f"spread = {spread} moves theta0 past theta_over; give a smaller "
-                         f"spread")
-    return FatePlan(run_plan=p, starts=starts, ensemble=ensemble, spread=tuple(spread),
-                    seed=seed, threads=threads)
-
-
-def run(plan: FatePlan, *, progress=False) -> FateResult:
+def run(plan: FatePlan, execution=None) -> FateResult:
     """Execute a :class:`FatePlan`."""
+    execution = Execution() if execution is None else execution
     p, starts = plan.run_plan, plan.starts
     nominal = run_one(p)
-    if p.forcing == "closed":
-        label, period, pts, n_got, t_end = _members_on_a_grid(p, starts, plan.threads,
-                                                              progress)
+    if not p.forcing.embedded:
+        label, period, pts, n_got, t_end = _members_on_a_grid(p, starts, execution)
     else:  # the embedding: one compiled run per member (the grid kernels use the closed form)
         label, period, pts, n_got, t_end = _members_one_by_one(p, starts)
     ids, found = identify(label, period, pts, n_got)
@@ -154,21 +133,24 @@ def run(plan: FatePlan, *, progress=False) -> FateResult:
     return FateResult(probabilities=probs, outcome=ids, t_end=t_end, initial=starts,
                       lambda1=lam1, horizon=horizon(lam1, plan.spread[1]),
                       horizon_rounding=horizon(lam1, ROUNDING), nominal=nominal,
-                      block=p.block, settings=dict(ensemble=plan.ensemble,
-                                                   spread=list(plan.spread), seed=plan.seed,
-                                                   forcing=p.forcing, periods=p.periods,
-                                                   n_steps=p.n_steps, horizon_tol=HORIZON_TOL))
+                      block=p.block, forcing=p.forcing,
+                      settings=dict(ensemble=plan.ensemble, spread=list(plan.spread),
+                                    seed=plan.seed, embedded=p.forcing.embedded,
+                                    periods=p.periods, n_steps=p.n_steps,
+                                    horizon_tol=HORIZON_TOL))
 
 
-def fate(hb, alpha, omega, law=None, *, ensemble=64, spread=None, seed=0, threads=None,
-         progress=False, **run_kw) -> FateResult:
+@gp.entry_point(run)
+def fate(block, forcing, state=None, *, integration=None, ensemble=64, spread=None, seed=0,
+         execution=None) -> FateResult:
     """Outcome probabilities of ``ensemble`` runs from initial states perturbed at relative
     sizes over ``spread`` (see the module docstring).
 
     Parameters
     ----------
-    hb, alpha, omega, law :
-        The block, as in :func:`rockjit.simulate`.
+    block, forcing, state, integration :
+        The run, as in :func:`rockjit.simulate` (its exponents are always computed for the
+        nominal run).
     ensemble : int
         Members, at least 2 (member 0 is the unperturbed run).
     spread : pair of float, optional
@@ -176,40 +158,61 @@ def fate(hb, alpha, omega, law=None, *, ensemble=64, spread=None, seed=0, thread
         :data:`DEFAULT_SPREAD`.
     seed : int
         Seed of the perturbations.
-    threads, progress :
-        As for the grids (closed-form forcing).
-    **run_kw :
-        The run's other settings, as in :func:`rockjit.simulate` (initial state, ``periods``,
-        ``n_steps``, ``forcing``, ``e``, ``xi``, ...). ``lyapunov`` is always on for the
-        nominal run.
+    execution : Execution, optional
+        Threads and progress of the ensemble's grid (closed-form forcing).
+
+    Returns
+    -------
+    FateResult
+        Each outcome's probability, the nominal run, its finite-time exponent and the
+        predictability horizon.
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> from rockjit import Block, Harmonic
+    >>> f = rockjit.fate(Block(hb=1), Harmonic(alpha=0.6, omega=1.3), ensemble=4)
+    >>> f.probabilities
+    {'symmetric p=1 #0': 1.0}
     """
-    return run(plan_fate(hb, alpha, omega, law, ensemble=ensemble, spread=spread, seed=seed,
-                         threads=threads, **run_kw), progress=progress)
+    execution = Execution() if execution is None else execution
+    ensemble = integer("ensemble", ensemble, 2, 10**6)
+    spread = DEFAULT_SPREAD if spread is None else pair("spread", spread, 0.0, 1e-2,
+                                                          lo_open=True)
+    seed = integer("seed", seed, 0, 2**63 - 1)
+    p = plan_run(block, forcing, state, integration=integration, lyapunov=True)
+    memory(f"ensemble = {ensemble}", kernel.grid_bytes(ensemble, p.periods, p.n_steps,
+                                                       Classification().pmax, 0, False,
+                                                       ensemble, 1))
+    starts = perturb(p.y0[:2], ensemble, spread, seed)
+    if np.abs(starts[:, 0]).max() >= p.integration.theta_over:
+        raise ValueError(f"spread = {spread} moves theta0 past theta_over; give a smaller "
+                         f"spread")
+    return FatePlan(run_plan=p, starts=starts, ensemble=ensemble, spread=tuple(spread),
+                    seed=seed)
 
 
-def _members_on_a_grid(p, starts, threads, progress):
+def _members_on_a_grid(p, starts, execution):
     """The members as the cells of one grid (closed-form forcing): full length, no early stop,
     so that each member's fate is its own run's, as far as the nominal run went."""
     n = starts.shape[0]
-    par = kernel.pack(p.block, p.phi, p.n_steps, analysis.SETTLE_TOL)
-    ipar = kernel.settings(p.n_steps, p.periods, p.max_impacts, p.window,
-                           pmax=analysis.PMAX, stop_at_overturn=p.stop_at_overturn)
-    cpar = np.array([analysis.TOL, analysis.LAM_TOL])
+    cl = Classification()
+    par = kernel.pack(p.block, p.forcing, p.phi, p.integration, p.n_steps, cl.settle_tol)
+    ipar = kernel.settings(p.n_steps, p.periods, p.max_impacts, p.window, pmax=cl.pmax,
+                           stop_at_overturn=p.integration.stop_at_overturn)
+    cpar = kernel.classification_vector(cl)
     y0s = np.column_stack([starts, np.full(n, p.y0[2]), np.full(n, p.y0[3])])
-    out = runner.run_grid(y0s, np.tile(par, (n, 1)), ipar, cpar, tangent=False,
-                          n_pts=analysis.PMAX, n_imp_pts=0, threads=threads,
-                          progress=progress, label="fate")
-    res = out["res"]
-    return (res[:, kernel.R_LABEL].astype(np.int64), res[:, kernel.R_PERIOD].astype(np.int64),
-            out["pts"], out["n_got"], res[:, kernel.R_T])
+    out = runner.run_grid(y0s, np.tile(par, (n, 1)), ipar, cpar, tangent=False, n_pts=cl.pmax,
+                          n_imp_pts=0, label="fate", execution=execution)
+    r = kernel.grid_results(out)
+    return r["label"], r["period"], out["pts"], out["n_got"], r["t_end"]
 
 
 def _members_one_by_one(p, starts):
     from dataclasses import replace
 
-    from ..grids.grids import classify_result
     n = starts.shape[0]
-    m = analysis.PMAX
+    m = Classification().pmax
     label = np.zeros(n, dtype=np.int64)
     period = np.zeros(n, dtype=np.int64)
     pts = np.full((n, m, 2), np.nan)

@@ -335,20 +335,22 @@ def _continues(a, b, label, period, pts, n_got, tol):
     return keep
 
 
-def floquet(block, phi, n_steps, point, period):
+def floquet(block, forcing, phi, integration, n_steps, point, period):
     """Floquet multipliers of the cycle through ``point`` (``theta, theta'`` at a strobe
     instant of phase ``phi``): the eigenvalues of the tangent over ``period`` periods, saltation
-    at every impact (zero when the cycle passes through rest). Returns ``(mu, lam)`` with
+    at every impact (zero when the cycle passes through rest). ``integration`` gives the
+    overturning threshold and the Zeno cut-off. Returns ``(mu, lam)`` with
     ``lam = ln|mu| / (period T)``, sorted decreasing."""
     from ..single import simulate
-    r = simulate(block.hb, block.alpha, block.omega, block.law, e=block.e, xi=block.xi,
-                 theta0=float(point[0]), dtheta0=float(point[1]), phase=phi,
-                 periods=int(period), n_steps=n_steps, lyapunov=True, qr_every=0,
-                 theta_over=block.theta_over, rest_speed=block.rest_speed)
+    r = simulate(block, forcing.replace(phase=phi, r0=None, s0=None),
+                 (float(point[0]), float(point[1])),
+                 integration=integration.replace(periods=int(period), n_steps=n_steps,
+                                                 qr_every=0, window=None, max_impacts=None),
+                 lyapunov=True)
     mu = np.linalg.eigvals(r.extra["tangent"])
     mu = mu[np.argsort(-np.abs(mu))]
     with np.errstate(divide="ignore"):
-        lam = np.log(np.abs(mu)) / (period * block.period)
+        lam = np.log(np.abs(mu)) / (period * forcing.period)
     return mu, lam
 
 

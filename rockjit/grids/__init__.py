@@ -1,2 +1,10 @@
-"""Grids of runs: α sweeps, basins of attraction and parameter planes, run chunk by chunk on the
-compiled engine (in this process or on a Dask cluster, resumable from a chunk store)."""
+"""Grids of runs: α sweeps (:mod:`.sweep_grid`), basins of attraction (:mod:`.basin_grid`) and parameter
+planes (:mod:`.plane_grid`), planned together (:mod:`.plan`) and run chunk by chunk on the compiled
+engine, in this process or on a Dask cluster, resumable from a chunk store (:mod:`.runner`)."""
+
+from .basin_grid import basin
+from .plan import GRID_N, alpha_grid
+from .plane_grid import plane
+from .sweep_grid import sweep
+
+__all__ = ["GRID_N", "alpha_grid", "basin", "plane", "sweep"]

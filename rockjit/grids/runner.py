@@ -11,6 +11,7 @@ optional and imported only when a client is given.
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import time
 
@@ -23,27 +24,43 @@ from ..storage.chunkstore import DamagedChunk
 __all__ = ["run_chunks", "run_grid"]
 
 
-def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, threads, progress, label,
-             chunk=None, client=None, store=None, message=None, lanes=None):
-    """All cells through :func:`run_chunk`, chunk by chunk (progress between chunks).
+def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, label, execution):
+    """All cells through :func:`rockjit._engine.kernel.run_chunk`, chunk by chunk, as
+    ``execution`` (a :class:`rockjit.Execution`) says: threads, chunk size, lanes, in this
+    process or on a Dask cluster, with a chunk store, with progress.
 
-    Returns the outputs by name: ``res`` (rows in the ``R_*`` layout), ``pts``, ``imp``,
-    ``n_got``, ``n_imp_got``. ``message(text)`` hears what the chunk store has to say (default
-    a line on stderr). ``lanes``: cells per thread in lockstep (:func:`run_chunk`; default
-    :data:`DEFAULT_LANES`).
+    Returns the outputs by name: ``res`` (the kernels' rows; :func:`rockjit._engine.kernel.
+    grid_results` names them), ``pts``, ``imp``, ``n_got``, ``n_imp_got``.
     """
+    ex = execution
     n = y0s.shape[0]
-    chunk = kernel.default_chunk(n) if chunk is None else chunk
+    chunk = kernel.default_chunk(n) if ex.chunk is None else ex.chunk
     outputs_ = kernel.grid_outputs(n, n_pts, n_imp_pts)
     cs = None
-    if store is not None:
+    if ex.store is not None:
         key = chunks.fingerprint((y0s, pars, ipar, cpar),
                                  dict(tangent=bool(tangent), n_pts=n_pts, n_imp_pts=n_imp_pts))
-        cs = chunks.ChunkStore(store, key, n, chunk, message=message)
-    run_chunks(kernel.run_chunk, (bool(tangent), y0s, pars, ipar, cpar, n_pts, n_imp_pts,
-                                  threads, lanes), n, chunk, outputs_, client=client, store=cs,
-                      progress=progress, label=label)
+        cs = chunks.ChunkStore(ex.store, key, n, chunk, message=ex.message)
+    with _client(ex) as client:
+        run_chunks(kernel.run_chunk, (bool(tangent), y0s, pars, ipar, cpar, n_pts, n_imp_pts,
+                                      ex.threads, ex.lanes), n, chunk, outputs_, client=client,
+                   store=cs, progress=ex.progress, label=label)
     return outputs_
+
+
+@contextlib.contextmanager
+def _client(execution):
+    """The Dask client of an execution: the one given, one opened on its scheduler for the
+    computation (closed after it), or ``None``."""
+    if execution.scheduler is None:
+        yield execution.client
+        return
+    from dask.distributed import Client
+    client = Client(execution.scheduler)
+    try:
+        yield client
+    finally:
+        client.close()
 
 
 class _Progress:

@@ -1,0 +1,298 @@
+"""What every grid computation shares: its validated plan, its memory check, and the step from
+the engine's arrays to a result with its attractors identified.
+
+A grid entry point (:mod:`.sweep_grid`, :mod:`.basin_grid`, :mod:`.plane_grid`, and the erosion profile and fate
+ensembles of :mod:`rockjit.basins`) checks its inputs together into a :class:`GridPlan` of
+packed kernel inputs; :func:`run` executes a plan through the grid runner (chunk by chunk, in
+this process or on a Dask cluster, resumable from a chunk store: :mod:`.runner`) and wraps the
+arrays into a result (:mod:`rockjit.result`).
+
+Cells are classified by the behaviour rules of docs/theory/behaviours.md on the stroboscopic
+samples over the asymptotic window or, with early stopping (on by default), on the stretch that
+showed a bounded run had settled: a run stops as soon as its last ``settle_reps * p`` periods
+repeat to ``settle_tol`` (much tighter than ``tol``).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass, field, replace
+
+import numba
+import numpy as np
+
+from .._engine import kernel
+from ..basins.identity import cycles_differ, floquet, identify, identify_along, match_attractors
+from ..excitation import ALPHA_MAX, Harmonic
+from ..model import Block
+from ..result import BasinResult, PlaneResult, SweepResult
+from ..settings import Classification, Execution, Integration
+from ..single import check_step, settings_for
+from ..validate import integer, memory, pair, real
+from . import runner
+
+__all__ = ["GRID_N", "MAX_CELLS", "GridPlan", "alpha_count", "alpha_grid", "common",
+           "entry_point", "grid_memory", "run", "uncertain_cells"]
+
+#: Steps per period of sweeps, basins and planes: they need labels and lambda_max, not 1e-10
+#: event times. On the study's four basins and its 501-amplitude sweep, N = 64 gives the labels
+#: of N = 256 in every cell (benchmarks/results/grids.md). Raised like the single runs' default
+#: when the forcing is slow or the damping strong.
+GRID_N = 64
+
+#: Largest number of cells of one grid (a bound for the integers; the memory check refuses
+#: large grids first, with the memory they would need).
+MAX_CELLS = 10**18
+
+
+@dataclass(frozen=True)
+class GridPlan:
+    """A validated grid computation: packed kernel inputs and what the result needs."""
+
+    kind: str                 # "sweep", "basin", "plane", "erosion" or "fate"
+    block: Block
+    forcing: Harmonic         # as given (without what the grid sweeps)
+    y0s: np.ndarray           # (n, 4) initial states
+    pars: np.ndarray          # (n, N_PAR) parameter rows
+    ipar: np.ndarray
+    cpar: np.ndarray
+    tangent: bool
+    n_pts: int
+    n_imp_pts: int
+    axes: dict                # the grid's axes, by name
+    shape: tuple              # the result arrays' shape
+    settings: dict = field(default_factory=dict)
+    memory_bytes: float = 0.0
+    attractors: bool = False  # identify the attractors (rockjit.basins.identity)
+    phi: float = 0.0          # the forcing phase (basins: of every cell)
+    uncertainty: float | None = None  # flag the cells whose outcome moves with eps
+
+
+def entry_point(execute):
+    """Make a planning function an entry point: the decorated function keeps its parameters
+    and docstring, plans, and runs the plan with ``execute(plan, execution)``; the planning
+    function itself stays reachable as ``entry.plan`` (the command line plans first, so that
+    it refuses bad input before any work). Written once, the signature cannot drift."""
+    def decorate(plan_fn):
+        @functools.wraps(plan_fn)
+        def entry(*args, **kwargs):
+            return execute(plan_fn(*args, **kwargs), kwargs.get("execution"))
+
+        entry.plan = plan_fn
+        return entry
+    return decorate
+
+
+def objects(block, integration, classification, execution):
+    """The settings objects of a grid, defaults filled in, each checked to be what it says."""
+    if not isinstance(block, Block):
+        raise ValueError(f"block must be a rockjit.Block (got {type(block).__name__})")
+    integration = Integration() if integration is None else integration
+    classification = Classification() if classification is None else classification
+    execution = Execution() if execution is None else execution
+    for name, obj, cls in (("integration", integration, Integration),
+                           ("classification", classification, Classification),
+                           ("execution", execution, Execution)):
+        if not isinstance(obj, cls):
+            raise ValueError(f"{name} must be a rockjit.{cls.__name__} "
+                             f"(got {type(obj).__name__})")
+    return integration, classification, execution
+
+
+def harmonic(forcing, *names, why):
+    """The grid's excitation: a :class:`Harmonic` with ``names`` given and the ``-names`` left
+    out (the grid sweeps those)."""
+    forcing = Harmonic() if forcing is None else forcing
+    if not isinstance(forcing, Harmonic):
+        raise ValueError(f"forcing must be a rockjit.Harmonic (got {type(forcing).__name__})")
+    if forcing.embedded:
+        raise ValueError(f"{why} runs the closed-form forcing: give Harmonic(..., "
+                         f"embedded=False)")
+    return forcing.require(*names, why=why)
+
+
+def common(block, forcing, phi, integration, classification):
+    """Settings shared by every grid, checked for this block and forcing (the step's
+    stability) and packed: ``(par, ipar, cpar, settings)``. ``forcing`` has the grid's first
+    ``alpha`` and ``omega``."""
+    n_steps, w0, max_impacts = settings_for(block, forcing, integration, GRID_N)
+    check_step(forcing.period, n_steps, "closed", 1.0, block.xi)
+    cl = classification
+    par = kernel.pack(block, forcing, phi, integration, n_steps, cl.settle_tol)
+    ipar = kernel.settings(n_steps, integration.periods, max_impacts, w0,
+                           settle_reps=cl.settle_reps if cl.early_stop else 0, pmax=cl.pmax,
+                           stop_at_overturn=integration.stop_at_overturn,
+                           h=forcing.period / n_steps, xi=block.xi)
+    cpar = kernel.classification_vector(cl)
+    settings = dict(periods=integration.periods, n_steps=n_steps, window=w0,
+                    early_stop=cl.early_stop, tol=cl.tol, pmax=cl.pmax, lam_tol=cl.lam_tol,
+                    settle_tol=cl.settle_tol, settle_reps=cl.settle_reps,
+                    max_impacts=max_impacts, stop_at_overturn=integration.stop_at_overturn,
+                    theta_over=integration.theta_over, rest_speed=integration.rest_speed,
+                    law=block.law, restitution=block.restitution)
+    return par, ipar, cpar, settings
+
+
+def grid_memory(what, n_cells, settings, execution, n_pts=0, n_imp_pts=0, lyapunov=False):
+    """Refuse a grid whose arrays would not fit (``what`` names the parameter that sized it, in
+    the message); returns the bytes it needs."""
+    nbytes = kernel.grid_bytes(n_cells, settings["periods"], settings["n_steps"], n_pts,
+                               n_imp_pts, bool(lyapunov),
+                               execution.chunk or kernel.default_chunk(int(min(n_cells,
+                                                                               MAX_CELLS))),
+                               execution.threads or numba.config.NUMBA_NUM_THREADS)
+    memory(f"{what} ({n_cells:.4g} cells)", nbytes)
+    return nbytes
+
+
+def alpha_count(alpha_range, alpha_step):
+    """Validated ``(a0, a1, step, count)`` of ``alpha_range`` at ``alpha_step`` (no array
+    made: the count may be too large for memory, and is checked first)."""
+    a0, a1 = pair("alpha_range", alpha_range, 0.0, ALPHA_MAX)
+    step = real("alpha_step", alpha_step, 0.0, None, lo_open=True)
+    count = (a1 - a0) / step + 1e-9
+    if not count < 2.0**53:  # also inf: a step of 5e-324
+        raise ValueError(f"alpha_step = {step:g} over alpha_range ({a0:g}, {a1:g}) would make "
+                         f"{count:.3g} amplitudes; give a larger alpha_step")
+    return a0, a1, step, math.floor(count) + 1
+
+
+def alpha_grid(alpha_range, alpha_step):
+    """The amplitudes ``alpha_range[0], alpha_range[0] + step, ..., alpha_range[1]`` (end
+    included), for a sweep or an erosion profile.
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> rockjit.alpha_grid((0.5, 0.6), 0.05)
+    array([0.5 , 0.55, 0.6 ])
+    """
+    a0, _, step, n = alpha_count(alpha_range, alpha_step)
+    memory(f"alpha_step = {step:g} over alpha_range", 8.0 * n)
+    return a0 + step * np.arange(n)
+
+
+def alphas_array(alphas):
+    """A sweep's amplitudes, checked: a non-empty 1-D sequence of numbers in
+    ``[0, ALPHA_MAX]``."""
+    if isinstance(alphas, (str, bytes)) or np.iscomplexobj(alphas):
+        raise ValueError(f"alphas must be a sequence of real numbers (got {alphas!r})")
+    try:
+        a = np.atleast_1d(np.asarray(alphas))
+    except (TypeError, ValueError):
+        raise ValueError(f"alphas must be a sequence of numbers (got {alphas!r})") from None
+    if a.dtype.kind not in "iuf":
+        raise ValueError(f"alphas must be a sequence of real numbers (got {alphas!r})")
+    a = a.astype(float)
+    if a.ndim != 1 or a.size == 0:
+        raise ValueError("alphas must be a non-empty 1-D sequence")
+    if not np.all(np.isfinite(a)) or np.any(a < 0) or np.any(a > ALPHA_MAX):
+        raise ValueError(f"alphas must be finite and in [0, {ALPHA_MAX:g}]")
+    return a
+
+
+def n_points(name, value, default):
+    """A count of samples kept per cell, ``>= 1`` (``None``: ``default``)."""
+    return default if value is None else integer(name, value, 1, 10**6)
+
+
+def run(plan: GridPlan, execution=None):
+    """Execute a :class:`GridPlan`; returns its :class:`SweepResult`, :class:`BasinResult` or
+    :class:`PlaneResult` (``execution``: a :class:`rockjit.Execution`, default in-process with
+    all threads)."""
+    p = plan
+    execution = Execution() if execution is None else execution
+    out = runner.run_grid(p.y0s, p.pars, p.ipar, p.cpar, tangent=p.tangent, n_pts=p.n_pts,
+                          n_imp_pts=p.n_imp_pts, label=p.kind, execution=execution)
+    r = kernel.grid_results(out)
+    label = r["label"].reshape(p.shape)
+    period = r["period"].reshape(p.shape)
+    lam = r["lam1"].reshape(p.shape)
+    common_ = dict(block=p.block, forcing=p.forcing, settings=dict(p.settings), label=label,
+                   period=period, t_end=r["t_end"].reshape(p.shape))
+    if p.attractors:
+        common_["attractor"], common_["attractors"] = _identify(p, r, out["pts"],
+                                                               out["n_got"])
+    if p.kind == "sweep":
+        result = SweepResult(alpha=p.axes["alpha"], lambda_max=lam, strobe=out["pts"],
+                             impact_section=out["imp"], t_overturn=r["t_overturn"],
+                             motion=r["motion"], **common_)
+    elif p.kind == "basin":
+        result = BasinResult(theta0=p.axes["theta0"], dtheta0=p.axes["dtheta0"],
+                             lambda_max=lam if p.tangent else None, **common_)
+    else:
+        result = PlaneResult(alpha=p.axes["alpha"], omega=p.axes["omega"], z0=p.axes["z0"],
+                             lambda_max=lam, **common_)
+    if p.uncertainty is not None:
+        result.uncertain = uncertain_cells(p, result, p.uncertainty, execution=execution)
+        result.settings["uncertainty"] = p.uncertainty
+    return result
+
+
+def uncertain_cells(plan, result, eps, *, seed=0, execution=None):
+    """Which cells of a grid change outcome when their initial state moves by ``eps``
+    (Grebogi, McDonald, Ott & Yorke 1983).
+
+    Each cell's ``(theta0, theta0')`` is moved by ``eps`` times its size (absolute where 0) in
+    a seeded random direction and run again with the same plan; a cell is uncertain when the
+    moved run reaches another outcome: another behaviour or period, or another attractor (the
+    two maps' attractors matched by their cycles, :mod:`rockjit.basins.identity`). Returns a
+    boolean array shaped like the labels.
+    """
+    rng = np.random.default_rng(seed)
+    ang = rng.uniform(0.0, 2.0 * np.pi, plan.y0s.shape[0])
+    y0s = plan.y0s.copy()
+    scale = np.where(np.abs(y0s[:, :2]) > 0, np.abs(y0s[:, :2]), 1.0)
+    y0s[:, 0] += eps * scale[:, 0] * np.cos(ang)
+    y0s[:, 1] += eps * scale[:, 1] * np.sin(ang)
+    moved = run(replace(plan, y0s=y0s, uncertainty=None), execution)
+    differ = (np.asarray(result.label) != moved.label) | (np.asarray(result.period) !=
+                                                          moved.period)
+    if result.attractor is not None and moved.attractor is not None and plan.kind == "basin":
+        pairs = match_attractors(result.attractors, moved.attractors)
+        lut = np.array([pairs.get(a.id, -3) for a in result.attractors] or [-3])
+        ids = np.asarray(result.attractor)
+        differ |= np.where(ids >= 0, lut[np.maximum(ids, 0)], ids) != moved.attractor
+    elif plan.kind == "sweep":  # each cell its own system: its cycle against its own
+        same = ~differ
+        differ[same] |= cycles_differ(result.strobe[same], moved.strobe[same],
+                                      result.period[same])
+    return differ
+
+
+def _identify(p, r, pts, n_got):
+    """Attractor ids (shaped like the labels) and attractors of a plan's cells, with the
+    Floquet multipliers of the periodic ones (:mod:`rockjit.basins.identity`)."""
+    label, period = r["label"], r["period"]
+    lam = np.column_stack([r["lam1"], r["lam2"]]) if p.tangent else None
+    n_steps = p.settings["n_steps"]
+    integration = Integration(theta_over=p.settings["theta_over"],
+                              rest_speed=p.settings["rest_speed"])
+    if p.kind == "basin":
+        ids, found = identify(label, period, pts, n_got, lam)
+        forcing = {a.id: (p.forcing.alpha, p.forcing.omega, p.phi) for a in found}
+    else:
+        shape = p.shape if p.kind == "sweep" else p.shape[1:]
+        per_state = int(np.prod(shape))
+        ids = np.empty(label.size, dtype=np.int64)
+        found, forcing = [], {}
+        for m in range(label.size // per_state):  # a plane's initial states, one by one
+            sl = slice(m * per_state, (m + 1) * per_state)
+            ids_m, found_m = identify_along(label[sl], period[sl], pts[sl], n_got[sl], shape,
+                                            lam=None if lam is None else lam[sl])
+            shift = len(found)
+            ids[sl] = np.where(ids_m >= 0, ids_m + shift, ids_m)
+            for a in found_m:
+                a.id += shift
+                cell = sl.start + a.cell
+                a.cell = cell
+                a.extent = (a.extent[0] + sl.start, a.extent[1] + sl.start)
+                forcing[a.id] = kernel.forcing_of(p.pars[cell])
+            found += found_m
+    for a in found:
+        if a.period:
+            alpha, omega, phi = forcing[a.id]
+            a.multipliers, a.lam = floquet(p.block, Harmonic(alpha=alpha, omega=omega), phi,
+                                           integration, n_steps, a.points[0], a.period)
+    return ids.reshape(p.shape), found
