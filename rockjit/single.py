@@ -23,11 +23,11 @@ from .result import Result
 from ._engine.classify import classify
 from .result import BEHAVIOURS
 from .settings import Classification, Integration
+from .entry import entry_point
 from .validate import boolean, choice, integer, memory, real
 
 __all__ = ["DAMPING_STEP", "DEFAULT_N", "IVP_METHODS", "MAX_STEP", "RunPlan", "STABLE_DAMPING",
-           "STEP_LIMIT", "Scipy", "Z0_STUDY", "check_step", "classify_result", "plan", "run",
-           "simulate",
+           "STEP_LIMIT", "Scipy", "Z0_STUDY", "check_step", "classify_result", "run", "simulate",
            "steps_per_period"]
 
 #: The study's initial state ``(theta, theta', r, s)`` of its single runs and sweeps
@@ -206,44 +206,7 @@ class RunPlan:
         return self.integration.periods
 
 
-def plan(block, forcing, state=None, *, integration=None, lyapunov=False, record_stride=None,
-         method="rockjit") -> RunPlan:
-    """Check the inputs of :func:`simulate` together (same parameters) into a
-    :class:`RunPlan`: the step's stability for this block and forcing, and the memory the
-    run would allocate. Each object was validated when it was made."""
-    if not isinstance(block, Block):
-        raise ValueError(f"block must be a rockjit.Block (got {type(block).__name__})")
-    if not isinstance(forcing, Harmonic):
-        raise ValueError(f"forcing must be a rockjit excitation such as Harmonic "
-                         f"(got {type(forcing).__name__})")
-    forcing.require("alpha", "omega", why="a single run")
-    integration = Integration() if integration is None else integration
-    if not isinstance(integration, Integration):
-        raise ValueError(f"integration must be a rockjit.Integration "
-                         f"(got {type(integration).__name__})")
-    theta0, dtheta0, phi, r0, s0 = initial_state(state, forcing, integration)
-    method = _method(method)
-    n_steps, window, max_impacts = settings_for(block, forcing, integration, DEFAULT_N)
-    check_step(forcing.period, n_steps, "embedded" if forcing.embedded else "closed",
-               math.hypot(r0, s0), block.xi)
-    if record_stride is not None:
-        record_stride = integer("record_stride", record_stride, 1, 2**62)
-    lyapunov = boolean("lyapunov", lyapunov)
-    if method != "rockjit" and lyapunov:
-        raise ValueError("lyapunov=True is only available with method='rockjit'")
-    periods = integration.periods
-    if periods * n_steps > 2**62:
-        raise ValueError(f"periods * n_steps must be <= 2**62 (got {periods} * {n_steps})")
-    n_traj = periods * n_steps // record_stride + 1 if record_stride else 1
-    nbytes = kernel.run_bytes(periods, n_steps, max_impacts, n_traj, lyapunov)
-    memory(f"periods = {periods} at n_steps = {n_steps}", nbytes)
-    return RunPlan(block=block, forcing=forcing, integration=integration,
-                   y0=(theta0, dtheta0, r0, s0), phi=phi, method=method, n_steps=n_steps,
-                   window=window, max_impacts=max_impacts, record_stride=record_stride,
-                   lyapunov=lyapunov, memory_bytes=nbytes)
-
-
-def run(p: RunPlan) -> Result:
+def run(p: RunPlan, execution=None) -> Result:
     """Execute a :class:`RunPlan` on its path (compiled or scipy)."""
     if p.method != "rockjit":
         from .reference import simulate_scipy  # scipy.integrate only when asked for
@@ -251,6 +214,7 @@ def run(p: RunPlan) -> Result:
     return kernel.run_single(p)
 
 
+@entry_point(run)
 def simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
              record_stride=None, method="rockjit") -> Result:
     """Simulate the rocking block under an excitation.
@@ -302,8 +266,36 @@ def simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
     >>> res.status, rockjit.classify_result(res)
     ('done', ('symmetric', 1))
     """
-    return run(plan(block, forcing, state, integration=integration, lyapunov=lyapunov,
-                    record_stride=record_stride, method=method))
+    if not isinstance(block, Block):
+        raise ValueError(f"block must be a rockjit.Block (got {type(block).__name__})")
+    if not isinstance(forcing, Harmonic):
+        raise ValueError(f"forcing must be a rockjit excitation such as Harmonic "
+                         f"(got {type(forcing).__name__})")
+    forcing.require("alpha", "omega", why="a single run")
+    integration = Integration() if integration is None else integration
+    if not isinstance(integration, Integration):
+        raise ValueError(f"integration must be a rockjit.Integration "
+                         f"(got {type(integration).__name__})")
+    theta0, dtheta0, phi, r0, s0 = initial_state(state, forcing, integration)
+    method = _method(method)
+    n_steps, window, max_impacts = settings_for(block, forcing, integration, DEFAULT_N)
+    check_step(forcing.period, n_steps, "embedded" if forcing.embedded else "closed",
+               math.hypot(r0, s0), block.xi)
+    if record_stride is not None:
+        record_stride = integer("record_stride", record_stride, 1, 2**62)
+    lyapunov = boolean("lyapunov", lyapunov)
+    if method != "rockjit" and lyapunov:
+        raise ValueError("lyapunov=True is only available with method='rockjit'")
+    periods = integration.periods
+    if periods * n_steps > 2**62:
+        raise ValueError(f"periods * n_steps must be <= 2**62 (got {periods} * {n_steps})")
+    n_traj = periods * n_steps // record_stride + 1 if record_stride else 1
+    nbytes = kernel.run_bytes(periods, n_steps, max_impacts, n_traj, lyapunov)
+    memory(f"periods = {periods} at n_steps = {n_steps}", nbytes)
+    return RunPlan(block=block, forcing=forcing, integration=integration,
+                   y0=(theta0, dtheta0, r0, s0), phi=phi, method=method, n_steps=n_steps,
+                   window=window, max_impacts=max_impacts, record_stride=record_stride,
+                   lyapunov=lyapunov, memory_bytes=nbytes)
 
 
 def classify_result(result, classification=None):

@@ -25,6 +25,7 @@ from .._engine import kernel
 from ..excitation import check_acceleration
 from ..grids import basin_grid as grid_basin
 from ..grids import plan as gp
+from ..entry import entry_point
 from ..grids import runner
 from ..settings import Integration
 from ..validate import real
@@ -209,7 +210,7 @@ def run(plan: ErosionPlan, execution=None):
                          settings=settings)
 
 
-@gp.entry_point(run)
+@entry_point(run)
 def erosion(block, forcing, alphas, grid=100, *, integration=None, classification=None,
             floquet=True, cont_tol=LINK_TOL, execution=None) -> ErosionResult:
     """Erosion profile of the basin over ``(theta0, theta0')`` along the forcing amplitude.

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..grids import plan as gp
+from ..entry import entry_point
 from ..grids import runner
 
 from .._engine import kernel
@@ -32,7 +33,7 @@ from .identity import identify
 from ..result import BEHAVIOURS, HORIZON_TOL, ROUNDING, horizon
 from ..settings import Classification, Execution
 from ..single import classify_result
-from ..single import plan as plan_run
+from ..single import simulate
 from ..single import run as run_one
 from ..validate import integer, memory, pair
 
@@ -140,7 +141,7 @@ def run(plan: FatePlan, execution=None) -> FateResult:
                                     horizon_tol=HORIZON_TOL))
 
 
-@gp.entry_point(run)
+@entry_point(run)
 def fate(block, forcing, state=None, *, integration=None, ensemble=64, spread=None, seed=0,
          execution=None) -> FateResult:
     """Outcome probabilities of ``ensemble`` runs from initial states perturbed at relative
@@ -180,7 +181,7 @@ def fate(block, forcing, state=None, *, integration=None, ensemble=64, spread=No
     spread = DEFAULT_SPREAD if spread is None else pair("spread", spread, 0.0, 1e-2,
                                                           lo_open=True)
     seed = integer("seed", seed, 0, 2**63 - 1)
-    p = plan_run(block, forcing, state, integration=integration, lyapunov=True)
+    p = simulate.plan(block, forcing, state, integration=integration, lyapunov=True)
     memory(f"ensemble = {ensemble}", kernel.grid_bytes(ensemble, p.periods, p.n_steps,
                                                        Classification().pmax, 0, False,
                                                        ensemble, 1))

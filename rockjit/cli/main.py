@@ -96,24 +96,74 @@ def _client(args):  # a Dask client for --scheduler, or None
         raise UsageError(f"cannot reach the Dask scheduler at {args.scheduler} ({exc})")
 
 
-def _block_kw(args):  # these three: the options by their API names
-    return dict(law=args.law, e=args.e, xi=args.xi)
+def _block(args, law=None):
+    """The block of ``--hb --law --e --xi`` (``law``: one of ``--law both``'s)."""
+    from ..model import XI_STUDY, Block
+    return Block(hb=args.hb, law=law or args.law, e=args.e,
+                 xi=XI_STUDY if args.xi is None else args.xi)
 
 
-def _state_kw(args):
-    return dict(theta0=args.theta0, dtheta0=args.dtheta0, r0=args.r0, s0=args.s0, phase=args.phase)
+def _laws(args):
+    """The laws a command runs: ``--law both`` is Housner's and Mao's."""
+    if args.law == "both":
+        if args.e is not None:
+            raise UsageError("--e goes with --law constant, not --law both")
+        return ("housner", "mao")
+    if args.law is None:  # as the library: --e alone selects the constant law
+        return ("housner" if args.e is None else "constant",)
+    return (args.law,)
 
 
-def _grid_kw(args):
-    return dict(periods=args.periods, n_steps=args.n_steps, early_stop=not args.full_length,
-                threads=args.threads, max_impacts=args.max_impacts,
-                stop_at_overturn=not args.continue_past_overturn,
-                uncertainty=getattr(args, "uncertainty", None))
+def _forcing(args, alpha=True, omega=True):
+    """The harmonic forcing of ``--alpha --omega --phase/--r0 --s0 --forcing``."""
+    from ..excitation import Harmonic
+    return Harmonic(alpha=args.alpha if alpha else None, omega=args.omega if omega else None,
+                    phase=getattr(args, "phase", None), r0=getattr(args, "r0", None),
+                    s0=getattr(args, "s0", None),
+                    embedded=getattr(args, "forcing", "closed") == "embedded")
 
 
-def _z0(args):
-    from ..single import closed_form_z0
-    return closed_form_z0(args.theta0, args.dtheta0, args.r0, args.s0, args.phase)
+def _state(args):
+    """``(--theta0, --dtheta0)`` (0 where one is left out), or ``None`` for the study's."""
+    if args.theta0 is None and args.dtheta0 is None:
+        return None
+    return (args.theta0 or 0.0, args.dtheta0 or 0.0)
+
+
+def _integration(args):
+    from ..settings import Integration
+    kw = dict(periods=args.periods, n_steps=getattr(args, "n_steps", None),
+              max_impacts=getattr(args, "max_impacts", None),
+              stop_at_overturn=not getattr(args, "continue_past_overturn", False))
+    if getattr(args, "rest_speed", None) is not None:
+        kw["rest_speed"] = args.rest_speed
+    return Integration(**kw)
+
+
+def _classification(args):
+    from ..settings import Classification
+    return Classification(early_stop=not getattr(args, "full_length", False),
+                          uncertainty=getattr(args, "uncertainty", None))
+
+
+def _execution(args, client=None, name=None):
+    """Threads, progress, the chunk store ``<out>.chunks[/name]`` and the Dask client."""
+    from ..settings import Execution
+    root = _chunk_root(args)
+    return Execution(threads=getattr(args, "threads", None), progress=not args.quiet,
+                     client=client, store=root / name if name else root,
+                     message=lambda m: _say(args, m))
+
+
+def _alphas(args):
+    """The amplitudes of ``--alpha-range --alpha-step``, their number checked first."""
+    from .._engine import kernel
+    from ..grids.plan import alpha_count, alpha_grid
+    from ..validate import memory
+    *_, n = alpha_count(args.alpha_range, args.alpha_step)
+    memory(f"--alpha-step {args.alpha_step:g} over --alpha-range ({n:.3g} amplitudes)",
+           kernel.grid_bytes(n, 1, 8, 101, 400, True, 1, 1))
+    return alpha_grid(args.alpha_range, args.alpha_step)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -121,67 +171,82 @@ def _z0(args):
 # ---------------------------------------------------------------------------------------------
 
 def _trajectory_plan(args):
-    from ..single import plan
+    from ..single import simulate
     from ..validate import integer
     integer("max-points", args.max_points, 2)
-    kw = dict(**_block_kw(args), **_state_kw(args), periods=args.periods,
-              n_steps=args.n_steps, forcing=args.forcing, method=args.method, rtol=args.rtol,
-              atol=args.atol, lyapunov=args.lyapunov, max_impacts=args.max_impacts,
-              rest_speed=args.rest_speed, stop_at_overturn=not args.continue_past_overturn)
-    p = plan(args.hb, args.alpha, args.omega, **kw)  # settles N; then the recording's stride
+    from ..single import Scipy, _method
+    method = _method(args.method)  # the tolerances are checked whatever the method
+    tolerances = Scipy("BDF" if method == "rockjit" else method.method, rtol=args.rtol,
+                       atol=args.atol)
+    method = method if method == "rockjit" else tolerances
+    kw = dict(integration=_integration(args), lyapunov=args.lyapunov, method=method)
+    block, forcing, state = _block(args), _forcing(args), _state(args)
+    p = simulate.plan(block, forcing, state, **kw)  # settles N; then the recording's stride
     stride = max(1, math.ceil(p.periods * p.n_steps / args.max_points))
-    return plan(args.hb, args.alpha, args.omega, record_stride=stride, **kw)
+    return simulate.plan(block, forcing, state, record_stride=stride, **kw)
 
 
 def _trajectory_run(args, p, out):
     from . import outputs
     from ..single import run
-    _say(args, f"trajectory: {p.periods} periods, {p.method}")
+    name = p.method if p.method == "rockjit" else p.method.name
+    _say(args, f"trajectory: {p.periods} periods, {name}")
     t0 = time.perf_counter()
     res, wall = run(p), time.perf_counter() - t0
-    for note in res.caveats(cli=True):
-        _warn(note)
+    for note in res.caveats():
+        _warn(_cli_words(note))
     return wall, dict(outputs.trajectory(out, res), record_stride=p.record_stride)
 
 
+def _cli_words(text):
+    """A library's sentence with its parameters named as the command line spells them."""
+    return text.replace("Integration.max_impacts", "--max-impacts").replace(
+        "rockjit.fate", "`rockjit fate`")
+
+
 def _sweep_plan(args):
-    from ..grids.grids import plan_sweep
-    return plan_sweep(args.hb, args.omega, **_block_kw(args), alpha_range=args.alpha_range,
-                      alpha_step=args.alpha_step, z0=_z0(args), lyapunov=not args.no_lyapunov,
-                      **_grid_kw(args))
-
-
-def _laws(args):
-    if args.law == "both":
-        if args.e is not None:
-            raise UsageError("--e goes with --law constant, not --law both")
-        return ("housner", "mao")
-    return (args.law,)
+    from ..grids import sweep
+    return sweep.plan(_block(args), _forcing(args, alpha=False), _alphas(args), _state(args),
+                      integration=_integration(args), classification=_classification(args),
+                      lyapunov=not args.no_lyapunov, execution=_execution(args))
 
 
 def _basin_plan(args):
-    from ..grids.grids import plan_basin
-    return {law: plan_basin(args.hb, args.alpha, args.omega, law=law, e=args.e, xi=args.xi,
-                            grid=args.grid, theta_range=args.theta_range,
-                            dtheta_range=args.dtheta_range, r0=args.r0, s0=args.s0,
-                            phase=args.phase, lyapunov=args.lyapunov, **_grid_kw(args))
+    from ..grids import basin
+    from ..settings import Lattice
+    lattice = Lattice(args.grid, tuple(args.theta_range), tuple(args.dtheta_range))
+    return {law: basin.plan(_block(args, law), _forcing(args), lattice,
+                            integration=_integration(args),
+                            classification=_classification(args), lyapunov=args.lyapunov,
+                            execution=_execution(args))
             for law in _laws(args)}
 
 
 def _plane_plan(args):
-    from ..grids.grids import plan_plane
-    return plan_plane(args.hb, args.alpha_range, args.omega_range, grid=args.grid,
-                      **_block_kw(args), z0=_z0(args), lyapunov=not args.no_lyapunov,
-                      **_grid_kw(args))
+    from ..grids import plane
+    phase = _forcing(args, alpha=False, omega=False)
+    return plane.plan(_block(args), args.alpha_range, args.omega_range, grid=args.grid,
+                      state=_state(args), forcing=phase, integration=_integration(args),
+                      classification=_classification(args), lyapunov=not args.no_lyapunov,
+                      execution=_execution(args))
 
 
 def _erosion_plan(args):
-    from ..basins.erosion import plan_erosion
-    kw = _grid_kw(args)
-    kw.pop("uncertainty")
-    return {law: plan_erosion(args.hb, args.omega, law=law, e=args.e, xi=args.xi,
-                              alpha_range=args.alpha_range, alpha_step=args.alpha_step,
-                              grid=args.grid, r0=args.r0, s0=args.s0, phase=args.phase, **kw)
+    from ..basins.erosion import erosion
+    from ..grids.plan import alpha_count, grid_memory
+    from ..single import settings_for
+    # the whole profile's memory before the amplitudes' array is made
+    *_, n = alpha_count(args.alpha_range, args.alpha_step)
+    integration, execution = _integration(args), _execution(args)
+    probe = _forcing(args, alpha=False).replace(alpha=args.alpha_range[0])
+    n_steps, _, _ = settings_for(_block(args, _laws(args)[0]), probe, integration, 64)
+    grid_memory(f"--alpha-range and --alpha-step ({n} amplitudes) at --grid {args.grid}",
+                float(args.grid) ** 2 * n, dict(periods=args.periods, n_steps=n_steps),
+                execution, 16)
+    alphas = _alphas(args)
+    return {law: erosion.plan(_block(args, law), _forcing(args, alpha=False), alphas, args.grid,
+                              integration=integration, classification=_classification(args),
+                              execution=execution)
             for law in _laws(args)}
 
 
@@ -189,11 +254,13 @@ def _grid_run(writer, name):
     """The run of a grid command: its plan (or one plan per law) computed with the command
     line's progress, Dask client and chunk store, then written by ``outputs.<writer>``."""
     def run_it(args, plans, out):
-        from ..grids import grids as analysis
-        from ..basins import erosion
-        from ..orbits import orbits
         from . import outputs
-        run = dict(erosion=erosion.run, orbits=orbits.run).get(writer, analysis.run)
+        if writer == "erosion":
+            from ..basins.erosion import run
+        elif writer == "orbits":
+            from ..orbits import run_orbits as run
+        else:
+            from ..grids.plan import run
         t0 = time.perf_counter()
         if isinstance(plans, dict):
             res = {law: _grid(args, run, p, law) for law, p in plans.items()}
@@ -206,26 +273,28 @@ def _grid_run(writer, name):
 
 
 def _orbits_plan(args):
-    from ..orbits.orbits import plan_orbits
-    return plan_orbits(args.hb, args.law, args.omega, args.alpha_range, e=args.e, xi=args.xi,
-                       sweep_step=args.alpha_step, periods=args.periods, threads=args.threads,
-                       max_period=args.max_period)
+    from .. import orbits
+    return orbits.orbits_of_sweep.plan(_block(args), _forcing(args, alpha=False),
+                                       args.alpha_range, sweep_step=args.alpha_step,
+                                       periods=args.periods, max_period=args.max_period,
+                                       execution=_execution(args))
 
 
 def _fate_plan(args):
-    from ..basins.fate import plan_fate
-    return plan_fate(args.hb, args.alpha, args.omega, **_block_kw(args), **_state_kw(args),
-                     ensemble=args.ensemble, spread=args.spread, seed=args.seed,
-                     periods=args.periods, n_steps=args.n_steps, forcing=args.forcing,
-                     max_impacts=args.max_impacts, threads=args.threads,
-                     stop_at_overturn=not args.continue_past_overturn)
+    from ..basins.fate import fate
+    from ..settings import Execution
+    return fate.plan(_block(args), _forcing(args), _state(args),
+                     integration=_integration(args), ensemble=args.ensemble,
+                     spread=args.spread, seed=args.seed,
+                     execution=Execution(threads=args.threads, progress=not args.quiet))
 
 
 def _fate_run(args, p, out):
     from . import outputs
     from ..basins.fate import run
+    from ..settings import Execution
     t0 = time.perf_counter()
-    fr = run(p, progress=not args.quiet)
+    fr = run(p, Execution(threads=args.threads, progress=not args.quiet))
     wall = time.perf_counter() - t0
     _say(args, "fate: " + ", ".join(f"{k} {v:.3f}" for k, v in fr.probabilities.items()))
     return wall, outputs.fate(out, fr)
@@ -234,7 +303,7 @@ def _fate_run(args, p, out):
 def _cor_plan(args):
     from ..model import Block
     from ..validate import real
-    [Block(hb=hb, alpha=0.0, omega=1.0, law="housner") for hb in args.hb_values]
+    [Block(hb=hb, law="housner") for hb in args.hb_values]
     real("hb_max", args.hb_max, 1 / math.sqrt(2), 100.0, lo_open=True)
 
 
@@ -250,24 +319,24 @@ def _paper_plan(args):
     return plan_paper(grid=args.grid, periods=args.periods, n_steps=args.n_steps,
                       alpha_step=args.alpha_step, zoom=args.zoom, zoom_step=args.zoom_step,
                       erosion_step=args.erosion_step, erosion_grid=args.erosion_grid,
-                      as_published=args.as_published, threads=args.threads)
+                      as_published=args.as_published, execution=_execution(args))
 
 
 def _paper_run(args, p, out):
     from ..study.paper import paper
     t0 = time.perf_counter()
-    results = _grid(args, functools.partial(paper, out, say=lambda m: _say(args, m)), p, None)
+    results = _grid(args, lambda plan, ex: paper(out, plan, execution=ex,
+                                                 say=lambda m: _say(args, m)), p, None)
     return time.perf_counter() - t0, results
 
 
 def _grid(args, run, plan, name):
-    """``run(plan, ...)`` with the command line's progress, Dask client (``--scheduler``) and
-    chunk store (``<out>.chunks/name``), the store's notes on stderr unless ``--quiet``."""
+    """``run(plan, execution)`` with the command line's progress, Dask client
+    (``--scheduler``) and chunk store (``<out>.chunks/name``), the store's notes on stderr
+    unless ``--quiet``."""
     client = _client(args)
     try:
-        return run(plan, progress=not args.quiet, client=client,
-                   store=_chunk_root(args) / name if name else _chunk_root(args),
-                   message=lambda m: _say(args, m))
+        return run(plan, _execution(args, client, name))
     finally:
         if client is not None:
             client.close()
@@ -279,7 +348,8 @@ def _grid(args, run, plan, name):
 
 def _add_block(p, alpha=True, omega=True, laws="housner, mao or constant"):
     p.add_argument("--hb", type=float, required=True, help="slenderness h/b")
-    p.add_argument("--law", default="housner", help=f"restitution law: {laws} (default housner)")
+    p.add_argument("--law", default=None,
+                   help=f"restitution law: {laws} (default housner, or constant with --e)")
     p.add_argument("--e", type=float, default=None,
                    help="constant coefficient of restitution in [0, 1] (with --law constant)")
     p.add_argument("--xi", type=float, default=None,
@@ -292,7 +362,7 @@ def _add_block(p, alpha=True, omega=True, laws="housner, mao or constant"):
 
 
 def _add_run(p, periods=500, grid=False):
-    from ..grids.grids import GRID_N
+    from ..grids.plan import GRID_N
     from ..single import DEFAULT_N, MAX_STEP
     p.add_argument("--periods", type=int, default=periods,
                    help=f"forcing periods to integrate (default {periods})")

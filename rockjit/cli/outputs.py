@@ -26,7 +26,7 @@ def summary(out, command, inputs, wall, **results):
 
 def trajectory(out, res, *, npz="trajectory.npz", png="trajectory.png"):
     """One run: its arrays (``Result.arrays``) and :func:`rockjit.plotting.figures.fig_trajectory`."""
-    from ..grids.grids import classify_result
+    from ..single import classify_result
     from ..plotting.figures import fig_trajectory
     name, period = classify_result(res)
     out.npz(npz, **res.arrays())

@@ -9,6 +9,7 @@ from ..result import BasinResult
 from ..settings import Lattice
 from ..validate import boolean
 from . import plan as gp
+from ..entry import entry_point
 
 __all__ = ["basin", "lattice"]
 
@@ -18,7 +19,7 @@ def lattice(grid):
     return grid if isinstance(grid, Lattice) else Lattice(grid)
 
 
-@gp.entry_point(gp.run)
+@entry_point(gp.run)
 def basin(block, forcing, grid=100, *, integration=None, classification=None, lyapunov=False,
           execution=None) -> BasinResult:
     """Basin of attraction over ``(theta0, theta0')`` on a ``grid x grid`` lattice.

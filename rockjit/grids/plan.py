@@ -15,7 +15,6 @@ repeat to ``settle_tol`` (much tighter than ``tol``).
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, field, replace
 
@@ -29,11 +28,12 @@ from ..model import Block
 from ..result import BasinResult, PlaneResult, SweepResult
 from ..settings import Classification, Execution, Integration
 from ..single import check_step, settings_for
+
 from ..validate import integer, memory, pair, real
 from . import runner
 
 __all__ = ["GRID_N", "MAX_CELLS", "GridPlan", "alpha_count", "alpha_grid", "common",
-           "entry_point", "grid_memory", "run", "uncertain_cells"]
+           "grid_memory", "run", "uncertain_cells"]
 
 #: Steps per period of sweeps, basins and planes: they need labels and lambda_max, not 1e-10
 #: event times. On the study's four basins and its 501-amplitude sweep, N = 64 gives the labels
@@ -67,21 +67,6 @@ class GridPlan:
     attractors: bool = False  # identify the attractors (rockjit.basins.identity)
     phi: float = 0.0          # the forcing phase (basins: of every cell)
     uncertainty: float | None = None  # flag the cells whose outcome moves with eps
-
-
-def entry_point(execute):
-    """Make a planning function an entry point: the decorated function keeps its parameters
-    and docstring, plans, and runs the plan with ``execute(plan, execution)``; the planning
-    function itself stays reachable as ``entry.plan`` (the command line plans first, so that
-    it refuses bad input before any work). Written once, the signature cannot drift."""
-    def decorate(plan_fn):
-        @functools.wraps(plan_fn)
-        def entry(*args, **kwargs):
-            return execute(plan_fn(*args, **kwargs), kwargs.get("execution"))
-
-        entry.plan = plan_fn
-        return entry
-    return decorate
 
 
 def objects(block, integration, classification, execution):

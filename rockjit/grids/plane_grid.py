@@ -11,6 +11,7 @@ from ..result import PlaneResult
 from ..single import initial_state
 from ..validate import boolean, integer, pair
 from . import plan as gp
+from ..entry import entry_point
 
 __all__ = ["plane"]
 
@@ -32,7 +33,7 @@ def _states(state):
     return list(z)
 
 
-@gp.entry_point(gp.run)
+@entry_point(gp.run)
 def plane(block, alpha_range, omega_range, *, grid=(50, 50), state=None, forcing=None,
           integration=None, classification=None, lyapunov=True,
           execution=None) -> PlaneResult:

@@ -11,11 +11,12 @@ from ..result import SweepResult
 from ..single import initial_state
 from ..validate import boolean, integer
 from . import plan as gp
+from ..entry import entry_point
 
 __all__ = ["sweep"]
 
 
-@gp.entry_point(gp.run)
+@entry_point(gp.run)
 def sweep(block, forcing, alphas, state=None, *, integration=None, classification=None,
           lyapunov=True, n_points=None, n_impact_points=400, execution=None) -> SweepResult:
     """Bifurcation sweep over the forcing amplitude ``alpha``.

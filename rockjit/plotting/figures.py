@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from ..grids.grids import classify_result
+from ..single import classify_result
 from ..result import BEHAVIOURS, fractions
 from ..model import delta_e_percent, e_housner, e_mao, thc_from_hb
 
@@ -53,9 +53,10 @@ def _law(block):
     return _LAW_NAMES.get(block.law, block.law)
 
 
-def _params(block):
-    return (f"{_law(block)}, h/b = {block.hb:g}, \u03b1 = {block.alpha:g}, "
-            f"\u03c9 = {block.omega:g}")
+def _params(res):
+    """The block and forcing of a result, in words."""
+    b, f = res.block, res.forcing
+    return f"{_law(b)}, h/b = {b.hb:g}, \u03b1 = {f.alpha:g}, \u03c9 = {f.omega:g}"
 
 
 def agreement(label_a, label_b):
@@ -221,7 +222,7 @@ def fig_trajectory(result, title=None):
                    + "\n(circles: stroboscopic points t = kT)", fontsize=10)
     name, p = classify_result(result)
     beh = name + (f", period {p}" if name == "multiperiodic" else "")
-    fig.suptitle(title or f"{_params(result.block)}: {beh} ({result.status})")
+    fig.suptitle(title or f"{_params(result)}: {beh} ({result.status})")
     return fig
 
 
@@ -255,9 +256,9 @@ def fig_gallery(results, notes=None):
         ax.set_xlabel("t")
         if c == 0:
             ax.set_ylabel("\u03b8  [rad]")
-        b = res.block
+        b, f = res.block, res.forcing
         beh = name + (f" (period {p})" if name == "multiperiodic" else "")
-        ax.set_title(f"{caption}\n\u03b1={b.alpha:g}, \u03c9={b.omega:g}, h/b={b.hb:g}\n"
+        ax.set_title(f"{caption}\n\u03b1={f.alpha:g}, \u03c9={f.omega:g}, h/b={b.hb:g}\n"
                      f"classified: {beh}", fontsize=9,
                      bbox=dict(boxstyle="round,pad=0.3", fc=colour, alpha=0.25, lw=0))
         if res.status == "overturned":
@@ -314,8 +315,9 @@ def fig_laws_timeseries(runs, t_max=None):
         ax_p.set_title("phase portrait: window (whole run if it overturned)", fontsize=9)
         if i == len(runs) - 1:
             ax_t.set_xlabel("t  (units of 1/\u03a9\u2080)")
-    b = next(iter(runs[0].values())).block
-    fig.suptitle(f"Housner vs Mao: h/b = {b.hb:g}, \u03b1 = {b.alpha:g}, \u03c9 = {b.omega:g}")
+    r0 = next(iter(runs[0].values()))
+    b, f = r0.block, r0.forcing
+    fig.suptitle(f"Housner vs Mao: h/b = {b.hb:g}, \u03b1 = {f.alpha:g}, \u03c9 = {f.omega:g}")
     return fig
 
 
@@ -346,7 +348,7 @@ def _bifurcation_column(fig, gs_col, sw, alpha_limits, show_y):
         ax.scatter(a[ok], y[ok], s=0.6, color=BEHAVIOUR_COLOURS[name], lw=0, rasterized=True)
     ax.set_ylabel("\u03b8\u2032(kT)" if show_y else "")
     published = sw.settings.get("stop_at_overturn") is False
-    ax.set_title(f"{_law(sw.block)}, h/b = {sw.block.hb:g}, \u03c9 = {sw.block.omega:g}"
+    ax.set_title(f"{_law(sw.block)}, h/b = {sw.block.hb:g}, \u03c9 = {sw.forcing.omega:g}"
                  + (" \u2014 as published: integrated past overturning" if published else ""),
                  fontsize=9 if published else 10)
     ax.tick_params(labelbottom=False)
@@ -472,7 +474,7 @@ def fig_basin(basin_result, title=None):
     ax = fig.add_subplot()
     _basin_axes(ax, b)
     _basin_legend(ax, b)
-    ax.set_title(title or f"Basins: {_params(b.block)}", fontsize=10)
+    ax.set_title(title or f"Basins: {_params(b)}", fontsize=10)
     return fig
 
 
@@ -505,9 +507,9 @@ def fig_basin_compare(housner_basin, mao_basin, title=None):
                             Patch(color="#7b3294", label=f"different {100 - pct:.1f} %")],
                    loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=1, fontsize=8,
                    frameon=False)
-    blk = a.block
-    fig.suptitle(title or f"Basins of attraction, h/b = {blk.hb:g}, \u03b1 = {blk.alpha:g}, "
-                 f"\u03c9 = {blk.omega:g}, (r\u2080, s\u2080) = "
+    blk, frc = a.block, a.forcing
+    fig.suptitle(title or f"Basins of attraction, h/b = {blk.hb:g}, \u03b1 = {frc.alpha:g}, "
+                 f"\u03c9 = {frc.omega:g}, (r\u2080, s\u2080) = "
                  f"({a.settings.get('r0', 0):.4g}, {a.settings.get('s0', 1):.4g})")
     return fig
 
@@ -576,9 +578,10 @@ def fig_attractors(basins, title=None):
                      fontsize=10)
         ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncols=2,
                   fontsize=7.5, frameon=False)
-    blk = next(iter(basins.values())).block
-    fig.suptitle(title or f"Attractors, h/b = {blk.hb:g}, \u03b1 = {blk.alpha:g}, "
-                 f"\u03c9 = {blk.omega:g}", fontsize=11)
+    b0 = next(iter(basins.values()))
+    blk, frc = b0.block, b0.forcing
+    fig.suptitle(title or f"Attractors, h/b = {blk.hb:g}, \u03b1 = {frc.alpha:g}, "
+                 f"\u03c9 = {frc.omega:g}", fontsize=11)
     return fig
 
 
@@ -621,7 +624,7 @@ def fig_erosion(profiles, title=None):
     fig.axes[-1].set_xlabel("\u03b1")
     r0 = next(iter(profiles.values()))
     fig.suptitle(title or f"Erosion profiles, h/b = {r0.block.hb:g}, "
-                 f"\u03c9 = {r0.block.omega:g}, {r0.attractor.shape[1]}\u00b2 cells per basin",
+                 f"\u03c9 = {r0.forcing.omega:g}, {r0.attractor.shape[1]}\u00b2 cells per basin",
                  fontsize=11)
     return fig
 
@@ -653,9 +656,9 @@ def fig_fate(fate_result, title=None):
         ax_t.axhline(fr.horizon_rounding, color="k", ls="--", lw=0.8,
                      label=f"horizon of rounding t* = {fr.horizon_rounding:.0f}")
     ax_t.legend(fontsize=8)
-    b = fr.block
+    b, f = fr.block, fr.forcing
     fig.suptitle(title or f"Fates of {fr.outcome.size} nearby runs: {_law(b)}, h/b = {b.hb:g}, "
-                 f"\u03b1 = {b.alpha:g}, \u03c9 = {b.omega:g}; \u03bb\u2081 of the "
+                 f"\u03b1 = {f.alpha:g}, \u03c9 = {f.omega:g}; \u03bb\u2081 of the "
                  f"transient {fr.lambda1:.3g}", fontsize=10)
     return fig
 
@@ -874,8 +877,8 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
         lines.append("(no bifurcation located)")
     ax_l.text(0.0, 1.0, "\n".join(lines), va="top", ha="left", family="monospace",
               fontsize=7.5, transform=ax_l.transAxes)
-    b = c.block
-    fixed = (f"\u03c9 = {b.omega:g}" if pname == "alpha" else f"\u03b1 = {b.alpha:g}")
+    b, f = c.block, c.forcing
+    fixed = (f"\u03c9 = {f.omega:g}" if pname == "alpha" else f"\u03b1 = {f.alpha:g}")
     ax.set_title(title or f"Periodic orbits: {_law(b)}, h/b = {b.hb:g}, {fixed}, "
                  f"phase {c.phase:.4g}", fontsize=10)
     return fig

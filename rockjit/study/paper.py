@@ -17,18 +17,21 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
-from ..grids import grids as analysis
-from ..basins import erosion
-from ..grids.grids import BEHAVIOURS, classify_result
-from ..model import delta_e_percent, e_housner, e_mao, thc_from_hb
-from ..single import DEFAULT_N, Z0_STUDY, simulate
-from ..basins.erosion import plan_erosion
+from ..basins.erosion import erosion
+from ..basins.erosion import run as erosion_run
 from ..basins.fate import fate
-from ..single import plan as plan_run
-from ..validate import integer, pair, real
+from ..excitation import Harmonic
+from ..grids import alpha_grid, basin, sweep
+from ..grids.plan import run as run_grid
+from ..model import Block, delta_e_percent, e_housner, e_mao, thc_from_hb
+from ..result import BEHAVIOURS
+from ..settings import Execution, Integration
+from ..single import DEFAULT_N, Z0_STUDY, classify_result, simulate
+from ..validate import integer, memory, pair, real
 
 __all__ = ["ALPHA_STEP", "BASIN_CASES", "BASIN_GRID", "EROSION", "EROSION_GRID", "EROSION_STEP",
            "GALLERY", "LAWS_IC", "LAWS_RUN", "PERIODS", "REFERENCE_RUN", "STUDY", "Z0", "ZOOM",
@@ -51,16 +54,17 @@ WINDOW = 400
 ZOOM = (0.88, 0.98)
 #: Figure 2: the reference symmetric run.
 REFERENCE_RUN = dict(hb=1.0, alpha=0.6, omega=1.3, law="housner")
-#: Figure 3: the behaviour gallery, ``name: (hb, alpha, omega, initial state)``; the study's
+#: Figure 3: the behaviour gallery, ``name: (hb, alpha, omega, (theta0, theta0') or None for
+#: the study's z0, the forcing point (r0, s0))``; the study's
 #: "multiperiodic" example (alpha = 0.969) is transient chaos ending in overturning once
 #: integrated accurately (README, "What the study's settings hide"): both it and a robust
 #: period-2 orbit of the same family are shown.
 GALLERY = {
-    "rest / damped": (1.0, 0.15, 1.0, dict(theta0=0.05, dtheta0=0.0, r0=Z0[2], s0=Z0[3])),
-    "asymmetric": (1.0, 0.8, 1.3, dict(z0=Z0)),
-    "multiperiodic": (1.0, 0.92, 1.3, dict(z0=Z0)),
-    "study's 'multiperiodic'": (1.0, 0.969, 1.3, dict(z0=Z0)),
-    "overturn": (2.0, 0.448, 1.3, dict(z0=Z0)),
+    "rest / damped": (1.0, 0.15, 1.0, (0.05, 0.0), Z0[2:]),
+    "asymmetric": (1.0, 0.8, 1.3, None, Z0[2:]),
+    "multiperiodic": (1.0, 0.92, 1.3, None, Z0[2:]),
+    "study's 'multiperiodic'": (1.0, 0.969, 1.3, None, Z0[2:]),
+    "overturn": (2.0, 0.448, 1.3, None, Z0[2:]),
 }
 #: The gallery's run whose outcome is decided by round-off, and the ensemble that measures it.
 TRANSIENT_CHAOS = "study's 'multiperiodic'"
@@ -123,24 +127,27 @@ class PaperPlan:
     alpha_step: float
     zoom: tuple
     zoom_step: float
-    threads: int | None
     sweeps: dict            # (hb, law) -> GridPlan
     zoom_sweep: object      # GridPlan
     basins: dict            # (hb, law) -> GridPlan
     erosions: dict          # (hb, law) -> ErosionPlan
     stride: int
     published: dict         # (hb, law) -> GridPlan of the sweep as the study computed it, or {}
+    memory_bytes: float = 0.0
 
 
 def plan_paper(*, grid=BASIN_GRID, periods=PERIODS, n_steps=None, alpha_step=ALPHA_STEP,
                zoom=ZOOM, zoom_step=None, erosion_step=EROSION_STEP,
-               erosion_grid=EROSION_GRID, as_published=False, threads=None) -> PaperPlan:
-    """Validate a paper's settings; every grid is planned here (memory checked), nothing run.
+               erosion_grid=EROSION_GRID, as_published=False, execution=None) -> PaperPlan:
+    """Validate a paper's settings; every grid is planned here and the memory of all of them
+    together checked, nothing run.
 
     ``n_steps=None`` takes the library's defaults (``DEFAULT_N`` for single runs, ``GRID_N`` for
     sweeps and basins). ``zoom`` must lie inside the Housner hb=1 range. ``as_published`` adds
-    figure 5 as the study computed it: its sweeps integrated on past overturning.
+    figure 5 as the study computed it: its sweeps integrated on past overturning. ``grid``
+    sizes every basin, the erosion profiles' included unless ``erosion_grid`` says otherwise.
     """
+    execution = Execution() if execution is None else execution
     grid = integer("grid", grid, 1, 10**5)
     periods = integer("periods", periods, 1)
     alpha_step = real("alpha_step", alpha_step, 0.0, 1.0, lo_open=True)
@@ -148,13 +155,16 @@ def plan_paper(*, grid=BASIN_GRID, periods=PERIODS, n_steps=None, alpha_step=ALP
     zoom = pair("zoom", zoom, 0.0, None)
     if zoom[0] < h_rng[0] or zoom[1] > h_rng[1]:
         raise ValueError(f"zoom must lie inside the Housner hb=1 range {h_rng} (got {zoom})")
-    kw = dict(periods=periods, n_steps=n_steps, threads=threads, lyapunov=True)
-    sweeps = {(hb, law): analysis.plan_sweep(float(hb), st["omega"], law=law, alpha_range=rng,
-                                             alpha_step=alpha_step, **kw)
+    integration = Integration(periods=periods, n_steps=n_steps)
+    kw = dict(integration=integration, execution=execution, lyapunov=True)
+    sweeps = {(hb, law): sweep.plan(Block(hb=float(hb), law=law),
+                                    Harmonic(omega=st["omega"]), alpha_grid(rng, alpha_step),
+                                    **kw)
               for hb, st in STUDY.items() for law, rng in st["alpha_range"].items()}
-    published = {(hb, law): analysis.plan_sweep(float(hb), st["omega"], law=law,
-                                                alpha_range=rng, alpha_step=alpha_step,
-                                                stop_at_overturn=False, **kw)
+    past = dict(kw, integration=integration.replace(stop_at_overturn=False))
+    published = {(hb, law): sweep.plan(Block(hb=float(hb), law=law),
+                                       Harmonic(omega=st["omega"]),
+                                       alpha_grid(rng, alpha_step), **past)
                  for hb, st in STUDY.items() for law, rng in st["alpha_range"].items()} \
         if as_published else {}
     zoom_step = alpha_step / 4 if zoom_step is None else \
@@ -163,27 +173,33 @@ def plan_paper(*, grid=BASIN_GRID, periods=PERIODS, n_steps=None, alpha_step=ALP
         raise ValueError(f"zoom_step = {zoom_step:g} over zoom {zoom} would make "
                          f"{(zoom[1] - zoom[0]) / zoom_step:.3g} amplitudes; give a larger "
                          f"zoom_step")
-    zoom_sweep = analysis.plan_sweep(1.0, STUDY[1]["omega"], law="housner", alpha_range=zoom,
-                                     alpha_step=zoom_step, **kw)
-    basins = {(hb, law): analysis.plan_basin(hb, alpha, omega, law=law, grid=grid, r0=0.0,
-                                             s0=1.0, periods=periods, n_steps=n_steps,
-                                             threads=threads)
+    zoom_sweep = sweep.plan(Block(hb=1.0, law="housner"), Harmonic(omega=STUDY[1]["omega"]),
+                            alpha_grid(zoom, zoom_step), **kw)
+    basins = {(hb, law): basin.plan(Block(hb=hb, law=law),
+                                    Harmonic(alpha=alpha, omega=omega, r0=0.0, s0=1.0), grid,
+                                    integration=integration, execution=execution)
               for hb, alpha, omega in BASIN_CASES for law in ("housner", "mao")}
     erosion_step = real("erosion_step", erosion_step, 1e-6, 1.0)
-    erosions = {(hb, law): plan_erosion(float(hb), ev["omega"], law=law,
-                                        alpha_range=ev["alpha_range"], alpha_step=erosion_step,
-                                        grid=integer("erosion_grid", erosion_grid, 1, 10**4),
-                                        r0=0.0, s0=1.0, periods=periods, n_steps=n_steps,
-                                        threads=threads)
+    erosion_grid = integer("erosion_grid", erosion_grid, 1, 10**4)
+    erosions = {(hb, law): erosion.plan(Block(hb=float(hb), law=law),
+                                        Harmonic(omega=ev["omega"], r0=0.0, s0=1.0),
+                                        alpha_grid(ev["alpha_range"], erosion_step),
+                                        erosion_grid, integration=integration,
+                                        execution=execution)
                 for hb, ev in EROSION.items() for law in ("housner", "mao")}
     if n_steps is not None:  # single runs take it too: check it against their blocks
-        for hb, alpha, omega, _ in GALLERY.values():
-            plan_run(hb, alpha, omega, periods=periods, n_steps=n_steps)
+        for hb, alpha, omega, _, _ in GALLERY.values():
+            simulate.plan(Block(hb=hb), Harmonic(alpha=alpha, omega=omega),
+                          integration=integration)
     stride = max(1, math.ceil(periods * (n_steps or DEFAULT_N) / MAX_TRAJ_POINTS))
+    total = sum(gp.memory_bytes for gp in (*sweeps.values(), *published.values(),
+                                           zoom_sweep, *basins.values())) + \
+        sum(ep.grid_plan.memory_bytes for ep in erosions.values())
+    memory("the paper's grids together", total)
     return PaperPlan(grid=grid, periods=periods, n_steps=n_steps, alpha_step=alpha_step,
-                     zoom=zoom, zoom_step=zoom_step, threads=threads, sweeps=sweeps,
-                     zoom_sweep=zoom_sweep, basins=basins, erosions=erosions, stride=stride,
-                     published=published)
+                     zoom=zoom, zoom_step=zoom_step, sweeps=sweeps, zoom_sweep=zoom_sweep,
+                     basins=basins, erosions=erosions, stride=stride, published=published,
+                     memory_bytes=total)
 
 
 def after_the_fall(sw):
@@ -212,7 +228,7 @@ def after_the_fall(sw):
                                        for a in found])
 
 
-def paper(out, plan=None, *, progress=False, client=None, store=None, say=None, message=None):
+def paper(out, plan=None, *, execution=None, say=None):
     """Compute every figure and table of the study into ``out``; returns the summary's results.
 
     Parameters
@@ -222,37 +238,37 @@ def paper(out, plan=None, *, progress=False, client=None, store=None, say=None, 
         publishes it.
     plan : PaperPlan, optional
         From :func:`plan_paper`; default the study's settings.
-    progress : bool
-        Show the grids' progress on stderr.
-    client : dask.distributed.Client, optional
-        Run the sweeps' and basins' chunks on this cluster.
-    store : path, optional
-        Directory of chunk stores, one per grid: an interrupted paper resumes from them.
+    execution : Execution, optional
+        The grids' progress, Dask client and chunk store: with a store directory, each grid
+        keeps its chunks in a store of its own beneath it, so that an interrupted paper
+        resumes.
     say : callable, optional
         ``say(message)`` for one line of progress per part.
-    message : callable, optional
-        ``message(text)`` for the chunk stores' notes (default a line on stderr).
     """
-    from pathlib import Path
-
     from ..basins.identity import attractor_agreement
-    from ..orbits.orbits import continue_branches
-    from ..plotting.figures import (agreement, fig_attractors, fig_basin_compare, fig_bifurcation,
-                           fig_branches, fig_erosion, fig_gallery, fig_laws_timeseries,
-                           fig_trajectory)
+    from ..orbits import continue_branches
+    from ..plotting.figures import (agreement, fig_attractors, fig_basin_compare,
+                                    fig_bifurcation, fig_branches, fig_erosion, fig_gallery,
+                                    fig_laws_timeseries, fig_trajectory)
 
     p = plan_paper() if plan is None else plan
+    execution = Execution() if execution is None else execution
     say = say or (lambda msg: None)
     walls = {}
     results = {}
     n_parts = 8
     basins_done = {}
-    run_kw = dict(periods=p.periods, n_steps=p.n_steps, record_stride=p.stride, lyapunov=True)
+    integration = Integration(periods=p.periods, n_steps=p.n_steps)
+    run_kw = dict(integration=integration, record_stride=p.stride, lyapunov=True)
     t_all = time.perf_counter()
 
+    def within(name):
+        """The execution of one grid: its own chunk store beneath the paper's."""
+        store = execution.store
+        return execution.replace(store=None if store is None else Path(store) / name)
+
     def grid(gp, name):
-        return analysis.run(gp, progress=progress, client=client, message=message,
-                            store=None if store is None else Path(store) / name)
+        return run_grid(gp, within(name))
 
     def part(i, name, what):
         say(f"paper [{i}/{n_parts}] {name}: {what}")
@@ -268,7 +284,9 @@ def paper(out, plan=None, *, progress=False, client=None, store=None, say=None, 
     done("fig1", t0)
 
     t0 = part(2, "fig2", "reference run alpha=0.6, omega=1.3, hb=1, Housner")
-    ref = simulate(**REFERENCE_RUN, z0=Z0, **run_kw)
+    ref = simulate(Block(hb=REFERENCE_RUN["hb"], law=REFERENCE_RUN["law"]),
+                   Harmonic(alpha=REFERENCE_RUN["alpha"], omega=REFERENCE_RUN["omega"]),
+                   **run_kw)
     tr = ref.trajectory
     out.npz("fig2_reference.npz", t=tr[:, 0], theta=tr[:, 1], dtheta=tr[:, 2],
             strobe=ref.strobe, impacts=ref.impacts, lyapunov_running=ref.lyapunov_running)
@@ -279,13 +297,16 @@ def paper(out, plan=None, *, progress=False, client=None, store=None, say=None, 
     done("fig2", t0)
 
     t0 = part(3, "fig3", "behaviour gallery")
-    gal = {k: simulate(hb, alpha, omega, "housner", **ic, **run_kw)
-           for k, (hb, alpha, omega, ic) in GALLERY.items()}
+    gal = {k: simulate(Block(hb=hb), Harmonic(alpha=alpha, omega=omega, r0=pt[0], s0=pt[1]),
+                       state, **run_kw)
+           for k, (hb, alpha, omega, state, pt) in GALLERY.items()}
     # the study's "multiperiodic" example is transient chaos: its fate, with either forcing,
     # is a probability over initial states within round-off of z0 (issue 14)
-    hb, alpha, omega, ic = GALLERY[TRANSIENT_CHAOS]
-    fates = {forcing: fate(hb, alpha, omega, "housner", ensemble=FATE_ENSEMBLE,
-                           forcing=forcing, periods=p.periods, n_steps=p.n_steps, **ic)
+    hb, alpha, omega, state, pt = GALLERY[TRANSIENT_CHAOS]
+    fates = {forcing: fate(Block(hb=hb), Harmonic(alpha=alpha, omega=omega, r0=pt[0], s0=pt[1],
+                                                  embedded=forcing == "embedded"),
+                           state, integration=integration, ensemble=FATE_ENSEMBLE,
+                           execution=within("fate").replace(store=None))
              for forcing in ("closed", "embedded")}
     note = "transient chaos; over {} runs within 1e-10 of z0:\n".format(FATE_ENSEMBLE) + \
         "\n".join(f"{forcing}: " + ", ".join(f"{k} {v:.0%}" for k, v in f.probabilities.items())
@@ -298,8 +319,10 @@ def paper(out, plan=None, *, progress=False, client=None, store=None, say=None, 
     done("fig3", t0)
 
     t0 = part(4, "fig4", "Housner vs Mao time series, alpha=0.2, omega=1.6, hb=2")
-    rows = [{law: simulate(**LAWS_RUN, law=law, theta0=th0, dtheta0=dth0, r0=0.0, s0=1.0,
-                           **run_kw) for law in ("housner", "mao")} for th0, dth0 in LAWS_IC]
+    rows = [{law: simulate(Block(hb=LAWS_RUN["hb"], law=law),
+                           Harmonic(alpha=LAWS_RUN["alpha"], omega=LAWS_RUN["omega"], r0=0.0,
+                                    s0=1.0), (th0, dth0), **run_kw)
+             for law in ("housner", "mao")} for th0, dth0 in LAWS_IC]
     out.figure("fig4_laws_timeseries.png", fig_laws_timeseries(rows))
     results["fig4"] = [{law: dict(zip(("behaviour", "period"), classify_result(r)),
                                   status=r.status) for law, r in row.items()}
@@ -343,7 +366,8 @@ def paper(out, plan=None, *, progress=False, client=None, store=None, say=None, 
     conts = {}
     for (hb, law), sw in sweeps.items():
         say(f"paper: periodic orbits {law} hb={hb:g}, continued from the sweep's attractors")
-        conts[(hb, law)] = cont = continue_branches(float(hb), law, STUDY[hb]["omega"],
+        conts[(hb, law)] = cont = continue_branches(Block(hb=float(hb), law=law),
+                                                    Harmonic(omega=STUDY[hb]["omega"]),
                                                     STUDY[hb]["alpha_range"][law], sweep=sw)
         out.figure(f"fig5_branches_hb{hb}_{law}.png", fig_branches(cont, sw))
         for bf in sorted(cont.bifurcations, key=lambda b: b.alpha):
@@ -425,9 +449,7 @@ def paper(out, plan=None, *, progress=False, client=None, store=None, say=None, 
         for law in ("housner", "mao"):
             say(f"paper: erosion {law} hb={hb:g}, {p.erosions[(hb, law)].alpha.size} "
                 f"amplitudes")
-            prof[law] = erosion.run(p.erosions[(hb, law)], progress=progress, client=client,
-                                    message=message, store=None if store is None else
-                                    Path(store) / f"erosion_hb{hb}_{law}")
+            prof[law] = erosion_run(p.erosions[(hb, law)], within(f"erosion_hb{hb}_{law}"))
         out.figure(f"fig8_erosion_hb{hb}.png", fig_erosion(prof))
         out.npz(f"fig8_erosion_hb{hb}.npz", alpha=prof["housner"].alpha,
                 theta0=prof["housner"].theta0, dtheta0=prof["housner"].dtheta0,

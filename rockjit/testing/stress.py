@@ -119,8 +119,10 @@ import numpy as np
 
 import rockjit
 
-from ..grids import grids as an
-from ..single import default_max_impacts, steps_per_period
+from ..excitation import Harmonic
+from ..model import Block
+from ..settings import Classification, Execution, Integration, Lattice, default_max_impacts
+from ..single import steps_per_period
 
 RANGES = dict(hb=(0.75, 20.0), alpha=(0.0, 3.0), omega=(0.05, 20.0), e=(0.0, 1.0))
 CATEGORIES = ("random", "near_zero", "grazing", "near_overturn", "long_horizon",
@@ -153,9 +155,37 @@ MAX_GRID_STEPS = 400_000
 STIFF_HXI = 2.5
 
 
+_BLOCK = ("hb", "law", "e", "xi")
+_FORCING = ("alpha", "omega", "phase", "r0", "s0")
+_INTEGRATION = ("n_steps", "periods", "window", "max_impacts", "rest_speed", "theta_over",
+                "stop_at_overturn", "qr_every")
+
+
+def objects(kw):
+    """``(block, forcing, state, integration, rest)``: the objects of rockjit's API from a
+    case's flat keywords (the form cases are drawn, stored and printed in), ``rest`` the
+    keywords left (``lyapunov``, ``record_stride``, ...)."""
+    kw = dict(kw)
+    block = Block(**{k: kw.pop(k) for k in _BLOCK if k in kw})
+    forcing = Harmonic(**{k: kw.pop(k) for k in _FORCING if k in kw},
+                       embedded=kw.pop("forcing", "closed") == "embedded")
+    theta0, dtheta0 = kw.pop("theta0", None), kw.pop("dtheta0", None)
+    state = None if theta0 is None and dtheta0 is None else (theta0 or 0.0, dtheta0 or 0.0)
+    if state is not None and not forcing.phase_given:
+        forcing = forcing.replace(r0=0.0, s0=1.0)
+    integration = Integration(**{k: kw.pop(k) for k in _INTEGRATION if k in kw})
+    return block, forcing, state, integration, kw
+
+
+def simulate_flat(**kw):
+    """``rockjit.simulate`` of a case's flat keywords (:func:`objects`)."""
+    block, forcing, state, integration, rest = objects(kw)
+    return rockjit.simulate(block, forcing, state, integration=integration, **rest)
+
+
 @dataclass
 class Case:
-    """One stress run: ``rockjit.simulate(**kwargs)``."""
+    """One stress run: :func:`simulate_flat` of ``kwargs``."""
 
     id: str
     category: str
@@ -561,7 +591,7 @@ def check_bookkeeping(kw, res):
             jumped = b.restitution * imp[:, 1]
         if not np.array_equal(imp[:, 2], jumped):
             probs.append("theta'+ != e theta'- at an impact")
-    th_over = b.theta_over
+    th_over = _theta_over(kw)
     for name in ("strobe", "strobe_half"):
         a = getattr(res, name)
         if a.size and np.nanmax(np.abs(a[:, 0])) > th_over * (1 + 1e-12) and \
@@ -573,7 +603,7 @@ def check_bookkeeping(kw, res):
             probs.append(f"overturned at |theta| = {abs(res.state[0])!r}, {off:.3g} off the "
                          "threshold")
     if res.status == "rest":
-        aw2 = b.alpha * b.omega**2
+        aw2 = res.forcing.aw2
         rad = max(1.0, math.hypot(res.state[2], res.state[3]))
         if res.state[0] != 0.0 or res.state[1] != 0.0:
             probs.append(f"at rest with state {res.state[:2]}")
@@ -585,7 +615,7 @@ def check_bookkeeping(kw, res):
 def overturn_offset(kw, res):
     """How far an overturned run's final ``|theta|`` is from the threshold (or from
     ``|theta0|`` for a run that started beyond it)."""
-    th_over = res.block.theta_over
+    th_over = _theta_over(kw)
     th0 = abs(kw.get("theta0", 0.0))
     want = th0 if th0 >= th_over else th_over
     return abs(abs(float(res.state[0])) - want) / max(1.0, want)
@@ -660,7 +690,7 @@ def refused(exc):
     ``ValueError`` whose message opens with the parameter's name, ``n_steps``), or a start at or
     past the overturning threshold (``theta0 must satisfy |theta0| < theta_over``, issue 10)?"""
     return isinstance(exc, ValueError) and (
-        str(exc).startswith("n_steps") or str(exc).startswith("theta0 must satisfy"))
+        str(exc).startswith("n_steps") or str(exc).startswith("state[0] (theta0) must satisfy"))
 
 
 def run_case(case):
@@ -673,7 +703,7 @@ def run_case(case):
     ``status`` check.
     """
     try:
-        res = rockjit.simulate(**case.kwargs)
+        res = simulate_flat(**case.kwargs)
     except Exception as exc:
         probs = {k: [] for k in RUN_CHECKS}
         if refused(exc):
@@ -719,7 +749,7 @@ def energy(thc, theta, dtheta):
 def check_energy(kw, res):
     """Largest energy error over the trajectory, samples, final state and impacts."""
     b = res.block
-    if not (b.restitution == 1.0 and b.xi == 0.0 and b.alpha == 0.0):
+    if not (b.restitution == 1.0 and b.xi == 0.0 and res.forcing.alpha == 0.0):
         return ["not an energy-conserving case"]
     thc = b.thc
     e0 = float(energy(thc, kw["theta0"], kw["dtheta0"]))
@@ -896,11 +926,17 @@ def _run_threads_case(case, threads):
     kw = dict(case.kwargs)
     kind = kw.pop("kind")
     grid = kw.pop("grid")
-    if kind == "basin":
-        return an.basin(grid=grid, threads=threads, **kw)
+    classification = Classification(early_stop=kw.pop("early_stop", True))
     alpha = kw.pop("alpha")
+    block, forcing, _, integration, rest = objects(kw)
+    execution = Execution(threads=threads)
+    if kind == "basin":
+        return rockjit.basin(block, forcing.replace(alpha=alpha), Lattice(grid),
+                             integration=integration, classification=classification,
+                             execution=execution, **rest)
     alphas = np.linspace(0.0, max(alpha, 0.05), grid * grid)
-    return an.sweep(kw.pop("hb"), kw.pop("omega"), alphas, threads=threads, **kw)
+    return rockjit.sweep(block, forcing, alphas, integration=integration,
+                         classification=classification, execution=execution, **rest)
 
 
 def check_threads(one, two):
