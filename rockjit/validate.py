@@ -37,13 +37,20 @@ def _range_text(lo, hi, lo_open, hi_open):
     return f"in {'(' if lo_open else '['}{_fmt(lo)}, {_fmt(hi)}{')' if hi_open else ']'}"
 
 
+def _refuse_non_number(name, value, kind):
+    """Refuse what is not a number at all: text (the command line parses its own options
+    into numbers first), booleans and complex numbers (whose imaginary part would be
+    dropped)."""
+    if isinstance(value, (bool, np.bool_, str, bytes, complex, np.complexfloating)):
+        raise ValueError(f"{name} must be {kind} (got {value!r})")
+
+
 def real(name, value, lo=None, hi=None, *, lo_open=False, hi_open=False):
     """A finite real number in the given range (``None``: unbounded on that side)."""
     if type(value) is float:  # the common case, checked first (a run's fixed cost)
         v = value
     else:
-        if isinstance(value, (bool, np.bool_)) or isinstance(value, str) and not value.strip():
-            raise ValueError(f"{name} must be a real number (got {value!r})")
+        _refuse_non_number(name, value, "a real number")
         try:
             v = float(value)
         except (TypeError, ValueError, OverflowError):
@@ -60,8 +67,7 @@ def real(name, value, lo=None, hi=None, *, lo_open=False, hi_open=False):
 
 def integer(name, value, lo=None, hi=None):
     """An integer in ``[lo, hi]``; integral floats (``3.0``) are accepted, ``True`` is not."""
-    if isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{name} must be an integer (got {value!r})")
+    _refuse_non_number(name, value, "an integer")
     if isinstance(value, numbers.Integral):
         v = int(value)
     else:

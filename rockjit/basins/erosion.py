@@ -258,6 +258,9 @@ def erosion(block, forcing, alphas, grid=100, *, integration=None, classificatio
                                                         execution)
     classification = classification.replace(attractors=True, uncertainty=None)
     lat = grid_basin.lattice(grid)
+    if lat.grid < 2:
+        raise ValueError(f"grid must be >= 2 for an erosion profile: its integrity measures need "
+                         f"a two-dimensional lattice (got {lat.grid})")
     # the whole stack's memory first, before any basin's arrays are made
     first_forcing = forcing.replace(alpha=float(alphas[0]))
     _, _, _, settings = gp.common(block, first_forcing, 0.0, integration, classification)

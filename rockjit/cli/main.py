@@ -214,12 +214,15 @@ def _sweep_plan(args):
 def _basin_plan(args):
     from ..grids import basin
     from ..settings import Lattice
+    from ..validate import memory
     lattice = Lattice(args.grid, tuple(args.theta_range), tuple(args.dtheta_range))
-    return {law: basin.plan(_block(args, law), _forcing(args), lattice,
-                            integration=_integration(args),
-                            classification=_classification(args), lyapunov=args.lyapunov,
-                            execution=_execution(args))
-            for law in _laws(args)}
+    plans = {law: basin.plan(_block(args, law), _forcing(args), lattice,
+                             integration=_integration(args),
+                             classification=_classification(args), lyapunov=args.lyapunov,
+                             execution=_execution(args))
+             for law in _laws(args)}
+    memory(f"--grid {args.grid} for {len(plans)} laws", sum(p.memory_bytes for p in plans.values()))
+    return plans
 
 
 def _plane_plan(args):
@@ -244,6 +247,10 @@ def _erosion_plan(args):
                 float(args.grid) ** 2 * n, dict(periods=args.periods, n_steps=n_steps),
                 execution, 16)
     alphas = _alphas(args)
+    if len(_laws(args)) > 1:
+        grid_memory(f"--grid {args.grid} at {n} amplitudes for {len(_laws(args))} laws",
+                    float(args.grid) ** 2 * n * len(_laws(args)),
+                    dict(periods=args.periods, n_steps=n_steps), execution, 16)
     return {law: erosion.plan(_block(args, law), _forcing(args, alpha=False), alphas, args.grid,
                               integration=integration, classification=_classification(args),
                               execution=execution)

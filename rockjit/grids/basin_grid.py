@@ -67,7 +67,8 @@ def basin(block, forcing, grid=100, *, integration=None, classification=None, ly
     lyapunov = boolean("lyapunov", lyapunov)
     n_pts = settings["pmax"] if classification.attractors else 0
     nbytes = gp.grid_memory(f"grid = {lat.grid}", float(lat.grid) ** 2, settings, execution,
-                            n_pts, lyapunov=lyapunov)
+                            n_pts, lyapunov=lyapunov,
+                            copies=2 if classification.uncertainty else 1)
     th, dth = lat.axes()
     TH, DTH = np.meshgrid(th, dth, indexing="ij")
     y0s = np.stack([TH.ravel(), DTH.ravel(), np.full(TH.size, r0), np.full(TH.size, s0)], 1)

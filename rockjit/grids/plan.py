@@ -119,10 +119,12 @@ def common(block, forcing, phi, integration, classification):
     return par, ipar, cpar, settings
 
 
-def grid_memory(what, n_cells, settings, execution, n_pts=0, n_imp_pts=0, lyapunov=False):
+def grid_memory(what, n_cells, settings, execution, n_pts=0, n_imp_pts=0, lyapunov=False,
+                copies=1):
     """Refuse a grid whose arrays would not fit (``what`` names the parameter that sized it, in
-    the message); returns the bytes it needs."""
-    nbytes = kernel.grid_bytes(n_cells, settings["periods"], settings["n_steps"], n_pts,
+    the message); returns the bytes it needs. ``copies``: outputs held at once (2 for the
+    uncertain-cell test, whose second run's outputs sit beside the first's)."""
+    nbytes = copies * kernel.grid_bytes(n_cells, settings["periods"], settings["n_steps"], n_pts,
                                n_imp_pts, bool(lyapunov),
                                execution.chunk or kernel.default_chunk(int(min(n_cells,
                                                                                MAX_CELLS))),

@@ -90,7 +90,8 @@ def plane(block, alpha_range, omega_range, *, grid=(50, 50), state=None, forcing
     lyapunov = boolean("lyapunov", lyapunov)
     n_pts = settings["pmax"] if classification.attractors else 0
     nbytes = gp.grid_memory(f"grid = ({na}, {nw})", float(M) * na * nw, settings, execution,
-                            n_pts, lyapunov=lyapunov)
+                            n_pts, lyapunov=lyapunov,
+                            copies=2 if classification.uncertainty else 1)
     alphas = np.linspace(a0, a1, na)
     omegas = np.linspace(w0, w1, nw)
     Z, A, W = np.meshgrid(np.arange(M), alphas, omegas, indexing="ij")

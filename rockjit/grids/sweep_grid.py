@@ -72,7 +72,8 @@ def sweep(block, forcing, alphas, state=None, *, integration=None, classificatio
     n_points = gp.n_points("n_points", n_points, settings["periods"] - settings["window"] + 1)
     n_impact_points = integer("n_impact_points", n_impact_points, 0, 10**6)
     nbytes = gp.grid_memory("alphas", n, settings, execution, n_points, n_impact_points,
-                            lyapunov)
+                            lyapunov,
+                            copies=2 if classification.uncertainty else 1)
     y0s = np.tile(np.array([th, dth, r0, s0]), (n, 1))
     pars = np.tile(par, (n, 1))
     kernel.vary(pars, alpha=alphas)

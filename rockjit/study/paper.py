@@ -148,7 +148,7 @@ def plan_paper(*, grid=BASIN_GRID, periods=PERIODS, n_steps=None, alpha_step=ALP
     sizes every basin, the erosion profiles' included unless ``erosion_grid`` says otherwise.
     """
     execution = Execution() if execution is None else execution
-    grid = integer("grid", grid, 1, 10**5)
+    grid = integer("grid", grid, 2, 10**5)
     periods = integer("periods", periods, 1)
     alpha_step = real("alpha_step", alpha_step, 0.0, 1.0, lo_open=True)
     h_rng = STUDY[1]["alpha_range"]["housner"]
@@ -180,7 +180,7 @@ def plan_paper(*, grid=BASIN_GRID, periods=PERIODS, n_steps=None, alpha_step=ALP
                                     integration=integration, execution=execution)
               for hb, alpha, omega in BASIN_CASES for law in ("housner", "mao")}
     erosion_step = real("erosion_step", erosion_step, 1e-6, 1.0)
-    erosion_grid = integer("erosion_grid", erosion_grid, 1, 10**4)
+    erosion_grid = integer("erosion_grid", erosion_grid, 2, 10**4)
     erosions = {(hb, law): erosion.plan(Block(hb=float(hb), law=law),
                                         Harmonic(omega=ev["omega"], r0=0.0, s0=1.0),
                                         alpha_grid(ev["alpha_range"], erosion_step),
