@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from ..grids.grids import classify_result
+from ..single import classify_result
 from ..result import BEHAVIOURS, fractions
 from ..model import delta_e_percent, e_housner, e_mao, thc_from_hb
 
@@ -708,7 +708,7 @@ def fig_plane(plane_result, state=0, title=None):
 
 
 # ---------------------------------------------------------------------------------------------
-# Periodic-orbit branches (rockjit.orbits.orbits) over a sweep
+# Periodic-orbit branches (rockjit.orbits) over a sweep
 # ---------------------------------------------------------------------------------------------
 
 #: Marker of each bifurcation type in :func:`fig_branches`.
@@ -750,8 +750,8 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
 
     Parameters
     ----------
-    continuation : rockjit.orbits.orbits.Continuation
-        From :func:`rockjit.orbits.orbits.continue_branches` (or :func:`~rockjit.orbits.orbits.continuation`).
+    continuation : rockjit.orbits.Continuation
+        From :func:`rockjit.orbits.continue_branches` (or :func:`~rockjit.orbits.continuation`).
     sweep : SweepResult, optional
         Its stroboscopic points are drawn as dots coloured by behaviour; it must be sampled at
         the continuation's forcing phase (``continue_branches`` uses the sweep's).
@@ -874,8 +874,8 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
         lines.append("(no bifurcation located)")
     ax_l.text(0.0, 1.0, "\n".join(lines), va="top", ha="left", family="monospace",
               fontsize=7.5, transform=ax_l.transAxes)
-    b = c.block
-    fixed = (f"\u03c9 = {b.omega:g}" if pname == "alpha" else f"\u03b1 = {b.alpha:g}")
+    b, f = c.block, c.forcing
+    fixed = (f"\u03c9 = {f.omega:g}" if pname == "alpha" else f"\u03b1 = {f.alpha:g}")
     ax.set_title(title or f"Periodic orbits: {_law(b)}, h/b = {b.hb:g}, {fixed}, "
                  f"phase {c.phase:.4g}", fontsize=10)
     return fig
