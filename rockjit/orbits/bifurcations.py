@@ -42,7 +42,9 @@ import numpy as np
 from .shooting import Info, failure
 from .types import Bifurcation, OrbitRefused
 
-__all__ = ["BranchPoint", "Locator", "unit"]
+#: Nothing here is called by users: :class:`Locator` is the continuation's base class
+#: (:mod:`.arclength`), which reports what it locates as :class:`rockjit.orbits.Bifurcation`.
+__all__: list[str] = []
 
 
 class LocateFailed(Exception):
@@ -86,6 +88,8 @@ class Locator:
 
     # -- bifurcations between two branch points -----------------------------------------------
     def detect(self, a, b, form, p, bifs, requests):
+        """Locate each bifurcation whose test function changes sign from ``a`` to ``b``
+        (appended to ``bifs``; a branch to switch onto, to ``requests``)."""
         pa, pb = a.info.psi, b.info.psi
         if pa[0] * pb[0] < 0:
             self.locate(a, b, 0, form, p, bifs, requests)
