@@ -585,14 +585,15 @@ def continue_branches(block, forcing, alpha_range, seeds=None, sweep=None, *, n_
                                    why="a continuation over alpha_range")
     a0, a1 = _range("alpha_range", alpha_range, 0.0)
     n_steps = check_n_steps(n_steps)
+    shooting = None if shooting is None else check_shooting(shooting)
     settings = _settings(settings)
     sl = [] if seeds is None else _seed_list(seeds, "seeds")
     if seeds is None and sweep is None:
         step = real("sweep_step", sweep_step, 0.0, None, lo_open=True)
-        run_settings = check_shooting(shooting)
+        runs = Shooting() if shooting is None else shooting
         sweep = sweep_grid.sweep(block, forcing, gp.alpha_grid((a0, a1), step),
-                                 integration=Integration(theta_over=run_settings.theta_over,
-                                                         rest_speed=run_settings.rest_speed))
+                                 integration=Integration(theta_over=runs.theta_over,
+                                                         rest_speed=runs.rest_speed))
     if sweep is not None:
         _same_system(sweep, block, forcing)
         z = sweep.settings.get("z0")
@@ -605,7 +606,7 @@ def continue_branches(block, forcing, alpha_range, seeds=None, sweep=None, *, n_
             shooting = Shooting(theta_over=sweep.settings.get("theta_over", 0.5 * math.pi),
                                 rest_speed=sweep.settings.get("rest_speed", 1e-6))
         sl += _sweep_seeds(sweep, settings.max_period)
-    shooting = check_shooting(shooting)
+    shooting = Shooting() if shooting is None else shooting
     forcing = forcing.replace(phase=phase, r0=None, s0=None)
     return _run(block, forcing, "alpha", (a0, a1), sl, n_steps, shooting, settings,
                 lambda v, p: f"seed p={p} at alpha = {v:.6g}")
@@ -618,7 +619,16 @@ def continue_branches(block, forcing, alpha_range, seeds=None, sweep=None, *, n_
 @dataclass(frozen=True)
 class OrbitsPlan:
     """A validated :func:`orbits_of_sweep`: the seeding sweep's plan and the continuation's
-    inputs."""
+    inputs, from ``orbits_of_sweep.plan(...)``; :func:`run` executes it.
+
+    Examples
+    --------
+    >>> from rockjit import Block, Harmonic
+    >>> from rockjit.orbits import orbits_of_sweep
+    >>> plan = orbits_of_sweep.plan(Block(hb=1), Harmonic(omega=1.3), (0.5, 1.0))
+    >>> plan.sweep_plan.axes["alpha"].size, plan.n_steps, plan.settings.max_period
+    (501, 384, 8)
+    """
 
     sweep_plan: gp.GridPlan
     block: object
@@ -630,9 +640,31 @@ class OrbitsPlan:
 
 
 def run(plan: OrbitsPlan, execution=None):
-    """Execute an :class:`OrbitsPlan`: the sweep (with ``execution``, a
-    :class:`rockjit.Execution`: progress, Dask, a chunk store), then the branches from its
-    periodic attractors. Returns ``(Continuation, SweepResult)``."""
+    """Execute an :class:`OrbitsPlan`: the sweep, then the branches from its periodic
+    attractors (:func:`continue_branches`).
+
+    Parameters
+    ----------
+    plan : OrbitsPlan
+        From ``orbits_of_sweep.plan(...)``.
+    execution : Execution, optional
+        How the sweep runs (threads, chunks, a Dask cluster, a chunk store, progress); default
+        in this process with all threads. It never changes a result.
+
+    Returns
+    -------
+    (Continuation, SweepResult)
+
+    Examples
+    --------
+    >>> from rockjit import Block, Execution, Harmonic
+    >>> from rockjit.orbits import ContinuationSettings, arclength, orbits_of_sweep
+    >>> plan = orbits_of_sweep.plan(Block(hb=1), Harmonic(omega=1.3), (0.79, 0.81),
+    ...                             alpha_step=0.01, settings=ContinuationSettings(switch=False))
+    >>> cont, sw = arclength.run(plan, Execution(progress=False))
+    >>> len(cont.branches), round(cont.phase, 6)
+    (1, -0.891245)
+    """
     sw = gp.run(plan.sweep_plan, Execution() if execution is None else execution)
     cont = continue_branches(plan.block, plan.forcing, plan.alpha_range, sweep=sw,
                              n_steps=plan.n_steps, shooting=plan.shooting,

@@ -74,8 +74,8 @@ def _fraction(name, value):
 
 @dataclass(frozen=True)
 class Shooting:
-    """How a periodic orbit is solved for, and when it is refused (:mod:`rockjit.orbits`,
-    "Shooting" and "Refusals").
+    """How a periodic orbit is solved for, and when it is refused
+    (:mod:`rockjit.orbits.shooting`, "Shooting" and "Refusals").
 
     Parameters
     ----------
@@ -136,7 +136,7 @@ class Shooting:
 
 @dataclass(frozen=True)
 class ContinuationSettings:
-    """How branches are followed (:mod:`rockjit.orbits`, "Continuation").
+    """How branches are followed (:mod:`rockjit.orbits.arclength`, "Continuation").
 
     Parameters
     ----------
@@ -221,7 +221,8 @@ class PeriodicOrbit:
         Forcing amplitude, frequency and phase.
     residual : float
         ``max|P^p(x) - x|`` at ``section_phase``: the requested phase, unless an impact sits so
-        close to it that Newton worked on a shifted section only (:mod:`rockjit.orbits`).
+        close to it that Newton worked on a shifted section only
+        (:mod:`rockjit.orbits.shooting`, "Section").
     multipliers : ndarray of complex, shape (2,)
         Floquet multipliers, largest modulus first.
     stable : bool
@@ -229,7 +230,8 @@ class PeriodicOrbit:
     impacts : int
         Impacts over one cycle (``p`` periods).
     symmetric : bool
-        ``x(t + pT/2) = -x(t)`` at every cycle point (:mod:`rockjit.orbits`).
+        ``x(t + pT/2) = -x(t)`` at every cycle point (:mod:`rockjit.orbits.shooting`,
+        "Symmetry").
     cycle, cycle_half : ndarray, shape (p, 2)
         The cycle's points at ``kT`` and at ``kT + T/2``.
     iterations : int
