@@ -1,8 +1,8 @@
-"""Issue 13: the speed of shooting and continuation, and the accuracy of the located bifurcations.
+"""The speed of shooting and continuation, and the accuracy of the located bifurcations.
 
 On the study's case (hb=1, Housner, omega=1.3, alpha in [0.5, 1.0]):
 
-1. one Newton solve of a period-1 orbit (``rockjit.orbits.orbits.periodic_orbit``, alpha = 0.8, the
+1. one Newton solve of a period-1 orbit (``rockjit.orbits.periodic_orbit``, alpha = 0.8, the
    asymmetric orbit, seeded from the sweep cell's stroboscopic point): median of repeats, warm
    (target 5 ms);
 2. ``continue_branches`` over [0.5, 1.0] from the study's sweep (step 0.001), every branch of
@@ -45,11 +45,13 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import _common as C  # noqa: E402
 
 import rockjit  # noqa: E402
-from rockjit.grids import grids as analysis  # noqa: E402
-from rockjit.orbits import orbits  # noqa: E402
+from rockjit import Block, Harmonic, Integration, orbits  # noqa: E402
+from rockjit.orbits import shooting  # noqa: E402
 from rockjit.plotting import figures as plotting  # noqa: E402
 
 CASE = dict(hb=1.0, law="housner", omega=1.3)
+BLOCK = Block(hb=CASE["hb"], law=CASE["law"])
+SWEEP_FORCING = Harmonic(omega=CASE["omega"])
 RANGE = (0.5, 1.0)
 NEWTON_ALPHA = 0.8
 TARGET_NEWTON_S = 5e-3
@@ -60,17 +62,18 @@ _PROBE = textwrap.dedent("""
     import json, statistics, sys, time
     t0 = time.perf_counter()
     import numpy as np
-    from rockjit import Block
-    from rockjit.orbits import orbits
+    from rockjit import Block, Harmonic
+    from rockjit import orbits
     t1 = time.perf_counter()
     a = json.loads(sys.argv[1])
-    b = Block(hb=a["hb"], alpha=a["alpha"], omega=a["omega"], law=a["law"])
-    orbits.periodic_orbit(b, a["seed"], 1, phase=a["phase"])
+    b = Block(hb=a["hb"], law=a["law"])
+    f = Harmonic(alpha=a["alpha"], omega=a["omega"], phase=a["phase"])
+    orbits.periodic_orbit(b, f, a["seed"], 1)
     t2 = time.perf_counter()
     warm = []
     for _ in range(20):
         s = time.perf_counter()
-        orbits.periodic_orbit(b, a["seed"], 1, phase=a["phase"])
+        orbits.periodic_orbit(b, f, a["seed"], 1)
         warm.append(time.perf_counter() - s)
     w = statistics.median(warm)
     print(json.dumps(dict(import_s=t1 - t0, first_s=t2 - t1, warm_s=w, compile_s=t2 - t1 - w)))
@@ -91,12 +94,13 @@ def probe(args: dict, cache_dir: str | None) -> dict:
 
 
 class Timer:
-    """Wraps ``rockjit.orbits.orbits.simulate`` to count its calls and the time spent in them."""
+    """Wraps ``rockjit.orbits.shooting.simulate`` (every run of the orbits) to count its calls
+    and the time spent in them."""
 
     def __init__(self):
         self.calls = 0
         self.seconds = 0.0
-        self.inner = orbits.simulate
+        self.inner = shooting.simulate
 
     def __call__(self, *a, **k):
         t = time.perf_counter()
@@ -107,11 +111,11 @@ class Timer:
             self.calls += 1
 
     def __enter__(self):
-        orbits.simulate = self
+        shooting.simulate = self
         return self
 
     def __exit__(self, *exc):
-        orbits.simulate = self.inner
+        shooting.simulate = self.inner
 
 
 def sweep_seed(sw, alpha):
@@ -124,12 +128,13 @@ def call_cost(phase, seed, repeats):
     """Median time of one tangent run (default N) over 1, 2, 4, 8, 16 periods, linear fit."""
     P = np.array([1, 2, 4, 8, 16])
     med = []
+    forcing = Harmonic(alpha=NEWTON_ALPHA, omega=CASE["omega"], phase=phase)
     for p in P:
-        kw = dict(**{k: CASE[k] for k in ("hb", "omega", "law")}, alpha=NEWTON_ALPHA,
-                  theta0=seed[0], dtheta0=seed[1], phase=phase, periods=int(p),
-                  n_steps=orbits.N_ORBIT, lyapunov=True, qr_every=0, record_stride=1)
-        rockjit.simulate(**kw)
-        ts = [C.timed(rockjit.simulate, **kw)[0] for _ in range(repeats)]
+        args = (BLOCK, forcing, (seed[0], seed[1]))
+        kw = dict(integration=Integration(periods=int(p), n_steps=orbits.N_ORBIT, qr_every=0),
+                  lyapunov=True, record_stride=1)
+        rockjit.simulate(*args, **kw)
+        ts = [C.timed(rockjit.simulate, *args, **kw)[0] for _ in range(repeats)]
         med.append(C.median(ts))
     slope, icpt = np.polyfit(P, med, 1)
     return dict(periods=P.tolist(), median_s=med, per_call_s=float(icpt),
@@ -146,15 +151,15 @@ def residual_study(cont, ns, n_ref, per_branch):
                 if ok.size else []:
             samples.append((float(br.value[k]), br.cycle[k].copy(), br.period))
     for a, cyc, p in samples:
-        b = rockjit.Block(hb=CASE["hb"], alpha=a, omega=CASE["omega"], law=CASE["law"])
+        f = Harmonic(alpha=a, omega=CASE["omega"], phase=cont.phase)
         for n in ns:
             try:
-                o = orbits.periodic_orbit(b, cyc, p, phase=cont.phase, n_steps=n, graze_tol=0)
+                o = orbits.periodic_orbit(BLOCK, f, cyc, p, n_steps=n,
+                                          shooting=orbits.Shooting(graze_tol=0))
             except orbits.OrbitRefused:
                 continue
-            r = rockjit.simulate(**{k: CASE[k] for k in ("hb", "omega", "law")}, alpha=a,
-                                 theta0=o.state[0], dtheta0=o.state[1], phase=cont.phase,
-                                 periods=p, n_steps=n_ref)
+            r = rockjit.simulate(BLOCK, f, (o.state[0], o.state[1]),
+                                 integration=Integration(periods=p, n_steps=n_ref))
             out[n].append(float(np.abs(r.strobe[p, :2] - o.state).max()))
     return {n: dict(max=max(v) if v else math.nan, median=C.median(v) if v else math.nan,
                     count=len(v)) for n, v in out.items()}, len(samples)
@@ -184,17 +189,15 @@ def main(argv=None):
     print(C.env_line(env))
 
     # -- the sweep (seeds), first calls (compile or load from cache) --------------------------
-    t_sweep0, sw = C.timed(analysis.sweep, CASE["hb"], CASE["omega"], law=CASE["law"],
-                           alpha_range=RANGE, alpha_step=step)
-    t_sweep, sw = C.timed(analysis.sweep, CASE["hb"], CASE["omega"], law=CASE["law"],
-                          alpha_range=RANGE, alpha_step=step)
+    alphas = rockjit.alpha_grid(RANGE, step)
+    t_sweep0, sw = C.timed(rockjit.sweep, BLOCK, SWEEP_FORCING, alphas)
+    t_sweep, sw = C.timed(rockjit.sweep, BLOCK, SWEEP_FORCING, alphas)
     z = sw.settings["z0"]
     phase = math.atan2(z[2], z[3])
     a_seed, seed = sweep_seed(sw, NEWTON_ALPHA)
-    blk = rockjit.Block(hb=CASE["hb"], alpha=a_seed, omega=CASE["omega"], law=CASE["law"])
-    t_first_newton, orb = C.timed(orbits.periodic_orbit, blk, seed, 1, phase=phase)
-    t_first_cont, _ = C.timed(orbits.continue_branches, CASE["hb"], CASE["law"],
-                              CASE["omega"], RANGE, sweep=sw)
+    frc = Harmonic(alpha=a_seed, omega=CASE["omega"], phase=phase)
+    t_first_newton, orb = C.timed(orbits.periodic_orbit, BLOCK, frc, seed, 1)
+    t_first_cont, _ = C.timed(orbits.continue_branches, BLOCK, SWEEP_FORCING, RANGE, sweep=sw)
     print(f"sweep {t_sweep:.3f} s (first {t_sweep0:.3f} s); first solve {t_first_newton:.3f} s;"
           f" first continuation {t_first_cont:.3f} s")
 
@@ -204,14 +207,13 @@ def main(argv=None):
     rough = seed + np.array([0.02, -0.02])
 
     def newton():
-        res["newton"] = orbits.periodic_orbit(blk, seed, 1, phase=phase)
+        res["newton"] = orbits.periodic_orbit(BLOCK, frc, seed, 1)
 
     def newton_rough():
-        res["rough"] = orbits.periodic_orbit(blk, rough, 1, phase=phase)
+        res["rough"] = orbits.periodic_orbit(BLOCK, frc, rough, 1)
 
     def cont():
-        res["cont"] = orbits.continue_branches(CASE["hb"], CASE["law"], CASE["omega"], RANGE,
-                                               sweep=sw)
+        res["cont"] = orbits.continue_branches(BLOCK, SWEEP_FORCING, RANGE, sweep=sw)
 
     times = C.side_by_side({"newton": newton, "rough": newton_rough, "cont": cont}, rep_newton,
                            counts={"cont": rep_cont}).wall
@@ -230,8 +232,7 @@ def main(argv=None):
 
     # -- 3, 4: calls and where the time goes ----------------------------------------------------
     with Timer() as tm:
-        t_prof, c2 = C.timed(orbits.continue_branches, CASE["hb"], CASE["law"], CASE["omega"],
-                             RANGE, sweep=sw)
+        t_prof, c2 = C.timed(orbits.continue_branches, BLOCK, SWEEP_FORCING, RANGE, sweep=sw)
     cost = call_cost(phase, orb.state, 5 if quick else 41)
     located = [b for b in c.bifurcations if b.type != "grazing"]
     calls_per_bif = [b.n_simulate for b in located]
@@ -247,8 +248,7 @@ def main(argv=None):
         print(f"N = {n}: largest residual in a converged run {resid[n]['max']:.2g} "
               f"({resid[n]['count']} orbits)")
     n2 = 2 * orbits.N_ORBIT
-    c2n = orbits.continue_branches(CASE["hb"], CASE["law"], CASE["omega"], RANGE, sweep=sw,
-                                   n_steps=n2)
+    c2n = orbits.continue_branches(BLOCK, SWEEP_FORCING, RANGE, sweep=sw, n_steps=n2)
     shift = match_shift(c, c2n)
 
     # -- 6: compile time --------------------------------------------------------------------

@@ -1,4 +1,4 @@
-"""Periodic orbits (rockjit.orbits.orbits): shooting, continuation and bifurcations against independent
+"""Periodic orbits (rockjit.orbits): shooting, continuation and bifurcations against independent
 references: plain and scipy runs, finite differences, Lyapunov exponents, brute-force sweeps."""
 
 import math
@@ -7,51 +7,51 @@ import numpy as np
 import pytest
 
 import rockjit
-from rockjit import Block
-from rockjit.grids import grids as analysis
-from rockjit.orbits import orbits
-from rockjit.orbits.orbits import OrbitRefused
+from rockjit import Block, Harmonic, Integration, orbits
+from rockjit.orbits import ContinuationSettings, OrbitRefused, Shooting
 
 HB, OMEGA = 1.0, 1.3
 T = 2 * math.pi / OMEGA
+BLOCK = Block(hb=HB, law="housner")
+SWEEP_FORCING = Harmonic(omega=OMEGA)
 
 
-def block(alpha, **kw):
-    return Block(hb=HB, alpha=alpha, omega=OMEGA, law="housner", **kw)
+def forcing(alpha, phase=0.0):
+    return Harmonic(alpha=alpha, omega=OMEGA, phase=phase)
 
 
 def settle(alpha, x0=(0.1, 0.0), periods=400):
     """A plain long run at phase 0: the attractor's stroboscopic point (an independent seed)."""
-    r = rockjit.simulate(HB, alpha, OMEGA, "housner", theta0=x0[0], dtheta0=x0[1], phase=0.0,
-                         periods=periods)
+    r = rockjit.simulate(BLOCK, forcing(alpha), x0, integration=Integration(periods=periods))
     assert r.status == "done"
     return r.strobe[-1, :2]
 
 
-def plain(x, alpha, p, phase=0.0, n_steps=4096, **kw):
-    return rockjit.simulate(HB, alpha, OMEGA, "housner", theta0=x[0], dtheta0=x[1],
-                            phase=phase, periods=p, n_steps=n_steps, **kw)
+def plain(x, alpha, p, phase=0.0, n_steps=4096, record_stride=None):
+    return rockjit.simulate(BLOCK, forcing(alpha, phase), (x[0], x[1]),
+                            integration=Integration(periods=p, n_steps=n_steps),
+                            record_stride=record_stride)
 
 
 @pytest.fixture(scope="module")
 def asym08():
     """The study's asymmetric orbit (alpha = 0.8), stable, real multipliers."""
-    return orbits.periodic_orbit(block(0.8), settle(0.8) + 0.01, 1)
+    return orbits.periodic_orbit(BLOCK, forcing(0.8), settle(0.8) + 0.01, 1)
 
 
 @pytest.fixture(scope="module")
 def sym085():
     """The symmetric orbit continued past its pitchfork: unstable (seeded from alpha = 0.75)."""
-    seed = orbits.periodic_orbit(block(0.75), settle(0.75), 1)
+    seed = orbits.periodic_orbit(BLOCK, forcing(0.75), settle(0.75), 1)
     assert seed.symmetric and seed.stable
-    return orbits.periodic_orbit(block(0.85), seed.state, 1)
+    return orbits.periodic_orbit(BLOCK, forcing(0.85), seed.state, 1)
 
 
 @pytest.fixture(scope="module")
 def study():
     """The hb=1 Housner branches over [0.5, 1.0] from a sweep's attractors."""
-    sw = analysis.sweep(HB, OMEGA, law="housner", alpha_range=(0.5, 1.0), alpha_step=0.002)
-    return sw, orbits.continue_branches(HB, "housner", OMEGA, (0.5, 1.0), sweep=sw)
+    sw = rockjit.sweep(BLOCK, SWEEP_FORCING, rockjit.alpha_grid((0.5, 1.0), 0.002))
+    return sw, orbits.continue_branches(BLOCK, SWEEP_FORCING, (0.5, 1.0), sweep=sw)
 
 
 def of_type(cont, kind, period=None, lo=-math.inf, hi=math.inf):
@@ -64,7 +64,7 @@ def of_type(cont, kind, period=None, lo=-math.inf, hi=math.inf):
 @pytest.mark.parametrize("alpha,p,x0", [(0.8, 1, (0.1, 0.0)), (0.92, 2, (0.1, 0.0)),
                                          (0.6, 1, (0.3, 0.0))])
 def test_fixed_point_confirmed_by_a_converged_plain_run(alpha, p, x0):
-    o = orbits.periodic_orbit(block(alpha), settle(alpha, x0) + 0.005, p)
+    o = orbits.periodic_orbit(BLOCK, forcing(alpha), settle(alpha, x0) + 0.005, p)
     assert o.residual <= 1e-11
     # an independent run (no tangent vectors, 16x finer grid) over p periods
     r = plain(o.state, alpha, p)
@@ -100,9 +100,8 @@ def test_multipliers_against_scipy_finite_differences(asym08, sym085):
             for sgn in (1, -1):
                 x = o.state.copy()
                 x[i] += sgn * h
-                r = rockjit.simulate(HB, o.alpha, OMEGA, "housner", theta0=x[0], dtheta0=x[1],
-                                     phase=o.phase, periods=1, method="scipy:DOP853",
-                                     rtol=1e-12, atol=1e-12)
+                r = rockjit.simulate(o.block, o.forcing, x, integration=Integration(periods=1),
+                                     method=rockjit.Scipy("DOP853", rtol=1e-12, atol=1e-12))
                 assert r.n_impacts == o.impacts
                 cols.append(r.strobe[1, :2])
             M[:, i] = (cols[0] - cols[1]) / (2 * h)
@@ -123,9 +122,10 @@ def test_det_monodromy_identity(asym08, sym085):
 
 def test_lyapunov_exponents_equal_log_multipliers(asym08):
     o = asym08
-    r = rockjit.simulate(HB, 0.8, OMEGA, "housner", theta0=o.state[0], dtheta0=o.state[1],
-                         phase=o.phase, periods=300, n_steps=o.n_steps, lyapunov=True,
-                         window=100)
+    assert o.forcing == Harmonic(alpha=0.8, omega=OMEGA, phase=o.phase)
+    r = rockjit.simulate(o.block, o.forcing, o.state,
+                         integration=Integration(periods=300, n_steps=o.n_steps, window=100),
+                         lyapunov=True)
     assert r.status == "done"
     lam = np.log(np.abs(o.multipliers)) / T
     assert np.allclose(r.lyapunov, lam, rtol=0, atol=1e-10)
@@ -137,7 +137,7 @@ def test_phase_is_the_section_and_states_match_a_trajectory(asym08):
     # 2 pi j / N is the instant t = j T / N
     o = asym08
     j, n = 37, 4096
-    o2 = orbits.periodic_orbit(block(0.8), o.state, 1, phase=2 * math.pi * j * 16 / n)
+    o2 = orbits.periodic_orbit(BLOCK, forcing(0.8, 2 * math.pi * j * 16 / n), o.state, 1)
     assert np.allclose(np.sort(np.abs(o2.multipliers)), np.sort(np.abs(o.multipliers)),
                        rtol=1e-8)
     r = plain(o.state, 0.8, 1, record_stride=16, n_steps=n)
@@ -148,36 +148,55 @@ def test_phase_is_the_section_and_states_match_a_trajectory(asym08):
 
 def test_refusals():
     with pytest.raises(OrbitRefused) as e:
-        orbits.periodic_orbit(block(0.8), (1.4, 2.0))
+        orbits.periodic_orbit(BLOCK, forcing(0.8), (1.4, 2.0))
     assert e.value.reason == "overturn"
     assert plain((1.4, 2.0), 0.8, 1, n_steps=256).status == "overturned"
     with pytest.raises(OrbitRefused) as e:
-        orbits.periodic_orbit(block(0.4), (0.05, 0.0))
+        orbits.periodic_orbit(BLOCK, forcing(0.4), (0.05, 0.0))
     assert e.value.reason == "rest"
     assert plain((0.05, 0.0), 0.4, 1, n_steps=256).status == "rest"
     with pytest.raises(OrbitRefused) as e:
-        orbits.periodic_orbit(block(0.65), (0.01, 0.0))
+        orbits.periodic_orbit(BLOCK, forcing(0.65), (0.01, 0.0))
     assert e.value.reason == "passes_through_rest"
     assert plain((0.01, 0.0), 0.65, 1, n_steps=256).n_rest > 0
 
 
 def test_bad_input():
     with pytest.raises(ValueError, match="p must be"):
-        orbits.periodic_orbit(block(0.8), (0.1, 0.1), 0)
+        orbits.periodic_orbit(BLOCK, forcing(0.8), (0.1, 0.1), 0)
     with pytest.raises(ValueError, match="x0"):
-        orbits.periodic_orbit(block(0.8), (0.1, 0.1, 0.2))
+        orbits.periodic_orbit(BLOCK, forcing(0.8), (0.1, 0.1, 0.2))
     with pytest.raises(ValueError, match="x0 must be finite"):
-        orbits.periodic_orbit(block(0.8), (0.1, math.nan))
+        orbits.periodic_orbit(BLOCK, forcing(0.8), (0.1, math.nan))
     with pytest.raises(ValueError, match="n_steps must be even"):
-        orbits.periodic_orbit(block(0.8), (0.1, 0.1), n_steps=255)
-    with pytest.raises(ValueError, match="block_or_params"):
-        orbits.periodic_orbit(0.8, (0.1, 0.1))
+        orbits.periodic_orbit(BLOCK, forcing(0.8), (0.1, 0.1), n_steps=255)
+    with pytest.raises(ValueError, match="block must be a rockjit.Block"):
+        orbits.periodic_orbit(0.8, forcing(0.8), (0.1, 0.1))
     with pytest.raises(ValueError, match="parameter must be"):
-        orbits.continuation(block(0.8), [], parameter="xi", bounds=(0.5, 1.0))
+        orbits.continuation(BLOCK, forcing(0.8), [], parameter="xi", bounds=(0.5, 1.0))
     with pytest.raises(ValueError, match="alpha_range"):
-        orbits.continue_branches(HB, "housner", OMEGA, (1.0, 0.5), seeds=[])
+        orbits.continue_branches(BLOCK, SWEEP_FORCING, (1.0, 0.5), seeds=[])
     with pytest.raises(ValueError, match=r"seeds\[0\]"):
-        orbits.continuation(block(0.8), [(0.8, (0.1,), 1)], bounds=(0.5, 1.0))
+        orbits.continuation(BLOCK, forcing(0.8), [(0.8, (0.1,), 1)], bounds=(0.5, 1.0))
+    # the excitation: alpha and omega for one orbit, no alpha where it is continued
+    with pytest.raises(ValueError, match="needs the excitation's alpha"):
+        orbits.periodic_orbit(BLOCK, SWEEP_FORCING, (0.1, 0.1))
+    with pytest.raises(ValueError, match="sweeps alpha itself"):
+        orbits.continue_branches(BLOCK, forcing(0.8), (0.5, 1.0), seeds=[])
+    with pytest.raises(ValueError, match="closed-form"):
+        orbits.periodic_orbit(BLOCK, Harmonic(alpha=0.8, omega=OMEGA, embedded=True),
+                              (0.1, 0.1))
+    # the settings objects, validated where they are made
+    with pytest.raises(ValueError, match="graze_tol must be in"):
+        Shooting(graze_tol=1.5)
+    with pytest.raises(ValueError, match="tol must be > 0"):
+        Shooting(tol=0)
+    with pytest.raises(ValueError, match="need ds_min <= ds0 <= ds_max"):
+        ContinuationSettings(ds_max=1e-3)
+    with pytest.raises(ValueError, match="max_period must be"):
+        ContinuationSettings(max_period=0)
+    with pytest.raises(ValueError, match="settings must be"):
+        orbits.continuation(BLOCK, forcing(0.8), [], bounds=(0.5, 1.0), settings=dict(ds0=1))
 
 
 # --------------------------------------------------------------------------- continuation
@@ -189,8 +208,7 @@ def test_period_doubling_where_the_sweeps_period_two_window_opens(study):
     a = pd[0].alpha
     assert 0.90 < a < 0.92  # the gallery's period-2 orbit (alpha = 0.92) lies just beyond
     # a brute-force sweep from the study's z0 on either side of it
-    near = analysis.sweep(HB, OMEGA, [a - 0.004, a - 0.002, a + 0.002, a + 0.004],
-                          law="housner")
+    near = rockjit.sweep(BLOCK, SWEEP_FORCING, [a - 0.004, a - 0.002, a + 0.002, a + 0.004])
     assert list(near.period) == [1, 1, 2, 2]
     # the doubled branch was switched onto and is stable beyond the point
     br = cont.branches[pd[0].new_branch]
@@ -231,8 +249,8 @@ def test_located_to_1e8_by_independent_shooting(study):
         c = -1.0 if b.type == "period_doubling" else 1.0
         side = []
         for da in (-2e-8, 2e-8):
-            o = orbits.periodic_orbit(block(b.alpha + da), b.state, b.period, phase=cont.phase,
-                                      graze_tol=0)
+            o = orbits.periodic_orbit(BLOCK, forcing(b.alpha + da, cont.phase), b.state,
+                                      b.period, shooting=Shooting(graze_tol=0))
             assert o.symmetric == (b.type == "symmetry_breaking")
             mu = o.multipliers[np.argmin(np.abs(o.multipliers - c))]
             side.append(np.sign(abs(mu.real) - 1.0))
@@ -249,11 +267,12 @@ def test_symmetry_breaking_near_078(study):
     # independent: plain runs from the symmetric orbit, slightly perturbed, settle on a
     # symmetric orbit below the point and on an asymmetric one above it
     for da, want in ((-0.005, "symmetric"), (0.005, "asymmetric")):
-        o = orbits.periodic_orbit(block(a + da), sb[0].state, 1, phase=cont.phase)
+        o = orbits.periodic_orbit(BLOCK, forcing(a + da, cont.phase), sb[0].state, 1)
         assert o.symmetric and o.stable == (da < 0)
-        r = rockjit.simulate(HB, a + da, OMEGA, "housner", theta0=o.state[0] + 1e-6,
-                             dtheta0=o.state[1], phase=cont.phase, periods=1500)
-        assert analysis.classify_result(r) == (want, 1)
+        r = rockjit.simulate(BLOCK, forcing(a + da, cont.phase),
+                             (o.state[0] + 1e-6, o.state[1]),
+                             integration=Integration(periods=1500))
+        assert rockjit.classify_result(r) == (want, 1)
     # the sweep labels the two sides the same way
     def label(x):
         return str(sw.names[sw.label[int(np.argmin(np.abs(sw.alpha - x)))]])
@@ -278,7 +297,7 @@ def test_every_periodic_sweep_cell_lies_on_a_stable_branch(study):
             k = int(np.argmin(dist))
             if dist[k] > 0.02:
                 continue
-            o = orbits.periodic_orbit(block(a), br.cycle[k], p, phase=cont.phase)
+            o = orbits.periodic_orbit(BLOCK, forcing(a, cont.phase), br.cycle[k], p)
             for cyc in (o.cycle, -o.cycle_half):
                 d = min(np.abs(pts - np.roll(cyc, s, axis=0)).max() for s in range(p))
                 hit |= d <= 1e-5 * scale  # the sweep's grid is N = 64
@@ -309,7 +328,8 @@ def test_grazing_end_of_the_unstable_symmetric_arm(study):
     depth = []
     (a1, a2) = (a - 3e-7, a - 1e-7)
     for al in (a1, a2):
-        o = orbits.periodic_orbit(block(al), g[0].state, 1, phase=cont.phase, graze_tol=0)
+        o = orbits.periodic_orbit(BLOCK, forcing(al, cont.phase), g[0].state, 1,
+                                  shooting=Shooting(graze_tol=0))
         assert o.impacts == 2 and not o.stable
         r = plain(o.state, al, 1, phase=cont.phase, record_stride=1, n_steps=16384)
         th = r.trajectory[:, 1]
@@ -323,7 +343,7 @@ def test_grazing_end_of_the_unstable_symmetric_arm(study):
     a0 = a1 - depth[0] * (a2 - a1) / (depth[1] - depth[0])
     assert abs(a0 - a) < 1e-8
     with pytest.raises(OrbitRefused) as e:
-        orbits.periodic_orbit(block(a - 5e-7), g[0].state, 1, phase=cont.phase)
+        orbits.periodic_orbit(BLOCK, forcing(a - 5e-7, cont.phase), g[0].state, 1)
     assert e.value.reason == "grazing"
 
 
@@ -338,8 +358,9 @@ def test_cascade_ratios_approach_feigenbaums(study):
 
 
 def test_continuation_in_omega_uses_the_same_code(asym08):
-    c = orbits.continuation(block(0.8), [(OMEGA, asym08.state, 1)], parameter="omega",
-                            bounds=(1.25, 1.35), switch=False)
+    c = orbits.continuation(BLOCK, Harmonic(alpha=0.8), [(OMEGA, asym08.state, 1)],
+                            parameter="omega", bounds=(1.25, 1.35),
+                            settings=ContinuationSettings(switch=False))
     br = c.branches[0]
     k = int(np.argmin(np.abs(br.value - OMEGA)))
     assert abs(br.value[k] - OMEGA) < 1e-12
@@ -349,8 +370,8 @@ def test_continuation_in_omega_uses_the_same_code(asym08):
     for k in (0, len(br) // 2, len(br) - 1):
         w = br.value[k]
         x = br.cycle[k, 0]
-        r = rockjit.simulate(HB, 0.8, w, "housner", theta0=x[0], dtheta0=x[1], phase=0.0,
-                             periods=1, n_steps=4096)
+        r = rockjit.simulate(BLOCK, Harmonic(alpha=0.8, omega=w, phase=0.0), x,
+                             integration=Integration(periods=1, n_steps=4096))
         assert np.abs(r.strobe[1, :2] - x).max() <= 1e-9
 
 
@@ -391,9 +412,62 @@ def test_fig_branches(study):
 def test_branches_and_bifurcations_stay_inside_the_range():
     # the asymmetric branch switched onto at Mao hb=1's symmetry breaking (alpha = 0.7876) was
     # followed to alpha = 1.93 and a grazing reported there, outside the requested (0.3, 0.8)
-    from rockjit.grids import grids as an
-    sw = an.sweep(1.0, 1.3, law="mao", alpha_range=(0.3, 0.8), alpha_step=0.004, periods=300)
-    c = orbits.continue_branches(1.0, "mao", 1.3, (0.3, 0.8), sweep=sw)
+    mao = Block(hb=1.0, law="mao")
+    sw = rockjit.sweep(mao, Harmonic(omega=1.3), rockjit.alpha_grid((0.3, 0.8), 0.004),
+                       integration=Integration(periods=300))
+    c = orbits.continue_branches(mao, Harmonic(omega=1.3), (0.3, 0.8), sweep=sw)
     assert c.bifurcations and all(0.3 <= b.alpha <= 0.8 for b in c.bifurcations)
     for br in c.branches:
         assert br.value.min() >= 0.3 - 1e-9 and br.value.max() <= 0.8 + 1e-9
+
+
+def test_a_periodic_orbit_seeds_a_continuation_at_its_own_section(asym08):
+    c = orbits.continuation(asym08.block, asym08.forcing, [asym08], bounds=(0.79, 0.81),
+                            settings=ContinuationSettings(switch=False))
+    assert c.forcing == Harmonic(omega=OMEGA, phase=asym08.phase)
+    br = c.branches[0]
+    k = int(np.argmin(np.abs(br.value - 0.8)))
+    assert abs(br.value[k] - 0.8) < 1e-12
+    assert np.abs(br.cycle[k] - asym08.cycle).max() <= 1e-10
+    with pytest.raises(ValueError, match="phase"):
+        orbits.continuation(BLOCK, forcing(0.8, 0.3), [asym08], bounds=(0.79, 0.81))
+    with pytest.raises(ValueError, match="omega"):
+        orbits.continuation(BLOCK, Harmonic(omega=1.2), [asym08], bounds=(0.79, 0.81))
+
+
+def test_a_sweep_fixes_the_section(study):
+    sw, cont = study
+    z = sw.settings["z0"]
+    assert cont.phase == math.atan2(z[2], z[3]) and cont.forcing.phase == cont.phase
+    with pytest.raises(ValueError, match="the sweep's forcing phase"):
+        orbits.continue_branches(BLOCK, Harmonic(omega=OMEGA, phase=0.3), (0.5, 1.0), sweep=sw)
+    with pytest.raises(ValueError, match="sweep must be of the same block"):
+        orbits.continue_branches(Block(hb=2), SWEEP_FORCING, (0.5, 1.0), sweep=sw)
+
+
+def test_orbits_of_sweep_plans_then_runs_the_sweep_and_its_branches():
+    """The command line's entry point: its plan refuses bad input before any run, and its run
+    is the sweep followed by continue_branches on it."""
+    with pytest.raises(ValueError, match="alpha_step"):
+        orbits.orbits_of_sweep.plan(BLOCK, SWEEP_FORCING, (0.75, 0.85), alpha_step=0)
+    with pytest.raises(ValueError, match="n_steps must be even"):
+        orbits.orbits_of_sweep.plan(BLOCK, SWEEP_FORCING, (0.75, 0.85), n_steps=383)
+    with pytest.raises(ValueError, match="execution must be"):
+        orbits.orbits_of_sweep.plan(BLOCK, SWEEP_FORCING, (0.75, 0.85), execution="threads")
+    settings = ContinuationSettings(max_period=2)
+    plan = orbits.orbits_of_sweep.plan(BLOCK, SWEEP_FORCING, (0.75, 0.85), alpha_step=0.01,
+                                       settings=settings)
+    assert plan.sweep_plan.axes["alpha"].size == 11 and plan.settings is settings
+    cont, sw = orbits.orbits_of_sweep(BLOCK, SWEEP_FORCING, (0.75, 0.85), alpha_step=0.01,
+                                      settings=settings,
+                                      execution=rockjit.Execution(progress=False))
+    ref_sw = rockjit.sweep(BLOCK, SWEEP_FORCING, rockjit.alpha_grid((0.75, 0.85), 0.01))
+    assert np.array_equal(sw.label, ref_sw.label)
+    assert np.array_equal(sw.strobe, ref_sw.strobe, equal_nan=True)
+    ref = orbits.continue_branches(BLOCK, SWEEP_FORCING, (0.75, 0.85), sweep=ref_sw,
+                                   settings=settings)
+    assert len(cont.branches) == len(ref.branches) >= 2
+    for a, b in zip(cont.branches, ref.branches):
+        assert np.array_equal(a.value, b.value) and np.array_equal(a.cycle, b.cycle)
+    assert [b.type for b in cont.bifurcations] == [b.type for b in ref.bifurcations]
+    assert cont.forcing.omega == OMEGA and cont.forcing.alpha is None

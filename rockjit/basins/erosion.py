@@ -30,7 +30,7 @@ from ..grids import runner
 from ..settings import Integration
 from ..validate import real
 from . import measures as M
-from .identity import cycle_distance, floquet, identify
+from .identity import attractor_distance, floquet, identify
 
 __all__ = ["LINK_TOL", "ErosionResult", "erosion"]
 
@@ -116,26 +116,24 @@ class ErosionResult:
 
 
 def _link(prev, cur, tol, floor):
-    """``{id_cur: id_prev}``: each current attractor to the nearest previous one of the same
-    behaviour and period whose cycle lies within ``tol`` of the size (rest to rest); the size
-    is at least ``floor`` (a small orbit moves by more than its own size from one amplitude to
-    the next, while staying far from any other)."""
+    """``{id_cur: id_prev}``: each current attractor, largest basin first, to the nearest
+    previous one not yet taken of the same behaviour and period whose
+    :func:`~rockjit.basins.identity.attractor_distance` is within ``tol`` (rest to rest; clouds
+    by their centroids); the size is at least ``floor`` (a small orbit moves by more than its
+    own size from one amplitude to the next, while staying far from any other).
+
+    Not :func:`~rockjit.basins.identity.match_attractors`, which pairs the nearest candidates
+    first over all pairs and leaves clouds unmatched: along a profile the largest basin claims
+    its predecessor first, and a chaotic attractor is followed too."""
     links = {}
     taken = set()
     for a in sorted(cur, key=lambda x: -x.n_cells):
         best, dist = None, math.inf
         for b in prev:
-            if b.id in taken or a.behaviour != b.behaviour or a.period != b.period:
+            if b.id in taken:
                 continue
-            if a.behaviour == "rest":
-                d = 0.0
-            elif a.period:
-                d = cycle_distance(b.points, a.points) / max(np.abs(a.points).max(),
-                                                             np.abs(b.points).max(), floor)
-            else:  # clouds: their samples' centroids
-                d = np.abs(a.points.mean(axis=0) - b.points.mean(axis=0)).max() / max(
-                    np.abs(a.points).max(), np.abs(b.points).max(), floor)
-            if d <= tol and d < dist:
+            d = attractor_distance(a, b, floor)
+            if d is not None and d <= tol and d < dist:
                 best, dist = b.id, d
         if best is not None:
             links[a.id] = best

@@ -42,10 +42,11 @@ from scipy.sparse.csgraph import connected_components
 
 from ..result import (APERIODIC, ASYMMETRIC, BEHAVIOURS, CHAOTIC, MULTIPERIODIC, OVERTURN,
                      REST, SYMMETRIC, UNRESOLVED)
+from .cycles import cycle_distance, cycle_size
 
 __all__ = ["CLOUD_GRID", "CONT_TOL", "MATCH_TOL", "OVERTURN_ID", "UNRESOLVED_ID", "Attractor",
-           "attractor_agreement", "cycle_distance", "cycles_differ", "floquet", "identify",
-           "identify_along", "match_attractors"]
+           "attractor_agreement", "attractor_distance", "cycle_distance", "cycles_differ",
+           "floquet", "identify", "identify_along", "match_attractors"]
 
 #: Outcome ids of the cells that reach no attractor.
 OVERTURN_ID = -1
@@ -122,34 +123,12 @@ def _cycles(pts, n_got, period):
     return np.take_along_axis(pts, idx[:, :, None], axis=1)
 
 
-def cycle_distance(a, b):
-    """Smallest over cyclic shifts of the largest point-wise difference of two cycles.
-
-    ``a`` has shape ``(p, 2)`` and ``b`` shape ``(n, p, 2)`` (or ``(p, 2)``); returns shape
-    ``(n,)`` (or a float).
-    """
-    a = np.asarray(a, dtype=float)
-    b = np.asarray(b, dtype=float)
-    single = b.ndim == 2
-    b = b[None] if single else b
-    p = a.shape[0]
-    best = np.full(b.shape[0], np.inf)
-    for s in range(p):
-        d = np.abs(np.roll(b, -s, axis=1) - a[None]).max(axis=(1, 2))
-        best = np.minimum(best, d)
-    return float(best[0]) if single else best
-
-
-def _scale(c):
-    return np.abs(c).max(axis=(-2, -1))
-
-
 def _periodic_groups(idx, cyc, tol):
     """Greedy grouping of the cycles ``cyc`` (cells ``idx``) of one period: the first
     ungrouped cycle and every cycle within ``tol`` of it form a group."""
     groups = []
     left = np.arange(idx.size)
-    scale = _scale(cyc)
+    scale = cycle_size(cyc)
     while left.size:
         ref = cyc[left[0]]
         d = cycle_distance(ref, cyc[left])
@@ -319,10 +298,8 @@ def _continues(a, b, label, period, pts, n_got, tol):
         k = k[(n_got[a[k]] >= p) & (n_got[b[k]] >= p)]
         ca = _cycles(pts[a[k]], n_got[a[k]], int(p))
         cb = _cycles(pts[b[k]], n_got[b[k]], int(p))
-        d = np.full(k.size, np.inf)
-        for sft in range(int(p)):
-            d = np.minimum(d, np.abs(np.roll(cb, -sft, axis=1) - ca).max(axis=(1, 2)))
-        keep[k] = d <= tol * np.maximum(np.maximum(_scale(ca), _scale(cb)), 1e-12)
+        d = cycle_distance(ca, cb)
+        keep[k] = d <= tol * np.maximum(np.maximum(cycle_size(ca), cycle_size(cb)), 1e-12)
     k = np.flatnonzero(np.isin(code, _CLOUD) & (n_got[a] > 0) & (n_got[b] > 0))
     if k.size:
         def centroid(c):
@@ -331,7 +308,7 @@ def _continues(a, b, label, period, pts, n_got, tol):
             return (np.where(ok, P, 0.0).sum(axis=1) / ok.sum(axis=1))[:, None, :]
         ca, cb = centroid(a[k]), centroid(b[k])
         d = np.abs(ca - cb).max(axis=(1, 2))
-        keep[k] = d <= tol * np.maximum(np.maximum(_scale(ca), _scale(cb)), 1e-12)
+        keep[k] = d <= tol * np.maximum(np.maximum(cycle_size(ca), cycle_size(cb)), 1e-12)
     return keep
 
 
@@ -354,27 +331,57 @@ def floquet(block, forcing, phi, integration, n_steps, point, period):
     return mu, lam
 
 
+def attractor_distance(x, y, floor=1e-12):
+    """How far apart two attractors are, relative to their size; ``None`` when they are not of
+    one kind (behaviour and period).
+
+    Rest and rest are 0 apart; two cycles, :func:`~rockjit.basins.cycles.cycle_distance`; two
+    clouds (chaotic, aperiodic), the largest difference of their samples' centroids. Sizes are
+    the larger attractor's largest ``|theta|, |theta'|``, at least ``floor``. The distance is
+    symmetric in ``x`` and ``y``, bit for bit.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rockjit.basins.identity import Attractor, attractor_distance
+    >>> def cycle(*pts):
+    ...     return Attractor(id=0, behaviour="symmetric", period=len(pts), points=np.array(pts),
+    ...                      fraction=100.0, n_cells=1, lam=np.zeros(2))
+    >>> attractor_distance(cycle([0.2, 0.1]), cycle([0.1, 0.1]))
+    0.5
+    >>> attractor_distance(cycle([0.2, 0.1]), cycle([0.2, 0.1], [-0.2, -0.1])) is None
+    True
+    """
+    if x.behaviour != y.behaviour or x.period != y.period:
+        return None
+    if x.behaviour == "rest":
+        return 0.0
+    size = max(cycle_size(x.points), cycle_size(y.points), floor)
+    if x.period:
+        return float(cycle_distance(x.points, y.points) / size)
+    return float(np.abs(x.points.mean(axis=0) - y.points.mean(axis=0)).max() / size)
+
+
 def match_attractors(a, b, tol=MATCH_TOL, floor=1e-12):
     """Pairs ``{id_a: id_b}`` of two lists of attractors whose cycles coincide: same behaviour
-    and period, :func:`cycle_distance` within ``tol`` of the size (the larger orbit's, at least
-    ``floor``); rest matches rest. Nearest pairs first, each attractor in one pair at most.
+    and period, :func:`attractor_distance` within ``tol`` (sizes at least ``floor``); rest
+    matches rest, clouds match nothing. Nearest pairs first over all candidates, each attractor
+    in one pair at most.
 
     Within one system (two maps of one basin) ``tol`` is :data:`MATCH_TOL`; across systems
     (the two laws' basins, :func:`attractor_agreement`) the cycles differ and the nearest
-    attractor of the same kind is taken (``tol`` of order 1).
+    attractor of the same kind is taken (``tol`` of order 1). An erosion profile links one
+    amplitude's attractors to the previous one's by another rule on the same distance
+    (:mod:`rockjit.basins.erosion`: largest basin first, clouds too).
     """
     cand = []
     for x in a:
         for y in b:
-            if x.behaviour != y.behaviour or x.period != y.period:
+            if x.behaviour != "rest" and not (x.period and x.points.shape == y.points.shape):
                 continue
-            if x.behaviour == "rest":
-                cand.append((0.0, x.id, y.id))
-            elif x.period and x.points.shape == y.points.shape:
-                size = max(_scale(x.points), _scale(y.points), floor)
-                d = cycle_distance(x.points, y.points) / size
-                if d <= tol:
-                    cand.append((d, x.id, y.id))
+            d = attractor_distance(x, y, floor)
+            if d is not None and d <= tol:
+                cand.append((d, x.id, y.id))
     pairs, used = {}, set()
     for d, i, j in sorted(cand):
         if i not in pairs and j not in used:
@@ -418,8 +425,6 @@ def cycles_differ(pts_a, pts_b, period, tol=MATCH_TOL):
         k = np.flatnonzero((period == p) & (ga >= p) & (gb >= p))
         ca = _cycles(pts_a[k], ga[k], int(p))
         cb = _cycles(pts_b[k], gb[k], int(p))
-        d = np.full(k.size, np.inf)
-        for sft in range(int(p)):
-            d = np.minimum(d, np.abs(np.roll(cb, -sft, axis=1) - ca).max(axis=(1, 2)))
-        out[k] = d > tol * np.maximum(np.maximum(_scale(ca), _scale(cb)), 1e-12)
+        size = np.maximum(np.maximum(cycle_size(ca), cycle_size(cb)), 1e-12)
+        out[k] = cycle_distance(ca, cb) > tol * size
     return out

@@ -1,1 +1,57 @@
-"""Periodic orbits of the stroboscopic map: shooting, continuation and located bifurcations."""
+"""Periodic orbits of the stroboscopic map: shooting, continuation and located bifurcations.
+
+A period-``p`` orbit of the forced block is a fixed point of ``P^p``, ``P`` the stroboscopic map
+``(theta, theta')(kT) -> (theta, theta')((k+1)T)`` at a fixed forcing phase (SPEC.md §8). This
+package finds such orbits by Newton's method (shooting), follows them as a forcing parameter
+(``alpha`` or ``omega``) varies by pseudo-arclength continuation, and locates where they
+bifurcate. It is built on the public :func:`rockjit.simulate` only.
+
+What lives where
+----------------
+:mod:`.types`
+    The settings (:class:`Shooting`, :class:`ContinuationSettings`), the results
+    (:class:`PeriodicOrbit`, :class:`Branch`, :class:`Bifurcation`, :class:`Continuation`), the
+    refusal :class:`OrbitRefused` with its :data:`REASONS`, and :data:`BIFURCATION_TYPES`.
+:mod:`.shooting`
+    The flow (every run of the package, one call of :func:`rockjit.simulate`), the Newton
+    solver on the full and the half map, what a converged run says about its orbit, and
+    :func:`periodic_orbit`.
+:mod:`.bifurcations`
+    Detection between two branch points and location: fold, symmetry breaking, period
+    doubling, Neimark–Sacker (test functions, Brent's method) and grazing, overturning and
+    rest (bisection).
+:mod:`.arclength`
+    Pseudo-arclength continuation and branch switching: :func:`continuation`,
+    :func:`continue_branches` (the branches of a sweep's periodic attractors) and the entry
+    point :func:`orbits_of_sweep` (the sweep and its branches; its ``.plan`` validates, and
+    :func:`rockjit.orbits.arclength.run` executes a plan).
+
+The imports go one way: ``types`` <- ``shooting`` <- ``bifurcations`` <- ``arclength``. Cycles
+are compared with :func:`rockjit.basins.cycles.cycle_distance`, as the attractors of the grids.
+
+Examples
+--------
+>>> from rockjit import Block, Harmonic
+>>> from rockjit.orbits import periodic_orbit
+>>> periodic_orbit(Block(hb=1), Harmonic(alpha=0.8, omega=1.3), (-0.3, -0.3)).impacts
+2
+
+Notes
+-----
+Saltation and grazing: di Bernardo, Budd, Champneys, Kowalczyk (2008), *Piecewise-smooth
+Dynamical Systems*, Springer, ch. 2 and 6 (grazing of impacting orbits). Continuation and test
+functions: Seydel (2010), *Practical Bifurcation and Stability Analysis*, 3rd ed., Springer;
+Kuznetsov (2004), *Elements of Applied Bifurcation Theory*, 3rd ed., Springer; Doedel, Keller,
+Kernévez (1991), "Numerical analysis and control of bifurcation problems", Int. J. Bifurcation
+and Chaos 1(3), 493–520 and 1(4), 745–772; Keller (1977), "Numerical solution of bifurcation
+and nonlinear eigenvalue problems", in *Applications of Bifurcation Theory*, Academic Press.
+"""
+
+from .arclength import continuation, continue_branches, orbits_of_sweep
+from .shooting import N_ORBIT, periodic_orbit
+from .types import (BIFURCATION_TYPES, REASONS, Bifurcation, Branch, Continuation,
+                    ContinuationSettings, OrbitRefused, PeriodicOrbit, Shooting)
+
+__all__ = ["BIFURCATION_TYPES", "N_ORBIT", "REASONS", "Bifurcation", "Branch", "Continuation",
+           "ContinuationSettings", "OrbitRefused", "PeriodicOrbit", "Shooting", "continuation",
+           "continue_branches", "orbits_of_sweep", "periodic_orbit"]

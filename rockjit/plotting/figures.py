@@ -711,7 +711,7 @@ def fig_plane(plane_result, state=0, title=None):
 
 
 # ---------------------------------------------------------------------------------------------
-# Periodic-orbit branches (rockjit.orbits.orbits) over a sweep
+# Periodic-orbit branches (rockjit.orbits) over a sweep
 # ---------------------------------------------------------------------------------------------
 
 #: Marker of each bifurcation type in :func:`fig_branches`.
@@ -753,8 +753,8 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
 
     Parameters
     ----------
-    continuation : rockjit.orbits.orbits.Continuation
-        From :func:`rockjit.orbits.orbits.continue_branches` (or :func:`~rockjit.orbits.orbits.continuation`).
+    continuation : rockjit.orbits.Continuation
+        From :func:`rockjit.orbits.continue_branches` (or :func:`~rockjit.orbits.continuation`).
     sweep : SweepResult, optional
         Its stroboscopic points are drawn as dots coloured by behaviour; it must be sampled at
         the continuation's forcing phase (``continue_branches`` uses the sweep's).
