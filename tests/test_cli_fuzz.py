@@ -653,7 +653,7 @@ def reached():
     # import every module the CLI may import lazily first: one imported while the patches are
     # in place would keep a sentinel under its own name for the rest of the session
     for name in ("grids.grids", "basins.identity", "basins.erosion", "basins.fate",
-                 "orbits.orbits", "cli.outputs", "plotting.figures", "study.paper"):
+                 "orbits.arclength", "cli.outputs", "plotting.figures", "study.paper"):
         importlib.import_module(f"rockjit.{name}")
     mp = pytest.MonkeyPatch()
     for target in GUARDED + GUARDED_IF_PRESENT:

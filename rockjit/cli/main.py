@@ -265,7 +265,7 @@ def _grid_run(writer, name):
         if writer == "erosion":
             from ..basins.erosion import run
         elif writer == "orbits":
-            from ..orbits import run_orbits as run
+            from ..orbits.arclength import run
         else:
             from ..grids.plan import run
         t0 = time.perf_counter()
@@ -280,11 +280,13 @@ def _grid_run(writer, name):
 
 
 def _orbits_plan(args):
-    from .. import orbits
-    return orbits.orbits_of_sweep.plan(_block(args), _forcing(args, alpha=False),
-                                       args.alpha_range, sweep_step=args.alpha_step,
-                                       periods=args.periods, max_period=args.max_period,
-                                       execution=_execution(args))
+    from ..orbits import ContinuationSettings, orbits_of_sweep
+    from ..settings import Integration
+    return orbits_of_sweep.plan(_block(args), _forcing(args, alpha=False),
+                                tuple(args.alpha_range), alpha_step=args.alpha_step,
+                                integration=Integration(periods=args.periods),
+                                settings=ContinuationSettings(max_period=args.max_period),
+                                execution=_execution(args))
 
 
 def _fate_plan(args):

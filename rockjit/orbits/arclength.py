@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..basins.cycles import cycle_distance
+from ..entry import entry_point
 from ..grids import plan as gp
 from ..grids import sweep_grid
 from ..settings import Execution, Integration
@@ -672,7 +673,7 @@ def run(plan: OrbitsPlan, execution=None):
     return cont, sw
 
 
-@gp.entry_point(run)
+@entry_point(run)
 def orbits_of_sweep(block, forcing, alpha_range, *, alpha_step=0.001, integration=None,
                     n_steps=N_ORBIT, shooting=None, settings=None, execution=None):
     """A sweep over ``alpha_range`` from the study's ``z0``, then every periodic branch of its

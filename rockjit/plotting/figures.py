@@ -262,7 +262,7 @@ def fig_gallery(results, notes=None):
                      f"classified: {beh}", fontsize=9,
                      bbox=dict(boxstyle="round,pad=0.3", fc=colour, alpha=0.25, lw=0))
         if res.status == "overturned":
-            ax.axhline(np.sign(tr[-1, 1]) * b.theta_over, color="0.5", ls=":", lw=0.8)
+            ax.axhline(np.sign(tr[-1, 1]) * res.integration.theta_over, color="0.5", ls=":", lw=0.8)
         if notes and caption in notes:
             ax.text(0.02, 0.03, notes[caption], transform=ax.transAxes, fontsize=7,
                     va="bottom", bbox=dict(boxstyle="round,pad=0.3", fc="w", alpha=0.85,
