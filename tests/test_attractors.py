@@ -1,4 +1,4 @@
-"""Attractor identity (issue 12) against a slow readable matcher, symmetry and the scipy path.
+"""Attractor identity against a slow readable matcher, symmetry and the scipy path.
 
 - a plain-Python matcher over single ``simulate`` runs of a small grid gives the same attractor
   map as the compiled basin (up to the numbering);
@@ -14,11 +14,16 @@ import numpy as np
 import pytest
 
 import rockjit
-from rockjit.grids import grids as an
+from rockjit import Block, Classification, Harmonic, Integration, Scipy
 from rockjit.basins.identity import cycle_distance, identify, match_attractors
 
-BASIN = dict(hb=1.0, alpha=0.66, omega=1.3, law="housner")  # the study's hb=1 basin
-SMALL = dict(grid=7, periods=300, n_steps=64, early_stop=False)
+BLOCK = Block(hb=1.0, law="housner")  # the study's hb=1 basin
+FORCING = Harmonic(alpha=0.66, omega=1.3)
+SMALL = dict(grid=7, periods=300, n_steps=64)
+
+
+def _basin(forcing=FORCING, grid=7, periods=300):
+    return rockjit.basin(BLOCK, forcing, grid, integration=Integration(periods=periods))
 
 
 def _slow_attractor_map(theta0, dtheta0, periods, n_steps, tol=1e-4):
@@ -27,9 +32,9 @@ def _slow_attractor_map(theta0, dtheta0, periods, n_steps, tol=1e-4):
     ids = np.empty((theta0.size, dtheta0.size), dtype=int)
     for i, th in enumerate(theta0):
         for j, dth in enumerate(dtheta0):
-            r = rockjit.simulate(**BASIN, theta0=th, dtheta0=dth, r0=0.0, s0=1.0,
-                                 periods=periods, n_steps=n_steps)
-            name, p = an.classify_result(r)
+            r = rockjit.simulate(BLOCK, FORCING.replace(r0=0.0, s0=1.0), (th, dth),
+                                 integration=Integration(periods=periods, n_steps=n_steps))
+            name, p = rockjit.classify_result(r)
             if name == "overturn":
                 ids[i, j] = -1
                 continue
@@ -59,7 +64,9 @@ def _slow_attractor_map(theta0, dtheta0, periods, n_steps, tol=1e-4):
 
 
 def test_compiled_attractor_map_equals_a_slow_matcher():
-    b = an.basin(**BASIN, **SMALL)
+    b = rockjit.basin(BLOCK, FORCING, SMALL["grid"],
+                      integration=Integration(periods=SMALL["periods"], n_steps=SMALL["n_steps"]),
+                      classification=Classification(early_stop=False))
     slow, known = _slow_attractor_map(b.theta0, b.dtheta0, SMALL["periods"], SMALL["n_steps"])
     assert len(known) >= 2  # the map holds at least two attractors (a non-trivial test)
     fast = b.attractor
@@ -72,7 +79,7 @@ def test_compiled_attractor_map_equals_a_slow_matcher():
 
 
 def test_fractions_sum_to_100_and_ids_follow_basin_size():
-    b = an.basin(**BASIN, grid=30, periods=300)
+    b = _basin(grid=30)
     fr = [a.fraction for a in b.attractors]
     other = 100.0 * np.mean(b.attractor < 0)
     assert sum(fr) + other == pytest.approx(100.0)
@@ -83,13 +90,13 @@ def test_fractions_sum_to_100_and_ids_follow_basin_size():
 
 def _half_period_image(point, phase, p):
     """The cycle through ``point`` sampled half a period later, ``p`` points."""
-    r = rockjit.simulate(**{**BASIN, "alpha": 0.8}, theta0=point[0], dtheta0=point[1],
-                         phase=phase, periods=p + 1, n_steps=64)
+    r = rockjit.simulate(BLOCK, Harmonic(alpha=0.8, omega=FORCING.omega, phase=phase),
+                         (point[0], point[1]), integration=Integration(periods=p + 1, n_steps=64))
     return r.strobe_half[:p, :2]
 
 
 def test_asymmetric_attractors_come_in_mirror_pairs():
-    b = an.basin(**{**BASIN, "alpha": 0.8}, grid=24, periods=300)
+    b = _basin(FORCING.replace(alpha=0.8), grid=24)
     asym = [a for a in b.attractors if a.behaviour == "asymmetric"]
     assert len(asym) == 2
     for a in asym:
@@ -101,13 +108,14 @@ def test_asymmetric_attractors_come_in_mirror_pairs():
 
 
 def test_floquet_multipliers_match_the_scipy_monodromy():
-    b = an.basin(**BASIN, grid=12, periods=300)
+    b = _basin(grid=12)
     a = next(x for x in b.attractors if x.behaviour == "symmetric" and x.multipliers[0] != 0)
     x = a.points[0]
 
     def one_period(y):
-        r = rockjit.simulate(**BASIN, theta0=y[0], dtheta0=y[1], phase=0.0, periods=1,
-                             method="scipy:DOP853", rtol=1e-12, atol=1e-12)
+        r = rockjit.simulate(BLOCK, FORCING.replace(phase=0.0), (y[0], y[1]),
+                             integration=Integration(periods=1),
+                             method=Scipy("DOP853", rtol=1e-12, atol=1e-12))
         return r.state[:2]
 
     eps = 1e-6
@@ -116,8 +124,8 @@ def test_floquet_multipliers_match_the_scipy_monodromy():
     mu = np.linalg.eigvals(J)
     np.testing.assert_allclose(np.sort(np.abs(mu)), np.sort(np.abs(a.multipliers)), rtol=1e-4)
     # and its exponents are ln|mu| / T: those of a long run on it
-    r = rockjit.simulate(**BASIN, theta0=x[0], dtheta0=x[1], phase=0.0, lyapunov=True,
-                         n_steps=64)
+    r = rockjit.simulate(BLOCK, FORCING.replace(phase=0.0), (x[0], x[1]), lyapunov=True,
+                         integration=Integration(n_steps=64))
     np.testing.assert_allclose(a.lam, r.lyapunov, rtol=1e-3)
 
 
@@ -139,8 +147,8 @@ def test_identify_on_synthetic_cycles():
 
 
 def test_sweep_ids_follow_its_branches():
-    sw = an.sweep(1.0, 1.3, law="housner", alpha_range=(0.70, 0.86), alpha_step=0.004,
-                  periods=300)
+    sw = rockjit.sweep(BLOCK, Harmonic(omega=1.3), rockjit.alpha_grid((0.70, 0.86), 0.004),
+                       integration=Integration(periods=300))
     ids = sw.attractor
     names = sw.names[sw.label]
     # one id never mixes behaviours, and each id is one contiguous run of amplitudes
@@ -152,7 +160,7 @@ def test_sweep_ids_follow_its_branches():
 
 
 def test_two_laws_attractors_are_matched_by_their_cycles():
-    a = an.basin(**BASIN, grid=10, periods=300)
+    a = _basin(grid=10)
     pairs = match_attractors(a.attractors, a.attractors)
     assert pairs == {x.id: x.id for x in a.attractors}
     moved = [type(x)(**{**x.__dict__, "points": x.points + 0.05}) for x in a.attractors]
@@ -162,7 +170,7 @@ def test_two_laws_attractors_are_matched_by_their_cycles():
 
 @pytest.mark.parametrize("grid", [1, 2, 3])
 def test_measures_of_tiny_maps_are_defined(grid):
-    m = an.basin(**BASIN, grid=grid, periods=20).measures()
+    m = _basin(grid=grid, periods=20).measures()
     assert set(m) >= {"basin_entropy", "boundary_basin_entropy", "integrity",
                       "uncertainty_exponent"}
     assert 0.0 <= m["integrity"]["GIM"] <= 1.0

@@ -1,26 +1,33 @@
-"""Erosion profiles (issue 12 §4): the stacked computation against separate basins, the
-measures against rockjit.basins.measures on each basin, and the continued branches' bookkeeping."""
+"""Erosion profiles: the stacked computation against separate basins, the measures against
+rockjit.basins.measures on each basin, and the continued branches' bookkeeping."""
 
 import numpy as np
 import pytest
 
-from rockjit.grids import grids as an
+import rockjit
+from rockjit import Block, Harmonic, Integration
 from rockjit.basins import erosion as er
 from rockjit.basins import measures as M
 
-KW = dict(hb=1.0, omega=1.3, law="housner", alpha_range=(0.60, 0.72), alpha_step=0.04, grid=16,
-          periods=200)
+BLOCK = Block(hb=1.0, law="housner")
+FORCING = Harmonic(omega=1.3)
+KW = dict(alpha_range=(0.60, 0.72), alpha_step=0.04, grid=16, periods=200)
+
+
+def _erosion(alpha_step=KW["alpha_step"], grid=KW["grid"]):
+    return er.erosion(BLOCK, FORCING, rockjit.alpha_grid(KW["alpha_range"], alpha_step), grid,
+                      integration=Integration(periods=KW["periods"]))
 
 
 @pytest.fixture(scope="module")
 def profile():
-    return er.erosion(**KW)
+    return _erosion()
 
 
 def test_each_amplitude_is_the_basin_computed_alone(profile):
     for k, alpha in enumerate(profile.alpha):
-        b = an.basin(KW["hb"], float(alpha), KW["omega"], law=KW["law"], grid=KW["grid"],
-                     periods=KW["periods"])
+        b = rockjit.basin(BLOCK, FORCING.replace(alpha=float(alpha)), KW["grid"],
+                          integration=Integration(periods=KW["periods"]))
         np.testing.assert_array_equal(profile.label[k], b.label)
         # the same partition into attractors (branch ids number them differently)
         for v in np.unique(b.attractor):
@@ -46,7 +53,7 @@ def test_fractions_and_overturn_add_up(profile):
 def test_a_branch_is_one_orbit_moving_a_little():
     # the symmetric orbit of the study's hb=1 Housner basin continues across 0.60..0.72: one
     # branch spanning every amplitude, whose cycle moves by less than the continuation tolerance
-    p = er.erosion(**KW)
+    p = _erosion()
     spans = [b for b in p.branches if b["behaviour"] == "symmetric" and
              b["alpha"] == [p.alpha[0], p.alpha[-1]]]
     assert spans
@@ -54,8 +61,8 @@ def test_a_branch_is_one_orbit_moving_a_little():
 
 def test_bad_input_names_the_parameter():
     with pytest.raises(ValueError, match="alpha_step"):
-        er.erosion(**{**KW, "alpha_step": 0.0})
+        _erosion(alpha_step=0.0)
     with pytest.raises(ValueError, match="grid"):
-        er.erosion(**{**KW, "grid": 0})
+        _erosion(grid=0)
     with pytest.raises(ValueError, match="would need"):
-        er.erosion(**{**KW, "grid": 100_000})
+        _erosion(grid=100_000)

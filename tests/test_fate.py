@@ -1,4 +1,4 @@
-"""Fates decided by round-off (issue 14): ensembles, horizons, uncertain cells.
+"""Fates decided by round-off: ensembles, horizons, uncertain cells.
 
 - an ensemble's probabilities sum to 1 and do not depend on the number of threads;
 - the predictability horizon of a chaotic run against the time two runs ``eps`` apart take to
@@ -15,17 +15,20 @@ import numpy as np
 import pytest
 
 import rockjit
-from rockjit.grids import grids as an
+from rockjit import Block, Classification, Execution, Harmonic, Integration
 from rockjit.basins import fate as F
 from rockjit.single import Z0_STUDY
 
-CHAOTIC = dict(hb=1.0, alpha=0.955, omega=1.3, law="housner")  # tests/test_lyapunov.py
+BLOCK = Block(hb=1.0, law="housner")
+CHAOTIC = Harmonic(alpha=0.955, omega=1.3)  # tests/test_lyapunov.py
+TRANSIENT = Harmonic(alpha=0.969, omega=1.3)  # transient chaos ending in overturning
 
 
 def test_probabilities_sum_to_one_and_ignore_the_thread_count():
-    kw = dict(hb=1.0, alpha=0.969, omega=1.3, law="housner", ensemble=40, periods=300)
-    one = F.fate(**kw, threads=1)
-    two = F.fate(**kw, threads=min(2, numba.config.NUMBA_NUM_THREADS))
+    kw = dict(ensemble=40, integration=Integration(periods=300))
+    one = F.fate(BLOCK, TRANSIENT, **kw, execution=Execution(threads=1))
+    two = F.fate(BLOCK, TRANSIENT, **kw,
+                 execution=Execution(threads=min(2, numba.config.NUMBA_NUM_THREADS)))
     assert sum(one.probabilities.values()) == pytest.approx(1.0)
     assert one.probabilities == two.probabilities
     np.testing.assert_array_equal(one.t_end, two.t_end)
@@ -35,14 +38,15 @@ def test_probabilities_sum_to_one_and_ignore_the_thread_count():
 
 def test_horizon_matches_the_separation_time_of_two_runs():
     # lambda1 of the chaotic orbit, over a long run
-    lam1 = rockjit.simulate(**CHAOTIC, periods=300, lyapunov=True).lyapunov[0]
+    integration = Integration(periods=300)
+    lam1 = rockjit.simulate(BLOCK, CHAOTIC, integration=integration, lyapunov=True).lyapunov[0]
     assert lam1 > 0.05
     eps = 1e-10
-    T = 2 * math.pi / CHAOTIC["omega"]
-    a = rockjit.simulate(**CHAOTIC, periods=300, record_stride=8)
+    T = 2 * math.pi / CHAOTIC.omega
+    a = rockjit.simulate(BLOCK, CHAOTIC, integration=integration, record_stride=8)
     z0 = rockjit.Z0_STUDY
-    b = rockjit.simulate(**CHAOTIC, periods=300, record_stride=8,
-                         z0=(z0[0] * (1 + eps), *z0[1:]))
+    b = rockjit.simulate(BLOCK, CHAOTIC.replace(r0=z0[2], s0=z0[3]), (z0[0] * (1 + eps), z0[1]),
+                         integration=integration, record_stride=8)
     n = min(len(a.trajectory), len(b.trajectory))
     d = np.abs(a.trajectory[:n, 1:3] - b.trajectory[:n, 1:3]).max(axis=1)
     size = np.abs(a.trajectory[:n, 1:3]).max()
@@ -52,7 +56,9 @@ def test_horizon_matches_the_separation_time_of_two_runs():
 
 
 def test_no_uncertain_cell_inside_a_periodic_basin():
-    b = an.basin(1.0, 0.66, 1.3, law="housner", grid=40, periods=300, uncertainty=1e-3)
+    b = rockjit.basin(BLOCK, Harmonic(alpha=0.66, omega=1.3), 40,
+                      integration=Integration(periods=300),
+                      classification=Classification(uncertainty=1e-3))
     ids = b.attractor
     # a cell is interior when it and its eight neighbours reach the same attractor
     inner = np.zeros_like(ids, dtype=bool)
@@ -68,11 +74,12 @@ def test_no_uncertain_cell_inside_a_periodic_basin():
 
 
 def test_a_single_run_reports_its_own_horizon():
-    r = rockjit.simulate(**CHAOTIC, periods=300, lyapunov=True)
+    r = rockjit.simulate(BLOCK, CHAOTIC, integration=Integration(periods=300), lyapunov=True)
     lam = r.lyapunov_running[-1, 0]
     assert r.horizon == pytest.approx(math.log(F.HORIZON_TOL / np.finfo(float).eps) / lam)
     assert r.beyond_horizon  # 300 chaotic periods: far beyond what rounding allows
-    s = rockjit.simulate(1.0, 0.6, 1.3, "housner", periods=100, lyapunov=True)
+    s = rockjit.simulate(BLOCK, Harmonic(alpha=0.6, omega=1.3),
+                         integration=Integration(periods=100), lyapunov=True)
     assert s.horizon == math.inf and not s.beyond_horizon  # a stable orbit forgets errors
 
 
@@ -82,15 +89,17 @@ def test_a_single_run_reports_its_own_horizon():
 ])
 def test_fate_refuses_bad_input(kw, match):
     with pytest.raises(ValueError, match=match):
-        F.fate(1.0, 0.969, 1.3, "housner", periods=10, **kw)
+        F.fate(BLOCK, TRANSIENT, integration=Integration(periods=10), **kw)
 
 
 def test_each_member_of_an_ensemble_is_its_own_plain_run():
     """The ensemble's grid kernel against a plain ``simulate`` from each member's start."""
-    kw = dict(hb=1.0, alpha=0.969, omega=1.3, law="housner", periods=150)
-    fr = F.fate(**kw, ensemble=6, seed=3)
+    kw = dict(integration=Integration(periods=150))
+    fr = F.fate(BLOCK, TRANSIENT, **kw, ensemble=6, seed=3)
     assert isinstance(fr, F.FateResult) and len(fr.t_end) == 6
     for (th, dth), t_end, outcome in zip(fr.initial, fr.t_end, fr.outcome):
-        alone = rockjit.simulate(**kw, z0=(th, dth) + Z0_STUDY[2:])  # fate's default z0
+        # fate's default forcing point, the study's
+        alone = rockjit.simulate(BLOCK, TRANSIENT.replace(r0=Z0_STUDY[2], s0=Z0_STUDY[3]),
+                                 (th, dth), **kw)
         assert alone.t == pytest.approx(t_end, abs=1e-9)
         assert (alone.status == "overturned") == (outcome == -1)

@@ -11,22 +11,27 @@ matplotlib.use("Agg")
 from matplotlib.colors import to_hex  # noqa: E402
 
 import rockjit  # noqa: E402
+from rockjit import Block, Harmonic, Integration  # noqa: E402
 from rockjit.plotting import figures as P  # noqa: E402
-from rockjit.grids.grids import BEHAVIOURS, BasinResult, SweepResult, fractions  # noqa: E402
+from rockjit.result import BEHAVIOURS, BasinResult, SweepResult, fractions  # noqa: E402
 from rockjit.storage.files import save_figure  # noqa: E402
 
-RUN = dict(periods=20, n_steps=64, record_stride=4, lyapunov=True)  # one compiled variant
+# one compiled variant
+RUN = dict(integration=Integration(periods=20, n_steps=64), record_stride=4, lyapunov=True)
 
 
 @pytest.fixture(scope="module")
 def ref_run():
-    return rockjit.simulate(1.0, 0.6, 1.3, "housner", z0=rockjit.Z0_STUDY, **RUN)
+    # from the study's z0 (the default state) at the study's forcing point
+    return rockjit.simulate(Block(hb=1.0, law="housner"), Harmonic(alpha=0.6, omega=1.3), **RUN)
 
 
 @pytest.fixture(scope="module")
 def short_runs():
-    rest = rockjit.simulate(1.0, 0.15, 1.0, "housner", theta0=0.05, dtheta0=0.0, **RUN)
-    over = rockjit.simulate(2.0, 0.448, 1.3, "housner", z0=rockjit.Z0_STUDY, **RUN)
+    rest = rockjit.simulate(Block(hb=1.0, law="housner"), Harmonic(alpha=0.15, omega=1.0),
+                            (0.05, 0.0), **RUN)
+    over = rockjit.simulate(Block(hb=2.0, law="housner"), Harmonic(alpha=0.448, omega=1.3),
+                            **RUN)
     return {"rest": rest, "overturn": over}
 
 
@@ -44,10 +49,9 @@ def _sweep():
     lam = rng.uniform(-0.5, 0.3, n)
     lam[label == BEHAVIOURS.index("rest")] = -np.inf
     lam[label == BEHAVIOURS.index("overturn")] = np.nan
-    block = rockjit.Block(hb=1.0, alpha=0.5, omega=1.3)
     return SweepResult(alpha=alpha, label=label, period=np.zeros(n, int), lambda_max=lam,
                        strobe=strobe, impact_section=np.full((n, 1, 2), np.nan),
-                       t_end=np.zeros(n), block=block)
+                       t_end=np.zeros(n), block=Block(hb=1.0), forcing=Harmonic(omega=1.3))
 
 
 def _basin(law, seed, n=7):
@@ -56,7 +60,7 @@ def _basin(law, seed, n=7):
     th = np.linspace(-1, 1, n)
     return BasinResult(theta0=th, dtheta0=np.linspace(-0.5, 0.5, n), label=label,
                        period=np.zeros((n, n), int), lambda_max=None, t_end=np.zeros((n, n)),
-                       block=rockjit.Block(hb=1.0, alpha=0.66, omega=1.3, law=law),
+                       block=Block(hb=1.0, law=law), forcing=Harmonic(alpha=0.66, omega=1.3),
                        settings=dict(r0=0.0, s0=1.0))
 
 
