@@ -238,3 +238,8 @@ def test_rest_only_in_the_transient_leaves_the_window_exponents_finite():
     assert r.n_rest_window == 0
     assert np.all(np.isfinite(r.lyapunov)), r.lyapunov
     np.testing.assert_allclose(r.lyapunov, ref.lyapunov, rtol=1e-3)
+    # the contrast: from rest under the reference forcing the orbit rests in the window too
+    c = rockjit.simulate(Block(1.0, "housner"), Harmonic(alpha=0.6, omega=1.3, phase=PHI0),
+                         (0.0, 0.0), lyapunov=True)
+    assert c.extra["collapses"] >= 1 and c.n_rest_window > 0
+    assert np.all(c.lyapunov == -math.inf)
