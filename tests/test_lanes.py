@@ -1,12 +1,13 @@
-"""Grids with several cells per thread in lockstep (issue 17): the same outputs, bit for bit.
+"""Grids with several cells per thread in lockstep: the same outputs, bit for bit.
 
-The reference is the single-lane grid kernel (``lanes=1``, :func:`rockjit._engine.kernel._grid`, which
-runs every cell through :func:`rockjit._engine.integrate._loop`): the lanes' vector step must equal the
-single-lane step in every lane, and every output array of a grid (labels, periods, end times,
-overturning instants, stroboscopic samples, impact sections, attractor ids) must be equal, on
-the study's four basins, full length and early-stopped, a sweep with per-cell parameters, a
-parameter plane (each cell its own step length) and the study's continue-past-overturning rule,
-for every lane count and thread count.
+The reference is the single-lane grid kernel (``lanes=1``, :func:`rockjit._engine.kernel._grid`,
+which runs every cell through :func:`rockjit._engine.integrate._loop`): the lanes' vector step
+must equal the single-lane step in every lane, and every output array of a grid (labels, periods,
+end times, overturning instants, stroboscopic samples, impact sections, attractor ids) must be
+equal, on the study's four basins, full length and early-stopped, a sweep with per-cell
+parameters, a parameter plane (each cell its own step length) and the study's
+continue-past-overturning rule, for every lane count and thread count. Grids with tangent
+vectors never enter the lanes.
 """
 
 import dataclasses
@@ -16,11 +17,12 @@ import numba
 import numpy as np
 import pytest
 
-from rockjit.grids import grids as an
+import rockjit
+from rockjit import Block, Classification, Execution, Harmonic, Integration
 from rockjit._engine import integrate as ig
 from rockjit._engine import kernel as kn
 from rockjit._engine import lanes as ln
-from rockjit.model import Block
+from rockjit.grids import plan as gp
 
 #: The study's four basins (SPEC.md §7).
 BASINS = (
@@ -30,6 +32,13 @@ BASINS = (
     dict(hb=2.0, alpha=0.2, omega=1.6, law="mao"),
 )
 OUTPUTS = ("res", "pts", "imp", "n_got", "n_imp_got")
+
+
+def basin_plan(hb, alpha, omega, law, *, grid, early_stop=True, **integration):
+    """The plan of a basin (``integration``: the keywords of its :class:`rockjit.Integration`)."""
+    return rockjit.basin.plan(Block(hb, law), Harmonic(alpha=alpha, omega=omega), grid,
+                              integration=Integration(**integration),
+                              classification=Classification(early_stop=early_stop))
 
 
 def chunk(plan, lanes, threads=None):
@@ -46,14 +55,14 @@ def assert_same(a, b):
 @pytest.mark.parametrize("early_stop", [True, False])
 @pytest.mark.parametrize("kw", BASINS, ids=lambda kw: f"hb{kw['hb']:g}-{kw['law']}")
 def test_study_basins_bit_for_bit(kw, early_stop):
-    plan = an.plan_basin(**kw, grid=12, periods=40, window=20, early_stop=early_stop)
+    plan = basin_plan(**kw, grid=12, periods=40, window=20, early_stop=early_stop)
     ref = chunk(plan, 1)
     assert len(np.unique(ref["res"][:, kn.R_LABEL])) >= 2  # the grid is not trivial
     assert_same(ref, chunk(plan, 8))
 
 
 def test_lane_counts_and_threads():
-    plan = an.plan_basin(**BASINS[0], grid=10, periods=30, window=15, early_stop=False)
+    plan = basin_plan(**BASINS[0], grid=10, periods=30, window=15, early_stop=False)
     ref = chunk(plan, 1, threads=1)
     for lanes in (2, 3, 4, 8):
         assert_same(ref, chunk(plan, lanes, threads=1))
@@ -62,46 +71,67 @@ def test_lane_counts_and_threads():
 
 
 def test_public_results_equal():
-    plan = an.plan_basin(**BASINS[2], grid=10, periods=40, window=20)
-    a = an.run(dataclasses.replace(plan, lanes=1))
-    b = an.run(plan)  # the default: lanes
-    assert plan.lanes is None and kn.DEFAULT_LANES > 1
+    plan = basin_plan(**BASINS[2], grid=10, periods=40, window=20)
+    a = gp.run(plan, Execution(lanes=1))
+    b = gp.run(plan)  # the default: lanes
+    assert Execution().lanes is None and kn.DEFAULT_LANES > 1
     for k in ("label", "period", "t_end", "attractor"):
         assert np.array_equal(getattr(a, k), getattr(b, k), equal_nan=True), k
 
 
 def test_sweep_and_plane_per_cell_parameters():
     # a sweep: each cell its own forcing amplitude (its own forcing table), impact sections
-    sw = an.plan_sweep(hb=1.0, alpha_range=(0.5, 1.0), alpha_step=0.02, omega=1.3,
-                       law="housner", periods=40, window=20, lyapunov=False)
+    sw = rockjit.sweep.plan(Block(1.0, "housner"), Harmonic(omega=1.3),
+                            rockjit.alpha_grid((0.5, 1.0), 0.02),
+                            integration=Integration(periods=40, window=20), lyapunov=False)
     assert sw.n_imp_pts > 0
     assert_same(chunk(sw, 1), chunk(sw, 8))
     # a plane: each cell its own period, so its own step length and step table
-    pl = an.plan_plane(hb=1.0, alpha_range=(0.4, 1.0), omega_range=(1.0, 2.0), grid=(5, 5),
-                       periods=30, window=15, lyapunov=False)
+    pl = rockjit.plane.plan(Block(1.0), (0.4, 1.0), (1.0, 2.0), grid=(5, 5),
+                            integration=Integration(periods=30, window=15), lyapunov=False)
     assert len(np.unique(pl.pars[:, ig.P_H])) > 1
     assert_same(chunk(pl, 1), chunk(pl, 8))
 
 
 def test_continue_past_overturning():
-    plan = an.plan_basin(**BASINS[0], grid=8, periods=30, window=15, early_stop=False,
-                         stop_at_overturn=False)
+    plan = basin_plan(**BASINS[0], grid=8, periods=30, window=15, early_stop=False,
+                      stop_at_overturn=False)
     ref = chunk(plan, 1)
     assert np.isfinite(ref["res"][:, kn.R_TOVER]).any()  # some cells fell and went on
     assert_same(ref, chunk(plan, 8))
 
 
-def test_tangent_grids_stay_single_lane():
-    sw = an.plan_sweep(hb=1.0, alpha_range=(0.6, 0.7), alpha_step=0.05, omega=1.3,
-                       law="housner", periods=20, window=10, lyapunov=True)
-    assert_same(chunk(sw, 1), chunk(sw, 8))
+def test_tangent_grids_stay_single_lane(monkeypatch):
+    """The lanes carry no tangent vectors: a grid with exponents asked to run in 8 lanes runs
+    one cell at a time, never entering the lanes' kernel, with the results of lanes=1."""
+    sw = rockjit.sweep.plan(Block(1.0, "housner"), Harmonic(omega=1.3),
+                            rockjit.alpha_grid((0.6, 0.7), 0.05),
+                            integration=Integration(periods=20, window=10), lyapunov=True)
+    assert sw.tangent
+    ref = chunk(sw, 1)
+    one = gp.run(sw, Execution(lanes=1))
+
+    def lanes_kernel(*args):
+        raise AssertionError("the lanes' kernel ran")
+
+    monkeypatch.setattr(ln, "grid_lanes", lanes_kernel)
+    assert_same(ref, chunk(sw, 8))
+    eight = gp.run(sw, Execution(lanes=8))
+    for k in ("label", "period", "t_end", "lambda_max", "strobe", "impact_section", "attractor"):
+        assert np.array_equal(getattr(one, k), getattr(eight, k), equal_nan=True), k
+    assert np.all(np.isfinite(eight.lambda_max))  # the exponents were computed
+    # the stand-in is live: the same grid without tangent vectors does enter the lanes
+    with pytest.raises(AssertionError, match="lanes' kernel ran"):
+        chunk(dataclasses.replace(sw, tangent=False), 8)
 
 
 @pytest.mark.parametrize("bad", [0, 9, 2.5, "four", True])
 def test_lanes_out_of_range(bad):
-    plan = an.plan_basin(**BASINS[0], grid=2, periods=2, window=1)
+    plan = basin_plan(**BASINS[0], grid=2, periods=2, window=1)
     with pytest.raises(ValueError, match="lanes"):
         chunk(plan, bad)
+    with pytest.raises(ValueError, match="lanes"):
+        Execution(lanes=bad)
 
 
 def test_vector_step_equals_single_lane_step():
@@ -109,9 +139,9 @@ def test_vector_step_equals_single_lane_step():
     outside the polynomials' range, some at rest, some crossing theta = 0)."""
     rng = np.random.default_rng(17)
     W = ln.W
-    block = Block(hb=1.0, alpha=0.66, omega=1.3)
+    block = Block(hb=1.0)
     n_per = 64
-    p = kn.pack(block, 0.3, n_per)
+    p = kn.pack(block, Harmonic(alpha=0.66, omega=1.3), 0.3, Integration(), n_per)
     par = np.zeros(ig.N_PARW)
     par[:ig.N_PAR] = p
     par[ig.P_STHC] = math.sin(p[ig.P_THC])

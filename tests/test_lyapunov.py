@@ -15,9 +15,20 @@ import numpy as np
 import pytest
 
 import rockjit
+from rockjit import Block, Harmonic, Integration, Scipy
+from rockjit.testing.stress import simulate_flat
 
 Z0 = (-0.2254, -0.1597, -0.7778, 0.6284)  # SPEC.md §7
 PHI0 = math.atan2(Z0[2], Z0[3])
+
+
+def _run(kw, **more):
+    """``rockjit.simulate`` of a table's flat keywords (those of
+    :func:`rockjit.testing.stress.simulate_flat`, and ``z0``: the four of the initial state)."""
+    kw = dict(kw, **more)
+    if "z0" in kw:
+        kw.update(zip(("theta0", "dtheta0", "r0", "s0"), kw.pop("z0")))
+    return simulate_flat(**kw)
 
 ORBITS = {
     "reference hb=1 housner a=0.6": dict(hb=1.0, alpha=0.6, omega=1.3, law="housner",
@@ -35,13 +46,14 @@ ORBITS = {
 @pytest.fixture(scope="module")
 def runs():
     """The Lyapunov runs, computed once for the module."""
-    return {name: rockjit.simulate(**kw, z0=Z0, lyapunov=True) for name, kw in ORBITS.items()}
+    return {name: _run(kw, z0=Z0, lyapunov=True) for name, kw in ORBITS.items()}
 
 
 def _one_period(kw, x):
     """The stroboscopic map: one period from (theta, theta') at the strobe phase PHI0."""
-    r = rockjit.simulate(kw["hb"], kw["alpha"], kw["omega"], kw["law"], theta0=x[0],
-                         dtheta0=x[1], phase=PHI0, periods=1)
+    r = rockjit.simulate(Block(kw["hb"], kw["law"]),
+                         Harmonic(alpha=kw["alpha"], omega=kw["omega"], phase=PHI0), (x[0], x[1]),
+                         integration=Integration(periods=1))
     return r.state[:2]
 
 
@@ -156,10 +168,10 @@ FIELDS = ("t", "status", "n_impacts", "state", "strobe", "strobe_half", "impacts
 def test_switches_do_not_change_the_trajectory(name, forcing):
     """Tangent vectors and trajectory recording on or off: the same run to the last bit."""
     kw = dict(BIT_CASES[name], forcing=forcing)
-    plain = rockjit.simulate(**kw)
-    tangent = rockjit.simulate(**kw, lyapunov=True)
-    recorded = rockjit.simulate(**kw, record_stride=3)
-    both = rockjit.simulate(**kw, lyapunov=True, record_stride=3)
+    plain = _run(kw)
+    tangent = _run(kw, lyapunov=True)
+    recorded = _run(kw, record_stride=3)
+    both = _run(kw, lyapunov=True, record_stride=3)
     for other in (tangent, recorded, both):
         for field in FIELDS:
             assert np.array_equal(getattr(other, field), getattr(plain, field)), field
@@ -168,7 +180,7 @@ def test_switches_do_not_change_the_trajectory(name, forcing):
     assert np.array_equal(both.lyapunov_running, tangent.lyapunov_running)
 
 
-# ---- orbits through rest (issue 10): every perturbation dies, the exponents are -inf ----------
+# ---- orbits through rest: every perturbation dies, the exponents are -inf ----------------------
 
 THROUGH_REST = dict(hb=1.0, alpha=0.6, omega=1.3, law="housner", theta0=0.0, dtheta0=0.0,
                     r0=0.0, s0=1.0)
@@ -177,8 +189,8 @@ THROUGH_REST = dict(hb=1.0, alpha=0.6, omega=1.3, law="housner", theta0=0.0, dth
 def _scipy_period(x, phase):
     """One period of the scipy path (DOP853, tight) from (theta, theta') at ``phase``."""
     kw = {k: v for k, v in THROUGH_REST.items() if k not in ("theta0", "dtheta0", "r0", "s0")}
-    r = rockjit.simulate(**kw, theta0=x[0], dtheta0=x[1], phase=phase, periods=1,
-                         method="scipy:DOP853", rtol=1e-12, atol=1e-12)
+    r = _run(kw, theta0=x[0], dtheta0=x[1], phase=phase, periods=1,
+             method=Scipy("DOP853", rtol=1e-12, atol=1e-12))
     return r.state[:2]
 
 
@@ -186,7 +198,7 @@ def test_orbit_through_rest_has_exponents_minus_infinity_at_every_cut_off():
     # Before the fix: lambda1 = +1.954 at rest_speed 1e-6, 0.79 at 1e-3, 0.82 at 1e-8 (the
     # saltation entries of the cascade's last impacts, ~1/theta', counted as growth).
     for rest_speed in (1e-3, 1e-4, 1e-6, 1e-8):
-        r = rockjit.simulate(**THROUGH_REST, lyapunov=True, rest_speed=rest_speed)
+        r = _run(THROUGH_REST, lyapunov=True, rest_speed=rest_speed)
         assert r.status == "done" and r.n_rest_window > 0
         assert np.all(r.lyapunov == -math.inf), (rest_speed, r.lyapunov)
 
@@ -196,7 +208,7 @@ def test_orbit_through_rest_has_a_zero_monodromy_like_the_scipy_path():
     # independent scipy path: zero, since both perturbed runs reach rest and leave it when the
     # forcing alone says.
     T = 2 * math.pi / THROUGH_REST["omega"]
-    r = rockjit.simulate(**THROUGH_REST, periods=40, qr_every=0, lyapunov=True)
+    r = _run(THROUGH_REST, periods=40, qr_every=0, lyapunov=True)
     k = 30
     x = r.strobe[k, :2]
     phase = THROUGH_REST["omega"] * k * T  # phi = atan2(0, 1) = 0 at t = 0
@@ -212,14 +224,22 @@ def test_orbit_through_rest_has_a_zero_monodromy_like_the_scipy_path():
 
 
 def test_rest_only_in_the_transient_leaves_the_window_exponents_finite():
-    # from rest at t = 0 (a collapse at the start), onto the reference orbit, which never rests:
-    # the window's exponents are the orbit's, as from the study's z0 (finite, negative)
-    ref = rockjit.simulate(1.0, 0.6, 1.3, "housner", z0=Z0, lyapunov=True)
-    kw = dict(hb=1.0, alpha=0.6, omega=1.3, law="housner", theta0=0.0, dtheta0=0.0,
-              phase=PHI0, lyapunov=True)
-    r = rockjit.simulate(**kw)
-    assert r.extra["collapses"] >= 1
-    if r.n_rest_window == 0:
-        np.testing.assert_allclose(r.lyapunov, ref.lyapunov, rtol=1e-3)
-    else:
-        assert np.all(r.lyapunov == -math.inf)
+    # hb = 1 at alpha omega^2 = 1.49 > cot(thc) = 1: from theta0 = -0.07 the block rocks down
+    # to rest within the first period (a Zeno cascade: every perturbation collapses), is lifted
+    # again and settles on a symmetric orbit that never rests. The window's exponents are that
+    # orbit's, finite, as from a start that never rests.
+    block, forcing = Block(1.0, "housner"), Harmonic(alpha=0.22, omega=2.6, phase=2.9)
+    r = rockjit.simulate(block, forcing, (-0.07, 0.0), lyapunov=True)
+    ref = rockjit.simulate(block, forcing, (0.1, 0.0), lyapunov=True)
+    assert ref.status == "done" and ref.n_rest == 0
+    assert r.status == "done" and r.n_rest >= 1 and r.extra["collapses"] >= 1
+    t_rest = r.impacts[np.abs(r.impacts[:, 2]) < Integration().rest_speed, 0]
+    assert len(t_rest) == r.n_rest and t_rest.max() < r.period  # long before the window
+    assert r.n_rest_window == 0
+    assert np.all(np.isfinite(r.lyapunov)), r.lyapunov
+    np.testing.assert_allclose(r.lyapunov, ref.lyapunov, rtol=1e-3)
+    # the contrast: from rest under the reference forcing the orbit rests in the window too
+    c = rockjit.simulate(Block(1.0, "housner"), Harmonic(alpha=0.6, omega=1.3, phase=PHI0),
+                         (0.0, 0.0), lyapunov=True)
+    assert c.extra["collapses"] >= 1 and c.n_rest_window > 0
+    assert np.all(c.lyapunov == -math.inf)

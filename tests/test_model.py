@@ -41,9 +41,9 @@ def test_restitution_matches_values_quoted_in_spec(hb, e_h, e_m, delta):
     assert abs(em - e_m) <= 0.5e-3
     assert abs(float(model.delta_e_percent(em, eh)) - delta) <= 0.5e-2
     # Block picks the law it is given
-    assert Block(hb, 0.1, 1.0, "housner").restitution == eh
-    assert Block(hb, 0.1, 1.0, "mao").restitution == em
-    assert Block(hb, 0.1, 1.0, e=0.37).restitution == 0.37
+    assert Block(hb, "housner").restitution == eh
+    assert Block(hb, "mao").restitution == em
+    assert Block(hb, e=0.37).restitution == 0.37
 
 
 def test_restitution_laws_match_spec_formulas(spec):

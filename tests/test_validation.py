@@ -1,19 +1,47 @@
-"""Input checking of ``rockjit.single``: every invalid input is a ValueError naming the parameter.
+"""Input checking of the API's objects and of ``rockjit.simulate``: every invalid input is a
+ValueError naming the parameter.
 
-Checked against SPEC.md's ranges (§1-3) and STYLE.md 12, on both the compiled and the scipy path
-(the wrapper validates before it dispatches, so no integration runs in these tests).
+Checked against SPEC.md's ranges (§1-3) and STYLE.md 12, on both the compiled and the scipy path.
+Each parameter is checked where it now lives: the block's in ``Block``, the excitation's in
+``Harmonic``, the integration's in ``Integration``, the grids' in ``Classification``, ``Lattice``
+and ``Execution``, the reference path's in ``Scipy``, what a run combines (its state, the step's
+stability, its memory) in ``simulate`` (which validates before it dispatches, so no integration
+runs in these tests).
 """
 
 import math
 
+import numba
 import numpy as np
 import pytest
 
 import rockjit
+from rockjit import (Block, Classification, Execution, Harmonic, Integration, Lattice, Scipy)
 from rockjit.single import MAX_STEP
+from rockjit.testing.stress import simulate_flat
 
 BASE = dict(hb=1.0, alpha=0.6, omega=1.3, periods=1)
 NAN = math.nan
+
+OWNERS = ((Block, ("hb", "law", "e", "xi")),
+          (Harmonic, ("alpha", "omega", "phase", "r0", "s0", "embedded")),
+          (Integration, ("n_steps", "periods", "window", "max_impacts", "rest_speed",
+                         "theta_over", "stop_at_overturn", "qr_every")))
+
+
+def simulate(method="rockjit", rtol=None, atol=None, **kw):
+    """``rockjit.simulate`` with each keyword given to the object that owns it (the block's to
+    ``Block``, the excitation's to ``Harmonic``, the integration's to ``Integration``, ``rtol``
+    and ``atol`` to the method's ``Scipy``), the rest (``state``, ``lyapunov``,
+    ``record_stride``) to ``simulate`` itself. The objects are made inside the call, so a
+    refusal by any of them is the call's."""
+    block, forcing, integration = (cls(**{k: kw.pop(k) for k in names if k in kw})
+                                   for cls, names in OWNERS)
+    if rtol is not None or atol is not None:
+        tol = {k: v for k, v in dict(rtol=rtol, atol=atol).items() if v is not None}
+        method = Scipy(method.partition(":")[2] or "BDF", **tol)
+    return rockjit.simulate(block, forcing, integration=integration, method=method, **kw)
+
 
 # (changes to BASE, regular expression the message must match)
 CASES = [
@@ -54,20 +82,20 @@ CASES = [
     (dict(window=1), "window"),                        # must be < periods
     (dict(window=-1), "window"),
     (dict(record_stride=0), "record_stride"),
-    (dict(forcing="open"), "forcing"),
+    (dict(embedded="open"), "embedded"),               # was forcing="open"
     (dict(r0=0.5, s0=0.5), "r0"),                      # off the circle with closed forcing
     (dict(r0=0.0), "r0"),                              # r0 without s0
     (dict(s0=1.0), "s0"),                              # s0 without r0
-    (dict(r0=0.0, s0=0.0, forcing="embedded"), "r0"),  # no phase at the origin
+    (dict(r0=0.0, s0=0.0, embedded=True), "r0"),       # no phase at the origin
     (dict(r0=NAN, s0=1.0), "r0"),
     (dict(phase=NAN), "phase"),
     (dict(phase=0.3, r0=0.0, s0=1.0), "phase"),
-    (dict(z0=(0.1, 0.2, 0.3)), "z0"),
-    (dict(z0=(0.1, 0.2, 0.0, 1.0), theta0=0.1), "z0"),
-    (dict(z0=(NAN, 0.2, 0.0, 1.0)), "theta0|z0"),
-    (dict(theta0=NAN), "theta0"),
-    (dict(dtheta0=NAN), "dtheta0"),
-    (dict(theta0=math.inf), "theta0"),
+    (dict(state=(0.1, 0.2, 0.3)), "state"),            # was z0 of 3 numbers
+    (dict(state=(0.1, 0.2, 0.0, 1.0)), "state"),       # the old z0 (theta, theta', r, s)
+    (dict(state=(NAN, 0.2)), "theta0|state"),
+    (dict(state=(NAN, 0.0)), "theta0"),
+    (dict(state=(0.0, NAN)), "theta0'"),               # was dtheta0
+    (dict(state=(math.inf, 0.0)), "theta0"),
 ]
 
 
@@ -81,7 +109,7 @@ def _id(case):
 def test_invalid_input_names_the_parameter(case, method):
     changes, match = case
     with pytest.raises(ValueError, match=match):
-        rockjit.simulate(**{**BASE, "method": method, **changes})
+        simulate(**{**BASE, "method": method, **changes})
 
 
 @pytest.mark.parametrize("changes, match", [
@@ -95,17 +123,175 @@ def test_invalid_input_names_the_parameter(case, method):
 ], ids=lambda v: repr(v) if isinstance(v, dict) else v)
 def test_invalid_settings_name_the_setting(changes, match):
     with pytest.raises(ValueError, match=match):
-        rockjit.simulate(**{**BASE, **changes})
+        simulate(**{**BASE, **changes})
+
+
+# ---- the objects' own checks -------------------------------------------------------------------
+
+# (object, its keywords, regular expression the message must match): the fields the cases above
+# do not reach through simulate, each refused by its object's constructor
+OBJECT_CASES = [
+    (Harmonic, dict(r0=1.0), "r0 and s0"),                       # r0 without s0
+    (Harmonic, dict(s0=1.0), "r0 and s0"),
+    (Harmonic, dict(alpha=1e9, omega=1e4), r"alpha \* omega\*\*2"),
+    (Harmonic, dict(embedded=1), "embedded"),
+    (Integration, dict(n_steps=9), "n_steps must be even"),
+    (Integration, dict(n_steps=True), "n_steps"),
+    (Integration, dict(max_impacts=2.5), "max_impacts"),
+    (Integration, dict(rest_speed=0.2), "rest_speed"),           # beyond 0.1
+    (Integration, dict(rest_speed=1e-13), "rest_speed"),         # below 1e-12
+    (Integration, dict(qr_every=-1), "qr_every"),
+    (Integration, dict(qr_every=1.5), "qr_every"),
+    (Integration, dict(stop_at_overturn="False"), "stop_at_overturn"),
+    (Integration, dict(stop_at_overturn=1), "stop_at_overturn"),
+    (Classification, dict(tol=0.0), "tol"),
+    (Classification, dict(tol=1.0), "tol"),
+    (Classification, dict(tol=NAN), "tol"),
+    (Classification, dict(settle_tol=2e-6), "settle_tol"),       # > tol
+    (Classification, dict(settle_tol=0.0), "settle_tol"),
+    (Classification, dict(pmax=0), "pmax"),
+    (Classification, dict(pmax=1001), "pmax"),
+    (Classification, dict(lam_tol=NAN), "lam_tol"),
+    (Classification, dict(settle_reps=1), "settle_reps"),
+    (Classification, dict(early_stop="yes"), "early_stop"),
+    (Classification, dict(attractors=None), "attractors"),
+    (Classification, dict(uncertainty=0.6), "uncertainty"),
+    (Classification, dict(uncertainty=0.0), "uncertainty"),
+    (Lattice, dict(grid=0), "grid"),
+    (Lattice, dict(grid=2.5), "grid"),
+    (Lattice, dict(theta_range=(1.0, -1.0)), "theta_range"),
+    (Lattice, dict(theta_range=(NAN, 1.0)), "theta_range"),
+    (Lattice, dict(theta_range=1.0), "theta_range"),
+    (Lattice, dict(dtheta_range=(-2e6, 0.0)), "dtheta_range"),
+    (Execution, dict(threads=0), "threads"),
+    (Execution, dict(threads=numba.config.NUMBA_NUM_THREADS + 1), "threads"),
+    (Execution, dict(chunk=0), "chunk"),
+    (Execution, dict(lanes=0), "lanes"),
+    (Execution, dict(lanes=9), "lanes"),
+    (Execution, dict(client=object(), scheduler="tcp://localhost:8786"), "client or scheduler"),
+    (Execution, dict(scheduler=" "), "scheduler"),
+    (Execution, dict(store=3), "store"),
+    (Execution, dict(message="stderr"), "message"),
+    (Execution, dict(progress="yes"), "progress"),
+    (Scipy, dict(method="NOPE"), "method"),
+    (Scipy, dict(rtol=0.0), "rtol"),
+    (Scipy, dict(rtol=1.0), "rtol"),
+    (Scipy, dict(atol=0.0), "atol"),
+]
+
+
+@pytest.mark.parametrize("cls, kw, match", OBJECT_CASES,
+                         ids=[f"{c.__name__}-{_id((kw, None))}" for c, kw, _ in OBJECT_CASES])
+def test_objects_refuse_bad_fields_naming_them(cls, kw, match):
+    with pytest.raises(ValueError, match=match):
+        cls(**kw)
+
+
+def test_objects_accept_the_edges_of_their_ranges():
+    assert Classification(settle_tol=1e-6).settle_tol == Classification().tol  # settle <= tol
+    assert Integration(rest_speed=1e-12).rest_speed == 1e-12
+    assert Integration(rest_speed=0.1).rest_speed == 0.1
+    assert Integration(n_steps=8, periods=1, window=0).n_steps == 8
+    assert Lattice(grid=1).cells == 1
+    assert Execution(threads=1, lanes=1, chunk=1).lanes == 1
+    assert Execution(lanes=8).lanes == 8
+    assert Classification(pmax=1000, uncertainty=0.5).pmax == 1000
+
+
+def test_an_unknown_keyword_is_a_type_error_naming_it():
+    # the objects are dataclasses: a keyword that is not a field (here the reference path's
+    # tolerance given to the integration) is Python's TypeError, naming the keyword
+    with pytest.raises(TypeError, match="rtol"):
+        Integration(rtol=None)
+    with pytest.raises(TypeError, match="alpha"):
+        Block(hb=1.0, alpha=0.6)  # the forcing moved to Harmonic
+    with pytest.raises(TypeError, match="theta_over"):
+        Block(hb=1.0, theta_over=1.0)  # moved to Integration
+    with pytest.raises(TypeError, match="rtol"):
+        rockjit.simulate(Block(1.0), Harmonic(alpha=0.6, omega=1.3), rtol=1e-9)
+
+
+# ---- values of the wrong kind --------------------------------------------------------------------
+
+ONE = dict(integration=Integration(periods=1))
+
+
+@pytest.mark.parametrize("call, match", [
+    (lambda: Integration(stop_at_overturn="False"), "stop_at_overturn"),
+    (lambda: rockjit.simulate(Block(1.0), Harmonic(alpha=0.6, omega=1.3), lyapunov="no", **ONE),
+     "lyapunov"),
+    (lambda: rockjit.simulate(Block(1.0), Harmonic(alpha=0.6, omega=1.3), lyapunov=1, **ONE),
+     "lyapunov"),
+    (lambda: rockjit.sweep(Block(1.0), Harmonic(omega=1.3), [True, False], **ONE), "alphas"),
+    (lambda: rockjit.sweep(Block(1.0), Harmonic(omega=1.3), [0.5 + 1j], **ONE), "alphas"),
+    (lambda: rockjit.simulate(Block(1.0), Harmonic(alpha=0.6, omega=1.3), [[0.1, 0.0], [0.0, 0.0]],
+                              **ONE), "state"),
+    (lambda: rockjit.sweep(Block(1.0), Harmonic(omega=1.3), [0.5], [[0.1, 0.0], [0.0, 0.0]],
+                           **ONE), "state"),
+    (lambda: rockjit.simulate(Block(1.0), Harmonic(alpha=0.6, omega=1.3), (0.1 + 1j, 0.0), **ONE),
+     "state"),
+    (lambda: Block(hb=1 + 2j), "hb"),
+    (lambda: Harmonic(alpha=0.6 + 0j, omega=1.3), "alpha"),
+    (lambda: Integration(periods=2 + 0j), "periods"),
+    (lambda: Block(hb=True), "hb"),
+], ids=["stop_at_overturn-str", "lyapunov-str", "lyapunov-int", "alphas-bool", "alphas-complex",
+        "state-2x2", "sweep-state-2x2", "state-complex", "hb-complex", "alpha-complex",
+        "periods-complex", "hb-bool"])
+def test_values_of_the_wrong_kind_are_refused_naming_the_parameter(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()
+
+
+# Refusals that do not happen today: the validators read strings as numbers (float("1")), and
+# numpy's complex scalars lose their imaginary part with a warning; booleans pass as a state
+# through numpy. Each is expected to fail by not raising (pytest.raises' own failure), nothing
+# else. For the lead to decide (the command line may rely on strings being parsed).
+@pytest.mark.xfail(strict=True, reason="rockjit.validate.real/integer parse strings as numbers",
+                   raises=pytest.fail.Exception)
+@pytest.mark.parametrize("call, match", [
+    (lambda: Block(hb="1"), "hb"),
+    (lambda: Harmonic(alpha="0.6", omega=1.3), "alpha"),
+    (lambda: Integration(periods="5"), "periods"),
+    (lambda: Lattice(grid="10"), "grid"),
+    (lambda: rockjit.simulate(Block(1.0), Harmonic(alpha=0.6, omega=1.3), ("0.1", "0"), **ONE),
+     "state"),
+], ids=["hb", "alpha", "periods", "grid", "state"])
+def test_strings_are_refused_as_numbers(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()
+
+
+@pytest.mark.xfail(strict=True, reason="float(np.complex128(z)) drops the imaginary part with "
+                                       "a ComplexWarning in rockjit.validate.real/integer",
+                   raises=pytest.fail.Exception)
+@pytest.mark.parametrize("call, match", [
+    (lambda: Block(hb=np.complex128(1 + 2j)), "hb"),
+    (lambda: Integration(periods=np.complex128(3 + 1j)), "periods"),
+], ids=["hb", "periods"])
+def test_numpy_complex_scalars_are_refused(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()
+
+
+@pytest.mark.xfail(strict=True, reason="a state is read through np.asarray(dtype=float), which "
+                                       "takes True for 1.0",
+                   raises=pytest.fail.Exception)
+def test_a_boolean_state_is_refused():
+    with pytest.raises(ValueError, match="state"):
+        rockjit.simulate(Block(1.0), Harmonic(alpha=0.6, omega=1.3), (True, False), **ONE)
 
 
 def test_valid_edge_values_are_accepted():
     # the edges of the allowed ranges are allowed (a guard against over-eager checks)
-    r = rockjit.simulate(1.0 / math.sqrt(2.0) + 1e-12, 0.0, 1.3, periods=1, theta0=0.1,
-                         dtheta0=0.0, n_steps=8, theta_over=0.5 * math.pi)
+    r = rockjit.simulate(Block(1.0 / math.sqrt(2.0) + 1e-12), Harmonic(alpha=0.0, omega=1.3),
+                         (0.1, 0.0),
+                         integration=Integration(periods=1, n_steps=8, theta_over=0.5 * math.pi))
     assert r.status in ("done", "rest")
-    r = rockjit.simulate(1.0, 0.6, 1.3, e=0.0, periods=1, n_steps=8)
+    r = rockjit.simulate(Block(1.0, e=0.0), Harmonic(alpha=0.6, omega=1.3),
+                         integration=Integration(periods=1, n_steps=8))
     assert r.status in ("done", "rest", "overturned")
-    r = rockjit.simulate(1.0, 0.6, 1.3, e=1.0, periods=1.0, n_steps=8.0)
+    r = rockjit.simulate(Block(1.0, e=1.0), Harmonic(alpha=0.6, omega=1.3),
+                         integration=Integration(periods=1.0, n_steps=8.0))
     assert r.periods == 1 and r.n_steps == 8
 
 
@@ -125,49 +311,54 @@ COARSE = [
 @pytest.mark.parametrize("kw", COARSE, ids=["embedded h=1.6", "embedded rho=1.5", "h=2"])
 def test_too_coarse_a_grid_is_refused(kw):
     with pytest.raises(ValueError, match=r"n_steps must be >= (\d+)") as err:
-        rockjit.simulate(**kw)
+        simulate_flat(**kw)
     need = int(err.value.args[0].split(">= ")[1].split()[0])
-    res = rockjit.simulate(**dict(kw, n_steps=need))  # the minimum it names is accepted
+    res = simulate_flat(**dict(kw, n_steps=need))  # the minimum it names is accepted
     assert res.status in ("done", "overturned", "rest", "max_impacts")
     assert np.all(np.isfinite(res.state))
 
 
 def test_slow_forcing_raises_the_default_step_count():
-    res = rockjit.simulate(hb=2.0, alpha=0.3, omega=0.05, periods=1, theta0=0.1, dtheta0=0.0)
+    res = rockjit.simulate(Block(hb=2.0), Harmonic(alpha=0.3, omega=0.05), (0.1, 0.0),
+                           integration=Integration(periods=1))
     assert res.period / res.n_steps <= MAX_STEP
     assert res.n_steps > rockjit.DEFAULT_N
 
 
-# ---- issue 10: strong damping, the Zeno cut-off, the start, memory -----------------------------
+# ---- strong damping, the Zeno cut-off, the start, memory ---------------------------------------
 
 def test_strong_damping_raises_the_default_step_count_and_stays_bounded():
     # xi = 200 at N = 160 is past the step's stability (3/4 xi T/N = 3.6 > 3.3): the run used
     # to overturn at t = 2.17 with an error estimate of 1.4e2. Radau says it stays bounded.
-    r = rockjit.simulate(1.0, 0.6, 1.3, xi=200.0, periods=10)
+    run = (Block(1.0, xi=200.0), Harmonic(alpha=0.6, omega=1.3))
+    r = rockjit.simulate(*run, integration=Integration(periods=10))
     assert 0.75 * 200.0 * r.period / r.n_steps <= 1.0
-    ref = rockjit.simulate(1.0, 0.6, 1.3, xi=200.0, periods=10, method="scipy:Radau",
-                           rtol=1e-10, atol=1e-12)
+    ref = rockjit.simulate(*run, integration=Integration(periods=10),
+                           method=Scipy("Radau", rtol=1e-10, atol=1e-12))
     assert r.status == ref.status == "done"
     np.testing.assert_allclose(r.state[:2], ref.state[:2], atol=1e-7)
 
 
 def test_an_unstable_explicit_step_count_is_refused_naming_the_n_needed():
+    run = (Block(1.0, xi=200.0), Harmonic(alpha=0.6, omega=1.3))
     with pytest.raises(ValueError, match=r"n_steps must be >= (\d+).*damping") as err:
-        rockjit.simulate(1.0, 0.6, 1.3, xi=200.0, n_steps=160, periods=1)
+        rockjit.simulate(*run, integration=Integration(n_steps=160, periods=1))
     need = int(err.value.args[0].split(">= ")[1].split()[0])
     T = 2 * math.pi / 1.3
     assert 0.75 * 200.0 * T / need <= 3.0 < 0.75 * 200.0 * T / (need - 2)
-    assert rockjit.simulate(1.0, 0.6, 1.3, xi=200.0, n_steps=need, periods=1).status == "done"
+    assert rockjit.simulate(*run, integration=Integration(n_steps=need, periods=1)).status == \
+        "done"
 
 
 def test_rest_speed_zero_is_refused():
     # it piled impacts at one instant until the impact bound
     with pytest.raises(ValueError, match="rest_speed must be > 0"):
-        rockjit.simulate(1.0, 0.6, 1.3, e=0.5, rest_speed=0.0, periods=1)
+        rockjit.simulate(Block(1.0, e=0.5), Harmonic(alpha=0.6, omega=1.3),
+                         integration=Integration(rest_speed=0.0, periods=1))
 
 
 @pytest.mark.parametrize("kw, match", [
-    (dict(theta0=2.0), "theta0"),                               # the CLI refused it, the API ran
+    (dict(state=(2.0, 0.0)), "theta0"),                         # the CLI refused it, the API ran
     (dict(omega=1e300), "omega"), (dict(omega=1e-300), "omega"),  # OverflowError
     (dict(omega=1e-8), "omega"),                                 # MemoryError
     (dict(periods=10**12), "would need .* fits"),               # numpy's 29 TiB error
@@ -177,9 +368,9 @@ def test_rest_speed_zero_is_refused():
     (dict(method="scipy", rtol=-1.0), "rtol"),                   # a TypeError with complex
     (dict(method="scipy:FOO"), "method"),                        # scipy's own error
 ])
-def test_issue_10_inputs_are_refused_by_the_api(kw, match):
+def test_inputs_beyond_what_a_run_can_take_are_refused_before_it_starts(kw, match):
     with pytest.raises(ValueError, match=match):
-        rockjit.simulate(**{**BASE, **kw})
+        simulate(**{**BASE, **kw})
 
 
 def test_memory_estimate_names_the_need_and_the_limit():
@@ -189,19 +380,18 @@ def test_memory_estimate_names_the_need_and_the_limit():
     memory("x", 2.0**20, limit=1000 * 2.0**20)  # fits: no error
 
 
-def test_blocks_made_once_and_refusals_never_remembered():
-    """simulate.make_block keeps the blocks it made from plain numbers (a run's fixed cost): the
-    same arguments give the same block, other arguments another, and a refused block is refused
-    again (nothing invalid is kept)."""
-    from rockjit.single import make_block
-    a = make_block(1.0, 0.6, 1.3, "housner")
-    assert make_block(1.0, 0.6, 1.3, "housner") is a
-    b = make_block(1.0, 0.6, 1.3, "mao")
-    assert b is not a and b.restitution != a.restitution
-    assert make_block(np.float64(1.0), 0.6, 1.3, "housner") == a  # not kept, still equal
+def test_equal_arguments_make_equal_blocks_and_refusals_repeat():
+    """A Block is a value: the same arguments give an equal block (hashable, so it may key a
+    cache), other arguments another, numpy's floats the same as Python's; a refused block or
+    forcing is refused again (nothing invalid is kept)."""
+    a = Block(1.0, "housner")
+    assert Block(1.0, "housner") == a and hash(Block(1.0, "housner")) == hash(a)
+    b = Block(1.0, "mao")
+    assert b != a and b.restitution != a.restitution
+    assert Block(np.float64(1.0), "housner") == a and type(Block(np.float64(1.0)).hb) is float
     for _ in range(2):
         with pytest.raises(ValueError, match="alpha"):
-            make_block(1.0, -0.6, 1.3, "housner")
+            Harmonic(alpha=-0.6, omega=1.3)
     with pytest.raises(ValueError, match="hb"):
-        make_block(0.5, 0.6, 1.3, "housner")  # below 1/sqrt(2) for Housner's law
-    assert make_block(0.5, 0.6, 1.3, "mao").hb == 0.5
+        Block(0.5, "housner")  # below 1/sqrt(2) for Housner's law
+    assert Block(0.5, "mao").hb == 0.5
