@@ -24,7 +24,7 @@ from ._engine.classify import classify
 from .result import BEHAVIOURS
 from .settings import Classification, Integration
 from .entry import entry_point
-from .validate import boolean, choice, integer, memory, real
+from .validate import boolean, choice, integer, memory, real, real_array
 
 __all__ = ["DAMPING_STEP", "DEFAULT_N", "IVP_METHODS", "MAX_STEP", "RunPlan", "STABLE_DAMPING",
            "STEP_LIMIT", "Scipy", "Z0_STUDY", "check_step", "classify_result", "run", "simulate",
@@ -170,12 +170,8 @@ def initial_state(state, forcing, integration):
         th, dth = Z0_STUDY[:2]
         default = STUDY_PHASE
     else:
-        try:
-            z = np.asarray(state, dtype=float)
-        except (TypeError, ValueError):
-            raise ValueError(f"state must be two numbers (theta0, theta0') (got {state!r})") \
-                from None
-        if z.shape != (2,) or np.iscomplexobj(state):
+        z = real_array("state", state, "two numbers (theta0, theta0')")
+        if z.shape != (2,):
             raise ValueError(f"state must be two numbers (theta0, theta0') (got {state!r})")
         th, dth = float(z[0]), float(z[1])
         default = (0.0, 1.0)

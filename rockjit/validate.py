@@ -19,7 +19,7 @@ import time
 import numpy as np
 
 __all__ = ["available_memory", "boolean", "choice", "integer", "memory", "pair", "real",
-           "size_text"]
+           "real_array", "size_text"]
 
 
 def _fmt(v):
@@ -81,6 +81,18 @@ def integer(name, value, lo=None, hi=None):
     if (lo is not None and v < lo) or (hi is not None and v > hi):
         raise ValueError(f"{name} must be {_range_text(lo, hi, False, False)} (got {v})")
     return v
+
+
+def real_array(name, value, what):
+    """``value`` as an array of floats: numbers only (no text, booleans or complex numbers
+    among them); ``what`` describes the expected shape in the message."""
+    try:
+        a = np.asarray(value)
+    except (TypeError, ValueError):
+        a = None
+    if a is None or a.dtype.kind not in "iuf":
+        raise ValueError(f"{name} must be {what} (got {value!r})")
+    return a.astype(float)
 
 
 def boolean(name, value):

@@ -242,12 +242,8 @@ def test_values_of_the_wrong_kind_are_refused_naming_the_parameter(call, match):
         call()
 
 
-# Refusals that do not happen today: the validators read strings as numbers (float("1")), and
-# numpy's complex scalars lose their imaginary part with a warning; booleans pass as a state
-# through numpy. Each is expected to fail by not raising (pytest.raises' own failure), nothing
-# else. For the lead to decide (the command line may rely on strings being parsed).
-@pytest.mark.xfail(strict=True, reason="rockjit.validate.real/integer parse strings as numbers",
-                   raises=pytest.fail.Exception)
+# Text, numpy's complex scalars and booleans are not numbers: the API refuses them rather
+# than read them (float("1"), a dropped imaginary part, True as 1.0).
 @pytest.mark.parametrize("call, match", [
     (lambda: Block(hb="1"), "hb"),
     (lambda: Harmonic(alpha="0.6", omega=1.3), "alpha"),
@@ -261,9 +257,6 @@ def test_strings_are_refused_as_numbers(call, match):
         call()
 
 
-@pytest.mark.xfail(strict=True, reason="float(np.complex128(z)) drops the imaginary part with "
-                                       "a ComplexWarning in rockjit.validate.real/integer",
-                   raises=pytest.fail.Exception)
 @pytest.mark.parametrize("call, match", [
     (lambda: Block(hb=np.complex128(1 + 2j)), "hb"),
     (lambda: Integration(periods=np.complex128(3 + 1j)), "periods"),
@@ -273,9 +266,6 @@ def test_numpy_complex_scalars_are_refused(call, match):
         call()
 
 
-@pytest.mark.xfail(strict=True, reason="a state is read through np.asarray(dtype=float), which "
-                                       "takes True for 1.0",
-                   raises=pytest.fail.Exception)
 def test_a_boolean_state_is_refused():
     with pytest.raises(ValueError, match="state"):
         rockjit.simulate(Block(1.0), Harmonic(alpha=0.6, omega=1.3), (True, False), **ONE)

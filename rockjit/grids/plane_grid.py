@@ -9,7 +9,7 @@ from .._engine import kernel
 from ..excitation import ALPHA_MAX, OMEGA_RANGE, check_acceleration
 from ..result import PlaneResult
 from ..single import initial_state
-from ..validate import boolean, integer, pair
+from ..validate import boolean, integer, pair, real_array
 from . import plan as gp
 from ..entry import entry_point
 
@@ -20,13 +20,7 @@ def _states(state):
     """``state`` as rows ``(theta0, theta0')``; ``None`` stays ``None`` (the study's)."""
     if state is None:
         return [None]
-    if np.iscomplexobj(state) or isinstance(state, (str, bytes)):
-        raise ValueError(f"state must be (theta0, theta0') or m rows of them (got {state!r})")
-    try:
-        z = np.atleast_2d(np.asarray(state, dtype=float))
-    except (TypeError, ValueError):
-        raise ValueError(f"state must be (theta0, theta0') or m rows of them "
-                         f"(got {state!r})") from None
+    z = np.atleast_2d(real_array("state", state, "(theta0, theta0') or m rows of them"))
     if z.ndim != 2 or z.shape[1] != 2 or z.shape[0] == 0:
         raise ValueError(f"state must be (theta0, theta0') or m rows of them "
                          f"(got shape {z.shape})")
