@@ -269,14 +269,11 @@ def side_by_side(cases: dict, repeats: int, *, counts: dict | None = None) -> Ti
 
 # --------------------------------------------------------------------------- compile probes
 
-_PROBE = textwrap.dedent("""
-    import json, statistics, sys, time
-    spec = json.loads(sys.argv[1])
-    t0 = time.perf_counter()
-    import rockjit
-    t1 = time.perf_counter()
-
+#: The source of ``decode(x)``, the inverse of :func:`encode`, for the scripts of child
+#: processes (which import rockjit before they call it).
+DECODE = textwrap.dedent("""
     def decode(x):
+        import rockjit
         if isinstance(x, dict) and "rockjit" in x:
             return getattr(rockjit, x["rockjit"])(**{k: decode(v) for k, v in x.items()
                                                       if k != "rockjit"})
@@ -285,7 +282,14 @@ _PROBE = textwrap.dedent("""
         if isinstance(x, list):
             return [decode(v) for v in x]
         return x
+""")
 
+_PROBE = DECODE + textwrap.dedent("""
+    import json, statistics, sys, time
+    spec = json.loads(sys.argv[1])
+    t0 = time.perf_counter()
+    import rockjit
+    t1 = time.perf_counter()
     fn = getattr(rockjit, spec["kind"])
     args, kwargs = decode(spec["args"]), decode(spec["kwargs"])
     fn(*args, **kwargs)
@@ -303,7 +307,8 @@ def encode(x):
     """``x`` as JSON: rockjit's settings objects (:class:`rockjit.Block`,
     :class:`rockjit.Harmonic`, :class:`rockjit.Integration`, ...) as ``{"rockjit": class name,
     field: value, ...}``, arrays and tuples as lists. What a compile probe is given (its child
-    process makes the objects again), and how a script records the inputs of what it measured.
+    process makes the objects again with :data:`DECODE`), and how a script records the inputs
+    of what it measured.
     """
     if dataclasses.is_dataclass(x) and not isinstance(x, type):
         return {"rockjit": type(x).__name__,
