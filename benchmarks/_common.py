@@ -7,8 +7,8 @@ module is all they share:
 - :class:`Bench` parses the common options (``--quick``, ``--out DIR``), records what the numbers
   were measured on, and writes the report: the Markdown table (``.md``, also pasted into its block
   of benchmarks/README.md by a full run), the ``.csv``, the ``.json`` and the plots, every file
-  through :mod:`rockjit.storage.files`'s atomic writers (so the JSON is strict, with non-finite floats
-  written as the strings ``"nan"``, ``"inf"``, ``"-inf"``, rockjit's one convention);
+  through :mod:`rockjit.storage.files`'s atomic writers (so the JSON is strict, with non-finite
+  floats written as the strings ``"nan"``, ``"inf"``, ``"-inf"``, rockjit's one convention);
 - :func:`side_by_side` times cases interleaved in rotating order (medians of repeats, every ratio
   taken within one process: the machine is shared and noisy);
 - :func:`compile_times` measures compile time apart from run time, in fresh processes sharing one

@@ -11,8 +11,8 @@ less than wall time.
 What is measured
 
 - **kernel variants** (:data:`rockjit._engine.kernel.VARIANTS`): the first call of each, through
-  :func:`rockjit._engine.kernel.compile_variant` (what ``rockjit compile`` runs), each alone on an empty
-  cache; and two sequences in one process, ``run`` then ``grid`` and ``run+tangent`` then
+  :func:`rockjit._engine.kernel.compile_variant` (what ``rockjit compile`` runs), each alone on an
+  empty cache; and two sequences in one process, ``run`` then ``grid`` and ``run+tangent`` then
   ``grid+tangent``, which show what a grid kernel costs once the single-run kernel it calls is
   compiled (the grid kernels call the same ``integrate._run`` specialisation).
 - **the compile time by stage**, in the cold process (exclusive CPU seconds, nested work counted

@@ -4,10 +4,11 @@ Measured side by side in one process, on one thread, the block's free-flight ste
 forcing tabulated per period, no tangent, no events; a lane leaving the polynomial's range is
 put back to its start, rarely):
 
-- ``scalar``: today's step (:func:`rockjit._engine.integrate.rk_step`) for each of L independent cells in
-  turn, then the step's acceptance; the out-of-order core may overlap neighbouring cells' chains;
-- ``lanes``: :func:`rockjit._engine.lanes.block_step_lanes`, the same arithmetic written as one loop over
-  lanes, vectorised (it always computes all ``W`` = 8 lanes, one AVX-512 vector; L of them
+- ``scalar``: today's step (:func:`rockjit._engine.integrate.rk_step`) for each of L independent
+  cells in turn, then the step's acceptance; the out-of-order core may overlap neighbouring
+  cells' chains;
+- ``lanes``: :func:`rockjit._engine.lanes.block_step_lanes`, the same arithmetic written as one
+  loop over lanes, vectorised (it always computes all ``W`` = 8 lanes, one AVX-512 vector; L of them
   count), which also accepts the step.
 
 (That the vector step equals the scalar one bit for bit is tests/test_lanes.py's.) The arithmetic
@@ -15,8 +16,8 @@ bound drawn in the plot is :data:`FLOPS_PER_STEP` floating-point instructions (c
 source, below) at :data:`FP_PER_CYCLE` per cycle (two FMA/multiply pipes), scalar and at the
 vector width.
 
-Then the grid kernel itself (:func:`rockjit._engine.kernel.run_chunk_counted`, ``lanes`` = 1, 2, 4, 8,
-side by side, outputs checked equal to ``lanes=1``'s): cells per second and wall ns per
+Then the grid kernel itself (:func:`rockjit._engine.kernel.run_chunk_counted`, ``lanes`` = 1, 2,
+4, 8, side by side, outputs checked equal to ``lanes=1``'s): cells per second and wall ns per
 cell-step on the study's hb=1 Housner basin, full length and early-stopped, on the same threads,
 and from the lanes' own cycle counters (one more run per L with ``profile=True``, not timed) the
 share of the time in the vector steps and in the steps taken by the single-lane code (events,

@@ -1,11 +1,12 @@
 """What the Lyapunov exponents cost, on the study's reference run.
 
 The run: hb=1, alpha=0.6, omega=1.3, Housner restitution, z0 = rockjit.Z0_STUDY, 500 periods,
-exponents averaged over the last 100 (docs/theory/exponents.md, docs/theory/study.md). Measured side by side in one process, in
-alternating order: ``lyapunov=False`` against ``lyapunov=True`` (tangent dynamics and saltation
-matrices compiled in) at the default N and at N=64; compile time of each kernel measured apart in
-fresh processes. Also reported: lambda1, lambda2, and the exact identity
-``lambda1 + lambda2 = -3/4 xi + 2 nu ln(e)`` with ``nu = n_impacts_window / window length``.
+exponents averaged over the last 100 (docs/theory/exponents.md, docs/theory/study.md). Measured
+side by side in one process, in alternating order: ``lyapunov=False`` against ``lyapunov=True``
+(tangent dynamics and saltation matrices compiled in) at the default N and at N=64; compile time of
+each kernel measured apart in fresh processes. Also reported: lambda1, lambda2, and the exact
+identity ``lambda1 + lambda2 = -3/4 xi + 2 nu ln(e)`` with ``nu = n_impacts_window / window
+length``.
 
 There is no scipy variational path: exponents exist only on the compiled path, so there is no
 reference timing to compare with.
@@ -129,7 +130,8 @@ def markdown(recs, compile_info, r_def, n_def, cfg, quick, env):
         H.md_table(["N", "lambda1", "lambda2", "lambda1 + lambda2", "-3/4 xi + 2 nu ln e",
                     "identity error", "nu (impacts / unit time)", "rest phases in window"],
                    lam_rows),
-        "\nIdentity (docs/theory/exponents.md): lambda1 + lambda2 = -3/4 xi + 2 nu ln e over the window, "
+        "\nIdentity (docs/theory/exponents.md): lambda1 + lambda2 = -3/4 xi + 2 nu ln e over "
+        "the window, "
         f"xi = {r_def.block.xi:.6g}, e = {r_def.block.restitution:.6g}.\n\n",
         H.md_table(["kernel", "compile, cold (s)", "compile, cached (s)"], comp_rows),
         "\nCompile: first call in a fresh process minus the warm median; cold = empty numba "

@@ -1,7 +1,7 @@
 """The study's reference run: rockjit against the study's scipy BDF path, speed and error.
 
 The run: hb=1, alpha=0.6, omega=1.3, Housner restitution, z0 = rockjit.Z0_STUDY, 500 periods
-(SPEC.md §7, figure 2). Measured side by side in one process:
+(docs/theory/study.md, figure 2). Measured side by side in one process:
 
 * rockjit (compiled fixed-step Dormand–Prince) at N in {32, 64, 128, 256, 512} steps per period,
   with the closed-form forcing (rockjit's default) and with the 4-D oscillator embedding;

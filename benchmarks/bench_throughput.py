@@ -76,9 +76,9 @@ def step_internals():
 
     Uses exactly these private names (today's layout):
 
-    - ``rockjit._engine.integrate``: ``rk_step``, ``rhs``, ``step_table``; the constants ``N_STAGES``,
-      ``N_TAB``, ``N_PAR``, ``N_PARW`` and the parameter-vector indices ``P_THC``, ``P_OMEGA``,
-      ``P_H``, ``P_STHC``, ``P_CTHC``;
+    - ``rockjit._engine.integrate``: ``rk_step``, ``rhs``, ``step_table``; the constants
+      ``N_STAGES``, ``N_TAB``, ``N_PAR``, ``N_PARW`` and the parameter-vector indices
+      ``P_THC``, ``P_OMEGA``, ``P_H``, ``P_STHC``, ``P_CTHC``;
     - ``rockjit._engine.kernel.pack`` (the float parameter vector, from a block, an excitation
       and integration settings);
     - ``rockjit.model.sincos_poly`` (the stepper's sine and cosine).
