@@ -7,12 +7,14 @@ module is all they share:
 - :class:`Bench` parses the common options (``--quick``, ``--out DIR``), records what the numbers
   were measured on, and writes the report: the Markdown table (``.md``, also pasted into its block
   of benchmarks/README.md by a full run), the ``.csv``, the ``.json`` and the plots, every file
-  through :mod:`rockjit.storage.files`'s atomic writers (so the JSON is strict, with non-finite floats
-  written as the strings ``"nan"``, ``"inf"``, ``"-inf"``, rockjit's one convention);
+  through :mod:`rockjit.storage.files`'s atomic writers (so the JSON is strict, with non-finite
+  floats written as the strings ``"nan"``, ``"inf"``, ``"-inf"``, rockjit's one convention);
 - :func:`side_by_side` times cases interleaved in rotating order (medians of repeats, every ratio
   taken within one process: the machine is shared and noisy);
 - :func:`compile_times` measures compile time apart from run time, in fresh processes sharing one
-  new ``NUMBA_CACHE_DIR``;
+  new ``NUMBA_CACHE_DIR`` (the call's settings objects travel to them as JSON: :func:`encode`);
+- :func:`call_in` makes one call in whichever API a rockjit package has (for the scripts that
+  compare versions);
 - :func:`impact_time_error` compares the impact times of two runs.
 
 House rules (benchmarks/README.md): every quoted time is a median of repeats taken side by side;
@@ -23,6 +25,9 @@ benchmarks/results/ and never touches the README.
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import importlib
+import inspect
 import json
 import math
 import os
@@ -42,8 +47,14 @@ RESULTS = HERE / "results"
 QUICK_RESULTS = RESULTS / "quick"
 README = HERE / "README.md"
 
-#: The study's reference run (SPEC.md §7, figure 2).
-REFERENCE_RUN = dict(hb=1.0, alpha=0.6, omega=1.3, law="housner")
+
+
+def reference_run():
+    """The study's reference run (docs/theory/study.md, figure 2), ``(block, forcing)``: hb=1,
+    Housner restitution, alpha=0.6, omega=1.3; it starts from the study's initial state (the
+    default ``state=None`` of :func:`rockjit.simulate`)."""
+    from rockjit import Block, Harmonic
+    return Block(hb=1.0, law="housner"), Harmonic(alpha=0.6, omega=1.3)
 
 
 # --------------------------------------------------------------------------- one benchmark run
@@ -258,24 +269,57 @@ def side_by_side(cases: dict, repeats: int, *, counts: dict | None = None) -> Ti
 
 # --------------------------------------------------------------------------- compile probes
 
-_PROBE = textwrap.dedent("""
+#: The source of ``decode(x)``, the inverse of :func:`encode`, for the scripts of child
+#: processes (which import rockjit before they call it).
+DECODE = textwrap.dedent("""
+    def decode(x):
+        import rockjit
+        if isinstance(x, dict) and "rockjit" in x:
+            return getattr(rockjit, x["rockjit"])(**{k: decode(v) for k, v in x.items()
+                                                      if k != "rockjit"})
+        if isinstance(x, dict):
+            return {k: decode(v) for k, v in x.items()}
+        if isinstance(x, list):
+            return [decode(v) for v in x]
+        return x
+""")
+
+_PROBE = DECODE + textwrap.dedent("""
     import json, statistics, sys, time
     spec = json.loads(sys.argv[1])
     t0 = time.perf_counter()
     import rockjit
-    from rockjit.grids import grids as analysis
     t1 = time.perf_counter()
-    fn = dict(simulate=rockjit.simulate, basin=analysis.basin, sweep=analysis.sweep,
-              plane=analysis.plane)[spec["kind"]]
-    fn(**spec["kw"])
+    fn = getattr(rockjit, spec["kind"])
+    args, kwargs = decode(spec["args"]), decode(spec["kwargs"])
+    fn(*args, **kwargs)
     t2 = time.perf_counter()
     warm = []
     for _ in range(spec["repeats"]):
         a = time.perf_counter()
-        fn(**spec["kw"])
+        fn(*args, **kwargs)
         warm.append(time.perf_counter() - a)
     print(json.dumps(dict(import_s=t1 - t0, first_s=t2 - t1, warm_s=statistics.median(warm))))
 """)
+
+
+def encode(x):
+    """``x`` as JSON: rockjit's settings objects (:class:`rockjit.Block`,
+    :class:`rockjit.Harmonic`, :class:`rockjit.Integration`, ...) as ``{"rockjit": class name,
+    field: value, ...}``, arrays and tuples as lists. What a compile probe is given (its child
+    process makes the objects again with :data:`DECODE`), and how a script records the inputs
+    of what it measured.
+    """
+    if dataclasses.is_dataclass(x) and not isinstance(x, type):
+        return {"rockjit": type(x).__name__,
+                **{f.name: encode(getattr(x, f.name)) for f in dataclasses.fields(x)}}
+    if isinstance(x, dict):
+        return {k: encode(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [encode(v) for v in x]
+    if hasattr(x, "tolist"):  # numpy arrays and scalars
+        return x.tolist()
+    return x
 
 
 def child_env(**extra) -> dict:
@@ -288,33 +332,36 @@ def child_env(**extra) -> dict:
     return env
 
 
-def compile_times(kind: str, kwargs: dict, *, sessions=("cold", "cached"),
+def compile_times(kind: str, args=(), kwargs=None, *, processes=("cold", "cached"),
                   warm_repeats: int = 5) -> dict:
     """Compile time of one call, measured in fresh processes: the one compile probe.
 
-    One fresh Python process per name in ``sessions``, one after the other, all sharing one new,
-    empty ``NUMBA_CACHE_DIR``: the first compiles from nothing (``cold``), the later ones start
-    with what the earlier ones wrote (what a user sees in every session after the first). In
+    One fresh Python process per name in ``processes``, one after the other, all sharing one
+    new, empty ``NUMBA_CACHE_DIR``: the first compiles from nothing (``cold``), the later ones
+    start with what the earlier ones wrote (what a user sees in every process after the
+    first). In
     each, ``compile_s`` is the first call's wall time minus the median of ``warm_repeats`` later
     calls (the run time itself); ``import_s`` (``import rockjit``) is reported apart.
 
     Parameters
     ----------
-    kind : {"simulate", "basin", "sweep", "plane"}
-        ``rockjit.simulate`` or the ``rockjit.grids.grids`` function called.
-    kwargs : dict
-        Its keyword arguments (JSON-serialisable).
+    kind : {"simulate", "basin", "sweep", "plane", "erosion", "fate"}
+        The ``rockjit`` entry point called.
+    args, kwargs : tuple, dict
+        Its arguments: numbers, arrays and rockjit's settings objects (sent as JSON through
+        :func:`encode`; a Dask client or a callable cannot travel).
 
     Returns
     -------
     dict
-        ``{session: dict(import_s, first_s, warm_s, compile_s)}``.
+        ``{process name: dict(import_s, first_s, warm_s, compile_s)}``.
     """
-    spec = json.dumps(dict(kind=kind, kw=kwargs, repeats=warm_repeats))
+    spec = json.dumps(dict(kind=kind, args=encode(list(args)), kwargs=encode(kwargs or {}),
+                           repeats=warm_repeats))
     out = {}
     with tempfile.TemporaryDirectory(prefix="rockjit-numba-cache-") as d:
         env = child_env(NUMBA_CACHE_DIR=d)
-        for name in sessions:
+        for name in processes:
             proc = subprocess.run([sys.executable, "-c", _PROBE, spec], env=env, cwd=d,
                                   capture_output=True, text=True, check=True)
             r = json.loads(proc.stdout.strip().splitlines()[-1])
@@ -323,6 +370,93 @@ def compile_times(kind: str, kwargs: dict, *, sessions=("cold", "cached"),
             print(f"compile {kind} {name}: {r['compile_s']:.1f} s (first call "
                   f"{r['first_s']:.1f} s, warm {r['warm_s']:.3g} s)", flush=True)
     return out
+
+
+# --------------------------------------------------------------------------- either API
+
+#: The flat keywords :func:`call_in` knows, by the settings object each belongs to.
+_FLAT = dict(Block=("hb", "law", "e", "xi"), Harmonic=("alpha", "omega", "phase", "r0", "s0"),
+             Integration=("n_steps", "periods", "window", "max_impacts"),
+             Classification=("early_stop", "attractors", "tol", "pmax"),
+             Execution=("threads", "chunk", "lanes"))
+
+
+def api_of(rj) -> str:
+    """Which API the rockjit package ``rj`` has: ``"objects"`` (the settings objects:
+    ``rockjit.Harmonic`` and its kind) or ``"flat"`` (every parameter a keyword of
+    ``simulate``, ``basin`` and ``sweep``, before them)."""
+    return "objects" if hasattr(rj, "Harmonic") else "flat"
+
+
+def _flat_grids(rj):
+    """The module of the grid functions of a flat-API package: ``rockjit.grids.grids``, or
+    ``rockjit.analysis`` in the older layout."""
+    for sub in ("grids.grids", "analysis"):
+        try:
+            return importlib.import_module(f"{rj.__name__}.{sub}")
+        except ImportError:
+            continue
+    raise ImportError(f"{rj.__name__} has neither grids.grids nor analysis")
+
+
+def call_in(rj, fn: str, kw: dict):
+    """A zero-argument callable running ``fn`` of the rockjit package ``rj`` in its own API.
+
+    For the scripts that time two versions of rockjit side by side (bench_versions.py,
+    bench_compile.py's speed part), whose cases must mean the same call in both: a case is
+    written once, in flat keywords (``hb``, ``alpha``, ``omega``, ``law``, ``periods``,
+    ``grid``, ``r0``, ``s0``, ``z0``, ``alpha_range``, ``alpha_step`` or ``alphas``,
+    ``lyapunov``, ``early_stop``, ``attractors``, ``threads``, ...), which is also the older
+    API's. A package with the settings objects (:func:`api_of`) gets them built from the
+    keywords: the study's initial state unless ``z0`` says otherwise, ``(r0, s0) = (0, 1)``
+    for a basin unless ``r0, s0`` do. A flat-API package gets the keywords its function
+    knows (a keyword it predates, such as ``attractors``, is left out).
+
+    Parameters
+    ----------
+    rj : module
+        A rockjit package (it may be imported under another name).
+    fn : {"simulate", "basin", "sweep"}
+    kw : dict
+        The case's flat keywords.
+    """
+    kw = dict(kw)
+    if api_of(rj) == "flat":
+        f = rj.simulate if fn == "simulate" else getattr(_flat_grids(rj), fn)
+        known = inspect.signature(f).parameters
+        kw = {k: v for k, v in kw.items() if k in known}
+        return lambda: f(**kw)
+    obj = {name: {k: kw.pop(k) for k in keys if k in kw} for name, keys in _FLAT.items()}
+    state = None
+    if "z0" in kw:
+        z0 = [float(x) for x in kw.pop("z0")]
+        state = tuple(z0[:2])
+        obj["Harmonic"].update(r0=z0[2], s0=z0[3])
+    block, forcing = rj.Block(**obj["Block"]), rj.Harmonic(**obj["Harmonic"])
+    settings = dict(integration=rj.Integration(**obj["Integration"]))
+    if fn != "simulate":
+        settings.update(classification=rj.Classification(**obj["Classification"]),
+                        execution=rj.Execution(**obj["Execution"]))
+    if "lyapunov" in kw:
+        settings["lyapunov"] = kw.pop("lyapunov")
+    if fn == "simulate":
+        args = (block, forcing, state)
+    elif fn == "basin":
+        args = (block, forcing, kw.pop("grid", 100))
+    elif fn == "sweep":
+        alphas = kw.pop("alphas", None)
+        if alphas is None:
+            alphas = rj.alpha_grid(kw.pop("alpha_range"), kw.pop("alpha_step"))
+        args = (block, forcing, alphas, state)
+    else:
+        raise ValueError(f"call_in: no {fn!r} (simulate, basin or sweep)")
+    if fn == "simulate":
+        kw.update(obj["Classification"], **obj["Execution"])
+    if kw:
+        raise ValueError(f"call_in: keywords {sorted(kw)} have no place in a {fn} of "
+                         f"rockjit's settings objects")
+    f = getattr(rj, fn)
+    return lambda: f(*args, **settings)
 
 
 # --------------------------------------------------------------------------- comparing runs

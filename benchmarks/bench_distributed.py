@@ -1,6 +1,6 @@
 """The same (alpha, omega) plane in-process and on a two-worker Dask LocalCluster.
 
-Issue 6: what distribution costs. The plane (Housner, h/b = 1, alpha in [0.3, 1.0], omega in
+What distribution costs. The plane (Housner, h/b = 1, alpha in [0.3, 1.0], omega in
 [0.8, 2.0], the study's z0, lambda_max on) runs in this process with numba's threads, and as
 chunks on a LocalCluster of two single-threaded worker processes, for several chunk sizes; the
 results must be identical. The overhead per chunk is the extra wall time of the cluster run over
@@ -23,7 +23,8 @@ import numpy as np
 
 import _common as H
 
-from rockjit.grids import grids as an
+import rockjit
+from rockjit import Block, Execution, Integration
 
 FULL = dict(grid=(60, 60), periods=500, repeats=3, chunk_divisors=(4, 16, 64))
 QUICK = dict(grid=(16, 16), periods=100, repeats=1, chunk_divisors=(4, 16))
@@ -31,14 +32,15 @@ HEADERS = ("run", "chunks", "wall median s", "ratio to in-process", "overhead pe
            "identical to in-process")
 
 
-def plane_kwargs(cfg):
-    return dict(hb=1, alpha_range=(0.3, 1.0), omega_range=(0.8, 2.0), grid=cfg["grid"],
-                periods=cfg["periods"])
+def plane(grid, periods, execution=None):
+    """The plane (hb=1, Housner, from the study's initial state, lambda_max on)."""
+    return rockjit.plane(Block(hb=1.0), (0.3, 1.0), (0.8, 2.0), grid=grid,
+                         integration=Integration(periods=periods), execution=execution)
 
 
 # --------------------------------------------------------------------------- the experiment
 
-def in_process_and_cluster(kw, chunk_sizes, repeats):
+def in_process_and_cluster(cfg, chunk_sizes, repeats):
     """The plane in this process and on the cluster at each chunk size, interleaved.
 
     Returns ``(wall times by case, identical to the in-process result by case, compile s,
@@ -46,18 +48,18 @@ def in_process_and_cluster(kw, chunk_sizes, repeats):
     """
     from dask.distributed import Client, LocalCluster
 
-    tiny = dict(kw, grid=(2, 2), periods=5)
-    t_compile, _ = H.timed(an.plane, **tiny)
-    ref = an.plane(**kw)  # warm, and the reference result
+    grid, periods = cfg["grid"], cfg["periods"]
+    t_compile, _ = H.timed(plane, (2, 2), 5)
+    ref = plane(grid, periods)  # warm, and the reference result
     cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                            dashboard_address=None)
     client = Client(cluster)
     try:
-        t_workers, _ = H.timed(an.plane, **tiny, client=client, chunk=2)
-        cases = {"in-process": lambda: an.plane(**kw)}
+        t_workers, _ = H.timed(plane, (2, 2), 5, Execution(client=client, chunk=2))
+        cases = {"in-process": lambda: plane(grid, periods)}
         for c in chunk_sizes:
-            cases[f"cluster, {c} cells/chunk"] = (lambda c=c: an.plane(**kw, chunk=c,
-                                                                      client=client))
+            cases[f"cluster, {c} cells/chunk"] = (
+                lambda c=c: plane(grid, periods, Execution(client=client, chunk=c)))
         t = H.side_by_side(cases, repeats)
     finally:
         client.close()
@@ -99,7 +101,7 @@ def main(argv=None):
     g = cfg["grid"]
     n = g[0] * g[1]
     times, identical, t_compile, t_workers = in_process_and_cluster(
-        plane_kwargs(cfg), [n // d for d in cfg["chunk_divisors"]], cfg["repeats"])
+        cfg, [n // d for d in cfg["chunk_divisors"]], cfg["repeats"])
     table = rows(times, identical, n)
     md = (H.md_table(HEADERS, table) + "\n"
           + f"Plane {g[0]} x {g[1]} = {n} cells, {cfg['periods']} periods, lambda_max on; "

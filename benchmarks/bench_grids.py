@@ -1,23 +1,25 @@
-"""Issue 4: sweeps and basins — wall time, threads, early stopping and grid resolution.
+"""Sweeps and basins: wall time, threads, early stopping and grid resolution.
 
-Everything at the study's settings (SPEC.md §6–7), measured side by side in one process:
+Everything at the study's settings (docs/theory/study.md), measured side by side in one process
+(the numbers 1, 2, 4 and 5 name the parts in the tables and the CSV's ``item`` column):
 
 1. the hb=1 Housner basin (100x100 cells over (theta0, theta0') in [-1, 1]^2, (r0, s0) = (0, 1),
    alpha=0.66, omega=1.3, 500 periods): 2 threads (all) vs 1 thread with early stopping (the
-   default), and full length (``early_stop=False``); fractions per behaviour; target <= 2 s;
+   default), and full length (``Classification(early_stop=False)``); fractions per behaviour;
+   goal <= 2 s;
 2. the hb=1 Housner alpha sweep (alpha 0.5...1.0 step 0.001 = 501 values, lambda_max on, 500
    periods, z0 = rockjit.Z0_STUDY, omega=1.3): early stopping on 2 and 1 threads, and full
-   length; target <= 3 s;
+   length; goal <= 3 s;
 4. early stopping against full length on the study's four basins (hb=1 alpha=0.66 omega=1.3,
    hb=2 alpha=0.2 omega=1.6, Housner and Mao): percentage of cells with the same label
-   (issue 4 requires >= 99.9 % on each), and every differing cell;
+   (required: >= 99.9 % on each), and every differing cell;
 5. grid resolution: the four basins and the sweep at n_steps = 64, 128 and 256 (GRID_N, the
    default of sweeps and basins, is one of them): label agreement of 64 and 128 with 256, wall
    time of each, and for the sweep the largest |lambda_max difference|.
 
-(Item 3, the ``rockjit paper`` command end to end, is benchmarks/bench_paper.py.) Compile time
-of the two grid kernels (basin: no tangent; sweep: tangent) is measured apart, in fresh
-processes with an empty and then a filled numba cache.
+(The ``rockjit paper`` command end to end is benchmarks/bench_paper.py.) Compile time of the
+two grid kernels (basin: no tangent; sweep: tangent) is measured apart, in fresh processes with
+an empty and then a filled numba cache.
 
     python benchmarks/bench_grids.py           # full measurement (~20 min on 2 loaded cores)
     python benchmarks/bench_grids.py --quick   # smoke mode (small grids, few periods)
@@ -29,7 +31,6 @@ benchmarks/results/ (benchmarks/results/quick/ with --quick, or --out DIR), and 
 
 from __future__ import annotations
 
-import math
 import sys
 import time
 
@@ -39,18 +40,24 @@ import numpy as np
 import _common as H
 
 import rockjit
-from rockjit.grids.grids import BEHAVIOURS, GRID_N, basin, sweep
+from rockjit import BEHAVIOURS, Block, Classification, Execution, Harmonic, Integration
+from rockjit.grids.plan import GRID_N
 from rockjit.plotting.figures import agreement
 
-#: The study's four basins (SPEC.md §7, figure 6).
+#: The study's four basins (docs/theory/study.md, figure 6): (block, forcing), every cell at
+#: the forcing phase (r0, s0) = (0, 1) (a basin's default)
 BASINS = (
-    dict(hb=1.0, alpha=0.66, omega=1.3, law="housner"),
-    dict(hb=1.0, alpha=0.66, omega=1.3, law="mao"),
-    dict(hb=2.0, alpha=0.2, omega=1.6, law="housner"),
-    dict(hb=2.0, alpha=0.2, omega=1.6, law="mao"),
+    (Block(hb=1.0, law="housner"), Harmonic(alpha=0.66, omega=1.3)),
+    (Block(hb=1.0, law="mao"), Harmonic(alpha=0.66, omega=1.3)),
+    (Block(hb=2.0, law="housner"), Harmonic(alpha=0.2, omega=1.6)),
+    (Block(hb=2.0, law="mao"), Harmonic(alpha=0.2, omega=1.6)),
 )
+#: The study's hb=1 Housner sweep over alpha at omega=1.3, from its initial state
+SWEEP = (Block(hb=1.0, law="housner"), Harmonic(omega=1.3))
 NS = (64, 128, 256)
 N_REF = 256
+#: Goals: the basin's and the sweep's wall time (early stop, all threads), and the agreement
+#: of early stopping with full length required on every basin
 TARGET_BASIN_S = 2.0
 TARGET_SWEEP_S = 3.0
 TARGET_AGREEMENT = 99.9
@@ -63,20 +70,48 @@ THREADS_CASES = ("early, all threads", "early, 1 thread", "full length, all thre
 
 
 def basin_name(b):
-    return f"hb={b['hb']:g} alpha={b['alpha']:g} omega={b['omega']:g} {b['law']}"
+    block, forcing = b
+    return f"hb={block.hb:g} alpha={forcing.alpha:g} omega={forcing.omega:g} {block.law}"
 
 
 def basin_tag(b):
-    return f"hb{b['hb']:g}_{b['law']}"
+    return f"hb{b[0].hb:g}_{b[0].law}"
 
 
-def settings(cfg):
-    """``(basin keywords, sweep keywords)`` of a configuration."""
-    bkw = dict(grid=cfg["grid"], r0=0.0, s0=1.0, periods=cfg["periods"])
-    skw = dict(hb=1.0, omega=1.3, law="housner", alpha_range=(0.5, 1.0),
-               alpha_step=cfg["alpha_step"], z0=rockjit.Z0_STUDY, periods=cfg["periods"],
-               lyapunov=True)
-    return bkw, skw
+class Grids:
+    """The basins and the sweep of a configuration, called with the settings varied here."""
+
+    def __init__(self, cfg):
+        self.grid = cfg["grid"]
+        self.periods = cfg["periods"]
+        self.alpha_step = cfg["alpha_step"]
+        self.alphas = rockjit.alpha_grid((0.5, 1.0), self.alpha_step)
+
+    def integration(self, n_steps=None):
+        return Integration(periods=self.periods, n_steps=n_steps)
+
+    @staticmethod
+    def options(threads, early_stop):
+        return dict(classification=Classification(early_stop=early_stop),
+                    execution=Execution(threads=threads))
+
+    def basin(self, b, *, n_steps=None, threads=None, early_stop=True):
+        return rockjit.basin(*b, self.grid, integration=self.integration(n_steps),
+                             **self.options(threads, early_stop))
+
+    def sweep(self, *, n_steps=None, threads=None, early_stop=True):
+        return rockjit.sweep(*SWEEP, self.alphas, integration=self.integration(n_steps),
+                             lyapunov=True, **self.options(threads, early_stop))
+
+    def description(self):
+        """The inputs, for the JSON: ``(basin settings, sweep settings)``."""
+        return (H.encode(dict(grid=self.grid, integration=self.integration(),
+                              basins=BASINS)),
+                H.encode(dict(block=SWEEP[0], forcing=SWEEP[1], alpha_range=(0.5, 1.0),
+                              alpha_step=self.alpha_step,
+                              n_alphas=self.alphas.size, state=None,
+                              z0=list(rockjit.Z0_STUDY), integration=self.integration(),
+                              lyapunov=True)))
 
 
 # --------------------------------------------------------------------------- comparisons
@@ -84,7 +119,7 @@ def settings(cfg):
 def differing_cells(a, b):
     """Every cell where the label arrays of two basins differ, as dicts."""
     out = []
-    T = 2 * math.pi / a.block.omega
+    T = a.forcing.period
     for i, j in zip(*np.nonzero(a.label != b.label)):
         out.append(dict(i=int(i), j=int(j), theta0=float(a.theta0[i]),
                         dtheta0=float(a.dtheta0[j]), label_a=BEHAVIOURS[a.label[i, j]],
@@ -120,23 +155,23 @@ def lam_diff(sa, sb):
 
 # --------------------------------------------------------------------------- experiments
 
-def first_calls(bkw, skw):
+def first_calls(g):
     """The first call of each grid kernel in this process (from the package's cache)."""
     first = {}
-    first["basin"], _ = H.timed(basin, **BASINS[0], **bkw)
-    first["sweep"], _ = H.timed(sweep, **skw)
+    first["basin"], _ = H.timed(g.basin, BASINS[0])
+    first["sweep"], _ = H.timed(g.sweep)
     print(f"first calls in process: basin {first['basin']:.2f} s, sweep {first['sweep']:.2f} s",
           flush=True)
     return first
 
 
-def item1_basin(bkw, cfg):
-    """Item 1: the hb=1 Housner basin, all threads vs 1 thread, early stop vs full length."""
+def item1_basin(g, cfg):
+    """Part 1: the hb=1 Housner basin, all threads vs 1 thread, early stop vs full length."""
     b0 = BASINS[0]
     t = H.side_by_side(dict(zip(THREADS_CASES, (
-        lambda: basin(**b0, **bkw),
-        lambda: basin(**b0, **bkw, threads=1),
-        lambda: basin(**b0, **bkw, early_stop=False)))), cfg["reps"],
+        lambda: g.basin(b0),
+        lambda: g.basin(b0, threads=1),
+        lambda: g.basin(b0, early_stop=False)))), cfg["reps"],
         counts={"full length, all threads": cfg["reps_full"]})
     a, one = t.result["early, all threads"], t.result["early, 1 thread"]
     identical = bool(np.array_equal(a.label, one.label) and np.array_equal(a.t_end, one.t_end))
@@ -144,12 +179,12 @@ def item1_basin(bkw, cfg):
     return t, identical
 
 
-def item2_sweep(skw, cfg):
-    """Item 2: the hb=1 Housner sweep, all threads vs 1 thread, early stop vs full length."""
+def item2_sweep(g, cfg):
+    """Part 2: the hb=1 Housner sweep, all threads vs 1 thread, early stop vs full length."""
     t = H.side_by_side(dict(zip(THREADS_CASES, (
-        lambda: sweep(**skw),
-        lambda: sweep(**skw, threads=1),
-        lambda: sweep(**skw, early_stop=False)))), cfg["reps"])
+        lambda: g.sweep(),
+        lambda: g.sweep(threads=1),
+        lambda: g.sweep(early_stop=False)))), cfg["reps"])
     a, one = t.result["early, all threads"], t.result["early, 1 thread"]
     identical = bool(np.array_equal(a.label, one.label)
                      and np.array_equal(a.lambda_max, one.lambda_max, equal_nan=True))
@@ -165,46 +200,47 @@ def item2_sweep(skw, cfg):
     return t, identical, early_vs_full
 
 
-def item5_resolution(bkw, skw, cfg):
-    """Item 5 (and the early-stop half of item 4): the four basins and the sweep at each N.
+def item5_resolution(g, cfg):
+    """Part 5 (and the early-stop half of part 4): the four basins and the sweep at each N.
 
     Returns ``{tag or "sweep": Timings keyed by N}``.
     """
     out = {}
     for b in BASINS:
         out[basin_tag(b)] = t = H.side_by_side(
-            {n: (lambda n=n: basin(**b, **bkw, n_steps=n)) for n in NS}, cfg["reps_n"])
+            {n: (lambda n=n: g.basin(b, n_steps=n)) for n in NS}, cfg["reps_n"])
         print(f"item 5 {basin_name(b)}:", {n: round(t.median(n), 3) for n in NS}, flush=True)
-    out["sweep"] = t = H.side_by_side({n: (lambda n=n: sweep(**skw, n_steps=n)) for n in NS},
+    out["sweep"] = t = H.side_by_side({n: (lambda n=n: g.sweep(n_steps=n)) for n in NS},
                                       cfg["reps_n"])
     print("item 5 sweep:", {n: round(t.median(n), 3) for n in NS}, flush=True)
     return out
 
 
-def item4_full_length(bkw, t1):
-    """Item 4's full-length basins: ``{tag: (wall s, CPU s, result)}`` (hb=1 Housner's is
-    item 1's)."""
+def item4_full_length(g, t1):
+    """Part 4's full-length basins: ``{tag: (wall s, CPU s, result)}`` (hb=1 Housner's is
+    part 1's)."""
     k = "full length, all threads"
     out = {basin_tag(BASINS[0]): (t1.median(k), t1.cpu_median(k), t1.result[k])}
     for b in BASINS[1:]:
-        out[basin_tag(b)] = H.timed_cpu(basin, **b, **bkw, early_stop=False)
+        out[basin_tag(b)] = H.timed_cpu(g.basin, b, early_stop=False)
         print(f"item 4 full length {basin_name(b)}: {out[basin_tag(b)][0]:.1f} s", flush=True)
     return out
 
 
-def compile_cost(bkw, skw):
+def compile_cost(g):
     """Compile time of the two grid kernels, apart, in three fresh processes each.
 
     Three, not two: before commit 4e61b69 rockjit's cache check found the folder the first
     process wrote without its source stamp and emptied it, so the second process compiled
-    again. The second process shows whether that is fixed; the third is what every later
-    session sees.
+    again. The second process shows that it no longer does; the third is what every later
+    process sees.
     """
-    sessions = ("cold", "second", "cached")
-    return dict(basin=H.compile_times("basin", dict(BASINS[0], **bkw), sessions=sessions,
+    processes = ("cold", "second", "cached")
+    kw = dict(integration=g.integration())
+    return dict(basin=H.compile_times("basin", (*BASINS[0], g.grid), kw, processes=processes,
                                       warm_repeats=2),
-                sweep=H.compile_times("sweep", dict(skw, z0=list(skw["z0"])),
-                                      sessions=sessions, warm_repeats=2))
+                sweep=H.compile_times("sweep", (*SWEEP, g.alphas), dict(kw, lyapunov=True),
+                                      processes=processes, warm_repeats=2))
 
 
 # --------------------------------------------------------------------------- summaries
@@ -220,8 +256,8 @@ def item4_rows(t5, full):
                         wall_early_s=t5[tag].median(GRID_N), wall_full_s=wall_full,
                         cpu_early_s=t5[tag].cpu_median(GRID_N), cpu_full_s=cpu_full,
                         fractions_early=e.fractions(), fractions_full=f.fractions(),
-                        mean_t_end_early_periods=float(np.mean(e.t_end) * b["omega"]
-                                                       / (2 * math.pi))))
+                        mean_t_end_early_periods=float(np.mean(e.t_end)
+                                                       / b[1].period)))
     return out
 
 
@@ -274,6 +310,14 @@ def _with_period(label, period):
     return label + (f" p={period}" if period else "")
 
 
+def goal(wall, limit, n_threads):
+    """Whether a wall time reached its goal, in words."""
+    if wall <= limit:
+        return f"Goal of {limit:g} s **reached** ({wall:.2f} s)"
+    return (f"Goal of {limit:g} s **out of reach** here: {wall:.2f} s on {n_threads} threads "
+            f"of a shared machine")
+
+
 def markdown(m):
     """The report's Markdown from the measurements ``m`` (a dict: see :func:`main`)."""
     cfg, t1, t2 = m["cfg"], m["t1"], m["t2"]
@@ -288,7 +332,7 @@ def markdown(m):
           f"step {cfg['alpha_step']:g} ({s_early.alpha.size} values), lambda_max on, z0 = "
           f"Z0_STUDY, {cfg['periods']} periods. 'all threads' = {n_threads}.\n\n"]
 
-    md.append(f"**1. Basin hb=1, alpha=0.66, omega=1.3, Housner** (target <= "
+    md.append(f"**1. Basin hb=1, alpha=0.66, omega=1.3, Housner** (goal <= "
               f"{TARGET_BASIN_S:g} s)\n\n")
     base = t1.median("early, all threads")
     md.append(_threads_table(t1))
@@ -296,12 +340,11 @@ def markdown(m):
               f"{n_threads} threads; early stopping saves "
               f"{t1.median('full length, all threads') / base:.0f}x over full length. Labels "
               f"and t_end identical on 1 and {n_threads} threads: {m['threads_identical']}. "
-              f"Target {'**met**' if base <= TARGET_BASIN_S else '**not met**'} "
-              f"({base:.2f} s).\n\n")
+              f"{goal(base, TARGET_BASIN_S, n_threads)}.\n\n")
     md.append(_fractions_table(t1))
 
     md.append(f"\n**2. Sweep hb=1, Housner, {s_early.alpha.size} alphas, lambda_max on** "
-              f"(target <= {TARGET_SWEEP_S:g} s)\n\n")
+              f"(goal <= {TARGET_SWEEP_S:g} s)\n\n")
     base2 = t2.median("early, all threads")
     md.append(_threads_table(t2))
     es = m["sweep_es"]
@@ -309,8 +352,8 @@ def markdown(m):
               f"saves {t2.median('full length, all threads') / base2:.1f}x. Results identical "
               f"on 1 and {n_threads} threads: {m['s_threads_identical']}. Early vs full length: "
               f"{es['agreement']:.2f} % of alphas with the same label "
-              f"({len(es['differing'])} differ). Target "
-              f"{'**met**' if base2 <= TARGET_SWEEP_S else '**not met**'} ({base2:.2f} s).\n\n")
+              f"({len(es['differing'])} differ). "
+              f"{goal(base2, TARGET_SWEEP_S, n_threads)}.\n\n")
     md.append(_fractions_table(t2))
 
     md.append(f"\n**4. Early stopping vs full length, the study's four basins** (N = {GRID_N}; "
@@ -423,12 +466,13 @@ def csv_rows(m):
     return rows
 
 
-def json_data(m, bkw, skw):
+def json_data(m, g):
     t1, t2, t5 = m["t1"], m["t2"], m["t5"]
     sw = t5["sweep"].result
+    basin_settings, sweep_settings = g.description()
     return dict(
-        quick=m["quick"], environment=m["env"], total_s=m["total"], basin_settings=bkw,
-        sweep_settings=dict(skw, z0=list(skw["z0"])), grid_n=GRID_N,
+        quick=m["quick"], environment=m["env"], total_s=m["total"],
+        basin_settings=basin_settings, sweep_settings=sweep_settings, grid_n=GRID_N,
         n_threads=m["n_threads"], first_call_in_process_s=m["first"], load_average=m["loads"],
         cpu_s=dict(item1=dict(t1.cpu), item2=dict(t2.cpu),
                    item5={tag: dict(t.cpu) for tag, t in t5.items()}),
@@ -467,7 +511,7 @@ def plot_timing(m):
             ax.plot([xi] * len(t.wall[k]), t.wall[k], "k.", ms=4)
             ax.annotate(f"{t.median(k):.2f} s", (xi, t.median(k)), ha="center", va="bottom",
                         fontsize=8, xytext=(0, 3), textcoords="offset points")
-        ax.axhline(target, color="k", ls="--", lw=1, label=f"target {target:g} s")
+        ax.axhline(target, color="k", ls="--", lw=1, label=f"goal {target:g} s")
         ax.set_xticks(x, [k.replace(", ", "\n").replace("all threads",
                                                            f"{m['n_threads']} threads")
                           for k in keys], fontsize=8)
@@ -603,7 +647,7 @@ def plot_sweep(m):
 def main(argv=None):
     b = H.Bench(__doc__, argv)
     cfg = QUICK if b.quick else FULL
-    bkw, skw = settings(cfg)
+    g = Grids(cfg)
     b.env["load_start"] = H.load_text()
     t_start = time.perf_counter()
     loads = {}
@@ -615,12 +659,12 @@ def main(argv=None):
         loads[key].append(H.load_text())
         return out
 
-    first = first_calls(bkw, skw)
-    t1, threads_identical = loaded("item1", item1_basin, bkw, cfg)
-    t2, s_threads_identical, sweep_es = loaded("item2", item2_sweep, skw, cfg)
-    t5 = loaded("item5", item5_resolution, bkw, skw, cfg)
-    full = loaded("item4", item4_full_length, bkw, t1)
-    compile_info = None if b.quick else compile_cost(bkw, skw)
+    first = first_calls(g)
+    t1, threads_identical = loaded("item1", item1_basin, g, cfg)
+    t2, s_threads_identical, sweep_es = loaded("item2", item2_sweep, g, cfg)
+    t5 = loaded("item5", item5_resolution, g, cfg)
+    full = loaded("item4", item4_full_length, g, t1)
+    compile_info = None if b.quick else compile_cost(g)
     b.env["load_end"] = H.load_text()
     item5, sweep5 = item5_rows(t5)
     m = dict(cfg=cfg, quick=b.quick, env=b.env, first=first, loads=loads,
@@ -630,7 +674,7 @@ def main(argv=None):
              compile=compile_info, total=time.perf_counter() - t_start)
 
     b.report("grids", markdown=markdown(m), csv=(CSV_HEADERS, csv_rows(m)),
-             data=json_data(m, bkw, skw),
+             data=json_data(m, g),
              figures=[("grids_timing.png", plot_timing(m), 120),
                       ("grids_agreement.png", plot_agreement(m), 110),
                       ("grids_sweep_resolution.png", plot_sweep(m), 120)],

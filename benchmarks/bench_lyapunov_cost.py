@@ -1,11 +1,12 @@
-"""Issue 3: what the Lyapunov exponents cost, on the study's reference run.
+"""What the Lyapunov exponents cost, on the study's reference run.
 
 The run: hb=1, alpha=0.6, omega=1.3, Housner restitution, z0 = rockjit.Z0_STUDY, 500 periods,
-exponents averaged over the last 100 (SPEC.md §5, §7). Measured side by side in one process, in
-alternating order: ``lyapunov=False`` against ``lyapunov=True`` (tangent dynamics and saltation
-matrices compiled in) at the default N and at N=64; compile time of each kernel measured apart in
-fresh processes. Also reported: lambda1, lambda2, and the exact identity
-``lambda1 + lambda2 = -3/4 xi + 2 nu ln(e)`` with ``nu = n_impacts_window / window length``.
+exponents averaged over the last 100 (docs/theory/exponents.md, docs/theory/study.md). Measured
+side by side in one process, in alternating order: ``lyapunov=False`` against ``lyapunov=True``
+(tangent dynamics and saltation matrices compiled in) at the default N and at N=64; compile time of
+each kernel measured apart in fresh processes. Also reported: lambda1, lambda2, and the exact
+identity ``lambda1 + lambda2 = -3/4 xi + 2 nu ln(e)`` with ``nu = n_impacts_window / window
+length``.
 
 There is no scipy variational path: exponents exist only on the compiled path, so there is no
 reference timing to compare with.
@@ -27,6 +28,7 @@ import numpy as np
 import _common as H
 
 import rockjit
+from rockjit import Integration
 
 FULL = dict(periods=500, repeats=21)
 QUICK = dict(periods=20, repeats=3)
@@ -52,7 +54,7 @@ def cost(run, ns, repeats):
                            for n in ns for lyap in (False, True)}, repeats)
 
 
-def compile_cost(base, n_def, warm, first, quick):
+def compile_cost(block, forcing, periods, n_def, warm, first, quick):
     """Compile time of each kernel: fresh processes (full), or the in-process first call."""
     out = {}
     for lyap in (False, True):
@@ -61,12 +63,14 @@ def compile_cost(base, n_def, warm, first, quick):
             out[lyap] = dict(cold=None, cached=None, inproc_s=inproc)
         else:
             out[lyap] = dict(inproc_s=inproc, **H.compile_times(
-                "simulate", dict(base, z0=list(base["z0"]), n_steps=n_def, lyapunov=lyap)))
+                "simulate", (block, forcing),
+                dict(integration=Integration(periods=periods, n_steps=n_def), lyapunov=lyap)))
     return out
 
 
 def identity(res):
-    """``(lambda1 + lambda2, -3/4 xi + 2 nu ln e, nu)`` over the run's window (SPEC.md §5)."""
+    """``(lambda1 + lambda2, -3/4 xi + 2 nu ln e, nu)`` over the run's window
+    (docs/theory/exponents.md)."""
     b = res.block
     t0, t1 = res.window
     nu = res.n_impacts_window / (t1 - t0)
@@ -126,7 +130,8 @@ def markdown(recs, compile_info, r_def, n_def, cfg, quick, env):
         H.md_table(["N", "lambda1", "lambda2", "lambda1 + lambda2", "-3/4 xi + 2 nu ln e",
                     "identity error", "nu (impacts / unit time)", "rest phases in window"],
                    lam_rows),
-        "\nIdentity (SPEC.md §5): lambda1 + lambda2 = -3/4 xi + 2 nu ln e over the window, "
+        "\nIdentity (docs/theory/exponents.md): lambda1 + lambda2 = -3/4 xi + 2 nu ln e over "
+        "the window, "
         f"xi = {r_def.block.xi:.6g}, e = {r_def.block.restitution:.6g}.\n\n",
         H.md_table(["kernel", "compile, cold (s)", "compile, cached (s)"], comp_rows),
         "\nCompile: first call in a fresh process minus the warm median; cold = empty numba "
@@ -168,21 +173,26 @@ def main(argv=None):
     cfg = QUICK if b.quick else FULL
     n_def = rockjit.DEFAULT_N
     ns = [n_def] + [n for n in (64,) if n != n_def]
-    base = dict(H.REFERENCE_RUN, z0=rockjit.Z0_STUDY, periods=cfg["periods"])
+    block, forcing = H.reference_run()  # from the study's initial state
+    periods = cfg["periods"]
 
     def run(n, lyap):
-        return rockjit.simulate(**base, n_steps=n, lyapunov=lyap)
+        return rockjit.simulate(block, forcing,
+                                integration=Integration(periods=periods, n_steps=n),
+                                lyapunov=lyap)
 
     first = first_calls(run, n_def)
     t = cost(run, ns, cfg["repeats"])
-    compile_info = compile_cost(base, n_def, t.medians(), first, b.quick)
+    compile_info = compile_cost(block, forcing, periods, n_def, t.medians(), first, b.quick)
     recs = records(ns, n_def, t)
 
     b.report("lyapunov_cost",
              markdown=markdown(recs, compile_info, t.result[(n_def, True)], n_def, cfg, b.quick,
                                b.env),
              csv=(CSV_COLUMNS, [[r[k] for k in CSV_COLUMNS] for r in recs]),
-             data=dict(run=dict(base, z0=list(rockjit.Z0_STUDY)), quick=b.quick,
+             data=dict(run=H.encode(dict(block=block, forcing=forcing, state=None,
+                                         z0=list(rockjit.Z0_STUDY), periods=periods)),
+                       quick=b.quick,
                        repeats=cfg["repeats"], default_n=n_def, environment=b.env, rows=recs,
                        compile={str(k): v for k, v in compile_info.items()},
                        first_call_in_process_s={str(k): v for k, v in first.items()},

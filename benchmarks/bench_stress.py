@@ -1,10 +1,10 @@
-"""Issues 5 and 10: the seeded numerical stress suite, full run.
+"""The seeded numerical stress suite, full run: thousands of extreme single runs, checked.
 
 Thousands of seeded runs over hb in [0.75, 20], alpha in [0, 3], omega in [0.05, 20], e in [0, 1]
 (Housner, Mao, constant), N from 8 to 1024, closed and embedded forcing, from initial states near
-0, grazing, near overturning, and over long horizons; and issue 10's cases beyond those ranges:
-damping up to xi = 500, omega from 1e-3 to 1e3, orbits through rest (rockjit/stress.py says
-exactly which). Every run must end with a known status, within the work bound, with no NaN or
+0, grazing, near overturning, and over long horizons; and cases beyond those ranges: damping up
+to xi = 500, omega from 1e-3 to 1e3, orbits through rest (rockjit/testing/stress.py says exactly
+which). Every run must end with a known status, within the work bound, with no NaN or
 inf in its output; the impact bound, when hit, is counted and reported. The exact checks ride
 along: energy conservation (e = 1, xi = 0, no forcing), the mirror symmetry (exact with the
 embedding, to the run's rounding horizon with the closed form) and 1 against 2 threads.
@@ -31,9 +31,10 @@ import numpy as np
 import _common as H
 
 import rockjit
+from rockjit import Block, Execution, Harmonic, Integration
 from rockjit.testing import stress as S
 
-#: n_runs: the stress cases of the study's ranges; n_extreme: issue 10's cases beyond them
+#: n_runs: the stress cases of the study's ranges; n_extreme: the cases beyond them
 FULL = dict(n_runs=3000, n_extreme=3900, max_periods=200, long_periods=20_000, n_energy=300,
             n_mirror=500, n_threads=40, threads_grid=10, threads_periods=100)
 QUICK = dict(n_runs=120, n_extreme=60, max_periods=20, long_periods=50, n_energy=30,
@@ -48,13 +49,17 @@ CSV_HEADERS = ["id", "category", "hb", "alpha", "omega", "law", "e", "n_steps", 
 def warm_up():
     """Load (or compile) every kernel variant, so that run times exclude compilation."""
     t0 = time.perf_counter()
-    base = dict(hb=1.0, alpha=0.6, omega=1.3, periods=2, n_steps=16, theta0=0.1, dtheta0=0.0)
-    for forcing in ("closed", "embedded"):
+    block, two = Block(hb=1.0), Integration(periods=2, n_steps=16)
+    for embedded in (False, True):
+        forcing = Harmonic(alpha=0.6, omega=1.3, embedded=embedded)
         for lyap in (False, True):
             for stride in (None, 4):
-                rockjit.simulate(**base, forcing=forcing, lyapunov=lyap, record_stride=stride)
+                rockjit.simulate(block, forcing, (0.1, 0.0), integration=two, lyapunov=lyap,
+                                 record_stride=stride)
     for lyap in (False, True):
-        rockjit.grids.grids.basin(1.0, 0.6, 1.3, grid=2, periods=2, lyapunov=lyap, threads=1)
+        rockjit.basin(block, Harmonic(alpha=0.6, omega=1.3), 2,
+                      integration=Integration(periods=2), lyapunov=lyap,
+                      execution=Execution(threads=1))
     return time.perf_counter() - t0
 
 
@@ -231,7 +236,7 @@ def markdown(m):
         f"#### Stress suite: results, seed {seed}{H.quick_note(quick)}\n",
         f"{m['n_cases']} stress runs ({cfg['n_runs']} over the study's ranges, "
         f"{cfg['max_periods']} periods at most, long horizons up to {cfg['long_periods']}; "
-        f"{cfg['n_extreme']} of issue 10's: xi up to 500, omega from 1e-3 to 1e3, orbits "
+        f"{cfg['n_extreme']} beyond them: xi up to 500, omega from 1e-3 to 1e3, orbits "
         f"through rest), {cfg['n_energy']} energy runs, {cfg['n_mirror']} mirror cases of each "
         f"kind (2 runs each embedded, 4 closed: run, mirror, two twins), "
         f"{exact['threads']['tried']} basins/sweeps with 1 and 2 threads: "
@@ -240,7 +245,7 @@ def markdown(m):
         "through the run checks.\n\n",
         "Runs by category and final status:\n\n",
         H.md_table(["category"] + [f"`{s}`" for s in STATUSES] + ["runs"], cat_rows),
-        "\nChecks (rockjit/stress.py defines each):\n\n",
+        "\nChecks (rockjit/testing/stress.py defines each):\n\n",
         H.md_table(["check", "tried", "failed", "not run"], check_rows),
         "\nReported, not failed:\n\n",
         H.md_table(["outcome", "runs"], obs_rows),
@@ -280,7 +285,7 @@ def plot(rows):
         ax.set_ylabel(name)
         ax.grid(True, alpha=0.3)
     axes[0].set_yscale("log")
-    axes[1].set_yscale("symlog", linthresh=3.0)  # issue 10's slow forcing takes alpha to 1e6
+    axes[1].set_yscale("symlog", linthresh=3.0)  # the slowest forcing takes alpha to 1e6
     axes[0].legend(fontsize=7, markerscale=3)
     fig.suptitle(f"Stress runs by final status ({len(rows)} runs)", fontsize=10)
     return fig

@@ -1,4 +1,4 @@
-"""Issue 5: throughput and scaling of rockjit.
+"""Throughput and scaling of rockjit: single runs, basins, sweeps, threads, compile, memory.
 
 Measured here, each as a table:
 
@@ -38,11 +38,15 @@ import numpy as np
 import _common as H
 
 import rockjit
-from rockjit.grids import grids as an
+from rockjit import (Block, Classification, Execution, Harmonic, Integration, basin, simulate,
+                     sweep)
+from rockjit.grids.plan import GRID_N
 
-REF = dict(H.REFERENCE_RUN, z0=rockjit.Z0_STUDY)
-BASIN = dict(hb=1.0, alpha=0.66, omega=1.3, law="housner")  # the study's hb=1 basin
-SWEEP = dict(hb=1.0, omega=1.3, law="housner")
+#: The reference run (from the study's initial state), the study's hb=1 basin and sweep
+REF = H.reference_run()
+BASIN = (Block(hb=1.0, law="housner"), Harmonic(alpha=0.66, omega=1.3))
+SWEEP = (Block(hb=1.0, law="housner"), Harmonic(omega=1.3))
+FULL_LENGTH = Classification(early_stop=False)
 FULL = dict(periods=500, reps=11, ns=(64, 128, 256, 1024), micro_steps=2_000_000,
             g_es=100, g_full=20, sweep_step=0.005, full_reps=1, sizes=(25, 50, 100, 200, 400),
             g_p=24, plist=(50, 100, 200, 500, 1000), thread_reps=(5, 3), g_l=50, lyap_reps=7,
@@ -72,10 +76,11 @@ def step_internals():
 
     Uses exactly these private names (today's layout):
 
-    - ``rockjit._engine.integrate``: ``rk_step``, ``rhs``, ``step_table``; the constants ``N_STAGES``,
-      ``N_TAB``, ``N_PAR``, ``N_PARW`` and the parameter-vector indices ``P_THC``, ``P_OMEGA``,
-      ``P_H``, ``P_STHC``, ``P_CTHC``;
-    - ``rockjit._engine.kernel.pack`` (the float parameter vector);
+    - ``rockjit._engine.integrate``: ``rk_step``, ``rhs``, ``step_table``; the constants
+      ``N_STAGES``, ``N_TAB``, ``N_PAR``, ``N_PARW`` and the parameter-vector indices
+      ``P_THC``, ``P_OMEGA``, ``P_H``, ``P_STHC``, ``P_CTHC``;
+    - ``rockjit._engine.kernel.pack`` (the float parameter vector, from a block, an excitation
+      and integration settings);
     - ``rockjit.model.sincos_poly`` (the stepper's sine and cosine).
 
     Returns
@@ -125,8 +130,8 @@ def step_internals():
                 rhs(None, 0.0, y, 1, par, K, jac, trig)
         return y[0]
 
-    blk = rockjit.Block(hb=1.0, alpha=0.0, omega=1.3)
-    p = pack(blk, 0.0, rockjit.DEFAULT_N)
+    p = pack(Block(hb=1.0), Harmonic(alpha=0.0, omega=1.3), 0.0, Integration(),
+             rockjit.DEFAULT_N)
     par = np.zeros(ig.N_PARW)  # with the derived constants, as the kernel makes it
     par[:ig.N_PAR] = p
     par[ig.P_STHC] = math.sin(p[ig.P_THC])
@@ -149,19 +154,22 @@ def step_internals():
 
 # --------------------------------------------------------------------------- experiments
 
+def run(periods, **integration):
+    """The reference run over ``periods`` (more integration settings as keywords)."""
+    return simulate(*REF, integration=Integration(periods=periods, **integration))
+
+
 def ns_per_step(cfg, mhz):
     """Nanoseconds per grid step and per rhs of the reference run at each N, side by side,
     less the fixed cost of a call (many 1-period N=8 calls in a row)."""
     ns_list = tuple(sorted(set(cfg["ns"]) | {rockjit.DEFAULT_N}))
-    cases = {n: (lambda n=n: rockjit.simulate(**REF, periods=cfg["periods"], n_steps=n))
-             for n in ns_list}
-    cases["call"] = lambda: rockjit.simulate(**REF, periods=1, n_steps=8)
+    cases = {n: (lambda n=n: run(cfg["periods"], n_steps=n)) for n in ns_list}
+    cases["call"] = lambda: run(1, n_steps=8)
     t = H.side_by_side(cases, cfg["reps"] * 3)
     call_cold_s = t.median("call")  # right after a large run: caches cold
-    call_s = H.median([H.timed(rockjit.simulate, **REF, periods=1, n_steps=8)[0]
-                       for _ in range(300)])
-    call_small_s = H.median([H.timed(rockjit.simulate, **REF, periods=1, n_steps=8,
-                                     max_impacts=100)[0] for _ in range(300)])
+    call_s = H.median([H.timed(run, 1, n_steps=8)[0] for _ in range(300)])
+    call_small_s = H.median([H.timed(run, 1, n_steps=8, max_impacts=100)[0]
+                             for _ in range(300)])
     rows = []
     for n in ns_list:
         r = t.result[n]
@@ -191,15 +199,15 @@ def trajectories(cfg, single_run_s):
     alphas = sweep_alphas(cfg)
     traj = {"single run": (single_run_s, 1, f"reference run, N={rockjit.DEFAULT_N}, "
                                             f"{cfg['periods']} periods")}
-    w = [H.timed(an.basin, **BASIN, grid=g_es)[0] for _ in range(3)]
+    w = [H.timed(basin, *BASIN, g_es)[0] for _ in range(3)]
     traj["basin, early stop"] = (H.median(w), g_es**2,
-                                 f"{g_es}x{g_es} study basin, N={an.GRID_N}, 500 periods")
-    w = [H.timed(an.basin, **BASIN, grid=g_full, early_stop=False)[0]
+                                 f"{g_es}x{g_es} study basin, N={GRID_N}, 500 periods")
+    w = [H.timed(basin, *BASIN, g_full, classification=FULL_LENGTH)[0]
          for _ in range(cfg["full_reps"])]
     traj["basin, full length"] = (H.median(w), g_full**2,
-                                  f"{g_full}x{g_full} study basin, N={an.GRID_N}, all 500 "
+                                  f"{g_full}x{g_full} study basin, N={GRID_N}, all 500 "
                                   "periods")
-    w = [H.timed(an.sweep, **SWEEP, alphas=alphas)[0] for _ in range(cfg["full_reps"])]
+    w = [H.timed(sweep, *SWEEP, alphas)[0] for _ in range(cfg["full_reps"])]
     traj["sweep with exponents"] = (H.median(w), alphas.size,
                                     f"study's hb=1 Housner sweep, alpha 0.5..1.0 "
                                     f"({alphas.size} values), lyapunov, early stop")
@@ -217,12 +225,12 @@ def basin_sizes(cfg):
     rows = []
     for n in cfg["sizes"]:
         k = 3 if n <= 100 else 1
-        ws = [H.timed_cpu(an.basin, **BASIN, grid=n) for _ in range(k)]
+        ws = [H.timed_cpu(basin, *BASIN, n) for _ in range(k)]
         wall = H.median([x[0] for x in ws])
         cpu = H.median([x[1] for x in ws])
         b = ws[-1][2]
         rows.append([n, n * n, k, wall, n * n / wall, cpu / wall,
-                     float(np.mean(b.t_end) / b.block.period)])
+                     float(np.mean(b.t_end) / b.forcing.period)])
         print("size", rows[-1])
     return rows
 
@@ -232,10 +240,13 @@ def basin_periods(cfg):
     g_p = cfg["g_p"]
     rows = []
     for p in cfg["plist"]:
-        w_es = H.median([H.timed(an.basin, **BASIN, grid=g_p, periods=p)[0] for _ in range(3)])
-        w_full = H.timed(an.basin, **BASIN, grid=g_p, periods=p, early_stop=False)[0]
-        rows.append([p, w_es, w_full, 1e9 * w_full / (g_p**2 * p * an.GRID_N),
-                     1e9 * w_full * numba.get_num_threads() / (g_p**2 * p * an.GRID_N)])
+        periods = Integration(periods=p)
+        w_es = H.median([H.timed(basin, *BASIN, g_p, integration=periods)[0]
+                         for _ in range(3)])
+        w_full = H.timed(basin, *BASIN, g_p, integration=periods,
+                         classification=FULL_LENGTH)[0]
+        rows.append([p, w_es, w_full, 1e9 * w_full / (g_p**2 * p * GRID_N),
+                     1e9 * w_full * numba.get_num_threads() / (g_p**2 * p * GRID_N)])
         print("periods", rows[-1])
     return rows
 
@@ -271,17 +282,19 @@ def threads(cfg):
     load0 = H.loadavg()[0]
     par_before = machine_parallelism(5)
     rows = []
-    for label, kw, k in (("early stop", dict(grid=cfg["g_es"]), cfg["thread_reps"][0]),
-                         ("full length", dict(grid=cfg["g_full"], early_stop=False),
-                          cfg["thread_reps"][1])):
+    for label, grid, cl, k in (("early stop", cfg["g_es"], Classification(),
+                                cfg["thread_reps"][0]),
+                               ("full length", cfg["g_full"], FULL_LENGTH,
+                                cfg["thread_reps"][1])):
         res = {1: [], 2: []}
         for rep in range(k):
             for th in ((1, 2) if rep % 2 == 0 else (2, 1)):
-                res[th].append(H.timed_cpu(an.basin, **BASIN, threads=th, **kw)[:2])
+                res[th].append(H.timed_cpu(basin, *BASIN, grid, classification=cl,
+                                           execution=Execution(threads=th))[:2])
         w1 = H.median([x[0] for x in res[1]])
         w2 = H.median([x[0] for x in res[2]])
         c2 = H.median([x[1] for x in res[2]])
-        rows.append([label, kw["grid"] ** 2, w1, w2, w1 / w2, c2 / w2])
+        rows.append([label, grid ** 2, w1, w2, w1 / w2, c2 / w2])
     par_after = machine_parallelism(5)
     load1 = H.loadavg()[0]
     print("threads", rows, par_before, par_after, load0, load1)
@@ -293,13 +306,14 @@ def exponents(cfg):
     """The exponents on and off: a single run, a basin and a sweep, interleaved."""
     g_l, periods = cfg["g_l"], cfg["periods"]
     alphas = sweep_alphas(cfg)[::2]
+    length = Integration(periods=periods)
     t = H.side_by_side({
-        ("single run", False): lambda: rockjit.simulate(**REF, periods=periods),
-        ("single run", True): lambda: rockjit.simulate(**REF, periods=periods, lyapunov=True),
-        ("basin", False): lambda: an.basin(**BASIN, grid=g_l),
-        ("basin", True): lambda: an.basin(**BASIN, grid=g_l, lyapunov=True),
-        ("sweep", False): lambda: an.sweep(**SWEEP, alphas=alphas, lyapunov=False),
-        ("sweep", True): lambda: an.sweep(**SWEEP, alphas=alphas, lyapunov=True),
+        ("single run", False): lambda: simulate(*REF, integration=length),
+        ("single run", True): lambda: simulate(*REF, integration=length, lyapunov=True),
+        ("basin", False): lambda: basin(*BASIN, g_l),
+        ("basin", True): lambda: basin(*BASIN, g_l, lyapunov=True),
+        ("sweep", False): lambda: sweep(*SWEEP, alphas, lyapunov=False),
+        ("sweep", True): lambda: sweep(*SWEEP, alphas, lyapunov=True),
     }, cfg["lyap_reps"])
     what = {"single run": f"reference run, N={rockjit.DEFAULT_N}, {periods} periods",
             "basin": f"{g_l}x{g_l} study basin, early stop",
@@ -311,36 +325,35 @@ def exponents(cfg):
     return dict(rows=rows, raw={f"{k[0]}/{k[1]}": v for k, v in t.wall.items()})
 
 
-#: The kernels whose compile time is measured: (label, kind, keyword arguments).
+#: The kernels whose compile time is measured: (label, entry point, arguments, keywords).
+_P50 = dict(integration=Integration(periods=50))
 COMPILE_SPECS = (
-    ("simulate (closed forcing)", "simulate", dict(REF, z0=list(REF["z0"]), periods=50)),
-    ("simulate, lyapunov=True", "simulate", dict(REF, z0=list(REF["z0"]), periods=50,
-                                                 lyapunov=True)),
-    ("simulate, embedded forcing", "simulate", dict(REF, z0=list(REF["z0"]), periods=50,
-                                                    forcing="embedded")),
-    ("basin (grid kernel)", "basin", dict(BASIN, grid=4, periods=50)),
-    ("sweep, lyapunov (tangent grid kernel)", "sweep", dict(SWEEP, alphas=[0.6, 0.7],
-                                                            periods=50)),
+    ("simulate (closed forcing)", "simulate", REF, _P50),
+    ("simulate, lyapunov=True", "simulate", REF, dict(_P50, lyapunov=True)),
+    ("simulate, embedded forcing", "simulate", (REF[0], REF[1].replace(embedded=True)), _P50),
+    ("basin (grid kernel)", "basin", (*BASIN, 4), _P50),
+    ("sweep, lyapunov (tangent grid kernel)", "sweep", (*SWEEP, [0.6, 0.7]), _P50),
 )
 
 
 def compile_cost():
     """Compile time of each kernel in three fresh processes sharing one new cache."""
     rows = []
-    for label, kind, kw in COMPILE_SPECS:
-        ct = H.compile_times(kind, kw, sessions=("cold", "second", "third"), warm_repeats=3)
+    for label, kind, args, kw in COMPILE_SPECS:
+        ct = H.compile_times(kind, args, kw, processes=("cold", "second", "third"),
+                             warm_repeats=3)
         rows.append([label, ct["cold"]["compile_s"], ct["second"]["compile_s"],
                      ct["third"]["compile_s"], ct["third"]["import_s"]])
     return rows
 
 
-_MEM = textwrap.dedent("""
+_MEM = H.DECODE + textwrap.dedent("""
     import json, resource, sys, time, tracemalloc
     spec = json.loads(sys.argv[1])
     import numpy as np
-    from rockjit.grids import grids as analysis
-    kw = spec["kw"]
-    analysis.basin(kw["hb"], kw["alpha"], kw["omega"], grid=2, periods=5)  # load the kernel
+    import rockjit
+    args = decode(spec["args"])
+    rockjit.basin(args[0], args[1], 2, integration=rockjit.Integration(periods=5))  # load
     base_kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 
     def status(key):
@@ -358,7 +371,7 @@ _MEM = textwrap.dedent("""
     rss0_kib = status("VmRSS:")
     tracemalloc.start()
     t = time.perf_counter()
-    b = analysis.basin(**kw)
+    b = rockjit.basin(*args)
     wall = time.perf_counter() - t
     _, tm_peak = tracemalloc.get_traced_memory()
     tracemalloc.stop()
@@ -368,16 +381,16 @@ _MEM = textwrap.dedent("""
     print(json.dumps(dict(base_kib=base_kib, peak_kib=peak_kib, tracemalloc_peak_b=tm_peak,
                           rss0_kib=rss0_kib, hwm_kib=hwm_kib, hwm_reset=hwm_reset,
                           wall_s=wall, result_bytes=out_bytes,
-                          mean_periods=float(np.mean(b.t_end) / b.block.period),
+                          mean_periods=float(np.mean(b.t_end) / b.forcing.period),
                           fractions=b.fractions())))
 """)
 
 
 def peak_memory(cfg):
     """Peak memory of a basin, in a fresh process (kernel loaded from the cache first)."""
-    p = subprocess.run([sys.executable, "-c", _MEM, json.dumps(dict(kw=dict(
-        BASIN, grid=cfg["g_m"])))], env=H.child_env(), capture_output=True, text=True,
-        check=True, cwd=tempfile.gettempdir())
+    p = subprocess.run([sys.executable, "-c", _MEM, json.dumps(dict(
+        args=H.encode([*BASIN, cfg["g_m"]])))], env=H.child_env(), capture_output=True,
+        text=True, check=True, cwd=tempfile.gettempdir())
     mem = json.loads(p.stdout.strip().splitlines()[-1])
     print("memory", mem)
     return mem
@@ -413,7 +426,7 @@ def markdown(rec, cfg, quick, env):
     md.append(H.md_table(["what", "setting", "trajectories", "wall (s)", "trajectories / s"],
                          rec["trajectories"]))
     md.append(f"\n**Basin time against grid size**: the study's basin (hb=1, alpha=0.66, "
-              f"omega=1.3, Housner), defaults (N={an.GRID_N}, 500 periods, early stop, "
+              f"omega=1.3, Housner), defaults (N={GRID_N}, 500 periods, early stop, "
               "default threads); median of 3 up to n=100, one run above. CPU/wall: the process's "
               "CPU time over wall time (2 would be both threads busy).\n\n")
     md.append(H.md_table(["n", "cells", "runs", "wall (s)", "cells / s", "CPU / wall",
@@ -439,10 +452,10 @@ def markdown(rec, cfg, quick, env):
     if rec["compile"]:
         md.append("\n**Compile time**: first call in a fresh process minus the warm median, in "
                   "three fresh processes one after the other sharing one new NUMBA_CACHE_DIR: "
-                  "cold = empty cache, then the 2nd and 3rd sessions with what the earlier ones "
+                  "cold = empty cache, then the 2nd and 3rd processes with what the earlier ones "
                   "wrote; each kernel in its own new cache, so a cold figure includes the shared "
                   "model and stepper functions.\n\n")
-        md.append(H.md_table(["kernel", "cold (s)", "2nd session (s)", "3rd session (s)",
+        md.append(H.md_table(["kernel", "cold (s)", "2nd process (s)", "3rd process (s)",
                               "import rockjit (s)"], rec["compile"]))
     md.append(f"\n**Peak memory of a {g_m}x{g_m} basin** (defaults, early stop; fresh process, "
               f"kernel loaded from cache first; {mem['wall_s']:.1f} s, "
@@ -516,10 +529,11 @@ def main(argv=None):
     cfg = QUICK if b.quick else FULL
     b.env["cpu_mhz"] = cpu_mhz()
     # load every kernel used below
-    rockjit.simulate(**REF, periods=2)
-    rockjit.simulate(**REF, periods=2, lyapunov=True)
-    an.basin(**BASIN, grid=2, periods=2)
-    an.basin(**BASIN, grid=2, periods=2, lyapunov=True)
+    two = Integration(periods=2)
+    simulate(*REF, integration=two)
+    simulate(*REF, integration=two, lyapunov=True)
+    basin(*BASIN, 2, integration=two)
+    basin(*BASIN, 2, integration=two, lyapunov=True)
 
     rec = dict(quick=b.quick, environment=b.env)
     rec["ns_per_step"] = ns_per_step(cfg, b.env["cpu_mhz"])

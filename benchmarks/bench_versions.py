@@ -1,11 +1,11 @@
 """Two versions of rockjit side by side: step time, basin and sweep time, and identical results.
 
-The issues that reshape the kernels (11: the kernel's I/O and the split loop; 15: compile time;
-17: lanes) promise warm speed within a few percent of an earlier commit and the same results.
-This script measures exactly that: it checks the earlier commit out into a temporary git
-worktree, starts one worker process per version (each imports its own rockjit and warms its
-kernels), and times the same calls in both, interleaved round by round in rotating order, so
-the ratio of the medians is taken side by side on one noisy machine:
+A change that reshapes the kernels (their inputs and outputs, the loop, compile time, lanes)
+must keep warm speed within a few percent of an earlier commit and the results the same. This
+script measures exactly that: it checks the earlier commit out into a temporary git worktree,
+starts one worker process per version (each imports its own rockjit and warms its kernels), and
+times the same calls in both, interleaved round by round in rotating order, so the ratio of the
+medians is taken side by side on one noisy machine:
 
 - ``run``: the study's reference run (hb=1, alpha=0.6, omega=1.3, Housner, z0, 500 periods),
   nanoseconds per step; ``run+lyapunov``: the same with the exponents;
@@ -15,6 +15,13 @@ the ratio of the medians is taken side by side on one noisy machine:
 
 Each case also reports whether both versions returned the same numbers, bit for bit (the final
 state and impact count of a run; the labels, periods, exponents and strobe points of a grid).
+
+Each version is called in its own API. A case is written once, in flat keywords (the API of the
+versions before rockjit's settings objects); each worker looks at the rockjit it imported
+(``_common.api_of``: does it have ``rockjit.Harmonic``?) and makes the call that version takes
+(``_common.call_in``): the flat keywords as they are (those its functions know), or the block,
+the excitation and the settings objects built from them. So ``--base f12ce1e`` (flat keywords)
+and ``--base HEAD`` (settings objects) both compare the same runs.
 
     python benchmarks/bench_versions.py --base 4b22de6           # this checkout against 4b22de6
     python benchmarks/bench_versions.py --quick   # smoke: this checkout against itself, small
@@ -39,10 +46,13 @@ from pathlib import Path
 
 import _common as H
 
-#: The cases: name -> (function, keyword arguments); ``quick`` shrinks them.
+#: The study's reference run, from its initial state, in flat keywords.
+REFERENCE_RUN = dict(hb=1.0, alpha=0.6, omega=1.3, law="housner")
+#: The cases: name -> (function, flat keyword arguments, see ``_common.call_in``); ``quick``
+#: shrinks them.
 CASES = {
-    "run": ("simulate", dict(H.REFERENCE_RUN, periods=500)),
-    "run+lyapunov": ("simulate", dict(H.REFERENCE_RUN, periods=500, lyapunov=True)),
+    "run": ("simulate", dict(REFERENCE_RUN, periods=500)),
+    "run+lyapunov": ("simulate", dict(REFERENCE_RUN, periods=500, lyapunov=True)),
     "basin": ("basin", dict(hb=1.0, alpha=0.66, omega=1.3, law="housner", grid=100, r0=0.0,
                             s0=1.0, attractors=False)),
     "sweep": ("sweep", dict(hb=1.0, omega=1.3, law="housner", alpha_range=(0.5, 1.0),
@@ -51,13 +61,13 @@ CASES = {
 QUICK = {"run": dict(periods=50), "run+lyapunov": dict(periods=50), "basin": dict(grid=20,
          periods=50), "sweep": dict(alpha_step=0.05, periods=50)}
 
-#: The worker: reads one JSON request per line, answers one JSON line (seconds and a digest).
+#: The worker: reads one JSON request per line, answers one JSON line (seconds, a digest, and
+#: which API it called); it imports the rockjit of its version and this folder's _common.
 _WORKER = textwrap.dedent("""
-    import hashlib, inspect, json, sys, time
+    import hashlib, json, sys, time
     import numpy as np
     import rockjit
-    from rockjit.grids import grids as analysis
-    FN = dict(simulate=rockjit.simulate, basin=analysis.basin, sweep=analysis.sweep)
+    import _common as H
 
     def digest(res):
         h = hashlib.sha256()
@@ -71,15 +81,13 @@ _WORKER = textwrap.dedent("""
 
     for line in sys.stdin:
         fn_name, kw = json.loads(line)
-        fn = FN[fn_name]
-        known = inspect.signature(fn).parameters
-        kw = {k: v for k, v in kw.items() if k in known}
+        call = H.call_in(rockjit, fn_name, kw)
         c0, t0 = time.process_time(), time.perf_counter()
-        res = fn(**kw)
+        res = call()
         wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         steps = getattr(res, "n_steps", 0) * kw.get("periods", 0) if fn_name == "simulate" else 0
         print(json.dumps(dict(wall=wall, cpu=cpu, digest=digest(res), steps=steps,
-                              file=rockjit.__file__)), flush=True)
+                              file=rockjit.__file__, api=H.api_of(rockjit))), flush=True)
 """)
 
 
@@ -87,7 +95,7 @@ class Worker:
     """One Python process importing the rockjit under ``src``."""
 
     def __init__(self, src):
-        env = dict(os.environ, PYTHONPATH=str(src))
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(src), str(H.HERE)]))
         self.proc = subprocess.Popen([sys.executable, "-c", _WORKER], env=env, cwd=str(src),
                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
 
@@ -116,7 +124,8 @@ def options(p):
 
 
 def measure(bench, base_src, cases, repeats, processes=1):
-    """Every case in both versions, interleaved; rows and the raw times.
+    """Every case in both versions, interleaved; rows, the raw times and the API each version
+    was called in (``{"base": [...], "this": [...]}``).
 
     The rounds are shared out over ``processes`` fresh pairs of workers, one pair after the
     other: a process's own layout (where its arrays and code land, which core it gets) moves
@@ -159,8 +168,14 @@ def measure(bench, base_src, cases, repeats, processes=1):
                          base_ns_step=b / steps * 1e9 if steps else None,
                          this_ns_step=t / steps * 1e9 if steps else None,
                          identical=last[c, "base"]["digest"] == last[c, "this"]["digest"]))
+    api = {v: sorted({last[c, v]["api"] for c in cases}) for v in ("base", "this")}
     return rows, {f"{c}/{v}/{k}": ts for k, d in (("wall", raw), ("cpu", cpu))
-                  for (c, v), ts in d.items()}
+                  for (c, v), ts in d.items()}, api
+
+
+def _api_words(names):
+    words = {"objects": "rockjit's settings objects", "flat": "flat keywords"}
+    return " and ".join(words.get(n, n) for n in names)
 
 
 def main(argv=None):
@@ -179,7 +194,7 @@ def main(argv=None):
              for c, (fn, kw) in CASES.items() if c in chosen}
     if a.base is None:
         rev = "this checkout"
-        rows, raw = measure(bench, H.ROOT, cases, repeats, processes)
+        rows, raw, api = measure(bench, H.ROOT, cases, repeats, processes)
     else:
         rev = subprocess.run(["git", "-C", str(H.ROOT), "rev-parse", "--short", a.base],
                              capture_output=True, text=True, check=True).stdout.strip()
@@ -188,7 +203,7 @@ def main(argv=None):
             subprocess.run(["git", "-C", str(H.ROOT), "worktree", "add", "--detach", "--quiet",
                             str(src), rev], check=True)
             try:
-                rows, raw = measure(bench, src, cases, repeats, processes)
+                rows, raw, api = measure(bench, src, cases, repeats, processes)
             finally:
                 subprocess.run(["git", "-C", str(H.ROOT), "worktree", "remove", "--force",
                                 str(src)], check=False)
@@ -199,7 +214,9 @@ def main(argv=None):
              f"call per process; `this/base` compares wall times (`pairs`: the lowest and highest "
              f"ratio of one pair of processes alone, the measurement's noise), `CPU "
              f"this/base` the process CPU times (all threads; less sensitive to other work on a "
-             f"shared machine); `identical`: both returned the same numbers bit for bit.", "",
+             f"shared machine); `identical`: both returned the same numbers bit for bit. "
+             f"Each version was called in its own API: base {_api_words(api['base'])}, this "
+             f"{_api_words(api['this'])}.", "",
              "| case | base | this | this/base | pairs | CPU this/base | ns/step base "
              "| ns/step this | identical |", "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
@@ -221,7 +238,7 @@ def main(argv=None):
     fig.tight_layout()
     keys = list(rows[0])
     bench.report("versions", markdown=markdown, csv=(keys, [[r[k] for k in keys] for r in rows]),
-                 data=dict(base=rev, rows=rows, raw=raw, env=bench.env),
+                 data=dict(base=rev, rows=rows, raw=raw, api=api, env=bench.env),
                  figures=[("versions.png", fig, 120)])
     return 0
 

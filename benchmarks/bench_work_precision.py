@@ -1,4 +1,4 @@
-"""Issue 5: work against precision, rockjit against scipy's solve_ivp, on four scenes.
+"""Work against precision: rockjit against scipy's solve_ivp, on four scenes.
 
 rockjit at N = 16, 32, ..., 1024 steps per period; ``solve_ivp`` (rockjit's scipy path, same
 model code, the same closed-form forcing, analytic Jacobian for the implicit methods) with BDF,
@@ -42,6 +42,7 @@ import numpy as np
 import _common as H
 
 import rockjit
+from rockjit import Block, Harmonic, Integration, Scipy
 
 METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853")
 NS = (16, 32, 64, 128, 160, 256, 512, 1024)
@@ -58,21 +59,32 @@ REF2 = dict(periodic=("DOP853", dict(rtol=1e-13, atol=1e-15)),
 REF_DOP = dict(rtol=1e-13, atol=1e-15)
 ATOL_RATIO = 1e-3
 
-_H = dict(z0=rockjit.Z0_STUDY, law="housner")
+
+def scene_run(hb, alpha, omega, periods):
+    """A run of a scene: Housner restitution, from the study's initial state (``state=None``)."""
+    return dict(block=Block(hb=hb, law="housner"), forcing=Harmonic(alpha=alpha, omega=omega),
+                periods=periods)
+
+
 SCENES = {
-    "periodic": dict(kw=dict(hb=1.0, alpha=0.6, omega=1.3, periods=50, **_H), measure="state",
+    "periodic": dict(run=scene_run(1.0, 0.6, 1.3, 50), measure="state",
                      title="periodic: hb=1, alpha=0.6, omega=1.3, 50 periods"),
-    "chaotic": dict(kw=dict(hb=1.0, alpha=0.955, omega=1.3, periods=5, **_H), measure="state",
+    "chaotic": dict(run=scene_run(1.0, 0.955, 1.3, 5), measure="state",
                     title="chaotic: hb=1, alpha=0.955, omega=1.3, 5 periods"),
-    "overturn": dict(kw=dict(hb=2.0, alpha=0.5, omega=1.6, periods=10, **_H),
-                     measure="overturn",
+    "overturn": dict(run=scene_run(2.0, 0.5, 1.6, 10), measure="overturn",
                      title="overturn: hb=2, alpha=0.5, omega=1.6 (t_over ~ 11.2)"),
-    "overturn_study": dict(kw=dict(hb=2.0, alpha=0.448, omega=1.3, periods=10, **_H),
-                           measure="overturn",
+    "overturn_study": dict(run=scene_run(2.0, 0.448, 1.3, 10), measure="overturn",
                            title="overturn_study: hb=2, alpha=0.448, omega=1.3 (t_over ~ 23.7, "
                                  "ill-conditioned)"),
 }
-HARD = dict(hb=1.0, alpha=0.969, omega=1.3, periods=30, **_H)
+HARD = scene_run(1.0, 0.969, 1.3, 30)
+
+
+def simulate(run, n_steps=None, method="rockjit"):
+    """One ``rockjit.simulate`` of a scene's run at ``n_steps`` or through ``method``."""
+    return rockjit.simulate(run["block"], run["forcing"],
+                            integration=Integration(periods=run["periods"], n_steps=n_steps),
+                            method=method)
 
 
 def error(measure, res, ref):
@@ -91,26 +103,26 @@ def error(measure, res, ref):
     return err, t_err if isinstance(t_err, float) else math.nan, flag
 
 
-def time_scipy(kw, method, rtol, repeats):
+def time_scipy(run, method, rtol, repeats):
     """Run once; when cheap (< 1 s), ``repeats - 1`` more; median wall and the result."""
-    call = dict(kw, method=f"scipy:{method}", rtol=rtol, atol=ATOL_RATIO * rtol)
-    dt, res = H.timed(rockjit.simulate, **call)
+    scipy = Scipy(method, rtol=rtol, atol=ATOL_RATIO * rtol)
+    dt, res = H.timed(simulate, run, method=scipy)
     walls = [dt]
     if dt < 1.0:
         for _ in range(repeats - 1):
-            walls.append(H.timed(rockjit.simulate, **call)[0])
+            walls.append(H.timed(simulate, run, method=scipy)[0])
     return walls, res
 
 
-def references(name, kw, measure, quick):
+def references(name, run, measure, quick):
     """The scene's reference (rockjit at N_REF), its independent second reference and the
     floor below which an error is not resolved."""
-    ref = rockjit.simulate(**kw, n_steps=N_REF)
-    half = rockjit.simulate(**kw, n_steps=N_REF // 2)
+    ref = simulate(run, N_REF)
+    half = simulate(run, N_REF // 2)
     m2, tol2 = REF2[name] if not quick else ("DOP853", REF_DOP)
-    ref2_wall, ref2 = H.timed(rockjit.simulate, **kw, method=f"scipy:{m2}", **tol2)
+    ref2_wall, ref2 = H.timed(simulate, run, method=Scipy(m2, **tol2))
     d2, _, flag2 = error(measure, ref2, ref)
-    dop = ref2 if m2 == "DOP853" else rockjit.simulate(**kw, method="scipy:DOP853", **REF_DOP)
+    dop = ref2 if m2 == "DOP853" else simulate(run, method=Scipy("DOP853", **REF_DOP))
     d_dop, _, flag_dop = error(measure, dop, ref)
     d_half, _, _ = error(measure, half, ref)
     print(f"[{name}] reference rockjit N={N_REF}: {ref.status} t={ref.t:.15g} "
@@ -127,10 +139,9 @@ def references(name, kw, measure, quick):
         floor=max(d2, d_half), floor_flag=flag2)
 
 
-def rockjit_rows(kw, measure, ref, ns, repeats):
+def rockjit_rows(run, measure, ref, ns, repeats):
     """rockjit at each N, interleaved: one row per N."""
-    t = H.side_by_side({n: (lambda n=n: rockjit.simulate(**kw, n_steps=n)) for n in ns},
-                       repeats)
+    t = H.side_by_side({n: (lambda n=n: simulate(run, n)) for n in ns}, repeats)
     rows = []
     for n in ns:
         r = t.result[n]
@@ -143,7 +154,7 @@ def rockjit_rows(kw, measure, ref, ns, repeats):
     return rows
 
 
-def scipy_rows(kw, measure, ref, method, rtols, repeats, cap):
+def scipy_rows(run, measure, ref, method, rtols, repeats, cap):
     """One scipy method at each rtol, until a run takes longer than ``cap``: one row per rtol."""
     rows = []
     skipped_from = None
@@ -155,7 +166,7 @@ def scipy_rows(kw, measure, ref, method, rtols, repeats, cap):
                              flag=f"skipped (rtol={skipped_from:.0e} took > {cap:g} s)",
                              status=None, n_impacts=None, error_estimate=math.nan))
             continue
-        walls, r = time_scipy(kw, method, rtol, repeats)
+        walls, r = time_scipy(run, method, rtol, repeats)
         err, t_err, flag = error(measure, r, ref)
         rows.append(dict(method=method, setting=f"rtol={rtol:.0e}", n=None, rtol=rtol,
                          wall_s=H.median(walls), wall_all_s=walls, n_rhs=r.n_rhs, error=err,
@@ -169,26 +180,27 @@ def scipy_rows(kw, measure, ref, method, rtols, repeats, cap):
 
 def run_scene(name, scene, quick, cap):
     """One scene: its references, rockjit at every N, each scipy method at every rtol."""
-    kw = dict(scene["kw"])
+    run = dict(scene["run"])
     if quick and name == "periodic":
-        kw["periods"] = 10
+        run["periods"] = 10
     measure = scene["measure"]
-    ref, refs = references(name, kw, measure, quick)
-    rows = rockjit_rows(kw, measure, ref, (16, 64, 256) if quick else NS, 3 if quick else 21)
+    ref, refs = references(name, run, measure, quick)
+    rows = rockjit_rows(run, measure, ref, (16, 64, 256) if quick else NS, 3 if quick else 21)
     for m in METHODS:
-        rows += scipy_rows(kw, measure, ref, m, (1e-3, 1e-6, 1e-9) if quick else RTOLS,
+        rows += scipy_rows(run, measure, ref, m, (1e-3, 1e-6, 1e-9) if quick else RTOLS,
                            2 if quick else 3, cap)
-    return dict(name=name, kw=kw, measure=measure, title=scene["title"], rows=rows, **refs)
+    return dict(name=name, run=H.encode(dict(run, state=None)), measure=measure,
+                title=scene["title"], rows=rows, **refs)
 
 
 def hard_table(quick):
     """The transient-chaos case: overturning times from rockjit and DOP853 at tight settings."""
     rows = []
     for n in ((256, 1024) if quick else (256, 1024, 4096, 16384, 65536)):
-        r = rockjit.simulate(**HARD, n_steps=n)
+        r = simulate(HARD, n)
         rows.append(["rockjit", f"N={n}", r.status, r.t, r.n_impacts])
     for rtol in ((1e-10,) if quick else (1e-10, 1e-11, 1e-12, 1e-13)):
-        r = rockjit.simulate(**HARD, method="scipy:DOP853", rtol=rtol, atol=rtol * 1e-2)
+        r = simulate(HARD, method=Scipy("DOP853", rtol=rtol, atol=rtol * 1e-2))
         rows.append(["DOP853", f"rtol={rtol:.0e}", r.status, r.t, r.n_impacts])
     return rows
 
@@ -310,7 +322,7 @@ def main(argv=None):
     b = H.Bench(__doc__, argv, options=options)
     quick = b.quick
     cap = b.args.cap if b.args.cap is not None else (2.0 if quick else 8.0)
-    rockjit.simulate(hb=1.0, alpha=0.6, omega=1.3, periods=2)  # load the kernel
+    simulate(scene_run(1.0, 0.6, 1.3, 2))  # load the kernel
 
     scenes = {name: run_scene(name, sc, quick, cap) for name, sc in SCENES.items()}
     hard = hard_table(quick)

@@ -1,4 +1,4 @@
-"""Issue 16: rockjit side by side with the compiled peers a user would pick instead.
+"""rockjit side by side with the compiled peers a user would pick instead.
 
 Peers (``benchmarks/peers/peer_*.py``, described in benchmarks/README.md): diffrax (JAX),
 SUNDIALS CVODE through scikit-sundae, numbakit-ode (nbkode) inside a numba impact loop; and the
@@ -8,7 +8,7 @@ best scipy method of ``bench_work_precision.py`` (DOP853) through rockjit's scip
    z0 = Z0_STUDY, 500 periods): each peer at tight tolerances against rockjit at N = 8192
    (impact count, impact times, final state, label). The hb=1 Housner basin (alpha=0.66,
    omega=1.3, (r0, s0) = (0, 1), 500 periods, rockjit's classification): labels against
-   ``rockjit.grids.grids.basin(...).label`` on a ``--basin-sub`` x ``--basin-sub`` subgrid of the
+   ``rockjit.basin(...).label`` on a ``--basin-sub`` x ``--basin-sub`` subgrid of the
    100 x 100 lattice (every peer), and on the whole lattice for peers whose estimated time is
    under ``--full-basin-cap`` seconds.
 2. **Work–precision** on bench_work_precision.py's periodic and chaotic scenes (same
@@ -54,8 +54,8 @@ sys.path.insert(0, str(HERE.parent))
 import _common as H  # noqa: E402
 
 import rockjit  # noqa: E402
-from rockjit.grids import grids as analysis  # noqa: E402
-from rockjit.result import BEHAVIOURS  # noqa: E402
+from rockjit import (BEHAVIOURS, Block, Classification, Harmonic, Integration,  # noqa: E402
+                     Scipy)
 
 N_REF = 8192
 NS = (16, 32, 64, 128, 256, 512, 1024)
@@ -80,6 +80,15 @@ SLOW_BASIN = ("cvode",)
 timed = H.timed
 fmt = H.fmt
 md_table = H.md_table
+
+
+def rj_run(kw, periods, n_steps=None, method="rockjit"):
+    """rockjit's run of ``kw`` (``hb``, ``alpha``, ``omega``): Housner restitution, from the
+    study's initial state, over ``periods``, at ``n_steps`` or through ``method``."""
+    return rockjit.simulate(Block(hb=kw["hb"], law="housner"),
+                            Harmonic(alpha=kw["alpha"], omega=kw["omega"]),
+                            integration=Integration(periods=periods, n_steps=n_steps),
+                            method=method)
 
 
 def interleaved(cases, repeats, counts=None):
@@ -121,7 +130,7 @@ def reference_check(peers, periods):
     """Each peer at tight settings against rockjit N = 8192 on the study's reference run."""
     z = rockjit.Z0_STUDY
     kw = dict(hb=C.REFERENCE["hb"], alpha=C.REFERENCE["alpha"], omega=C.REFERENCE["omega"])
-    ref = rockjit.simulate(**kw, law="housner", periods=periods, n_steps=N_REF)
+    ref = rj_run(kw, periods, N_REF)
     p = C.params(**kw)
     rows = []
     for name, mod in peers.items():
@@ -136,7 +145,7 @@ def reference_check(peers, periods):
                          n_impacts=r.n_impacts, ref_n_impacts=ref.n_impacts,
                          ref_status=ref.status,
                          impact_time_error=dt, final_state_error=err, label=C.label(r, periods),
-                         ref_label=analysis.classify_result(ref)[0], wall_s=wall,
+                         ref_label=rockjit.classify_result(ref)[0], wall_s=wall,
                          first_call_s=first))
         print(f"[reference] {name} {method} rtol={rtol:g}: {r.status}, {r.n_impacts} impacts "
               f"(rockjit {ref.n_impacts}), impact times {fmt(dt)}, final state {fmt(err)}, "
@@ -149,12 +158,11 @@ def scene_runs(peers, name, scene, quick, repeats):
     kw = dict(hb=scene["hb"], alpha=scene["alpha"], omega=scene["omega"])
     periods = scene["periods"]
     z = rockjit.Z0_STUDY
-    ref = rockjit.simulate(**kw, law="housner", periods=periods, n_steps=N_REF)
-    half = rockjit.simulate(**kw, law="housner", periods=periods, n_steps=N_REF // 2)
+    ref = rj_run(kw, periods, N_REF)
+    half = rj_run(kw, periods, N_REF // 2)
     floor = float(np.max(np.abs(half.state[:2] - ref.state[:2])))
     if not quick:
-        d = rockjit.simulate(**kw, law="housner", periods=periods, method="scipy:DOP853",
-                             rtol=1e-13, atol=1e-15)
+        d = rj_run(kw, periods, method=Scipy("DOP853", rtol=1e-13, atol=1e-15))
         floor = max(floor, float(np.max(np.abs(d.state[:2] - ref.state[:2]))))
     p = C.params(**kw)
     ns = (16, 64, 256) if quick else NS
@@ -168,8 +176,7 @@ def scene_runs(peers, name, scene, quick, repeats):
 
     for n in ns:
         key = ("rockjit", "", f"N={n}")
-        cases[key] = keep(key, lambda n=n: rockjit.simulate(**kw, law="housner",
-                                                            periods=periods, n_steps=n))
+        cases[key] = keep(key, lambda n=n: rj_run(kw, periods, n))
         meta[key] = dict(method="rockjit", setting=f"N={n}", n=n, rtol=None)
     for pname, mod in peers.items():
         for m in PEER_METHODS[pname]:
@@ -186,9 +193,8 @@ def scene_runs(peers, name, scene, quick, repeats):
                                  rtol=rtol)
     for rtol in rtols:
         key = ("scipy", "DOP853", f"rtol={rtol:.0e}")
-        cases[key] = keep(key, lambda rtol=rtol: rockjit.simulate(
-            **kw, law="housner", periods=periods, method="scipy:DOP853", rtol=rtol,
-            atol=ATOL_RATIO * rtol))
+        cases[key] = keep(key, lambda rtol=rtol: rj_run(
+            kw, periods, method=Scipy("DOP853", rtol=rtol, atol=ATOL_RATIO * rtol)))
         meta[key] = dict(method="scipy DOP853", setting=f"rtol={rtol:.0e}", n=None, rtol=rtol)
     # one untimed call of each case; slow ones (> 50 ms) run in fewer rounds
     probe = {k: timed(fn)[0] for k, fn in cases.items()}
@@ -221,17 +227,19 @@ def scene_runs(peers, name, scene, quick, repeats):
 def call_floor(peers, n=41):
     """The fixed cost of one call: a one-period run of the chaotic scene's block at the
     loosest settings, median of ``n``; for rockjit also its two halves, validating the inputs
-    (``rockjit.single.plan``) and running the plan (``rockjit.single.run``)."""
+    (``rockjit.simulate.plan``) and running the plan (``rockjit.single.run``)."""
     sim = importlib.import_module("rockjit.single")
     sc = C.SCENES["chaotic"]
     kw = dict(hb=sc["hb"], alpha=sc["alpha"], omega=sc["omega"])
     z = rockjit.Z0_STUDY
     p = C.params(**kw)
-    plan = sim.plan(**kw, law="housner", periods=1, n_steps=8)
-    cases = {"rockjit simulate": lambda: rockjit.simulate(**kw, law="housner", periods=1,
-                                                          n_steps=8),
-             "rockjit plan (validation)": lambda: sim.plan(**kw, law="housner", periods=1,
-                                                           n_steps=8),
+    block, forcing = Block(hb=kw["hb"], law="housner"), Harmonic(alpha=kw["alpha"],
+                                                                 omega=kw["omega"])
+    one = Integration(periods=1, n_steps=8)
+    plan = rockjit.simulate.plan(block, forcing, integration=one)
+    cases = {"rockjit simulate": lambda: rockjit.simulate(block, forcing, integration=one),
+             "rockjit plan (validation)": lambda: rockjit.simulate.plan(block, forcing,
+                                                                        integration=one),
              "rockjit run(plan)": lambda: sim.run(plan)}
     for name, mod in peers.items():
         m = PEER_METHODS[name][0]
@@ -258,15 +266,20 @@ def basin_part(peers, quick, sub, sub_slow, full_cap, repeats):
     """Labels at equal accuracy: ladder on the subgrid, then the whole grid if affordable."""
     b = C.BASIN
     periods = 100 if quick else b["periods"]
-    kw = dict(hb=b["hb"], alpha=b["alpha"], omega=b["omega"], law="housner", grid=b["grid"],
-              r0=b["r0"], s0=b["s0"], periods=periods)
-    first, ref = timed(lambda: analysis.basin(**kw))
-    t_rj = interleaved({"early": lambda: analysis.basin(**kw)}, repeats)["early"]
+    block = Block(hb=b["hb"], law="housner")
+    forcing = Harmonic(alpha=b["alpha"], omega=b["omega"], r0=b["r0"], s0=b["s0"])
+    length = Integration(periods=periods)
+
+    def rj_basin(integration=length, early_stop=True):
+        return rockjit.basin(block, forcing, b["grid"], integration=integration,
+                             classification=Classification(early_stop=early_stop))
+
+    first, ref = timed(rj_basin)
+    t_rj = interleaved({"early": rj_basin}, repeats)["early"]
     full_n = 1 if quick else 3
-    t_rj_full = [timed(lambda: analysis.basin(**kw, early_stop=False))[0]
-                 for _ in range(full_n)]
-    ref_full = analysis.basin(**kw, early_stop=False)
-    ref256 = analysis.basin(**kw, n_steps=256)
+    t_rj_full = [timed(lambda: rj_basin(early_stop=False))[0] for _ in range(full_n)]
+    ref_full = rj_basin(early_stop=False)
+    ref256 = rj_basin(integration=length.replace(n_steps=256))
     rj = dict(wall_s=statistics.median(t_rj), wall_all_s=t_rj, first_call_s=first,
               full_length_wall_s=statistics.median(t_rj_full),
               agree_full_length=100.0 * float(np.mean(ref_full.label == ref.label)),
@@ -333,7 +346,7 @@ IMPACT_TIME_TOL = 1e-8
 
 def correctness(ref_rows, basin):
     """``{peer: dict(reference=bool, basin=bool or None, why=str)}``: the checks made before
-    any time is read (SPEC.md's model reproduced: the reference run's impact times, the
+    any time is read (the model of docs/theory reproduced: the reference run's impact times, the
     basin's labels at >= 99.5 % agreement), with the reason where one fails."""
     out = {}
     for r in ref_rows:
@@ -455,7 +468,7 @@ def main(argv=None):
     peers, missing = load_peers(args.peers)
     for k, v in missing.items():
         print(f"peer {k} not available: {v}", flush=True)
-    t_first_rj, _ = timed(lambda: rockjit.simulate(hb=1.0, alpha=0.6, omega=1.3, periods=2))
+    t_first_rj, _ = timed(lambda: rj_run(dict(hb=1.0, alpha=0.6, omega=1.3), 2))
 
     floor_calls = call_floor(peers)
     ref_rows, ref_info = reference_check(peers, 100 if quick else C.REFERENCE["periods"])

@@ -1,18 +1,18 @@
 """What every peer implementation shares: the block's constants, the scenes, the run record,
 and the classification of a run's stroboscopic samples by rockjit's own compiled classifier.
 
-The peers (``peer_nbkode.py``, ``peer_cvode.py``, ``peer_diffrax.py``) each write the rocking
-block again in their library's idiom: SPEC.md §1's equations on either corner, the jump
-``theta'(+) = e theta'(-)`` on ``theta = 0`` with ``e`` from :func:`rockjit.model.e_housner` /
-:func:`rockjit.model.e_mao`, overturning at ``|theta| >= theta_over`` (``pi/2``), and SPEC.md §3's
-rest rule as rockjit applies it: an impact leaving with ``|theta'| < rest_speed`` (``1e-6``)
-puts the block at rest, held until ``|alpha omega^2 sin(omega t + phi)| > cot(thc)``, and the
-block leaves on the side of the forcing's sign. The forcing is rockjit's closed form
-``r = sin(omega t + phi)``, ``phi = atan2(r0, s0)``.
+The peers (``peer_nbkode.py``, ``peer_cvode.py``, ``peer_diffrax.py``) each write the rocking block
+again in their library's idiom: the equations of docs/theory/model.md on either corner, the jump
+``theta'(+) = e theta'(-)`` on ``theta = 0`` with ``e`` from :func:`rockjit.e_housner` /
+:func:`rockjit.e_mao`, overturning at ``|theta| >= theta_over`` (``pi/2``), and the rest rule of
+docs/theory/impacts.md as rockjit applies it: an impact leaving with ``|theta'| < rest_speed``
+(``1e-6``) puts the block at rest, held until ``|alpha omega^2 sin(omega t + phi)| > cot(thc)``,
+and the block leaves on the side of the forcing's sign. The forcing is rockjit's closed form ``r =
+sin(omega t + phi)``, ``phi = atan2(r0, s0)``.
 
 Every peer returns a :class:`PeerRun`: samples ``(theta, theta')`` at ``t = j T/2`` (``strobe``
 at ``kT``, ``half`` at ``kT + T/2``) and the count of impacts up to each ``kT``, which is what
-:func:`rockjit._engine.classify.classify` (the classifier behind :func:`rockjit.grids.grids.classify_result`
+:func:`rockjit._engine.classify.classify` (the classifier behind :func:`rockjit.classify_result`
 and the basin kernels) reads; :func:`label` calls it on them exactly as ``classify_result``
 does, over the window ``[round(0.8 P) T, P T]``.
 """
@@ -25,8 +25,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 import rockjit
+from rockjit import Block, Classification, Integration, e_housner, e_mao
 from rockjit._engine.classify import classify
-from rockjit.model import Block, e_housner, e_mao
 from rockjit.result import BEHAVIOURS, OVERTURN, REST, UNRESOLVED
 
 #: Statuses, as rockjit names them.
@@ -35,8 +35,8 @@ DONE, OVERTURNED, RESTED, MAX_IMPACTS = "done", "overturned", "rest", "max_impac
 FAILED = "failed"
 STATUS_CODES = (DONE, OVERTURNED, RESTED, MAX_IMPACTS, FAILED)
 
-#: rockjit's classification defaults (rockjit.grids.grids.TOL, PMAX, LAM_TOL).
-TOL, PMAX, LAM_TOL = 1e-6, 16, 1e-2
+#: rockjit's classification defaults (those of rockjit.Classification).
+TOL, PMAX, LAM_TOL = Classification().tol, Classification().pmax, Classification().lam_tol
 
 #: The work–precision scenes of benchmarks/bench_work_precision.py (same parameters, same
 #: error measure: the final (theta, theta') against rockjit at N = 8192), copied here so that
@@ -47,9 +47,9 @@ SCENES = {
     "chaotic": dict(hb=1.0, alpha=0.955, omega=1.3, periods=5,
                     title="chaotic: hb=1, alpha=0.955, omega=1.3, 5 periods"),
 }
-#: The study's reference run (SPEC.md §7, figure 2).
+#: The study's reference run (docs/theory/study.md, figure 2).
 REFERENCE = dict(hb=1.0, alpha=0.6, omega=1.3, periods=500)
-#: The study's hb=1 Housner basin (SPEC.md §7, figure 6).
+#: The study's hb=1 Housner basin (docs/theory/study.md, figure 6).
 BASIN = dict(hb=1.0, alpha=0.66, omega=1.3, grid=100, periods=500, r0=0.0, s0=1.0)
 
 
@@ -85,9 +85,11 @@ class Params:
 
 def params(hb, alpha, omega, *, law="housner", r0=None, s0=None, phi=None):
     """:class:`Params` of a block; the forcing phase from ``(r0, s0)`` (default the study's
-    ``Z0_STUDY``) or ``phi``. The damping ``xi``, ``theta_over`` and ``rest_speed`` are rockjit's
-    defaults (``rockjit.model.Block``); ``e`` from ``rockjit.model.e_housner`` / ``e_mao``."""
-    block = Block(hb=hb, alpha=alpha, omega=omega, law=law)
+    ``Z0_STUDY``) or ``phi``. The damping ``xi`` is rockjit's default (``rockjit.Block``),
+    ``theta_over`` and ``rest_speed`` too (``rockjit.Integration``); ``e`` from
+    ``rockjit.e_housner`` / ``e_mao``."""
+    block = Block(hb=hb, law=law)
+    integration = Integration()
     thc = math.atan(hb)
     e = float(e_housner(thc) if law == "housner" else e_mao(thc))
     if phi is None:
@@ -96,7 +98,7 @@ def params(hb, alpha, omega, *, law="housner", r0=None, s0=None, phi=None):
         phi = math.atan2(r0, s0)
     return Params(hb=hb, alpha=alpha, omega=omega, phi=phi, aw2=alpha * omega**2, thc=thc,
                   sthc=math.sin(thc), cthc=math.cos(thc), xi=block.xi, e=e, cot=1.0 / hb,
-                  theta_over=block.theta_over, rest_speed=block.rest_speed,
+                  theta_over=integration.theta_over, rest_speed=integration.rest_speed,
                   T=2.0 * math.pi / omega)
 
 
@@ -146,7 +148,7 @@ def samples_from(n_samples, values, n_got):
 
 def label_code(status, strobe, half, per_imp, periods, *, tol=TOL, pmax=PMAX):
     """Behaviour code of a run (an index of ``rockjit.result.BEHAVIOURS``), as
-    :func:`rockjit.grids.grids.classify_result` finds it: overturn, rest (for good), unresolved
+    :func:`rockjit.classify_result` finds it: overturn, rest (for good), unresolved
     (impact bound), else :func:`rockjit._engine.classify.classify` on the samples ``k0..k1`` with
     ``k0 = round(0.8 periods)`` and no Lyapunov exponent (as a basin without ``lyapunov``)."""
     if status == OVERTURNED:
@@ -172,8 +174,9 @@ def label(run: PeerRun, periods):
 
 
 def uplift_time(t, aw2, cot, omega, phi):
-    """SPEC.md §3's uplift instant: the first ``t' >= t`` with ``|aw2 sin(omega t' + phi)| >
-    cot`` (``inf`` if never), when a block at rest from ``t`` lifts off."""
+    """The uplift instant (docs/theory/impacts.md): the first ``t' >= t`` with
+    ``|aw2 sin(omega t' + phi)| > cot`` (``inf`` if never), when a block at rest from ``t``
+    lifts off."""
     if aw2 <= cot:
         return math.inf
     a = math.asin(cot / aw2)

@@ -11,7 +11,8 @@ located by CVODE's own root finder (Illinois). The driver steps from one output 
 ``j T/2`` to the next in CVODE's ``normal`` mode (CVODE steps past the output time and
 interpolates, its usual mode); at a root CVODE returns the root's time and state, the driver
 applies the jump and re-initialises the solver there (``CVodeReInit``: CVODE's documented way to
-restart after a discontinuity). Rest and uplift as in SPEC.md §3 (``common``'s docstring).
+restart after a discontinuity). Rest and uplift as in docs/theory/impacts.md (``common``'s
+docstring).
 The basin runs the cells in a process pool, one process per core.
 """
 
@@ -81,7 +82,7 @@ def _clear(events):
     events._i_cnt[:] = 0
 
 
-#: SPEC.md §3's uplift instant (plain Python: CVODE's driver is Python).
+#: The uplift instant (docs/theory/impacts.md) (plain Python: CVODE's driver is Python).
 uplift_time = C.uplift_time
 
 

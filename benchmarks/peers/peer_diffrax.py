@@ -1,20 +1,19 @@
 """diffrax (JAX) peer: an event on theta = 0, a jump and a restart inside ``jax.lax.while_loop``,
 ``jax.jit`` over the whole run, ``jax.vmap`` over the basin's cells.
 
-What a user competent in diffrax writes: the rocking block's vector field on
-``y = (theta, theta')`` with the block's constants and the corner ``side`` in ``args``; a
-``diffrax.Event`` with two continuous conditions, ``side theta`` (impact) and
-``theta_over - side theta`` (overturning), both on down-crossings, located by
-``optimistix.Newton`` on the solver's dense output (diffrax's documented event location); each
-``diffeqsolve`` runs from the current time to the next output time ``j T/2`` (``SaveAt(t1=True)``)
-or to the first event, whichever comes first, with an adaptive ``PIDController``; an outer
-``lax.while_loop`` records the output sample, or applies the jump ``theta'(+) = e theta'(-)``
-and restarts on the other corner (a new ``diffeqsolve`` from the impact: the solver's FSAL
-derivative is fresh), or handles rest and uplift (SPEC.md §3, the closed-form uplift instant
-written in ``jax.numpy``). The whole run is one ``jax.jit``-compiled function of traced block
-constants and tolerances (one compilation per solver and number of periods); the basin is the
-same function under ``jax.vmap`` over ``(theta0, theta0')``, in chunks. Float64 throughout
-(``jax_enable_x64``), CPU.
+What a user competent in diffrax writes: the rocking block's vector field on ``y = (theta,
+theta')`` with the block's constants and the corner ``side`` in ``args``; a ``diffrax.Event`` with
+two continuous conditions, ``side theta`` (impact) and ``theta_over - side theta`` (overturning),
+both on down-crossings, located by ``optimistix.Newton`` on the solver's dense output (diffrax's
+documented event location); each ``diffeqsolve`` runs from the current time to the next output time
+``j T/2`` (``SaveAt(t1=True)``) or to the first event, whichever comes first, with an adaptive
+``PIDController``; an outer ``lax.while_loop`` records the output sample, or applies the jump
+``theta'(+) = e theta'(-)`` and restarts on the other corner (a new ``diffeqsolve`` from the
+impact: the solver's FSAL derivative is fresh), or handles rest and uplift (docs/theory/impacts.md,
+the closed-form uplift instant written in ``jax.numpy``). The whole run is one ``jax.jit``-compiled
+function of traced block constants and tolerances (one compilation per solver and number of
+periods); the basin is the same function under ``jax.vmap`` over ``(theta0, theta0')``, in chunks.
+Float64 throughout (``jax_enable_x64``), CPU.
 """
 
 from __future__ import annotations
@@ -46,8 +45,9 @@ _TINY = float(np.finfo(np.float64).tiny)
 
 
 def vector_field(t, y, args):
-    """SPEC.md §1 on corner ``side``: ``theta'' = 3/4 (f sin(thc + s theta) - s cos(thc + s
-    theta) - xi theta')``, ``f = alpha omega^2 sin(omega t + phi)``."""
+    """The equation of motion (docs/theory/model.md) on corner ``side``: ``theta'' = 3/4
+    (f sin(thc + s theta) - s cos(thc + s theta) - xi theta')``,
+    ``f = alpha omega^2 sin(omega t + phi)``."""
     aw2, omega, phi, thc, xi, side = args
     a = thc + side * y[0]
     f = aw2 * jnp.sin(omega * t + phi)

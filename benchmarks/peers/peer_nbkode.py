@@ -65,7 +65,7 @@ def make_rhs(p: C.Params):
     return rhs
 
 
-#: SPEC.md §3's uplift instant, compiled for the impact loop.
+#: The uplift instant (docs/theory/impacts.md), compiled for the impact loop.
 uplift_time = numba.njit(C.uplift_time)
 
 
