@@ -10,7 +10,7 @@ again from the papers (Housner 1963; Mao et al. 2024; Müller 1995) and never im
 - the saltation matrix against Müller's formula; the uplift instant against a brute-force scan;
 - whole runs, compiled and scipy, against a slow event-driven ``solve_ivp`` integration with
   its own jump, rest and uplift (impact times and speeds, the stroboscopic samples);
-- Floquet multipliers (:func:`rockjit.attractors.floquet`, :func:`rockjit.orbits.
+- Floquet multipliers (:func:`rockjit.basins.identity.floquet`, :func:`rockjit.orbits.
   periodic_orbit`) of period-1, 2 and 3 orbits against the eigenvalues of a finite-difference
   Jacobian of ``P^p`` computed from that slow integrator.
 
@@ -26,8 +26,8 @@ import pytest
 
 import physics as ph  # tests/physics.py: the independent statement
 import rockjit
-from rockjit import model
-from rockjit.attractors import floquet
+from rockjit import Block, Harmonic, Integration, Scipy, model
+from rockjit.basins.identity import floquet
 from rockjit.orbits import periodic_orbit
 
 #: The study's initial state (theta, theta', r, s) of its single runs and sweeps.
@@ -79,10 +79,8 @@ def test_restitution_laws_match_the_papers_formulas():
     # the Block picks the law it is given
     for hb in (1.0, 2.0):
         thc = math.atan(hb)
-        assert model.Block(hb, 0.1, 1.0, "housner").restitution == pytest.approx(
-            ph.e_housner(thc), rel=1e-14)
-        assert model.Block(hb, 0.1, 1.0, "mao").restitution == pytest.approx(
-            ph.e_mao(thc), rel=1e-14)
+        assert Block(hb, "housner").restitution == pytest.approx(ph.e_housner(thc), rel=1e-14)
+        assert Block(hb, "mao").restitution == pytest.approx(ph.e_mao(thc), rel=1e-14)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -210,12 +208,22 @@ RUNS = {
     "uplift": (dict(hb=1.0, alpha=0.6, omega=1.3, law="housner"), (0.0, 0.0, 0.0, 1.0)),
 }
 
-#: The paths compared: rockjit.simulate's extra keywords.
+#: The paths compared: rockjit.simulate's steps per period and method.
 METHODS = {
-    "compiled": {},  # the default grid, N = 160
-    "compiled-N640": dict(n_steps=640),
-    "scipy-DOP853": dict(method="scipy:DOP853", rtol=1e-12, atol=1e-12),
+    "compiled": dict(n_steps=None, method="rockjit"),  # the default grid, N = 160
+    "compiled-N640": dict(n_steps=640, method="rockjit"),
+    "scipy-DOP853": dict(n_steps=None, method=Scipy("DOP853", rtol=1e-12, atol=1e-12)),
 }
+
+
+def _run(kw, z0, *, periods, n_steps=None, method="rockjit", **more):
+    """``rockjit.simulate`` of a block ``kw`` (hb, alpha, omega, law) from ``z0``
+    ``(theta, theta', r, s)``."""
+    return rockjit.simulate(Block(kw["hb"], kw["law"]),
+                            Harmonic(alpha=kw["alpha"], omega=kw["omega"], r0=z0[2], s0=z0[3]),
+                            tuple(z0[:2]), integration=Integration(periods=periods,
+                                                                   n_steps=n_steps, **more),
+                            method=method)
 
 #: Tolerance on impact times, impact speeds and strobe samples, about 10x the largest of the
 #: three differences measured (in brackets) over the 15 periods.
@@ -251,7 +259,7 @@ def _reference(name):
 def test_run_matches_the_independent_integrator(name, method):
     kw, z0 = RUNS[name]
     ref = _reference(name)
-    r = rockjit.simulate(**kw, z0=z0, periods=PERIODS, **METHODS[method])
+    r = _run(kw, z0, periods=PERIODS, **METHODS[method])
     tol = RUN_TOL[name, method]
     assert r.status == ref.status
     assert r.n_impacts == len(ref.impacts) == len(r.impacts)
@@ -315,7 +323,7 @@ def _settled(name):
     """The attractor's cycle point at t = kT after 600 periods, and the reference's
     Jacobian of P^p there."""
     kw, z0, p = ATTRACTORS[name]
-    r = rockjit.simulate(**kw, z0=z0, periods=600)
+    r = _run(kw, z0, periods=600)
     s = r.strobe[:, :2]
     size = np.abs(s[-p:]).max()
     assert np.abs(s[-1] - s[-1 - p]).max() <= 1e-10 * size  # settled on period p ...
@@ -335,17 +343,19 @@ def test_floquet_multipliers_match_the_finite_difference_monodromy(name):
     ``ln|mu| / (pT)``."""
     kw, _, p = ATTRACTORS[name]
     x, phi, M, y = _settled(name)
-    block = model.Block(**kw)
+    block = Block(kw["hb"], kw["law"])
+    forcing = Harmonic(alpha=kw["alpha"], omega=kw["omega"])
     T = 2.0 * math.pi / kw["omega"]
     mu_fd = np.linalg.eigvals(M)
-    mu, lam = floquet(block, phi, 160, x, p)
+    mu, lam = floquet(block, forcing, phi, Integration(), 160, x, p)
     assert ph.match_pairs(mu, mu_fd) <= MULT_TOL[p], (mu, mu_fd)
     if name == "p2":  # the value an independent monodromy gave when floquet's loop was broken
         assert abs(np.abs(mu).max() - 0.2074) <= 0.5e-4
     np.testing.assert_allclose(np.sort(lam), np.sort(np.log(np.abs(mu_fd)) / (p * T)),
                                rtol=0, atol=MULT_TOL[p] / np.abs(mu_fd).min() / (p * T))
-    r = rockjit.simulate(**kw, theta0=x[0], dtheta0=x[1], phase=phi, periods=p, n_steps=160,
-                         lyapunov=True, qr_every=0)
+    r = rockjit.simulate(block, forcing.replace(phase=phi), (x[0], x[1]),
+                         integration=Integration(periods=p, n_steps=160, qr_every=0),
+                         lyapunov=True)
     assert np.abs(r.extra["tangent"] - M).max() <= MATRIX_TOL[p]
     # the reference agrees the point is on the cycle (measured 1.2e-12 to 7.6e-11: the
     # settled point of the N = 160 run)
@@ -364,7 +374,7 @@ def _orbit_case(name):
         x, phi, _, _ = _settled(name)
         return kw, x, p, phi
     kw = dict(hb=1.0, alpha=0.92, omega=1.3, law="housner")
-    seed = rockjit.simulate(**{**kw, "alpha": 0.9}, z0=Z0, periods=600).strobe[-1, :2]
+    seed = _run({**kw, "alpha": 0.9}, Z0, periods=600).strobe[-1, :2]
     return kw, seed, 1, PHI0
 
 
@@ -375,7 +385,8 @@ def test_periodic_orbit_multipliers_match_the_finite_difference_monodromy(name):
     the eigenvalues of the reference's Jacobian of ``P^p`` there; so is its monodromy matrix,
     entry by entry, when its section is the requested phase (no impact near it)."""
     kw, seed, p, phi = _orbit_case(name)
-    orb = periodic_orbit(model.Block(**kw), seed, p, phase=phi)
+    orb = periodic_orbit(Block(kw["hb"], kw["law"]),
+                         Harmonic(alpha=kw["alpha"], omega=kw["omega"], phase=phi), seed, p)
     assert orb.period == p
     params = _params(kw, phi)
     M, y = ph.monodromy_fd(orb.state, p, **params)
