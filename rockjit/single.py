@@ -11,14 +11,15 @@ and refuse exactly the same inputs.
 
 from __future__ import annotations
 
+import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ._engine import kernel
 from .excitation import STUDY_PHASE, Harmonic
-from .model import Block
+from .model import Block, initial_side
 from .result import Result
 from ._engine.classify import classify
 from .result import BEHAVIOURS
@@ -292,6 +293,92 @@ def simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
                    y0=(theta0, dtheta0, r0, s0), phi=phi, method=method, n_steps=n_steps,
                    window=window, max_impacts=max_impacts, record_stride=record_stride,
                    lyapunov=lyapunov, memory_bytes=nbytes)
+
+
+class Prepared:
+    """A single run made ready to repeat: its validated plan, packed parameters and compiled
+    kernel are kept, so that a call with a new initial state or amplitude costs the
+    integration and little else (the plan's checks, the packing and the kernel's look-up are
+    not made again).
+
+    Made by ``rockjit.simulate.prepare(...)`` (the parameters of :func:`simulate`);
+    :func:`simulate` keeps one per block, excitation and settings it is called with again.
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> from rockjit import Block, Harmonic, Integration
+    >>> run = rockjit.simulate.prepare(Block(hb=1), Harmonic(alpha=0.6, omega=1.3),
+    ...                                integration=Integration(periods=20))
+    >>> [run(state=(th, 0.0)).status for th in (0.1, 0.2)]
+    ['done', 'done']
+    >>> run(alpha=0.7).forcing.alpha
+    0.7
+    """
+
+    __slots__ = ("plan", "_kernel", "_par", "_ipar")
+
+    def __init__(self, plan):
+        if plan.method != "rockjit":
+            raise ValueError("only runs of the compiled path can be prepared "
+                             "(method='rockjit')")
+        self.plan = plan
+        self._kernel, self._par, self._ipar, _ = kernel.prepare_single(plan)
+
+    def __call__(self, state=None, *, alpha=None):
+        """Run from ``state`` (``(theta0, theta0')``; default the plan's) at amplitude
+        ``alpha`` (default the plan's): a :class:`Result`."""
+        p = self.plan
+        par = self._par
+        if alpha is not None:
+            forcing = p.forcing.replace(alpha=alpha)
+            par = par.copy()
+            kernel.vary(par[None, :], alpha=np.array([forcing.alpha]))
+            p = replace(p, forcing=forcing)
+        if state is not None:
+            th, dth, _, r0, s0 = initial_state(state, p.forcing, p.integration)
+            p = replace(p, y0=(th, dth, r0, s0))
+        out = kernel.single_outputs(p)
+        y0 = np.array(p.y0)
+        code = self._kernel(y0, initial_side(y0[0], y0[1]), par, self._ipar, out)
+        return kernel.single_result(p, code, out)
+
+
+def _prepare(*args, **kwargs):
+    return Prepared(simulate.plan(*args, **kwargs))
+
+
+_prepare.__doc__ = """A :class:`Prepared` run: the parameters of :func:`simulate`, validated once;
+call it with a new ``state`` or ``alpha``."""
+
+#: Prepared runs :func:`simulate` reuses, by its arguments but the state (a few at most).
+_PREPARED = {}
+_PREPARED_MAX = 64
+_plan_and_run = simulate
+
+
+def _simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
+              record_stride=None, method="rockjit"):
+    key = (block, forcing, integration, lyapunov, record_stride, method)
+    try:
+        prepared = _PREPARED.get(key)
+    except TypeError:  # an argument that cannot be hashed: no reuse (and no error here)
+        return _plan_and_run(block, forcing, state, integration=integration,
+                             lyapunov=lyapunov, record_stride=record_stride, method=method)
+    if prepared is not None:
+        return prepared(state)
+    p = simulate.plan(block, forcing, state, integration=integration, lyapunov=lyapunov,
+                      record_stride=record_stride, method=method)
+    if p.method == "rockjit" and type(lyapunov) is bool:
+        if len(_PREPARED) >= _PREPARED_MAX:
+            _PREPARED.clear()
+        _PREPARED[key] = Prepared(p)
+    return run(p)
+
+
+simulate = functools.wraps(_plan_and_run)(_simulate)
+simulate.plan = _plan_and_run.plan
+simulate.prepare = _prepare
 
 
 def classify_result(result, classification=None):

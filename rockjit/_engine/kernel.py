@@ -175,18 +175,39 @@ def grid_bytes(n_cells, periods, n_steps, n_pts, n_imp_pts, tangent, chunk, thre
 
 def run_single(p):
     """One compiled run of a :class:`rockjit.single.RunPlan` (validated); a Result."""
+    run, par, ipar, out = prepare_single(p)
+    y0 = np.asarray(p.y0, dtype=float)
+    code = run(y0, initial_side(y0[0], y0[1]), par, ipar, out)
+    return single_result(p, code, out)
+
+
+def prepare_single(p):
+    """What a compiled run of the plan ``p`` needs besides its initial state:
+    ``(kernel, par, ipar, out)``, the outputs freshly allocated."""
+    block, forcing, n_steps, periods = p.block, p.forcing, p.n_steps, p.periods
+    record_stride = p.record_stride
+    run = ig.build(embed4=forcing.embedded, tangent=p.lyapunov)
+    par = pack(block, forcing, p.phi, p.integration, n_steps)
+    ipar = settings(n_steps, periods, p.max_impacts, p.window, stride=record_stride or 1,
+                    qr_every=p.integration.qr_every,
+                    stop_at_overturn=p.integration.stop_at_overturn,
+                    h=forcing.period / n_steps, xi=block.xi)
+    return run, par, ipar, single_outputs(p)
+
+
+def single_outputs(p):
+    """Fresh outputs for a run of plan ``p``."""
+    stride = p.record_stride
+    n_traj = p.periods * p.n_steps // stride + 1 if stride else 1
+    return outputs(p.periods, p.max_impacts, n_traj, p.lyapunov)
+
+
+def single_result(p, code, out):
+    """The :class:`rockjit.Result` of plan ``p`` from the kernel's status ``code`` and outputs
+    ``out`` (views of ``out``'s arrays: give each run its own outputs)."""
     block, forcing, n_steps, periods = p.block, p.forcing, p.n_steps, p.periods
     lyapunov, record_stride, window = p.lyapunov, p.record_stride, p.window
     qr_every = p.integration.qr_every
-    run = ig.build(embed4=forcing.embedded, tangent=lyapunov)
-    par = pack(block, forcing, p.phi, p.integration, n_steps)
-    ipar = settings(n_steps, periods, p.max_impacts, window, stride=record_stride or 1,
-                    qr_every=qr_every, stop_at_overturn=p.integration.stop_at_overturn,
-                    h=forcing.period / n_steps, xi=block.xi)
-    n_traj = periods * n_steps // record_stride + 1 if record_stride else 1
-    out = outputs(periods, p.max_impacts, n_traj, lyapunov)
-    y0 = np.asarray(p.y0, dtype=float)
-    code = run(y0, initial_side(y0[0], y0[1]), par, ipar, out)
     iout, fout = out.iout, out.fout
     status = ig.STATUS_NAMES[int(code)]
     n_imp = int(iout[ig.O_IMPACTS])
