@@ -67,6 +67,14 @@ class Scipy:
     tolerances, restarted at every impact (docs/theory/integrator.md). The study's was BDF at
     ``rtol=1e-6, atol=1e-9``.
 
+    Parameters
+    ----------
+    method : {"BDF", "RK23", "RK45", "DOP853", "Radau", "LSODA"}
+        The ``solve_ivp`` method; default ``"BDF"`` (the study's).
+    rtol, atol : float
+        Relative tolerance in ``(0, 1)`` and absolute tolerance ``> 0``; default the study's
+        ``1e-6`` and ``1e-9``.
+
     Examples
     --------
     >>> from rockjit import Scipy
@@ -302,8 +310,22 @@ def classify_result(result, classification=None):
     """Behaviour name and period of a :class:`rockjit.Result` (the run's window).
 
     Uses the same compiled classifier as the sweeps and basins on the result's stroboscopic
-    samples from ``window`` on, with the tolerances of ``classification`` (a
-    :class:`rockjit.Classification`; its defaults when not given). Returns ``(name, period)``.
+    samples from ``window`` on (docs/theory/behaviours.md).
+
+    Parameters
+    ----------
+    result : Result
+        A run of :func:`rockjit.simulate`.
+    classification : Classification, optional
+        The period test's tolerances (``tol``, ``pmax``, ``lam_tol``); default
+        ``Classification()``.
+
+    Returns
+    -------
+    name : str
+        One of :data:`rockjit.BEHAVIOURS`.
+    period : int
+        The period in forcing periods (0 for overturn, rest, chaotic, aperiodic, unresolved).
 
     Examples
     --------

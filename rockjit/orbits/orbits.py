@@ -112,7 +112,7 @@ __all__ = ["BIFURCATION_TYPES", "N_ORBIT", "Bifurcation", "Branch", "Continuatio
            "periodic_orbit"]
 
 #: Steps per forcing period of the shooting runs. On orbits sampled along every branch of the
-#: hb=1 Housner case over alpha in [0.5, 1.0] (periods 1 to 8, |mu| up to 50), the fixed
+#: hb=1 Housner case over alpha in [0.5, 1.0] (periods 1 to 8, ``|mu|`` up to 50), the fixed
 #: points found at N = 384 have residuals of at most 2.4e-11 in a converged plain run
 #: (N = 8192), against 2.2e-10 at N = 256 and 2.4e-9 at N = 160 (benchmarks/bench_orbits.py);
 #: a step costs little beside the fixed cost of a call (+13 % for the continuation over 256).
