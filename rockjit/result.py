@@ -28,6 +28,7 @@ OVERTURN, REST, SYMMETRIC, ASYMMETRIC, MULTIPERIODIC, CHAOTIC, APERIODIC, UNRESO
 #: Statuses of a run, in the order of the kernels' status codes (rockjit._engine.integrate).
 STATUSES = ("done", "overturned", "rest", "max_impacts", "nonfinite", "settled")
 
+#: Each status in words (:attr:`rockjit.Result.message`).
 STATUS_MESSAGES = {
     "done": "reached the requested number of periods",
     "overturned": "the block overturned (|theta| reached theta_over)",

@@ -239,7 +239,7 @@ def simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
         ``z0`` (docs/theory/study.md), at the study's forcing phase unless ``forcing`` gives one.
     integration : Integration, optional
         Steps per period, periods, window, impact bound, Zeno cut-off, overturning threshold
-        (:class:`rockjit.Integration`; default N here is :data:`DEFAULT_N`).
+        (:class:`rockjit.Integration`; default N here is :data:`rockjit.DEFAULT_N`).
     lyapunov : bool
         Compute the block's Lyapunov exponents (docs/theory/exponents.md); compiled path only.
     record_stride : int, optional

@@ -18,20 +18,20 @@ callable ``outcome(points) -> ids`` (the compiled kernels, in rockjit).
 
 References
 ----------
-.. [1] A. Daza, A. Wagemakers, B. Georgeot, D. Guéry-Odelin, M. A. F. Sanjuán, "Basin entropy: a
-   new tool to analyze uncertainty in dynamical systems", Sci. Rep. 6, 31416 (2016).
-.. [2] C. Grebogi, S. W. McDonald, E. Ott, J. A. Yorke, "Final state sensitivity: an obstruction
-   to predictability", Phys. Lett. A 99, 415-418 (1983).
-.. [3] S. W. McDonald, C. Grebogi, E. Ott, J. A. Yorke, "Fractal basin boundaries", Physica D 17,
-   125-153 (1985).
-.. [4] M. S. Soliman, J. M. T. Thompson, "Integrity measures quantifying the erosion of smooth
-   and fractal basins of attraction", J. Sound Vib. 135, 453-475 (1989).
-.. [5] G. Rega, S. Lenci, "Identifying, evaluating, and controlling dynamical integrity measures
-   in non-linear mechanical oscillators", Nonlinear Anal. 63, 902-914 (2005).
-.. [6] S. Lenci, G. Rega (eds.), "Global Nonlinear Dynamics for Engineering Design and System
-   Safety", CISM Courses and Lectures 588, Springer (2019).
-.. [7] G. Datseris, A. Wagemakers, "Effortless estimation of basins of attraction", Chaos 32,
-   023104 (2022) (Attractors.jl).
+- A. Daza, A. Wagemakers, B. Georgeot, D. Guéry-Odelin, M. A. F. Sanjuán, "Basin entropy: a
+  new tool to analyze uncertainty in dynamical systems", Sci. Rep. 6, 31416 (2016).
+- C. Grebogi, S. W. McDonald, E. Ott, J. A. Yorke, "Final state sensitivity: an obstruction
+  to predictability", Phys. Lett. A 99, 415-418 (1983).
+- S. W. McDonald, C. Grebogi, E. Ott, J. A. Yorke, "Fractal basin boundaries", Physica D 17,
+  125-153 (1985).
+- M. S. Soliman, J. M. T. Thompson, "Integrity measures quantifying the erosion of smooth
+  and fractal basins of attraction", J. Sound Vib. 135, 453-475 (1989).
+- G. Rega, S. Lenci, "Identifying, evaluating, and controlling dynamical integrity measures
+  in non-linear mechanical oscillators", Nonlinear Anal. 63, 902-914 (2005).
+- S. Lenci, G. Rega (eds.), "Global Nonlinear Dynamics for Engineering Design and System
+  Safety", CISM Courses and Lectures 588, Springer (2019).
+- G. Datseris, A. Wagemakers, "Effortless estimation of basins of attraction", Chaos 32,
+  023104 (2022) (Attractors.jl).
 """
 
 from __future__ import annotations
