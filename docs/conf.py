@@ -25,7 +25,6 @@ sys.path.insert(0, str(ROOT / "docs" / "_ext"))
 # the executed pages run in Jupyter kernels (subprocesses): they import this checkout's rockjit
 os.environ["PYTHONPATH"] = os.pathsep.join(
     p for p in (str(ROOT), os.environ.get("PYTHONPATH", "")) if p)
-os.environ.setdefault("MPLBACKEND", "Agg")
 
 import rockjit  # noqa: E402
 
