@@ -26,7 +26,7 @@ OMEGA_RANGE = (1e-4, 1e4)
 ACCEL_MAX = 1e8
 
 #: The study's forcing point ``(r0, s0)`` of its single runs and sweeps (with its initial angle
-#: and velocity, :data:`rockjit.single.Z0_STUDY`).
+#: and velocity, :data:`rockjit.Z0_STUDY`).
 STUDY_PHASE = (-0.7778, 0.6284)
 
 #: How far from the unit circle a closed-form ``(r0, s0)`` may lie.

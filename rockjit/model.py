@@ -64,24 +64,86 @@ HB_MIN_HOUSNER = 1.0 / math.sqrt(2.0)
 # --------------------------------------------------------------------------------------------
 
 def thc_from_hb(hb):
-    """Angle of the block's diagonal from the ground, ``arctan(h/b)``."""
+    """Angle of the block's diagonal from the ground, ``thc = arctan(h/b)``.
+
+    Parameters
+    ----------
+    hb : float or array_like
+        Slenderness ``h/b``.
+
+    Returns
+    -------
+    float or ndarray
+        ``thc`` in radians.
+
+    Examples
+    --------
+    >>> from rockjit import thc_from_hb
+    >>> round(float(thc_from_hb(1.0)), 6), round(float(thc_from_hb(2.0)), 4)
+    (0.785398, 1.1071)
+    """
     return np.arctan(hb)
 
 
 def e_housner(thc):
-    """Housner's coefficient of restitution ``1 - 1.5 cos^2(thc)``.
+    """Housner's coefficient of restitution ``e_H = 1 - 1.5 cos^2(thc)``.
 
     Conserves angular momentum about the new corner (Housner 1963). Negative for
     ``thc < arctan(1/sqrt(2))``, where the law has no physical meaning.
+
+    Parameters
+    ----------
+    thc : float or array_like
+        Angle of the block's diagonal from the ground, radians (:func:`rockjit.thc_from_hb`).
+
+    Returns
+    -------
+    float or ndarray
+        ``e_H``.
+
+    See Also
+    --------
+    e_mao : Mao et al.'s law.
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> round(float(rockjit.e_housner(rockjit.thc_from_hb(1.0))), 12)
+    0.25
+    >>> round(float(rockjit.e_housner(rockjit.thc_from_hb(2.0))), 12)
+    0.7
     """
     return 1.0 - 1.5 * np.cos(thc) ** 2
 
 
 def e_mao(thc):
-    """Mao et al. (2024) coefficient of restitution ``sqrt(N / D)`` (SPEC.md §2).
+    """Mao et al. (2024) coefficient of restitution ``e_M = sqrt(N / D)``.
 
     ``N = tan(thc)(tan^2(thc) - 3) + 3 tan^4(thc)(pi/2 - thc) + 3 thc`` and
-    ``D = 4 tan(thc) sec^2(thc)``.
+    ``D = 4 tan(thc) sec^2(thc)``: the kinetic energy kept through the impact
+    (docs/theory/impacts.md).
+
+    Parameters
+    ----------
+    thc : float or array_like
+        Angle of the block's diagonal from the ground, radians (:func:`rockjit.thc_from_hb`).
+
+    Returns
+    -------
+    float or ndarray
+        ``e_M``.
+
+    See Also
+    --------
+    e_housner : Housner's law.
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> round(float(rockjit.e_mao(rockjit.thc_from_hb(1.0))), 3)
+    0.582
+    >>> round(float(rockjit.e_mao(rockjit.thc_from_hb(2.0))), 3)
+    0.83
     """
     t = np.tan(thc)
     num = t * (t * t - 3.0) + 3.0 * t**4 * (0.5 * np.pi - thc) + 3.0 * thc
@@ -90,7 +152,25 @@ def e_mao(thc):
 
 
 def delta_e_percent(e1, e2):
-    """Symmetric percentage difference ``|e1 - e2| / (0.5 (e1 + e2)) * 100``."""
+    """Symmetric percentage difference ``|e1 - e2| / (0.5 (e1 + e2)) * 100``.
+
+    Parameters
+    ----------
+    e1, e2 : float or array_like
+        Two coefficients of restitution.
+
+    Returns
+    -------
+    ndarray
+        The difference in percent of their mean.
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> thc = rockjit.thc_from_hb(1.0)
+    >>> round(float(rockjit.delta_e_percent(rockjit.e_mao(thc), rockjit.e_housner(thc))), 2)
+    79.85
+    """
     e1 = np.asarray(e1, dtype=float)
     e2 = np.asarray(e2, dtype=float)
     return np.abs(e1 - e2) / (0.5 * (e1 + e2)) * 100.0
@@ -122,7 +202,8 @@ class Block:
     e : float, optional
         Coefficient of restitution in ``[0, 1]``, only with the constant law.
     xi : float
-        Viscous damping in ``[0, 1e4]``; default the study's, :data:`XI_STUDY`.
+        Viscous damping in ``[0, 1e4]``; default the study's,
+        :data:`rockjit.model.XI_STUDY`.
 
     Examples
     --------

@@ -20,7 +20,7 @@ __all__ = ["BEHAVIOURS", "HORIZON_TOL", "ROUNDING", "BasinResult", "GridResult",
            "PlaneResult", "Result", "STATUSES", "STATUS_MESSAGES", "SweepResult", "fractions",
            "horizon"]
 
-#: Behaviour names; a label array holds their indices (SPEC.md §6, README "Behaviours").
+#: Behaviour names; a label array holds their indices (docs/theory/behaviours.md).
 BEHAVIOURS = ("overturn", "rest", "symmetric", "asymmetric", "multiperiodic", "chaotic",
               "aperiodic", "unresolved")
 OVERTURN, REST, SYMMETRIC, ASYMMETRIC, MULTIPERIODIC, CHAOTIC, APERIODIC, UNRESOLVED = range(8)
@@ -28,6 +28,7 @@ OVERTURN, REST, SYMMETRIC, ASYMMETRIC, MULTIPERIODIC, CHAOTIC, APERIODIC, UNRESO
 #: Statuses of a run, in the order of the kernels' status codes (rockjit._engine.integrate).
 STATUSES = ("done", "overturned", "rest", "max_impacts", "nonfinite", "settled")
 
+#: Each status in words (:attr:`rockjit.Result.message`).
 STATUS_MESSAGES = {
     "done": "reached the requested number of periods",
     "overturned": "the block overturned (|theta| reached theta_over)",
@@ -78,7 +79,7 @@ class Result:
     method : str
         ``"rockjit"`` or ``"scipy:<solve_ivp method>"``.
     status : str
-        One of :data:`STATUSES`; ``message`` says it in words.
+        One of :data:`rockjit.result.STATUSES`; ``message`` says it in words.
     t : float
         Time reached (the overturning or rest instant for runs that stopped there).
     state : ndarray, shape (4,)
@@ -94,8 +95,9 @@ class Result:
     strobe_half : ndarray, shape (k, 4)
         The same at ``t = T/2, 3T/2, ...``.
     impacts : ndarray, shape (m, 3)
-        ``(t, theta'-, theta'+)`` of the impacts, in order: all of them, or the latest
-        :data:`rockjit._engine.kernel.IMPACT_RECORD` when there were more (``n_impacts`` counts all).
+        ``(t, theta'-, theta'+)`` of the impacts, in order: all of them, or the latest million
+        (``rockjit._engine.kernel.IMPACT_RECORD``) when there were more (``n_impacts`` counts
+        all).
     n_impacts, n_grid_steps, n_rhs : int
         Counts of impacts, grid steps completed, right-hand-side evaluations.
     max_error_estimate : float
@@ -113,13 +115,29 @@ class Result:
     n_rest, n_rest_window : int
         Rest phases entered (Zeno cut-offs), overall and within ``window``.
     n_impacts_window : int
-        Impacts within the window (for the exact identity of SPEC.md §5).
+        Impacts within the window (for the exact identity of docs/theory/exponents.md).
     n_locate_unconverged : int
         Events whose time the Newton polish could not bring within its tolerance (taken at the
         best bracketed estimate; expected 0, counted so that tests can require it).
     t_overturn : float
         A run that went on past the overturning threshold (``stop_at_overturn=False``, the
         study's way): the first instant ``|theta|`` reached it; ``nan`` otherwise.
+    extra : dict
+        Further arrays of some runs (``"tangent"``: the tangent matrix of a run with
+        ``lyapunov=True`` and ``qr_every=0``).
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> from rockjit import Block, Harmonic, Integration
+    >>> res = rockjit.simulate(Block(hb=1), Harmonic(alpha=0.6, omega=1.3),
+    ...                        integration=Integration(periods=20))
+    >>> res.status, res.n_impacts, round(res.t, 4)
+    ('done', 40, 96.6644)
+    >>> res.message
+    'reached the requested number of periods'
+    >>> res.strobe.shape, res.impacts.shape
+    ((21, 4), (40, 3))
     """
 
     block: Block
@@ -152,6 +170,7 @@ class Result:
 
     @property
     def message(self) -> str:
+        """The status in words (:data:`rockjit.result.STATUS_MESSAGES`)."""
         return STATUS_MESSAGES[self.status]
 
     @property
@@ -186,8 +205,9 @@ class Result:
     @property
     def horizon(self) -> float:
         """The run's own predictability horizon: how long rounding (``eps = 2.2e-16``) takes to
-        grow to :data:`HORIZON_TOL` at the finite-time exponent of the whole run, ``lambda1``
-        over ``[0, t]`` (``inf`` when it is not positive, ``nan`` without exponents)."""
+        grow to :data:`rockjit.result.HORIZON_TOL` at the finite-time exponent of the whole run,
+        ``lambda1`` over ``[0, t]`` (``inf`` when it is not positive, ``nan`` without
+        exponents)."""
         if self.lyapunov_running is None or len(self.lyapunov_running) < 2:
             return math.nan
         return horizon(float(self.lyapunov_running[-1, 0]), ROUNDING)
@@ -245,10 +265,11 @@ class GridResult:
     #: Outcome id of each cell (same shape as ``label``): ``>= 0`` the attractor it reaches,
     #: ``-1`` overturn, ``-2`` unresolved (rockjit.basins.identity); None when not identified.
     attractor: np.ndarray | None = None
-    #: The attractors (rockjit.basins.identity.Attractor), by id.
+    #: The attractors, by id: each one's behaviour, period, cycle points, basin fraction and
+    #: Floquet multipliers (``rockjit.basins.identity.Attractor``).
     attractors: list = field(default_factory=list)
     #: Cells whose outcome changes when their initial state moves by ``settings["uncertainty"]``
-    #: (rockjit.grids.grids.uncertain_cells); None when not asked for.
+    #: (``Classification(uncertainty=...)``); None when not asked for.
     uncertain: np.ndarray | None = None
 
     def fractions(self):
@@ -268,7 +289,7 @@ class SweepResult(GridResult):
     ----------
     alpha : ndarray, shape (n,)
     label : ndarray of int, shape (n,)
-        Behaviour codes; ``names[label]`` gives the names (:data:`BEHAVIOURS`).
+        Behaviour codes; ``names[label]`` gives the names (:data:`rockjit.BEHAVIOURS`).
     period : ndarray of int, shape (n,)
         Period in forcing periods (0 when none).
     lambda_max : ndarray, shape (n,)
@@ -280,6 +301,17 @@ class SweepResult(GridResult):
         ``(t mod T, theta'-)`` of the impacts over the classified stretch (``nan``-padded).
     t_end : ndarray, shape (n,)
         Time each run stopped (early stop, overturn, rest or the end).
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> from rockjit import Block, Harmonic, Integration
+    >>> sw = rockjit.sweep(Block(hb=1), Harmonic(omega=1.3), [0.6, 0.8],
+    ...                    integration=Integration(periods=100))
+    >>> [str(n) for n in sw.names[sw.label]], sw.period.tolist()
+    (['symmetric', 'asymmetric'], [1, 1])
+    >>> sw.strobe.shape
+    (2, 21, 2)
     """
 
     alpha: np.ndarray
@@ -313,6 +345,31 @@ class BasinResult(GridResult):
     """A basin of attraction over ``(theta0, theta0')`` at a fixed forcing phase.
 
     ``label[i, j]`` belongs to ``theta0[i]``, ``dtheta0[j]``.
+
+    Attributes
+    ----------
+    theta0, dtheta0 : ndarray, shape (n,)
+        The lattice's axes.
+    label, period : ndarray of int, shape (n, n)
+        Behaviour code (``names[label]``) and period of each cell.
+    lambda_max : ndarray, shape (n, n) or None
+        ``lambda1`` of each cell, when asked for.
+    t_end : ndarray, shape (n, n)
+        Time each run stopped.
+    block, forcing, settings :
+        The block, the excitation and the settings it was computed with; ``attractor``,
+        ``attractors`` and ``uncertain`` are below.
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> from rockjit import Block, Harmonic, Integration
+    >>> b = rockjit.basin(Block(hb=1), Harmonic(alpha=0.66, omega=1.3), grid=10,
+    ...                   integration=Integration(periods=100))
+    >>> b.label.shape, str(b.names[b.label[5, 5]]), len(b.attractors)
+    ((10, 10), 'symmetric', 2)
+    >>> {k: round(float(v), 1) for k, v in b.fractions().items() if v}
+    {'overturn': 48.0, 'symmetric': 52.0}
     """
 
     theta0: np.ndarray
@@ -372,6 +429,26 @@ class PlaneResult(GridResult):
     """Behaviours over the forcing plane ``(alpha, omega)`` from one or more initial states.
 
     ``label[m, i, j]`` belongs to initial state ``z0[m]``, ``alpha[i]``, ``omega[j]``.
+
+    Attributes
+    ----------
+    alpha : ndarray, shape (na,)
+    omega : ndarray, shape (nw,)
+    z0 : ndarray, shape (m, 4)
+        The initial states ``(theta0, theta0', r0, s0)``.
+    label, period : ndarray of int, shape (m, na, nw)
+        Behaviour code (``names[label]``) and period of each cell.
+    lambda_max, t_end : ndarray, shape (m, na, nw)
+    block, forcing, settings :
+        As in :class:`rockjit.BasinResult`; the attractors are continued across the plane.
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> from rockjit import Block
+    >>> pl = rockjit.plane(Block(hb=1), (0.5, 0.6), (1.2, 1.3), grid=(2, 2))
+    >>> pl.names[pl.label[0]].tolist()
+    [['rest', 'rest'], ['rest', 'symmetric']]
     """
 
     alpha: np.ndarray

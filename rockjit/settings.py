@@ -75,7 +75,8 @@ class Integration(_Replace):
         a full-length classification; default 80 % of the run (the study's ``[400T, 500T]``).
     max_impacts : int, optional
         Bound on the number of impacts; reaching it ends a run with status ``max_impacts``.
-        Default :func:`default_max_impacts`.
+        Default 10,000 impacts per period, at least 100,000
+        (``rockjit.settings.default_max_impacts``).
     rest_speed : float
         The Zeno cut-off in ``[1e-12, 0.1]``: an impact leaving with ``|theta'| < rest_speed``
         puts the block at rest. Default ``1e-6``.
@@ -137,7 +138,8 @@ class Integration(_Replace):
         return int(round(0.8 * self.periods)) if self.window is None else self.window
 
     def impact_bound(self):
-        """``max_impacts``, or :func:`default_max_impacts` of the run's length."""
+        """``max_impacts``, or the default bound of the run's length
+        (``rockjit.settings.default_max_impacts``)."""
         return default_max_impacts(self.periods) if self.max_impacts is None else \
             self.max_impacts
 

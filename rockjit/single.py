@@ -68,6 +68,14 @@ class Scipy:
     tolerances, restarted at every impact (docs/theory/integrator.md). The study's was BDF at
     ``rtol=1e-6, atol=1e-9``.
 
+    Parameters
+    ----------
+    method : {"BDF", "RK23", "RK45", "DOP853", "Radau", "LSODA"}
+        The ``solve_ivp`` method; default ``"BDF"`` (the study's).
+    rtol, atol : float
+        Relative tolerance in ``(0, 1)`` and absolute tolerance ``> 0``; default the study's
+        ``1e-6`` and ``1e-9``.
+
     Examples
     --------
     >>> from rockjit import Scipy
@@ -228,7 +236,7 @@ def simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
         ``z0`` (docs/theory/study.md), at the study's forcing phase unless ``forcing`` gives one.
     integration : Integration, optional
         Steps per period, periods, window, impact bound, Zeno cut-off, overturning threshold
-        (:class:`rockjit.Integration`; default N here is :data:`DEFAULT_N`).
+        (:class:`rockjit.Integration`; default N here is :data:`rockjit.DEFAULT_N`).
     lyapunov : bool
         Compute the block's Lyapunov exponents (docs/theory/exponents.md); compiled path only.
     record_stride : int, optional
@@ -385,8 +393,22 @@ def classify_result(result, classification=None):
     """Behaviour name and period of a :class:`rockjit.Result` (the run's window).
 
     Uses the same compiled classifier as the sweeps and basins on the result's stroboscopic
-    samples from ``window`` on, with the tolerances of ``classification`` (a
-    :class:`rockjit.Classification`; its defaults when not given). Returns ``(name, period)``.
+    samples from ``window`` on (docs/theory/behaviours.md).
+
+    Parameters
+    ----------
+    result : Result
+        A run of :func:`rockjit.simulate`.
+    classification : Classification, optional
+        The period test's tolerances (``tol``, ``pmax``, ``lam_tol``); default
+        ``Classification()``.
+
+    Returns
+    -------
+    name : str
+        One of :data:`rockjit.BEHAVIOURS`.
+    period : int
+        The period in forcing periods (0 for overturn, rest, chaotic, aperiodic, unresolved).
 
     Examples
     --------

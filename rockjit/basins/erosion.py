@@ -77,6 +77,16 @@ class ErosionResult:
     forcing : Harmonic
         The excitation (without the amplitude the profile sweeps).
     settings : dict
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> from rockjit import Block, Harmonic
+    >>> prof = rockjit.erosion(Block(hb=1), Harmonic(omega=1.3), [0.6, 0.7], grid=10)
+    >>> prof.GIM.tolist(), prof.attractor.shape
+    ([0.54, 0.49], (2, 10, 10))
+    >>> [(b["behaviour"], b["period"]) for b in prof.branches]
+    [('symmetric', 1), ('symmetric', 1), ('asymmetric', 1)]
     """
 
     alpha: np.ndarray

@@ -82,6 +82,19 @@ class FateResult:
         The same for rounding alone (``eps = 2.2e-16``): the horizon of a single run.
     nominal : Result
         The unperturbed run (with exponents).
+    block, forcing, settings :
+        The run's block, excitation and the ensemble's settings.
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> from rockjit import Block, Harmonic, Integration
+    >>> f = rockjit.fate(Block(hb=1), Harmonic(alpha=0.969, omega=1.3), ensemble=8,
+    ...                  integration=Integration(periods=200))
+    >>> f.outcome.shape, sorted(f.probabilities)
+    ((8,), ['overturn'])
+    >>> round(f.lambda1, 2), round(f.horizon, 1)
+    (0.21, 87.0)
     """
 
     probabilities: dict
@@ -156,7 +169,7 @@ def fate(block, forcing, state=None, *, integration=None, ensemble=64, spread=No
         Members, at least 2 (member 0 is the unperturbed run).
     spread : pair of float, optional
         Smallest and largest relative perturbation, ``0 < lo <= hi <= 1e-2``; default
-        :data:`DEFAULT_SPREAD`.
+        :data:`rockjit.basins.fate.DEFAULT_SPREAD`.
     seed : int
         Seed of the perturbations.
     execution : Execution, optional

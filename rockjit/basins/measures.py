@@ -1,6 +1,7 @@
 """Measures of a basin map: basin entropy, uncertainty exponent and dynamical integrity.
 
-Every function here works on a map of integer *outcomes* (SPEC.md §8): attractor ids ``>= 0``,
+Every function here works on a map of integer *outcomes* (docs/theory/global-dynamics.md):
+attractor ids ``>= 0``,
 ``-1`` for overturn, ``-2`` for unresolved. It is pure NumPy/SciPy and knows nothing of the
 integrator; the grid-free uncertainty estimate :func:`uncertain_fraction_sampled` takes any
 callable ``outcome(points) -> ids`` (the compiled kernels, in rockjit).
@@ -17,20 +18,20 @@ callable ``outcome(points) -> ids`` (the compiled kernels, in rockjit).
 
 References
 ----------
-.. [1] A. Daza, A. Wagemakers, B. Georgeot, D. Guéry-Odelin, M. A. F. Sanjuán, "Basin entropy: a
-   new tool to analyze uncertainty in dynamical systems", Sci. Rep. 6, 31416 (2016).
-.. [2] C. Grebogi, S. W. McDonald, E. Ott, J. A. Yorke, "Final state sensitivity: an obstruction
-   to predictability", Phys. Lett. A 99, 415-418 (1983).
-.. [3] S. W. McDonald, C. Grebogi, E. Ott, J. A. Yorke, "Fractal basin boundaries", Physica D 17,
-   125-153 (1985).
-.. [4] M. S. Soliman, J. M. T. Thompson, "Integrity measures quantifying the erosion of smooth
-   and fractal basins of attraction", J. Sound Vib. 135, 453-475 (1989).
-.. [5] G. Rega, S. Lenci, "Identifying, evaluating, and controlling dynamical integrity measures
-   in non-linear mechanical oscillators", Nonlinear Anal. 63, 902-914 (2005).
-.. [6] S. Lenci, G. Rega (eds.), "Global Nonlinear Dynamics for Engineering Design and System
-   Safety", CISM Courses and Lectures 588, Springer (2019).
-.. [7] G. Datseris, A. Wagemakers, "Effortless estimation of basins of attraction", Chaos 32,
-   023104 (2022) (Attractors.jl).
+- A. Daza, A. Wagemakers, B. Georgeot, D. Guéry-Odelin, M. A. F. Sanjuán, "Basin entropy: a
+  new tool to analyze uncertainty in dynamical systems", Sci. Rep. 6, 31416 (2016).
+- C. Grebogi, S. W. McDonald, E. Ott, J. A. Yorke, "Final state sensitivity: an obstruction
+  to predictability", Phys. Lett. A 99, 415-418 (1983).
+- S. W. McDonald, C. Grebogi, E. Ott, J. A. Yorke, "Fractal basin boundaries", Physica D 17,
+  125-153 (1985).
+- M. S. Soliman, J. M. T. Thompson, "Integrity measures quantifying the erosion of smooth
+  and fractal basins of attraction", J. Sound Vib. 135, 453-475 (1989).
+- G. Rega, S. Lenci, "Identifying, evaluating, and controlling dynamical integrity measures
+  in non-linear mechanical oscillators", Nonlinear Anal. 63, 902-914 (2005).
+- S. Lenci, G. Rega (eds.), "Global Nonlinear Dynamics for Engineering Design and System
+  Safety", CISM Courses and Lectures 588, Springer (2019).
+- G. Datseris, A. Wagemakers, "Effortless estimation of basins of attraction", Chaos 32,
+  023104 (2022) (Attractors.jl).
 """
 
 from __future__ import annotations
@@ -50,9 +51,9 @@ __all__ = [
     "uncertain_fraction_sampled", "uncertainty_exponent",
 ]
 
-#: Outcome id of a cell that overturns (SPEC.md §8).
+#: Outcome id of a cell that overturns.
 OVERTURN = -1
-#: Outcome id of a cell that could not be resolved (SPEC.md §8).
+#: Outcome id of a cell that could not be resolved (the impact bound was reached).
 UNRESOLVED = -2
 
 
@@ -120,6 +121,16 @@ class BasinEntropy:
         Number of those holding more than one outcome.
     box : int
         Side of the boxes, in cells.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rockjit.basins.measures import basin_entropy
+    >>> ids = np.zeros((10, 10), dtype=int)
+    >>> ids[:, 4:] = 1
+    >>> Sb, Sbb = basin_entropy(ids)
+    >>> round(Sb, 4), round(Sbb, 4), basin_entropy(ids).n_boundary
+    (0.2502, 0.5004, 2)
     """
 
     Sb: float
@@ -157,23 +168,35 @@ def basin_entropy(ids, box=5):
 
     Notes
     -----
-    Daza et al. [1]_: the map is covered with non-overlapping boxes of ``box x box`` cells; in box
-    ``i``, ``p_ij`` is the fraction of its cells with outcome ``j`` and
-    ``S_i = -sum_j p_ij ln p_ij`` (natural logarithm). ``Sb`` is the mean of ``S_i`` over all
-    boxes, ``Sbb`` the mean over the boxes with more than one outcome. ``Sbb > ln 2`` is a
-    sufficient condition for a fractal boundary [1]_.
+    Daza et al. (2016): the map is covered with non-overlapping boxes of ``box x box`` cells; in
+    box ``i``, ``p_ij`` is the fraction of its cells with outcome ``j`` and ``S_i = -sum_j p_ij
+    ln p_ij`` (natural logarithm). ``Sb`` is the mean of ``S_i`` over all boxes, ``Sbb`` the
+    mean over the boxes with more than one outcome. ``Sbb > ln 2`` is a sufficient condition for
+    a fractal boundary (Daza et al. 2016).
 
     Boxes start at cell ``(0, 0)``. When a side is not a multiple of ``box``, the last
     ``n % box`` rows and ``m % box`` columns, which would only fill partial boxes, are left out:
     every box then holds the same number of cells, so every ``S_i`` has the same resolution.
-    Attractors.jl [7]_ does the same in its box-counting dimension, but its ``basin_entropy``
-    refuses such a map instead; rockjit's grids are the user's choice (101 x 101 is common), so
-    the remainder is dropped and the boxes used are reported.
+    Attractors.jl (Datseris & Wagemakers 2022) does the same in its box-counting dimension, but
+    its ``basin_entropy`` refuses such a map instead; rockjit's grids are the user's choice (101
+    x 101 is common), so the remainder is dropped and the boxes used are reported.
 
     ``Sbb`` is ``nan`` when no box holds two outcomes (a constant map, or boundaries that all
     lie on box edges): the mean over an empty set is undefined, and ``0`` would claim a boundary
     of zero entropy, which no boundary box can have (its ``S_i >= ln(box^2) / box^2 > 0``).
     Attractors.jl returns ``0/0`` (NaN) there too. ``Sb`` is then ``0``.
+
+    Examples
+    --------
+    Two outcomes split by a straight boundary inside the first column of boxes:
+
+    >>> import numpy as np
+    >>> from rockjit.basins.measures import basin_entropy
+    >>> ids = np.zeros((10, 10), dtype=int)
+    >>> ids[:, 4:] = 1
+    >>> e = basin_entropy(ids, box=5)
+    >>> round(e.Sb, 4), round(e.Sbb, 4), e.n_boxes, e.n_boundary
+    (0.2502, 0.5004, 4, 2)
     """
     a = _ids_2d(ids)
     n, m = a.shape
@@ -240,7 +263,8 @@ def uncertain_fraction(ids, eps_cells, margin=None):
 
     Notes
     -----
-    The grid form of the perturbation method of Grebogi et al. [2]_, [3]_: a cell ``(i, j)`` is
+    The grid form of the perturbation method of Grebogi et al. (1983; McDonald et al. 1985): a
+    cell ``(i, j)`` is
     *uncertain at eps* when its outcome differs from that of at least one of its four
     neighbours at distance ``eps`` along the axes, ``(i +- eps, j)`` and ``(i, j +- eps)`` (GMOY
     perturb an initial condition by ``+-eps`` along one coordinate; both coordinates are used
@@ -250,10 +274,19 @@ def uncertain_fraction(ids, eps_cells, margin=None):
     counted (a census rather than GMOY's random sample); for a smooth boundary ``f`` is
     proportional to ``eps`` exactly, up to the lattice.
 
-    Attractors.jl's ``uncertainty_exponent`` [7]_ is not this method: it counts, for box sides
+    Attractors.jl's ``uncertainty_exponent`` is not this method: it counts, for box sides
     ``eps``, the non-overlapping boxes holding more than one outcome (partial boxes dropped),
     fits the box-counting dimension ``d`` of the boundary from ``log N`` against ``log(1/eps)``,
     and returns ``D - d``. Both estimate the same exponent when the boundary is self-similar.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rockjit.basins.measures import uncertain_fraction
+    >>> ids = np.zeros((10, 10), dtype=int)
+    >>> ids[:, 4:] = 1
+    >>> uncertain_fraction(ids, [1, 2])
+    array([0.33333333, 0.66666667])
     """
     a = _ids_2d(ids)
     eps, scalar = _eps_list(eps_cells, "eps_cells", "int")
@@ -292,6 +325,13 @@ class UncertaintyExponent:
         The boundary's dimension ``D - alpha``.
     intercept : float
         ``ln f`` at ``eps = 1`` on the fitted line.
+
+    Examples
+    --------
+    >>> from rockjit.basins.measures import uncertainty_exponent
+    >>> alpha, stderr, dimension = uncertainty_exponent([1, 2, 4], [0.1, 0.2, 0.4])
+    >>> round(alpha, 12), round(dimension, 12)
+    (1.0, 1.0)
     """
 
     alpha: float
@@ -331,12 +371,21 @@ def uncertainty_exponent(eps, f, dim=2):
 
     Notes
     -----
-    Grebogi et al. [2]_, [3]_: the fraction of uncertain initial conditions scales as
-    ``f ~ eps^alpha`` and the box-counting dimension of the basin boundary is ``D - alpha``
-    (``alpha = 1`` for a smooth boundary in the plane, ``alpha -> 0`` for a riddled one). The fit
-    is ordinary least squares of ``ln f`` on ``ln eps`` with equal weights; the standard error
-    is ``sqrt(SSR / (k - 2) / Sxx)``, the usual one of a fitted slope (as in
+    Grebogi et al. (1983; McDonald et al. 1985): the fraction of uncertain initial conditions
+    scales as ``f ~ eps^alpha`` and the box-counting dimension of the basin boundary is ``D -
+    alpha`` (``alpha = 1`` for a smooth boundary in the plane, ``alpha -> 0`` for a riddled
+    one). The fit is ordinary least squares of ``ln f`` on ``ln eps`` with equal weights; the
+    standard error is ``sqrt(SSR / (k - 2) / Sxx)``, the usual one of a fitted slope (as in
     ``scipy.stats.linregress``), so at least three points are needed.
+
+    Examples
+    --------
+    A smooth boundary (the fraction grows like ``eps``) has ``alpha = 1``, dimension 1:
+
+    >>> from rockjit.basins.measures import uncertainty_exponent
+    >>> u = uncertainty_exponent([1, 2, 4], [0.1, 0.2, 0.4])
+    >>> round(u.alpha, 12), round(u.stderr, 12), round(u.dimension, 12)
+    (1.0, 0.0, 1.0)
     """
     x = np.asarray(eps, dtype=float)
     y = np.asarray(f, dtype=float)
@@ -379,6 +428,15 @@ class SampledUncertainty:
         Number of uncertain points at each ``eps``.
     n : int
         Number of base points.
+
+    Examples
+    --------
+    >>> from rockjit.basins.measures import uncertain_fraction_sampled
+    >>> half_plane = lambda points: (points[:, 0] > 0).astype(int)
+    >>> s = uncertain_fraction_sampled(half_plane, (-1, -1), (1, 1), [0.01, 0.02, 0.04],
+    ...                                n=2000)
+    >>> s.f.tolist(), round(s.exponent().alpha, 2)
+    ([0.0135, 0.023, 0.054], 1.0)
     """
 
     eps: np.ndarray
@@ -417,10 +475,11 @@ def uncertain_fraction_sampled(outcome, lo, hi, eps, n=10_000, seed=0):
 
     Notes
     -----
-    Grebogi et al. [2]_, [3]_: a random initial condition ``x`` is *uncertain at eps* when the
-    outcome of ``x + delta`` or of ``x - delta`` differs from that of ``x``, ``|delta| = eps``.
-    Here the direction of ``delta`` is drawn at random (uniform angle) for each point, in the
-    coordinates normalised by the box's sides: ``delta = eps (hi - lo) (cos phi, sin phi)``, so
+    Grebogi et al. (1983; McDonald et al. 1985): a random initial condition ``x`` is *uncertain
+    at eps* when the outcome of ``x + delta`` or of ``x - delta`` differs from that of ``x``,
+    ``|delta| = eps``. Here the direction of ``delta`` is drawn at random (uniform angle) for
+    each point, in the coordinates normalised by the box's sides: ``delta = eps (hi - lo) (cos
+    phi, sin phi)``, so
     ``eps`` is dimensionless like the grid form's ``eps_cells / (n - 1)`` (``theta`` and
     ``theta'`` have different units; GMOY perturbed along one coordinate). For a smooth boundary
     crossing the box, ``f = (4 / pi) eps L / A`` to first order (``L`` the boundary's length, ``A``
@@ -430,6 +489,17 @@ def uncertain_fraction_sampled(outcome, lo, hi, eps, n=10_000, seed=0):
     perturbed point stays in the sampled box; the same base points and directions serve every
     ``eps`` (common random numbers: the fitted slope is less noisy than with independent
     samples).
+
+    Examples
+    --------
+    The outcome of a half-plane: its boundary is a straight line, its exponent 1:
+
+    >>> from rockjit.basins.measures import uncertain_fraction_sampled
+    >>> half_plane = lambda points: (points[:, 0] > 0).astype(int)
+    >>> s = uncertain_fraction_sampled(half_plane, (-1, -1), (1, 1), [0.01, 0.02, 0.04],
+    ...                                n=2000, seed=0)
+    >>> s.uncertain.tolist(), round(s.exponent().alpha, 2)
+    ([27, 46, 108], 1.0)
     """
     if not callable(outcome):
         raise ValueError(f"outcome must be a callable outcome(points) -> ids "
@@ -498,6 +568,17 @@ class Integrity:
         Its centre ``(theta, theta')`` (a grid node), ``None`` when nothing is safe.
     half_width : float
         The normalisation: half the shorter side of the sampled region, state units.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rockjit.basins.measures import integrity
+    >>> axis = np.linspace(-1, 1, 21)
+    >>> ids = np.zeros((21, 21), dtype=int)
+    >>> ids[:5] = -1
+    >>> m = integrity(ids, axis, axis)
+    >>> round(m.radius, 6), m.half_width, m.to_dict()["LIM"]
+    (0.8, 1.0, {})
     """
 
     GIM: float
@@ -555,9 +636,9 @@ def integrity(ids, theta, dtheta, points=None, lim_basin="safe"):
     points : mapping of int to array_like, shape (p, 2), optional
         Cycle points ``(theta, theta')`` of each attractor whose LIM is wanted, keyed by id.
     lim_basin : {"safe", "own"}, optional
-        The basin the LIM disc must stay in: ``"safe"`` (default, SPEC.md §8), the whole safe
+        The basin the LIM disc must stay in: ``"safe"`` (default), the whole safe
         basin; ``"own"``, the attractor's own basin (cells with its id), as in Soliman &
-        Thompson's original LIM [4]_.
+        Thompson's original LIM (1989).
 
     Returns
     -------
@@ -567,8 +648,8 @@ def integrity(ids, theta, dtheta, points=None, lim_basin="safe"):
 
     Notes
     -----
-    Definitions of Soliman & Thompson [4]_ and Rega & Lenci [5]_, [6]_, on the safe basin of
-    SPEC.md §8:
+    Definitions of Soliman & Thompson (1989) and Rega & Lenci (2005; Lenci & Rega 2019), on
+    the safe basin of docs/theory/global-dynamics.md:
 
     - **Safe cells** are those with an attractor id ``>= 0``. Unresolved cells (``-2``) are
       *not* safe: nothing shows they stay bounded, and an integrity measure must not claim
@@ -593,11 +674,26 @@ def integrity(ids, theta, dtheta, points=None, lim_basin="safe"):
     - **LIM** of an attractor is the radius of the largest disc centred on the attractor that
       stays in the basin, same normalisation. For a cycle of ``p`` points this is the *minimum*
       over its points: the LIM is the distance from the attractor, a set, to the basin's
-      boundary [4]_, [5]_, which is the smallest distance of its points; a disturbance at the
-      most exposed point is the one that loses the orbit. A point's radius is its distance to
-      the nearest node outside the basin and to the region's edge, measured from the point
-      itself (not its node); it is ``0`` when the point's nearest node is outside the basin, and
-      ``nan`` when the point lies outside the sampled region (the map says nothing there).
+      boundary (Soliman & Thompson 1989; Rega & Lenci 2005), which is the smallest distance of
+      its points; a disturbance at the most exposed point is the one that loses the orbit. A
+      point's radius is its distance to the nearest node outside the basin and to the region's
+      edge, measured from the point itself (not its node); it is ``0`` when the point's nearest
+      node is outside the basin, and ``nan`` when the point lies outside the sampled region (the
+      map says nothing there).
+
+    Examples
+    --------
+    A 21 x 21 map over ``[-1, 1]^2`` whose first five rows of ``theta`` overturn, and one
+    attractor at ``(0.5, 0)``:
+
+    >>> import numpy as np
+    >>> from rockjit.basins.measures import integrity
+    >>> axis = np.linspace(-1, 1, 21)
+    >>> ids = np.zeros((21, 21), dtype=int)
+    >>> ids[:5] = -1
+    >>> m = integrity(ids, axis, axis, {0: [[0.5, 0.0]]})
+    >>> round(m.GIM, 4), round(m.IF, 6), m.LIM
+    (0.7619, 0.8, {0: 0.5})
     """
     a = _ids_2d(ids)
     n, m = a.shape

@@ -149,6 +149,19 @@ def alpha_grid(alpha_range, alpha_step):
     """The amplitudes ``alpha_range[0], alpha_range[0] + step, ..., alpha_range[1]`` (end
     included), for a sweep or an erosion profile.
 
+    Parameters
+    ----------
+    alpha_range : pair of float
+        First and last amplitude, ``0 <= a0 <= a1``.
+    alpha_step : float
+        The step, ``> 0``; the last amplitude is kept when the range is a whole number of steps
+        (to ``1e-9`` of a step).
+
+    Returns
+    -------
+    ndarray
+        The amplitudes.
+
     Examples
     --------
     >>> import rockjit

@@ -57,7 +57,10 @@ def sweep(block, forcing, alphas, state=None, *, integration=None, classificatio
     >>> from rockjit import Block, Harmonic
     >>> sw = rockjit.sweep(Block(hb=1), Harmonic(omega=1.3), rockjit.alpha_grid((0.5, 0.6), 0.05))
     >>> [str(n) for n in sw.names[sw.label]]
-    ['symmetric', 'symmetric', 'symmetric']
+    ['rest', 'rest', 'symmetric']
+
+    Below ``alpha = 1/omega^2 = 0.59`` the forcing cannot lift the block (``alpha omega^2 <
+    b/h``): it comes to rest.
     """
     integration, classification, execution = gp.objects(block, integration, classification,
                                                         execution)

@@ -377,8 +377,8 @@ class OutputDir:
     - ``path`` present: each file :func:`os.replace`\\ d over its namesake, ``summary.json``
       last.
 
-    SIGINT and SIGTERM are deferred (:func:`defer_signals`) for these few moves, so an
-    interrupt cannot split the set. A signal that arrived is recorded in :attr:`interrupted`,
+    SIGINT and SIGTERM are deferred (``defer_signals``) for these few moves, so an
+    interrupt cannot split the set. A signal that arrived is recorded in ``interrupted``,
     not raised: the outputs are published and the run can report success.
 
     On any failure or interrupt before :meth:`publish`, :meth:`discard` (called by the ``with``
@@ -410,18 +410,24 @@ class OutputDir:
 
     Examples
     --------
-    The command line's use::
+    The command line's use: stage the files, publish them together (or discard them all on
+    any failure), and report a note about files of an earlier run that stay:
 
-        out = OutputDir(args.out)
-        try:
-            out.npz("basin.npz", label=label)
-            out.json("summary.json", {"command": "basin", "files": out.written + ["summary.json"]})
-            note = out.publish()
-        except BaseException:
-            out.discard()
-            raise
-        if note:
-            print(note, file=sys.stderr)
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import numpy as np
+    >>> from rockjit.storage.files import OutputDir
+    >>> out = OutputDir(Path(tempfile.mkdtemp()) / "basin")
+    >>> try:
+    ...     out.npz("basin.npz", label=np.zeros((2, 2), dtype=int))
+    ...     out.json("summary.json", {"command": "basin",
+    ...                               "files": out.written + ["summary.json"]})
+    ...     note = out.publish()
+    ... except BaseException:
+    ...     out.discard()
+    ...     raise
+    >>> sorted(p.name for p in out.path.iterdir()), note is None
+    (['basin.npz', 'summary.json'], True)
     """
 
     def __init__(self, path, command=None):
@@ -479,7 +485,7 @@ class OutputDir:
     def file(self, name):
         """The staged path of ``name``, for a writer of its own; ``name`` is listed as written.
 
-        Write it completely (e.g. with :func:`atomic_open`) before :meth:`publish`.
+        Write it completely (e.g. with ``atomic_open``) before :meth:`publish`.
         """
         _check_name(name)
         path = self._stage_dir() / name
@@ -495,28 +501,28 @@ class OutputDir:
             self.written.append(name)
 
     def json(self, name, obj):
-        """Stage ``obj`` as strict JSON (:func:`write_json`)."""
+        """Stage ``obj`` as strict JSON (``write_json``)."""
         write_json(self._target(name), obj)
         self._add(name)
 
     def npz(self, name, **arrays):
-        """Stage arrays as an ``.npz`` archive (:func:`write_npz`)."""
+        """Stage arrays as an ``.npz`` archive (``write_npz``)."""
         write_npz(self._target(name), **arrays)
         self._add(name)
 
     def figure(self, name, fig, *, dpi=150):
-        """Stage a matplotlib figure (:func:`save_figure`), then clear it to free its memory."""
+        """Stage a matplotlib figure (``save_figure``), then clear it to free its memory."""
         save_figure(fig, self._target(name), dpi=dpi)
         self._add(name)
         fig.clear()
 
     def csv(self, name, header, rows):
-        """Stage a CSV table (:func:`write_csv`)."""
+        """Stage a CSV table (``write_csv``)."""
         write_csv(self._target(name), header, rows)
         self._add(name)
 
     def text(self, name, text):
-        """Stage a text file (:func:`write_text`)."""
+        """Stage a text file (``write_text``)."""
         write_text(self._target(name), text)
         self._add(name)
 
@@ -571,9 +577,9 @@ class OutputDir:
         Returns
         -------
         str or None
-            :meth:`stale_warning` as it stood before the move (also kept in :attr:`warning`):
+            :meth:`stale_warning` as it stood before the move (also kept in ``warning``):
             one line for the command line to print, or ``None``. The names published are
-            :attr:`written`.
+            ``written``.
         """
         if self.published:
             return self.warning

@@ -162,9 +162,37 @@ _INTEGRATION = ("n_steps", "periods", "window", "max_impacts", "rest_speed", "th
 
 
 def objects(kw):
-    """``(block, forcing, state, integration, rest)``: the objects of rockjit's API from a
-    case's flat keywords (the form cases are drawn, stored and printed in), ``rest`` the
-    keywords left (``lyapunov``, ``record_stride``, ...)."""
+    """The objects of rockjit's API from a case's flat keywords.
+
+    Cases are drawn, stored and printed as flat keywords (``hb``, ``alpha``, ``omega``,
+    ``theta0``, ``periods``, ...), the keywords of :class:`rockjit.Block`,
+    :class:`rockjit.Harmonic` and :class:`rockjit.Integration` together, plus ``theta0``,
+    ``dtheta0`` and ``forcing="embedded"``. A state given without a phase starts the forcing
+    at ``(r0, s0) = (0, 1)``.
+
+    Parameters
+    ----------
+    kw : dict
+        The flat keywords.
+
+    Returns
+    -------
+    block : Block
+    forcing : Harmonic
+    state : tuple of float or None
+        ``(theta0, theta0')``, or ``None`` (the study's).
+    integration : Integration
+    rest : dict
+        The keywords left (``lyapunov``, ``record_stride``, ...).
+
+    Examples
+    --------
+    >>> from rockjit.testing.stress import objects
+    >>> block, forcing, state, integration, rest = objects(
+    ...     dict(hb=1.0, alpha=0.6, omega=1.3, theta0=0.1, periods=20, lyapunov=True))
+    >>> forcing.start()[1:], state, integration.periods, rest
+    ((0.0, 1.0), (0.1, 0.0), 20, {'lyapunov': True})
+    """
     kw = dict(kw)
     block = Block(**{k: kw.pop(k) for k in _BLOCK if k in kw})
     forcing = Harmonic(**{k: kw.pop(k) for k in _FORCING if k in kw},
@@ -178,14 +206,50 @@ def objects(kw):
 
 
 def simulate_flat(**kw):
-    """``rockjit.simulate`` of a case's flat keywords (:func:`objects`)."""
+    """:func:`rockjit.simulate` of a case's flat keywords (:func:`objects`).
+
+    Parameters
+    ----------
+    **kw
+        The flat keywords of a case.
+
+    Returns
+    -------
+    Result
+        The run.
+
+    Examples
+    --------
+    >>> from rockjit.testing.stress import simulate_flat
+    >>> simulate_flat(hb=1.0, alpha=0.6, omega=1.3, theta0=0.1, periods=20).status
+    'done'
+    """
     block, forcing, state, integration, rest = objects(kw)
     return rockjit.simulate(block, forcing, state, integration=integration, **rest)
 
 
 @dataclass
 class Case:
-    """One stress run: :func:`simulate_flat` of ``kwargs``."""
+    """One stress run: :func:`simulate_flat` of ``kwargs``.
+
+    Attributes
+    ----------
+    id : str
+        ``s<seed>-<i>`` (:func:`cases`) or ``x<seed>-<i>`` (:func:`extreme_cases`): the case
+        drawn again by :func:`case_by_id`.
+    category : str
+        What kind of case it is (the module's categories).
+    kwargs : dict
+        The run's flat keywords.
+
+    Examples
+    --------
+    >>> from rockjit.testing.stress import Case, run_case
+    >>> case = Case("demo", "random", dict(hb=1.0, alpha=0.6, omega=1.3, periods=20))
+    >>> result, problems, refusal = run_case(case)
+    >>> result.status, any(problems.values()), refusal
+    ('done', False, None)
+    """
 
     id: str
     category: str
@@ -384,8 +448,27 @@ def case_impact_bound(rng, max_periods):
 def cases(n, seed=0, *, max_periods=200, long_periods=20_000):
     """``n`` seeded stress cases, the categories in turn.
 
-    ``max_periods`` bounds the horizon of every category but ``long_horizon``, whose horizon goes
-    up to ``long_periods`` (and at most 4e6 grid steps).
+    Parameters
+    ----------
+    n : int
+        Number of cases.
+    seed : int
+        Seed: the same seed draws the same cases on every machine.
+    max_periods : int
+        Bound on the horizon of every category but ``long_horizon``.
+    long_periods : int
+        Bound on the horizon of ``long_horizon`` cases (and at most 4e6 grid steps).
+
+    Returns
+    -------
+    list of Case
+        Ids ``s<seed>-<i>``.
+
+    Examples
+    --------
+    >>> from rockjit.testing.stress import cases
+    >>> [(c.id, c.category) for c in cases(3)]
+    [('s0-0', 'random'), ('s0-1', 'near_zero'), ('s0-2', 'grazing')]
     """
     out = []
     for i in range(n):
@@ -469,9 +552,28 @@ def case_through_rest(rng, max_periods):
 
 
 def extreme_cases(n, seed=0, *, max_periods=200):
-    """``n`` seeded cases of issue 10's categories (:data:`EXTREME_CATEGORIES`), in turn.
+    """``n`` seeded cases beyond the study's ranges (strong damping, slow and fast forcing,
+    orbits through rest: ``EXTREME_CATEGORIES``), in turn.
 
-    Ids are ``x<seed>-<i>``, drawn from their own seeds, so that :func:`cases` keeps its ids.
+    Parameters
+    ----------
+    n : int
+        Number of cases.
+    seed : int
+        Seed.
+    max_periods : int
+        Bound on the horizon (cut further so that no run exceeds ``MAX_GRID_STEPS`` steps).
+
+    Returns
+    -------
+    list of Case
+        Ids ``x<seed>-<i>``, drawn from their own seeds, so that :func:`cases` keeps its ids.
+
+    Examples
+    --------
+    >>> from rockjit.testing.stress import extreme_cases
+    >>> [(c.id, c.category) for c in extreme_cases(3)]
+    [('x0-0', 'stiff_damping'), ('x0-1', 'wide_omega'), ('x0-2', 'through_rest')]
     """
     out = []
     for i in range(n):
@@ -483,8 +585,27 @@ def extreme_cases(n, seed=0, *, max_periods=200):
 
 
 def case_by_id(case_id, *, max_periods=200, long_periods=20_000):
-    """The case ``s<seed>-<i>`` (:func:`cases`) or ``x<seed>-<i>`` (:func:`extreme_cases`)
-    drawn with the same horizon settings as the run that listed it."""
+    """The case ``s<seed>-<i>`` (:func:`cases`) or ``x<seed>-<i>`` (:func:`extreme_cases`),
+    drawn again.
+
+    Parameters
+    ----------
+    case_id : str
+        The case's id.
+    max_periods, long_periods : int
+        The horizon settings of the run that listed it.
+
+    Returns
+    -------
+    Case
+
+    Examples
+    --------
+    >>> from rockjit.testing.stress import case_by_id
+    >>> case = case_by_id("s0-1")
+    >>> case.category, case.kwargs["periods"], case.kwargs["dtheta0"]
+    ('near_zero', 1, -1e-300)
+    """
     pre, idx = case_id.split("-")
     kind, seed, i = pre[0], int(pre[1:]), int(idx)
     if kind == "s":
@@ -675,7 +796,28 @@ RUN_CHECK_FUNCS = dict(status=check_status, finite=check_finite, time=check_time
 
 
 def check_run(kw, res):
-    """``{check: [problems]}`` for every check in :data:`RUN_CHECKS` (empty lists pass)."""
+    """The checks every run must pass (``RUN_CHECKS``; the module docstring says each).
+
+    Parameters
+    ----------
+    kw : dict
+        The run's flat keywords.
+    res : Result
+        Its result.
+
+    Returns
+    -------
+    dict of str to list of str
+        ``{check: [problems]}``; an empty list passes.
+
+    Examples
+    --------
+    >>> from rockjit.testing.stress import check_run, simulate_flat
+    >>> kw = dict(hb=1.0, alpha=0.6, omega=1.3, periods=20)
+    >>> problems = check_run(kw, simulate_flat(**kw))
+    >>> sorted(problems), any(problems.values())
+    (['bookkeeping', 'finite', 'progress', 'rest_exponents', 'status', 'time', 'work'], False)
+    """
     out = {}
     for name in RUN_CHECKS:
         try:
@@ -694,13 +836,35 @@ def refused(exc):
 
 
 def run_case(case):
-    """``(result, problems, refusal)``.
+    """Run one case and check it.
 
     A grid too coarse to integrate (``T/N`` beyond rockjit's step limit, an embedded step beyond
     the oscillator's stability, or a step beyond the explicit stability of a large damping) must
     be refused with a ``ValueError`` naming ``n_steps``:
     that is ``(None, {no problems}, message)``. Any other exception is a failure of the
     ``status`` check.
+
+    Parameters
+    ----------
+    case : Case
+        The case.
+
+    Returns
+    -------
+    result : Result or None
+        The run (``None`` when it raised).
+    problems : dict of str to list of str
+        :func:`check_run`'s problems.
+    refusal : str or None
+        The message of a documented refusal.
+
+    Examples
+    --------
+    >>> from rockjit.testing.stress import Case, run_case
+    >>> coarse = Case("demo", "random", dict(hb=1.0, alpha=0.6, omega=0.05, n_steps=8))
+    >>> result, problems, refusal = run_case(coarse)
+    >>> result is None, refusal.startswith("n_steps must be >=")
+    (True, True)
     """
     try:
         res = simulate_flat(**case.kwargs)

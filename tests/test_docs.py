@@ -1,0 +1,278 @@
+"""The documentation's promises, checked: every example in a public docstring runs and prints
+what it says; every public object is documented; the outputs page lists every file, array and
+summary key each command writes; the performance page includes every benchmark's results; the
+command-line reference covers every option.
+
+The site itself is built by ``.ci/run`` (``python -m sphinx -W --keep-going -n``), which also
+executes the guides and the gallery and validates the docstrings with numpydoc; these tests need
+neither Sphinx nor a kernel.
+"""
+
+from __future__ import annotations
+
+import doctest
+import importlib
+import inspect
+import json
+import re
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rockjit
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+
+#: The modules whose docstrings the site renders: their examples are the doctests.
+PUBLIC_MODULES = [
+    "rockjit.model", "rockjit.excitation", "rockjit.settings", "rockjit.single",
+    "rockjit.result", "rockjit.grids.plan", "rockjit.grids.sweep_grid",
+    "rockjit.grids.basin_grid", "rockjit.grids.plane_grid", "rockjit.basins.erosion",
+    "rockjit.basins.fate", "rockjit.basins.measures", "rockjit.storage.files",
+    "rockjit.testing.stress", "rockjit.orbits.orbits",
+]
+
+
+# ------------------------------------------------------------------------------- doctests
+
+def _doctests():
+    finder = doctest.DocTestFinder(exclude_empty=True)
+    found = {}
+    for name in PUBLIC_MODULES:
+        module = importlib.import_module(name)
+        for test in finder.find(module):
+            if test.examples and test.name not in found:
+                found[test.name] = test
+    return [found[k] for k in sorted(found)]
+
+
+DOCTESTS = _doctests()
+
+
+def test_there_are_doctests():
+    assert len(DOCTESTS) >= 40, [t.name for t in DOCTESTS]
+
+
+@pytest.mark.parametrize("test", DOCTESTS, ids=[t.name for t in DOCTESTS])
+def test_docstring_example(test):
+    """Each example runs and prints exactly what its docstring shows."""
+    runner = doctest.DocTestRunner(optionflags=doctest.NORMALIZE_WHITESPACE)
+    out = []
+    runner.run(test, out=out.append, clear_globs=True)
+    assert runner.failures == 0, "".join(out)
+
+
+# ------------------------------------------------------------------------------- public API
+
+def _public_objects():
+    """``(qualified name, object)`` of everything the API reference documents."""
+    from rockjit.basins import erosion, fate, measures
+    from rockjit.storage import files
+    from rockjit.testing import stress
+    out = [(f"rockjit.{n}", getattr(rockjit, n)) for n in rockjit.__all__]
+    out += [(f"rockjit.basins.measures.{n}", getattr(measures, n)) for n in measures.__all__]
+    out += [("rockjit.basins.erosion.ErosionResult", erosion.ErosionResult),
+            ("rockjit.basins.fate.FateResult", fate.FateResult),
+            ("rockjit.storage.files.OutputDir", files.OutputDir)]
+    out += [(f"rockjit.testing.stress.{n}", getattr(stress, n)) for n in
+            ("cases", "extreme_cases", "case_by_id", "run_case", "check_run", "simulate_flat",
+             "objects", "Case")]
+    return [(n, o) for n, o in out if inspect.isclass(o) or inspect.isfunction(o)
+            or hasattr(o, "plan")]
+
+
+PUBLIC = _public_objects()
+
+
+@pytest.mark.parametrize("name, obj", PUBLIC, ids=[n for n, _ in PUBLIC])
+def test_public_object_is_documented(name, obj):
+    """A numpydoc docstring with its parameters (or a class's attributes) and an example."""
+    doc = inspect.getdoc(obj) or ""
+    assert re.search(r"^Examples\n-{8}", doc, re.M), f"{name}: no Examples section"
+    sig_params = [p for p in inspect.signature(obj).parameters.values()
+                  if p.name not in ("self",)]
+    if sig_params:
+        assert re.search(r"^(Parameters|Attributes)\n-{5,}", doc, re.M), \
+            f"{name}: no Parameters (or Attributes) section"
+    if inspect.isclass(obj):
+        for attr, member in vars(obj).items():
+            if attr.startswith("_"):
+                continue
+            func = member.fget if isinstance(member, property) else \
+                getattr(member, "func", member)
+            if inspect.isfunction(func):
+                assert inspect.getdoc(func), f"{name}.{attr}: no docstring"
+
+
+def test_the_reference_lists_every_public_name():
+    text = (DOCS / "reference" / "index.md").read_text()
+    listed = set(re.findall(r"^\s+([A-Za-z_][\w.]*)\s*$", text, re.M))
+    listed |= set(re.findall(r"py:data:: (\w+)", text))
+    missing = [n for n in rockjit.__all__ if n not in listed]
+    assert not missing, f"add to docs/reference/index.md: {missing}"
+
+
+# ------------------------------------------------------------------------------- outputs page
+
+def _sections(text):
+    """``{name: text}`` of the ``(outputs-<name>)=`` sections of the outputs page."""
+    parts = re.split(r"^\(outputs-([\w-]+)\)=$", text, flags=re.M)
+    return dict(zip(parts[1::2], parts[2::2]))
+
+
+def _patterns(section):
+    """The backquoted names of a section as regular expressions (``<law>`` and the like match
+    any name part)."""
+    out = []
+    for token in re.findall(r"`([^`\n]+)`", section):
+        rx = re.sub(r"<\w+>", "@@", token)
+        rx = re.escape(rx).replace("@@", r"[A-Za-z0-9_.]+")
+        out.append(re.compile(rx))
+    return out
+
+
+def _listed(name, patterns):
+    return any(p.fullmatch(name) for p in patterns)
+
+
+OUTPUTS = _sections((DOCS / "guide" / "outputs.md").read_text())
+#: npz archives whose arrays another section lists ("with the arrays of `sweep.npz`")
+SHARED_ARRAYS = {"sweep.npz": "sweep", "erosion.npz": "erosion"}
+
+BASIN = ["--hb", "1", "--alpha", "0.66", "--omega", "1.3", "--grid", "6", "--periods", "20"]
+TINY = ["--periods", "20", "--quiet"]
+
+#: (test id, section, command line): a tiny run of every command, with the options that add
+#: files or arrays
+RUNS = [
+    ("trajectory", "trajectory", ["trajectory", "--hb", "1", "--alpha", "0.6", "--omega", "1.3",
+                                  "--lyapunov"] + TINY),
+    ("sweep", "sweep", ["sweep", "--hb", "1", "--omega", "1.3", "--alpha-range", "0.5", "0.9",
+                        "--alpha-step", "0.1", "--continue-past-overturn"] + TINY),
+    ("sweep-uncertain", "sweep", ["sweep", "--hb", "1", "--omega", "1.3", "--alpha-range", "0.5",
+                                  "0.7", "--alpha-step", "0.1", "--uncertainty", "1e-3"] + TINY),
+    ("basin", "basin", ["basin", "--lyapunov", "--quiet"] + BASIN),
+    ("basin-both", "basin", ["basin", "--law", "both", "--lyapunov", "--quiet"] + BASIN),
+    ("basin-uncertain", "basin", ["basin", "--uncertainty", "1e-3", "--quiet"] + BASIN),
+    ("plane", "plane", ["plane", "--hb", "1", "--alpha-range", "0.5", "0.7", "--omega-range",
+                        "1.2", "1.4", "--grid", "3", "3"] + TINY),
+    ("plane-uncertain", "plane", ["plane", "--hb", "1", "--alpha-range", "0.5", "0.7",
+                                  "--omega-range", "1.2", "1.4", "--grid", "3", "3",
+                                  "--uncertainty", "1e-3"] + TINY),
+    ("erosion", "erosion", ["erosion", "--hb", "1", "--law", "both", "--omega", "1.3",
+                            "--alpha-range", "0.6", "0.7", "--alpha-step", "0.05",
+                            "--grid", "6"] + TINY),
+    ("fate", "fate", ["fate", "--hb", "1", "--alpha", "0.969", "--omega", "1.3", "--ensemble",
+                      "4"] + TINY),
+    ("cor", "cor", ["cor", "--quiet"]),
+    ("orbits", "orbits", ["orbits", "--hb", "1", "--omega", "1.3", "--alpha-range", "0.7",
+                          "0.85", "--alpha-step", "0.01", "--periods", "100", "--quiet"]),
+    ("paper", "paper", ["paper", "--grid", "4", "--periods", "20", "--n-steps", "64",
+                        "--alpha-step", "0.1", "--zoom-step", "0.05", "--as-published",
+                        "--quiet"]),
+]
+
+#: While rockjit.orbits is redesigned its package exports nothing yet, and the commands built on
+#: it cannot run; they are checked again as soon as it does.
+ORBITS_READY = bool(getattr(importlib.import_module("rockjit.orbits"), "__all__", None))
+#: Known to fail, and strict: the test says so as soon as it passes. A grid's uncertainty rerun
+#: goes through the command's own chunk store, which refuses it as another computation.
+KNOWN = {i: "the uncertainty rerun shares the grid's chunk store (<out>.chunks), which "
+            "refuses it as a different computation"
+         for i in ("sweep-uncertain", "basin-uncertain", "plane-uncertain")}
+
+
+def _marks(run_id):
+    marks = []
+    if run_id in ("orbits", "paper") and not ORBITS_READY:
+        marks.append(pytest.mark.skip(
+            reason="rockjit.orbits is being redesigned: its package exports nothing yet"))
+    if run_id in KNOWN:
+        marks.append(pytest.mark.xfail(strict=True, reason=KNOWN[run_id]))
+    return marks
+
+
+@pytest.mark.parametrize("section, argv", [pytest.param(s, a, id=i, marks=_marks(i))
+                                           for i, s, a in RUNS])
+def test_outputs_page_lists_what_a_command_writes(section, argv, tmp_path):
+    from rockjit.cli.main import main
+    out = tmp_path / "out"
+    assert main(argv + ["--out", str(out)]) == 0
+    own = OUTPUTS[section]
+    patterns = _patterns(own)
+    common = _patterns(OUTPUTS["common"])
+    written = sorted(p.name for p in out.iterdir())
+    summary = json.loads((out / "summary.json").read_text())
+    assert sorted(summary["files"]) == written
+    missing = [f for f in written if not _listed(f, patterns + common)]
+    assert not missing, f"docs/guide/outputs.md, section {section}: add the files {missing}"
+    for f in written:
+        if not f.endswith(".npz"):
+            continue
+        arrays = list(patterns)
+        for shared, other in SHARED_ARRAYS.items():
+            if f"arrays of `{shared}`" in own:
+                arrays += _patterns(OUTPUTS[other])
+        with np.load(out / f) as z:
+            keys = [k for k in z.files if not _listed(k, arrays)]
+        assert not keys, f"docs/guide/outputs.md, section {section}: {f} holds {keys}"
+    keys = [k for k in summary if not _listed(k, patterns + common)]
+    assert not keys, f"docs/guide/outputs.md, section {section}: summary.json's keys {keys}"
+
+
+def test_outputs_page_has_a_section_per_command():
+    from rockjit.cli.main import build_parser
+    sub = next(a for a in build_parser()._actions if hasattr(a, "choices") and a.choices)
+    assert set(sub.choices) <= set(OUTPUTS), set(sub.choices) - set(OUTPUTS)
+
+
+# ------------------------------------------------------------------------------- generated pages
+
+def _ext(name):
+    sys.path.insert(0, str(DOCS / "_ext"))
+    try:
+        return importlib.import_module(name)
+    finally:
+        sys.path.remove(str(DOCS / "_ext"))
+
+
+def test_performance_page_includes_every_benchmark():
+    page = (DOCS / "performance.md").read_text()
+    results = sorted(p.stem for p in (ROOT / "benchmarks" / "results").glob("*.md"))
+    # grids_section.md joins grids.md and paper.md for benchmarks/README.md
+    missing = [r for r in results if r != "grids_section"
+               and f"_generated/bench/{r}.md" not in page]
+    assert not missing, f"include in docs/performance.md: {missing}"
+    for script in re.findall(r"python benchmarks/(\S+\.py)", page):
+        assert (ROOT / "benchmarks" / script).exists(), script
+
+
+def test_command_line_reference_lists_every_command_and_option():
+    import argparse
+    from rockjit.cli.main import build_parser
+    text = _ext("rockjit_cli").render()
+    parser = build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    for name, p in sub.choices.items():
+        assert f"(cli-{name})=" in text and f"## `rockjit {name}`" in text, name
+        section = text.split(f"(cli-{name})=", 1)[1].split("(cli-", 1)[0]
+        for action in p._actions:
+            for opt in action.option_strings:
+                if opt not in ("-h", "--help"):
+                    assert f"`{opt}" in section or f", {opt}" in section, (name, opt)
+
+
+def test_scrub_keeps_the_figures():
+    """The results as the site shows them: no internal reference left, every table row that
+    had none unchanged."""
+    sc = _ext("_scrub")
+    internal = re.compile(rf"{sc._ITEM}|{sc._SPEC}|\b{sc._RUN}")
+    for md in sorted((ROOT / "benchmarks" / "results").glob("*.md")):
+        text = md.read_text()
+        shown = sc.scrub(text)
+        assert not internal.search(shown), md.name
+        rows = [r for r in text.splitlines() if r.startswith("|") and not internal.search(r)]
+        assert set(rows) <= set(shown.splitlines()), md.name
