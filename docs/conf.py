@@ -51,7 +51,7 @@ extensions = [
     "rockjit_api",
 ]
 
-exclude_patterns = ["_build", "_generated", "jupyter_execute", "README-draft.md",
+exclude_patterns = ["_build", "_generated", "jupyter_execute",
                     "**.ipynb_checkpoints"]
 templates_path = ["_templates"]
 root_doc = "index"

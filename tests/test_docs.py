@@ -32,7 +32,8 @@ PUBLIC_MODULES = [
     "rockjit.result", "rockjit.grids.plan", "rockjit.grids.sweep_grid",
     "rockjit.grids.basin_grid", "rockjit.grids.plane_grid", "rockjit.basins.erosion",
     "rockjit.basins.fate", "rockjit.basins.measures", "rockjit.storage.files",
-    "rockjit.testing.stress", "rockjit.orbits.orbits",
+    "rockjit.testing.stress", "rockjit.orbits.shooting", "rockjit.orbits.arclength",
+    "rockjit.orbits.types", "rockjit.basins.identity", "rockjit.basins.cycles",
 ]
 
 
@@ -175,24 +176,8 @@ RUNS = [
                         "--quiet"]),
 ]
 
-#: While rockjit.orbits is redesigned its package exports nothing yet, and the commands built on
-#: it cannot run; they are checked again as soon as it does.
-ORBITS_READY = bool(getattr(importlib.import_module("rockjit.orbits"), "__all__", None))
-#: Known to fail, and strict: the test says so as soon as it passes. A grid's uncertainty rerun
-#: goes through the command's own chunk store, which refuses it as another computation.
-KNOWN = {i: "the uncertainty rerun shares the grid's chunk store (<out>.chunks), which "
-            "refuses it as a different computation"
-         for i in ("sweep-uncertain", "basin-uncertain", "plane-uncertain")}
-
-
 def _marks(run_id):
-    marks = []
-    if run_id in ("orbits", "paper") and not ORBITS_READY:
-        marks.append(pytest.mark.skip(
-            reason="rockjit.orbits is being redesigned: its package exports nothing yet"))
-    if run_id in KNOWN:
-        marks.append(pytest.mark.xfail(strict=True, reason=KNOWN[run_id]))
-    return marks
+    return []
 
 
 @pytest.mark.parametrize("section, argv", [pytest.param(s, a, id=i, marks=_marks(i))

@@ -246,6 +246,10 @@ def uncertain_cells(plan, result, eps, *, seed=0, execution=None):
     scale = np.where(np.abs(y0s[:, :2]) > 0, np.abs(y0s[:, :2]), 1.0)
     y0s[:, 0] += eps * scale[:, 0] * np.cos(ang)
     y0s[:, 1] += eps * scale[:, 1] * np.sin(ang)
+    if execution is not None and execution.store is not None:
+        # the moved grid is another computation: its chunks keep a store of their own
+        from pathlib import Path
+        execution = execution.replace(store=Path(execution.store) / "uncertainty")
     moved = run(replace(plan, y0s=y0s, uncertainty=None), execution)
     differ = (np.asarray(result.label) != moved.label) | (np.asarray(result.period) !=
                                                           moved.period)
