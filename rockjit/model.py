@@ -5,16 +5,16 @@ acceleration on either corner and its Jacobian, the forcing oscillator, the impa
 the saltation matrix. The compiled integrator (:mod:`rockjit._engine.integrate`) and the scipy reference
 path call these same functions; nothing else writes an equation of motion.
 
-Conventions (SPEC.md §1–2). State ``(theta, dtheta)``; ``side = +1`` rocks on the corner reached
+Conventions (docs/theory/model.md, impacts.md). State ``(theta, dtheta)``; ``side = +1`` rocks on the corner reached
 for ``theta > 0`` and ``side = -1`` on the other one; ``side = 0`` is the block at rest. The
 forcing acceleration is ``f = aw2 * r`` with ``aw2 = alpha * omega**2`` and ``r`` either
 ``sin(omega t + phi)`` (closed form) or the first component of the oscillator embedding.
 
 Notes
 -----
-Equations of motion: Housner (1963), in the dimensionless form of SPEC.md §1.
+Equations of motion: Housner (1963), in the dimensionless form of docs/theory/model.md.
 Restitution: Housner (1963) angular-momentum law; Mao et al. (2024) kinetic-energy law.
-Saltation matrix: Müller (1995), specialised to the impact surface ``theta = 0`` (SPEC.md §5).
+Saltation matrix: Müller (1995), specialised to the impact surface ``theta = 0`` (docs/theory/exponents.md).
 """
 
 from __future__ import annotations
@@ -365,7 +365,7 @@ def forcing_closed(t, omega, phi):
 def corner(f, side, sthc, cthc):
     """``(P, Q)`` with ``theta'' = P cos(theta) + Q sin(theta) - 3/4 xi theta'`` on corner ``side``.
 
-    SPEC.md §1 on either corner is ``theta'' = 3/4 (f sin(thc + s theta) - s cos(thc + s theta)
+    docs/theory/model.md on either corner is ``theta'' = 3/4 (f sin(thc + s theta) - s cos(thc + s theta)
     - xi theta')`` with ``s = side`` (+1 or -1) and ``f`` the forcing acceleration
     ``alpha omega^2 r``. Expanding the sum angles, ``P = 3/4 (f sin(thc) - s cos(thc))`` and
     ``Q = 3/4 (f s cos(thc) + sin(thc))``: they depend on time only through ``f``, so the
@@ -411,7 +411,7 @@ def slope_pq(P, Q, s, c):
 def accel(theta, dtheta, f, side, thc, xi):
     """Angular acceleration ``theta''`` while rocking on corner ``side`` (+1 or -1).
 
-    ``f`` is the forcing acceleration ``alpha omega^2 r``; the formula is SPEC.md §1's, arranged
+    ``f`` is the forcing acceleration ``alpha omega^2 r``; the formula is docs/theory/model.md, arranged
     by :func:`corner`. On ``side = 0`` (rest) the acceleration is zero.
     """
     if side == 0:
@@ -438,7 +438,7 @@ def accel_jac(theta, dtheta, f, side, thc, xi):
 def uplift_time(t, aw2, cot, omega, phi):
     """First time ``>= t`` at which the closed-form forcing lifts a block at rest.
 
-    The block at rest leaves it when ``|aw2 sin(omega t + phi)| > cot`` (SPEC.md §3). Returns
+    The block at rest leaves it when ``|aw2 sin(omega t + phi)| > cot`` (docs/theory/impacts.md). Returns
     ``t`` itself if that already holds, and ``inf`` if ``aw2 <= cot`` (it never leaves).
     """
     if aw2 <= cot:
@@ -455,7 +455,7 @@ def uplift_time(t, aw2, cot, omega, phi):
 
 @jit
 def oscillator(r, s, omega):
-    """Right-hand side ``(r', s')`` of the autonomous forcing oscillator (SPEC.md §1)."""
+    """Right-hand side ``(r', s')`` of the autonomous forcing oscillator (docs/theory/model.md)."""
     q = r * r + s * s
     return r + omega * s - r * q, s - omega * r - s * q
 
@@ -471,7 +471,7 @@ def oscillator_jac(r, s, omega):
 @jit
 def initial_side(theta0, dtheta0):
     """The corner a run starts on: the sign of ``theta0``, else of ``theta0'``, else 0 (at
-    rest) (SPEC.md §3)."""
+    rest) (docs/theory/impacts.md)."""
     if theta0 > 0.0 or (theta0 == 0.0 and dtheta0 > 0.0):
         return 1
     if theta0 < 0.0 or (theta0 == 0.0 and dtheta0 < 0.0):
@@ -490,7 +490,7 @@ def saltation(dtheta_minus, f, side_old, thc, xi, e):
     """Lower-left entry of the saltation matrix of an impact on ``theta = 0``.
 
     ``S = [[e, 0], [s10, e]]`` with ``s10 = (F+ - e F-) / theta'-``, ``F-`` the acceleration on
-    the old corner before the jump and ``F+`` on the new corner after it (SPEC.md §5; Müller
+    the old corner before the jump and ``F+`` on the new corner after it (docs/theory/exponents.md; Müller
     1995). Both come from :func:`accel`, so damping cancels exactly as it does analytically.
     """
     f_minus = accel(0.0, dtheta_minus, f, side_old, thc, xi)

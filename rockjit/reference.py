@@ -1,6 +1,6 @@
 """The scipy reference path: ``solve_ivp`` driven through the same model functions.
 
-This is how the study computed its trajectories (SPEC.md §4): ``solve_ivp`` (BDF, rtol 1e-6,
+This is how the study computed its trajectories (docs/theory/integrator.md): ``solve_ivp`` (BDF, rtol 1e-6,
 atol 1e-9) on the 4-D embedding, with terminal events at ``theta = 0`` and ``|theta| = theta_over``
 and a restart after each impact. Any ``solve_ivp`` method and tolerance may be chosen; the rest and
 overturning rules, the jump and the Zeno cut-off are those of the compiled path, and every

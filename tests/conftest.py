@@ -1,6 +1,6 @@
 """Shared helpers of the test suite: independent references that never import rockjit.model.
 
-``spec_run`` integrates the rocking block from the equations of SPEC.md §1-2 written out here a
+``spec_run`` integrates the rocking block from the equations of docs/theory/model.md and impacts.md, written out here a
 second time, with ``scipy.integrate.solve_ivp`` (DOP853, tight tolerances), a terminal event on
 ``theta = 0`` and on ``|theta| = theta_over``, and a restart after each impact. It knows nothing of
 rest or uplift (the runs it is used on have none before the horizon), so it is short enough to
@@ -16,18 +16,18 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-#: The study's initial state (SPEC.md §7), typed in from the SPEC, not imported from rockjit.
+#: The study's initial state (docs/theory/study.md), typed in from the study, not imported from rockjit.
 Z0_SPEC = (-0.2254, -0.1597, -0.7778, 0.6284)
 PHI_SPEC = math.atan2(Z0_SPEC[2], Z0_SPEC[3])
 
 
 def e_housner_spec(hb):
-    """SPEC.md §2: ``1 - 1.5 cos^2(thc)``."""
+    """docs/theory/impacts.md: ``1 - 1.5 cos^2(thc)``."""
     return 1.0 - 1.5 * math.cos(math.atan(hb)) ** 2
 
 
 def e_mao_spec(hb):
-    """SPEC.md §2: ``sqrt(N / D)``."""
+    """docs/theory/impacts.md: ``sqrt(N / D)``."""
     thc = math.atan(hb)
     t = math.tan(thc)
     n = t * (t**2 - 3.0) + 3.0 * t**4 * (math.pi / 2 - thc) + 3.0 * thc
@@ -36,7 +36,7 @@ def e_mao_spec(hb):
 
 
 def theta_ddot_spec(t, theta, dtheta, side, hb, aw2, omega, phi, xi):
-    """SPEC.md §1, the two corners written separately."""
+    """docs/theory/model.md, the two corners written separately."""
     thc = math.atan(hb)
     f = aw2 * math.sin(omega * t + phi)
     if side > 0:
@@ -47,7 +47,7 @@ def theta_ddot_spec(t, theta, dtheta, side, hb, aw2, omega, phi, xi):
 def spec_run(hb, alpha, omega, e, *, theta0, dtheta0, phi, t_end, xi=0.0, t0=0.0, side=None,
              theta_over=0.5 * math.pi, rtol=1e-12, atol=1e-13, dense=False,
              max_impacts=None, max_step=0.01):
-    """Event-driven reference integration of SPEC.md §1-2 (no rest, no uplift).
+    """Event-driven reference integration of docs/theory/model.md, impacts.md (no rest, no uplift).
 
     Stops at ``t_end``, on overturning, or after ``max_impacts`` impacts (status "impacts").
     ``max_step`` bounds the solver's steps: solve_ivp looks for events only as sign changes

@@ -1,7 +1,7 @@
 """Behaviours, sweeps and basins.
 
-Checked against: the hand-checked behaviour gallery of SPEC.md §7 item 3; a slow, readable
-NumPy classifier written here from SPEC.md §6 (independent of the compiled one); the exact mirror
+Checked against: the hand-checked behaviour gallery of docs/theory/study.md item 3; a slow, readable
+NumPy classifier written here from docs/theory/behaviours.md (independent of the compiled one); the exact mirror
 symmetry ``(theta, theta', t) -> (-theta, -theta', t + T/2)`` of the equations; the same grid run
 with one and two threads; and the full-length runs that early stopping short-cuts.
 """
@@ -20,7 +20,7 @@ PERIODS = 200
 
 
 def slow_classify(res, window, tol=1e-6, pmax=16):
-    """SPEC.md §6 from a Result's samples, written plainly (nothing shared with the compiled
+    """docs/theory/behaviours.md from a Result's samples, written plainly (nothing shared with the compiled
     classifier)."""
     if res.status == "overturned":
         return "overturn", 0
@@ -44,7 +44,7 @@ def slow_classify(res, window, tol=1e-6, pmax=16):
 
 
 GALLERY = [
-    # (label, hb, alpha, omega, initial state): SPEC.md §7 item 3 and the reference run. The
+    # (label, hb, alpha, omega, initial state): docs/theory/study.md item 3 and the reference run. The
     # study's multiperiodic example alpha = 0.969 lies in a band of transient chaos where the
     # converged solution overturns (test_transient_chaos_is_resolved); alpha = 0.92 is a robust
     # period-2 orbit of the same family.

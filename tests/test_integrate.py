@@ -176,7 +176,7 @@ def test_empirical_order_is_five():
 # ---- one step, against a readable reference step ------------------------------------------
 
 def _reference_dp5_step(spec, t, y, h, side, hb, aw2, omega, phi, xi):
-    """One Dormand–Prince step written plainly (tableau from rockjit, field from the SPEC)."""
+    """One Dormand–Prince step written plainly (tableau from rockjit, field from conftest's equations)."""
     k = []
     for i in range(7):
         if i == 0:
@@ -264,7 +264,7 @@ def test_tangent_matches_finite_differences_across_impacts(hb, law, omega, alpha
         assert rp.n_impacts == rm.n_impacts == r.n_impacts
         J[:, j] = (rp.state[:2] - rm.state[:2]) / (2 * eps)
     assert np.abs(J - V).max() <= 1e-6 * np.abs(V).max(), (J, V)
-    # and the product of the impacts' determinants e^2 shows up (det S = e^2, SPEC §5)
+    # and the product of the impacts' determinants e^2 shows up (det S = e^2, docs/theory/exponents.md)
     e = r.block.restitution
     assert abs(np.linalg.det(V)) == pytest.approx(
         e ** (2 * r.n_impacts) * math.exp(-0.75 * r.block.xi * r.t), rel=1e-8)
@@ -298,7 +298,7 @@ def test_free_elastic_rocking_conserves_energy(hb):
     assert np.all(np.sign(r.impacts[1:, 1]) == -np.sign(r.impacts[:-1, 1]))
 
 
-# ---- Zeno, rest and uplift (SPEC.md §3) ---------------------------------------------------------
+# ---- Zeno, rest and uplift (docs/theory/impacts.md) ---------------------------------------------------------
 
 def test_zeno_cascade_comes_to_rest():
     # hb = 2: cot(thc) = 0.5 > alpha omega^2 = 0.3: once at rest the block stays there
@@ -363,7 +363,7 @@ def test_release_after_zeno_rest(spec):
         assert ref["impacts"][0, 1] == pytest.approx(r.impacts[i + 1, 1], rel=1e-8)
 
 
-# ---- the oscillator embedding (SPEC.md §1) ---------------------------------------------------
+# ---- the oscillator embedding (docs/theory/model.md) ---------------------------------------------------
 
 EMBED_CASES = [
     (1.0, 0.6, 1.3, "housner", 0.0),

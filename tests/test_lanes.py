@@ -24,7 +24,7 @@ from rockjit._engine import kernel as kn
 from rockjit._engine import lanes as ln
 from rockjit.grids import plan as gp
 
-#: The study's four basins (SPEC.md §7).
+#: The study's four basins (docs/theory/study.md).
 BASINS = (
     dict(hb=1.0, alpha=0.66, omega=1.3, law="housner"),
     dict(hb=1.0, alpha=0.66, omega=1.3, law="mao"),

@@ -1,4 +1,4 @@
-"""Lyapunov exponents through impacts (SPEC.md §5) against what they must equal.
+"""Lyapunov exponents through impacts (docs/theory/exponents.md) against what they must equal.
 
 - the exact identity ``lambda1 + lambda2 = -3/4 xi + 2 nu ln(e)``, with the impact rate ``nu``
   counted here from the recorded impacts;
@@ -18,7 +18,7 @@ import rockjit
 from rockjit import Block, Harmonic, Integration, Scipy
 from rockjit.testing.stress import simulate_flat
 
-Z0 = (-0.2254, -0.1597, -0.7778, 0.6284)  # SPEC.md §7
+Z0 = (-0.2254, -0.1597, -0.7778, 0.6284)  # docs/theory/study.md
 PHI0 = math.atan2(Z0[2], Z0[3])
 
 
@@ -82,7 +82,7 @@ def test_sum_of_exponents_is_exact(runs, name):
 
 
 def test_period_one_orbit_exponents_are_log_multipliers(runs):
-    """Asymmetric orbit (SPEC §7 gallery): real, distinct multipliers."""
+    """Asymmetric orbit (docs/theory/study.md gallery): real, distinct multipliers."""
     name = "asymmetric hb=1 housner a=0.8"
     kw, r = ORBITS[name], runs[name]
     k = 400

@@ -1,10 +1,10 @@
 """rockjit.model against independent statements of the same physics.
 
-- restitution laws: the values SPEC.md §2 quotes from the paper, and the SPEC formulas typed in
+- restitution laws: the values docs/theory/impacts.md quotes from the paper, and the papers' formulas typed in
   again in conftest;
-- ``accel``: the two corner equations of SPEC.md §1 written out separately (conftest);
+- ``accel``: the two corner equations of docs/theory/model.md written out separately (conftest);
 - ``accel_jac``, ``oscillator_jac``: central finite differences of ``accel``, ``oscillator``;
-- ``saltation``: the closed form of SPEC.md §5 written out here;
+- ``saltation``: the closed form of docs/theory/exponents.md written out here;
 - ``uplift_time``: a brute-force scan of the forcing, and the closed form in conftest.
 """
 
@@ -28,7 +28,7 @@ def _states(n=8, seed=RNG_SEED):
     return list(zip(th, dth, f))
 
 
-# ---- restitution (SPEC.md §2) -----------------------------------------------------------------
+# ---- restitution (docs/theory/impacts.md) -----------------------------------------------------------------
 
 @pytest.mark.parametrize("hb, e_h, e_m, delta", [(1.0, 0.250, 0.582, 79.85),
                                                    (2.0, 0.700, 0.830, 17.03)])
@@ -58,7 +58,7 @@ def test_restitution_laws_match_spec_formulas(spec):
 
 
 def test_housner_law_vanishes_at_its_limit():
-    # e_H = 1 - 1.5 cos^2(thc) = 0 exactly when tan(thc) = 1/sqrt(2) (SPEC.md §2)
+    # e_H = 1 - 1.5 cos^2(thc) = 0 exactly when tan(thc) = 1/sqrt(2) (docs/theory/impacts.md)
     assert abs(float(model.e_housner(model.thc_from_hb(1 / math.sqrt(2))))) < 1e-15
     assert float(model.e_housner(model.thc_from_hb(0.7))) < 0.0
 
@@ -111,7 +111,7 @@ def test_acceleration_near_a_base_angle_is_the_acceleration_there():
                     model.accel_jac(th0 + d, dth, f, side, thc, xi)[0], abs=2e-15)
 
 
-# ---- the vector field (SPEC.md §1) ------------------------------------------------------------
+# ---- the vector field (docs/theory/model.md) ------------------------------------------------------------
 
 @pytest.mark.parametrize("side", [1, -1])
 @pytest.mark.parametrize("hb", [1.0, 2.0, 0.8])
@@ -120,7 +120,7 @@ def test_accel_matches_spec_equations(spec, side, hb):
     xi = 0.07
     omega, phi = 1.7, 0.3
     for k, (th, dth, f) in enumerate(_states()):
-        # put the forcing value f at some time t through the SPEC's own sin(omega t + phi)
+        # put the forcing value f at some time t through the documented sin(omega t + phi)
         t = 0.1 * k
         aw2 = f / math.sin(omega * t + phi)
         want = spec.theta_ddot(t, th, dth, side, hb, aw2, omega, phi, xi)
@@ -172,7 +172,7 @@ def test_oscillator_on_the_circle_is_the_closed_form():
         assert model.forcing_closed(t, omega, phi) == pytest.approx(r, abs=1e-15)
 
 
-# ---- the impact (SPEC.md §2, §5) --------------------------------------------------------------
+# ---- the impact (docs/theory/impacts.md, §5) --------------------------------------------------------------
 
 def test_jump_map():
     assert model.jump(-0.4, 0.25) == -0.1
@@ -182,7 +182,7 @@ def test_jump_map():
 @pytest.mark.parametrize("xi", [0.0, 0.3])
 @pytest.mark.parametrize("hb", [0.8, 1.0, 2.0, 4.0])
 def test_saltation_matches_spec_closed_form(hb, xi):
-    """S[1, 0] = 3/4 [(1-e) aw2 r sin(thc) - sgn(theta'-)(1+e) cos(thc)] / theta'- (SPEC §5)."""
+    """S[1, 0] = 3/4 [(1-e) aw2 r sin(thc) - sgn(theta'-)(1+e) cos(thc)] / theta'- (docs/theory/exponents.md)."""
     thc = math.atan(hb)
     rng = np.random.default_rng(RNG_SEED)
     for _ in range(20):
@@ -196,7 +196,7 @@ def test_saltation_matches_spec_closed_form(hb, xi):
         assert got == pytest.approx(want, rel=1e-12, abs=1e-12 / abs(dm))
 
 
-# ---- rest and uplift (SPEC.md §3) -------------------------------------------------------------
+# ---- rest and uplift (docs/theory/impacts.md) -------------------------------------------------------------
 
 @pytest.mark.parametrize("t0, aw2, cot, omega, phi", [
     (0.0, 0.6, 0.5, 3.0, 0.0),

@@ -112,7 +112,7 @@ def test_multipliers_against_scipy_finite_differences(asym08, sym085):
 
 
 def test_det_monodromy_identity(asym08, sym085):
-    # SPEC.md section 5: lambda1 + lambda2 = -3/4 xi + 2 nu ln e, i.e. over one cycle
+    # docs/theory/exponents.md: lambda1 + lambda2 = -3/4 xi + 2 nu ln e, i.e. over one cycle
     # det M = e^(2 n) exp(-3/4 xi p T), n impacts per cycle
     for o in (asym08, sym085):
         b = o.block

@@ -3,7 +3,7 @@
 - ``simulate(..., method=Scipy("DOP853", rtol=1e-12, atol=1e-12))`` (rockjit.reference, which
   shares rockjit.model with the compiled path): impact times, statuses, impact counts and final
   states over 20 forcing periods on a spread of parameter points;
-- conftest's ``spec_run``, an event-driven solve_ivp of the SPEC.md §1-2 equations written out
+- conftest's ``spec_run``, an event-driven solve_ivp of the equations of docs/theory/model.md and impacts.md, written out
   again in the tests: it shares no code with rockjit, so it also checks the model itself
   (forcing, damping, restitution) that the two rockjit paths have in common.
 """
@@ -18,7 +18,7 @@ from rockjit import Block, Harmonic, Integration, Scipy
 from rockjit.testing.stress import simulate_flat
 
 DOP = Scipy("DOP853", rtol=1e-12, atol=1e-12)
-Z0 = (-0.2254, -0.1597, -0.7778, 0.6284)  # SPEC.md §7
+Z0 = (-0.2254, -0.1597, -0.7778, 0.6284)  # docs/theory/study.md
 
 
 def _run(kw, **more):
@@ -74,9 +74,9 @@ def _p(hb, alpha, omega, law, **init):
 
 
 ZS = dict(z0=Z0)
-FIG4 = [(0.8586, -0.8182), (-0.0505, -0.2121), (0.3535, -0.3333)]  # SPEC.md §7, figure 4
+FIG4 = [(0.8586, -0.8182), (-0.0505, -0.2121), (0.3535, -0.3333)]  # docs/theory/study.md, figure 4
 POINTS = [
-    # the study's grids from z0 (SPEC §7): bounded, rest, overturning
+    # the study's grids from z0 (docs/theory/study.md): bounded, rest, overturning
     _p(1, 0.5, 1.3, "housner", **ZS),      # comes to rest
     _p(1, 0.6, 1.3, "housner", **ZS),
     _p(1, 0.8, 1.3, "housner", **ZS),
@@ -133,7 +133,7 @@ def test_points_cover_the_brief():
     assert sum(1 for r in runs if r.status == "overturned" and r.n_impacts > 0) >= 3
 
 
-# ---- both paths against the independent SPEC reference --------------------------------------
+# ---- both paths against the independent reference written in conftest --------------------------------------
 
 SPEC_RUNS = {
     "reference": dict(hb=1.0, alpha=0.6, omega=1.3, law="housner", theta0=Z0[0],
@@ -173,7 +173,7 @@ def test_both_paths_match_independent_spec_reference(spec, name):
 
 
 def test_study_damping_value():
-    # SPEC.md §1: xi = c_b / (M R^2 Omega0), M = 2e4 kg, c_b = 101 N s m, R = 3.764 m, g = 9.81
+    # docs/theory/model.md: xi = c_b / (M R^2 Omega0), M = 2e4 kg, c_b = 101 N s m, R = 3.764 m, g = 9.81
     xi = 101.0 / (2e4 * 3.764**2 * math.sqrt(9.81 / 3.764))
     assert rockjit.Block(1.0).xi == pytest.approx(xi, rel=1e-12)
     assert xi == pytest.approx(2.208e-4, rel=1e-3)

@@ -1,7 +1,7 @@
 """Input checking of the API's objects and of ``rockjit.simulate``: every invalid input is a
 ValueError naming the parameter.
 
-Checked against SPEC.md's ranges (§1-3) and STYLE.md 12, on both the compiled and the scipy path.
+Checked against the documented ranges (docs/theory/model.md, impacts.md), on both the compiled and the scipy path.
 Each parameter is checked where it now lives: the block's in ``Block``, the excitation's in
 ``Harmonic``, the integration's in ``Integration``, the grids' in ``Classification``, ``Lattice``
 and ``Execution``, the reference path's in ``Scipy``, what a run combines (its state, the step's

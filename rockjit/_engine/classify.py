@@ -1,4 +1,4 @@
-"""The behaviour rules (SPEC.md §6), compiled: the period test, the classes, the exponents over
+"""The behaviour rules (docs/theory/behaviours.md), compiled: the period test, the classes, the exponents over
 a stretch of periods.
 
 Everything here reads a run's stroboscopic samples ``x_k = (theta, theta')`` at ``kT``

@@ -2,7 +2,7 @@
 
 The grid kernels classify a cell by its behaviour (:mod:`rockjit._engine.classify`); this module names
 the *attractor*: two cells of a basin reach the same attractor when their settled stroboscopic
-cycles coincide (SPEC.md §8). Outcome ids: ``>= 0`` attractors (numbered by decreasing basin
+cycles coincide (docs/theory/global-dynamics.md). Outcome ids: ``>= 0`` attractors (numbered by decreasing basin
 size; rest for good is one), ``-1`` overturn, ``-2`` unresolved.
 
 The rules (documented in the README, "Attractors"):

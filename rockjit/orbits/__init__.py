@@ -1,7 +1,7 @@
 """Periodic orbits of the stroboscopic map: shooting, continuation and located bifurcations.
 
 A period-``p`` orbit of the forced block is a fixed point of ``P^p``, ``P`` the stroboscopic map
-``(theta, theta')(kT) -> (theta, theta')((k+1)T)`` at a fixed forcing phase (SPEC.md §8). This
+``(theta, theta')(kT) -> (theta, theta')((k+1)T)`` at a fixed forcing phase (docs/theory/global-dynamics.md). This
 package finds such orbits by Newton's method (shooting), follows them as a forcing parameter
 (``alpha`` or ``omega``) varies by pseudo-arclength continuation, and locates where they
 bifurcate. It is built on the public :func:`rockjit.simulate` only.

@@ -19,7 +19,7 @@ Symmetric orbits
 Neimark–Sacker
     It cannot occur in this model unless ``e = 1`` and ``xi = 0``: ``det M = e^(2n)
     exp(-3 xi pT / 4)`` with ``n`` impacts per cycle (the trace of the variational equation is
-    ``-3 xi / 4`` and each saltation matrix has determinant ``e^2``, SPEC.md §5), so a complex
+    ``-3 xi / 4`` and each saltation matrix has determinant ``e^2``, docs/theory/exponents.md), so a complex
     pair always has ``|mu| < 1``; the test is kept for completeness.
 Grazing
     A step whose orbit has a different number of impacts per cycle brackets a grazing, located

@@ -1,7 +1,7 @@
 """Shooting: periodic orbits of the stroboscopic map as fixed points found by Newton's method.
 
 A period-``p`` orbit of the forced block is a fixed point of ``P^p``, ``P`` the stroboscopic map
-``(theta, theta')(kT) -> (theta, theta')((k+1)T)`` at a fixed forcing phase (SPEC.md §8). Every
+``(theta, theta')(kT) -> (theta, theta')((k+1)T)`` at a fixed forcing phase (docs/theory/global-dynamics.md). Every
 integration goes through one method, :meth:`Flow.run`, a call of the public
 :func:`rockjit.simulate`: a run with ``lyapunov=True`` and ``qr_every=0`` returns in
 ``result.extra["tangent"]`` the Jacobian of the flow over the run, the saltation matrix applied
@@ -33,7 +33,7 @@ Section
 Symmetry
     The equations are odd under ``theta -> -theta`` with the forcing shifted by ``T/2``. A cycle
     is *symmetric* when ``x(t + pT/2) = -x(t)``; this needs ``p`` odd (for ``p = 1``:
-    ``x(T/2) = -x(0)``, the SPEC's definition; for even ``p`` no orbit is symmetric), checked at
+    ``x(T/2) = -x(0)``, the documented definition; for even ``p`` no orbit is symmetric), checked at
     every cycle point to ``sym_tol`` times the orbit's size. A symmetric branch is solved on the
     half map, ``x + Phi_{pT/2}(x) = 0`` (Jacobian by forward differences), on which the
     symmetry-breaking pitchfork is a regular point, not a branch point. The mirror image of a

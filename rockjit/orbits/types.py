@@ -298,7 +298,7 @@ class PeriodicOrbit:
 
     @property
     def lyapunov(self) -> np.ndarray:
-        """``ln|mu| / (pT)``, largest first: the orbit's Lyapunov exponents (SPEC.md §8)."""
+        """``ln|mu| / (pT)``, largest first: the orbit's Lyapunov exponents (docs/theory/global-dynamics.md)."""
         with np.errstate(divide="ignore"):
             return np.log(np.abs(self.multipliers)) / (self.period * self.forcing_period)
 

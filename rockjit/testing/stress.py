@@ -34,7 +34,7 @@ recording, and these initial states:
 ``impact_bound``
     ``max_impacts`` from 1 to 100, to exercise the bound.
 
-Issue 10 takes the suite beyond those ranges with three more categories, drawn by
+The extreme cases take the suite beyond those ranges with three more categories, drawn by
 :func:`extreme_cases` (ids ``x<seed>-<i>``, so that the ids of the cases above stay what they
 were); their horizon is cut so that no run is given more than ``MAX_GRID_STEPS`` grid steps:
 
@@ -82,11 +82,11 @@ Checks of every run (:func:`check_run`; each returns a list of problems, empty w
     an orbit that passes through rest within the averaging window (``n_rest_window > 0``) has no
     positive exponent: a rest phase holds ``theta = theta' = 0`` until the forcing lifts the
     block, whatever the perturbation, so every perturbation dies and the exponents are ``-inf``
-    (SPEC.md §5; issue 10 found lambda1 = +1.95 on such an orbit).
+    (docs/theory/exponents.md; a wrong update once gave lambda1 = +1.95 on such an orbit).
 
 Hitting the impact bound is not a failure; it is counted and reported as such. Neither is the
 refusal of a grid too coarse to integrate (``T/N`` above rockjit's step limit, an embedded step
-beyond the oscillator's stability, or, issue 10, a step beyond the explicit stability of a large
+beyond the oscillator's stability, or a step beyond the explicit stability of a large
 damping): it must be a ``ValueError`` naming ``n_steps`` first (any other exception fails the
 ``status`` check), and it is counted as ``refused``.
 
@@ -127,7 +127,7 @@ from ..single import steps_per_period
 RANGES = dict(hb=(0.75, 20.0), alpha=(0.0, 3.0), omega=(0.05, 20.0), e=(0.0, 1.0))
 CATEGORIES = ("random", "near_zero", "grazing", "near_overturn", "long_horizon",
               "impact_bound")
-#: issue 10: the categories beyond the ranges above (:func:`extreme_cases`)
+#: The extreme cases: the categories beyond the ranges above (:func:`extreme_cases`)
 EXTREME_CATEGORIES = ("stiff_damping", "wide_omega", "through_rest")
 EXTREME_RANGES = dict(xi=(0.5, 500.0), omega=(1e-3, 1e3))
 ALL_CATEGORIES = CATEGORIES + EXTREME_CATEGORIES
@@ -268,7 +268,7 @@ def _pick(rng, seq):
 
 
 def _params(rng):
-    """Block parameters over the issue's ranges, end points included now and then."""
+    """Block parameters over the documented ranges (RANGES), end points included now and then."""
     u = rng.random()
     hb = 0.75 if u < 0.05 else 20.0 if u < 0.1 else _logu(rng, *RANGES["hb"])
     u = rng.random()
@@ -313,7 +313,7 @@ def _settings(rng, kw, max_periods, lo_periods=1):
         kw["theta_over"] = float(rng.uniform(0.05, HALF_PI))
     u = rng.random()
     if u < 0.1:
-        kw["rest_speed"] = 1e-10  # nearly no cut-off (0 is refused: issue 10)
+        kw["rest_speed"] = 1e-10  # nearly no cut-off (0 is refused)
     elif u < 0.2:
         kw["rest_speed"] = 1e-3
     if rng.random() < 0.2:
@@ -482,7 +482,7 @@ def cases(n, seed=0, *, max_periods=200, long_periods=20_000):
     return out
 
 
-# --------------------------------------------------------------------------- issue 10's cases
+# --------------------------------------------------------------------------- the extreme cases
 
 
 def cost_n(kw):
@@ -780,7 +780,7 @@ def check_progress(kw, res):
 
 def check_rest_exponents(kw, res):
     """An orbit through rest within the averaging window has no positive exponent: a rest phase
-    erases every perturbation (the exponents are ``-inf``, SPEC.md §5)."""
+    erases every perturbation (the exponents are ``-inf``, docs/theory/exponents.md)."""
     if res.lyapunov is None or res.n_rest_window == 0:
         return []
     lam = np.asarray(res.lyapunov)
@@ -830,7 +830,7 @@ def check_run(kw, res):
 def refused(exc):
     """Is ``exc`` one of rockjit's documented refusals: a grid too coarse to integrate (a
     ``ValueError`` whose message opens with the parameter's name, ``n_steps``), or a start at or
-    past the overturning threshold (``theta0 must satisfy |theta0| < theta_over``, issue 10)?"""
+    past the overturning threshold (``state[0] (theta0) must satisfy |theta0| < theta_over``)?"""
     return isinstance(exc, ValueError) and (
         str(exc).startswith("n_steps") or str(exc).startswith("state[0] (theta0) must satisfy"))
 
