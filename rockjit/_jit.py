@@ -37,8 +37,8 @@ def jit(func=None, *, parallel=False, nrt=True, inline=False):
     an out-of-line call passes every array as seven scalars on the stack and hides the stage
     chain from the scheduler (1.6x the time per step). Inlining in numba's own IR
     (``inline="always"``, used before) gave the same speed but re-typed and re-lowered the piece
-    at every call site: the step's pieces made a cold compile 1.5x longer (
-    benchmarks/bench_compile.py). The flag is set on every function, off where not asked for:
+    at every call site: the step's pieces made a cold compile 1.5x longer
+    (benchmarks/bench_compile.py). The flag is set on every function, off where not asked for:
     numba would otherwise let a callee inherit it from its caller.
     """
     opts = dict(cache=True, fastmath=set(FASTMATH), parallel=parallel, error_model="numpy",
