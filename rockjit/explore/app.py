@@ -292,6 +292,10 @@ class ExplorerApp:
         self.cell_src = ColumnDataSource(data=dict(x=[], y=[], w=[], h=[]))
         p.rect("x", "y", "w", "h", source=self.cell_src, fill_alpha=0, line_color="black",
                line_width=2)
+        p.scatter("x", "y", source=self.cell_src, marker="circle", size=16, fill_alpha=0,
+                  line_color="white", line_width=3)
+        p.scatter("x", "y", source=self.cell_src, marker="circle", size=16, fill_alpha=0,
+                  line_color="black", line_width=1.5)
         p.on_event(Tap, self._basin_tap)
         self.basin_fig = p
         mode = RadioButtonGroup(labels=["behaviour", "attractor"], active=0, width=200,
@@ -518,7 +522,7 @@ class ExplorerApp:
     def _build_sweep(self):
         a0, a1 = self.params.alpha_range
         xr = Range1d(a0, a1)
-        b = _fig("bifurcation diagram: θ′(kT) from the study's z0", 560, 330,
+        b = _fig("θ′(kT) from the study's z0", 560, 330,
                  tools="xbox_zoom,tap,reset,save", y_label="θ′(kT)", x_range=xr,
                  y_range=Range1d(-1, 1), name="bif")
         self.bif_src = ColumnDataSource(data=dict(a=[], y=[], c=[]))
@@ -610,8 +614,8 @@ class ExplorerApp:
             f"{_swatch(colours[n])}{n} {fr[n]:.0f} %" for n in present)
             + " &nbsp; <span style='color:#666'>(strip: the behaviour of every α)</span></div>")
         p = v.params
-        self.bif_figs[0].title.text = (f"bifurcation diagram, {LAW_NAMES[p.law]}, h/b = "
-                                       f"{_fmt(p.hb)}, ω = {_fmt(p.omega)}, from the study's z0")
+        self.bif_figs[0].title.text = (f"{LAW_NAMES[p.law]}, h/b = {_fmt(p.hb)}, ω = "
+                                       f"{_fmt(p.omega)}: θ′(kT) from the study's z0")
         _dim(self.bif_figs, False)
         a0, a1 = p.alpha_range
         self.sweep_state.text = (f'<span class="rj-sweep-shown" data-a0="{a0!r}" '
