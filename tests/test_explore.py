@@ -287,6 +287,22 @@ def test_nearest_cell():
     assert R.nearest_cell(b, 1.2, 0.0) is None
 
 
+def test_every_view_exports_its_figure_as_a_png():
+    pytest.importorskip("bokeh", reason="the explore extra is not installed")
+    import base64
+
+    from rockjit.explore.app import _png
+    p = R.Params(periods=40).check()
+    basin = R.basin_stages(p, levels=(10,))[0]()
+    views = dict(basin=basin, sweep=R.sweep_stages(p.with_(alpha_range=(0.6, 0.7)))[0](),
+                 run=R.run_stages(p, (0.1, 0.2))[0](), compare=R.compare_stages(p, grid=10)[0]())
+    for view, shown in views.items():
+        for colour_by in ("behaviour", "attractor") if view == "basin" else ("behaviour",):
+            data, name = _png(view, shown, colour_by)
+            assert base64.b64decode(data)[:8] == b"\x89PNG\r\n\x1a\n"
+            assert name.endswith(".png") and "/" not in name
+
+
 def test_rockjit_explore_is_the_package_and_callable():
     import rockjit.explore as pkg
     assert callable(rockjit.explore) and rockjit.explore is pkg

@@ -254,7 +254,8 @@ class ExplorerApp:
             header,
             row(self.controls, column(row(self.basin_panel, self.sweep_panel), self.run_panel,
                                       self.compare_panel)),
-            self.download_holder))
+        ))
+        self.doc.add_root(self.download)  # not drawn: in the document so that it syncs
         self.doc.title = "rockjit explore"
 
     def _with_error(self, name, widget):
@@ -649,7 +650,6 @@ class ExplorerApp:
             self.compare_code, visible=False)
         self.compare_panel = column(self.compare_toggle, self.compare_body,
                                     css_classes=["rj-view", "rj-view-compare"])
-        self.download_holder = Div(text="", visible=False)
 
     def _compare(self, on):
         self.compare_body.visible = bool(on)

@@ -53,7 +53,7 @@ class Explorer:
         return self._thread.is_alive()
 
     def stop(self, timeout=10.0):
-        """Stop the server and its sessions' computations."""
+        """Stop the server and the computations of its open pages."""
         if not self._thread.is_alive():
             return
 
