@@ -125,7 +125,7 @@ def main(argv=None):
         rows.append(["browser: box zoom → bifurcation diagram recomputed (500 α)",
                      timings["zoom_to_sweep"], timings["zoom_to_sweep"],
                      timings["zoom_to_sweep"], 1, ""])
-        rows.append(["browser: page opened → 200² basin and diagram (first page)",
+        rows.append(["browser: page opened → 100² basin and diagram (first page)",
                      timings["first_view"], timings["first_view"], timings["first_view"], 1,
                      ""])
     else:

@@ -456,14 +456,13 @@ def test_the_app_in_a_browser(server, tmp_path):
         page.on("pageerror", lambda e: errors.append(str(e)))
         t0 = time.perf_counter()
         page.goto(url)
-        # the basin renders, refined to 200², and the bifurcation diagram
-        page.wait_for_selector(".rj-basin-shown[data-final='1'][data-grid='200']",
-                               timeout=120_000)
+        # the basin renders (100², then refined) and the bifurcation diagram
+        page.wait_for_selector(".rj-basin-shown[data-grid='100']", timeout=120_000)
         page.wait_for_selector(".rj-sweep-shown", timeout=120_000)
         timings["first_view"] = time.perf_counter() - t0
         call = page.locator(".rj-call-basin pre").inner_text()
         assert "rockjit.basin(Block(hb=1, law='housner'), Harmonic(alpha=0.66, omega=1.3), " \
-               "grid=200)" in call
+               "grid=100)" in call
         _assert_palette(page.locator(".rj-view-basin canvas").first.screenshot(),
                         ("symmetric", "overturn"))
 
@@ -490,15 +489,15 @@ def test_the_app_in_a_browser(server, tmp_path):
         assert Path(dl.value.path()).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
         # a click on a known cell shows the run the library gives for it
-        res = R.basin_stages(R.Params(alpha=0.62).check(), levels=(200,))[0]().result
+        theta0, dtheta0 = rockjit.Lattice(200).axes()  # the basin shown: 200², the final one
         i, j = 150, 40
-        th, dth = float(res.theta0[i]), float(res.dtheta0[j])
+        th, dth = float(theta0[i]), float(dtheta0[j])
         x, y = page.evaluate(PIXEL_JS, ["basin", th, dth])
         page.mouse.click(x, y)
         page.wait_for_selector(".rj-run-behaviour", timeout=30_000)
         call = page.locator(".rj-call-run pre").inner_text()
         assert f"({R.python_number(th)}, {R.python_number(dth)})" in call
-        n = int(res.settings["n_steps"])
+        n = R.run_n_steps(R.Params(alpha=0.62))
         expected = rockjit.classify_result(rockjit.simulate(
             Block(hb=1, law="housner"), Harmonic(alpha=0.62, omega=1.3), (th, dth),
             integration=rockjit.Integration(n_steps=n), lyapunov=True))

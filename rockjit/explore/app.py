@@ -151,7 +151,7 @@ class ExplorerApp:
         self.state = None           # the selected (theta0, theta0')
         self.colour_by = "behaviour"
         self._quiet = False         # widget updates made by the app, not by the user
-        self.computer = Computer(self._from_worker)
+        self.computer = Computer(self._from_worker, progress_every=0.25)
         self._build()
         doc.on_session_destroyed(lambda ctx: self.computer.close())
         self.submit_basin()
@@ -612,7 +612,8 @@ class ExplorerApp:
         present = [n for n in BEHAVIOURS if np.any(label == names.index(n))]
         fr = sw.fractions()
         self.bif_legend.text = ("<div style='font-size:12px'>" + " &nbsp; ".join(
-            f"{_swatch(colours[n])}{n} {fr[n]:.0f} %" for n in present)
+            f"<span style='white-space:nowrap'>{_swatch(colours[n])}{n} {fr[n]:.0f} %</span>"
+            for n in present)
             + " &nbsp; <span style='color:#666'>(strip: the behaviour of every α)</span></div>")
         p = v.params
         self.bif_figs[0].title.text = (f"{LAW_NAMES[p.law]}, h/b = {_fmt(p.hb)}, ω = "
