@@ -183,7 +183,8 @@ class ExplorerApp:
     # ---------------------------------------------------------------------------------------
     def _build(self):
         p = self.params
-        self.status = {c: Div(text="", width=280, css_classes=[f"rj-status-{c}"])
+        # fixed sizes: a progress update rerenders the line without laying the page out again
+        self.status = {c: Div(text="", width=280, height=40, css_classes=[f"rj-status-{c}"])
                        for c in ("basin", "run", "sweep", "compare")}
         self.errors = {}
         controls = [Div(text="<b>Block</b>")]
@@ -256,6 +257,20 @@ class ExplorerApp:
                                       self.compare_panel)),
         ))
         self.doc.add_root(self.download)  # not drawn: in the document so that it syncs
+        # the page's own timing log, window.rockjitLog: [what, value, time in ms], stamped
+        # when the user changes alpha and after the frame that shows a new basin or diagram
+        # (benchmarks/bench_explore.py reads it; nothing polls the page's DOM)
+        stamp = ("(window.rockjitLog = window.rockjitLog || []);"
+                 "const v = {value}; requestAnimationFrame(() => "
+                 "window.rockjitLog.push(['{what}', v, performance.now()]));")
+        now = ("(window.rockjitLog = window.rockjitLog || []).push(['{what}', {value}, "
+               "performance.now()]);")
+        self.w["alpha"].js_on_change("value", CustomJS(code=now.format(
+            what="alpha", value="cb_obj.value")))
+        self.basin_state.js_on_change("text", CustomJS(code=stamp.format(
+            what="basin", value="cb_obj.text")))
+        self.sweep_state.js_on_change("text", CustomJS(code=stamp.format(
+            what="sweep", value="cb_obj.text")))
         self.doc.title = "rockjit explore"
 
     def _with_error(self, name, widget):
@@ -303,7 +318,7 @@ class ExplorerApp:
                                 css_classes=["rj-colour-by"])
         mode.on_change("active", lambda attr, old, new: self._colour_by(new))
         self.basin_info = Div(text="", width=250, css_classes=["rj-basin-info"])
-        self.basin_state = Div(text="", css_classes=["rj-basin-state"], width=250)
+        self.basin_state = Div(text="", css_classes=["rj-basin-state"], width=250, height=20)
         buttons, self.basin_code = self._export_row("basin", width=680)
         side = column(Div(text="<b>colour by</b>"), mode, self.basin_state, self.status["basin"],
                       self.basin_info, buttons, width=250)
@@ -542,8 +557,10 @@ class ExplorerApp:
         self.blam_src = ColumnDataSource(data=dict(a=[], lam=[], c=[]))
         lam.scatter("a", "lam", source=self.blam_src, size=3, color="c", line_color=None)
         lam.add_layout(Span(location=0, dimension="width", line_color="#888", line_width=1))
+        # drawn on the overlay layer: moving it repaints the overlay, not the 50k points
         self.alpha_spans = [Span(location=self.params.alpha, dimension="height",
-                                 line_color="#444", line_dash="dashed", line_width=1)
+                                 line_color="#444", line_dash="dashed", line_width=1,
+                                 level="overlay")
                             for _ in range(2)]
         b.add_layout(self.alpha_spans[0])
         lam.add_layout(self.alpha_spans[1])
