@@ -735,9 +735,7 @@ class ExplorerApp:
             self.w["e"].visible = value == "constant"
             if value != "constant":
                 self.errors["e"].visible = False
-        if name == "alpha" and source != "slider":
-            self._set_widgets(alpha=new.alpha)
-        elif name == "alpha":
+        if name == "alpha":  # the slider and the box show the same value
             self._set_widgets(alpha=new.alpha)
         self.apply(new)
 
