@@ -6,6 +6,7 @@ API is a handful of small validated objects (the block, the excitation, the sett
 entry points that take them; docs/ holds the theory and the guides.
 """
 
+from . import explore
 from .basins.erosion import erosion
 from .basins.fate import fate
 from .excitation import Harmonic
@@ -19,6 +20,6 @@ __all__ = [
     "BEHAVIOURS", "BasinResult", "Block", "Classification", "DEFAULT_N", "Execution",
     "Harmonic", "Integration", "Lattice", "PlaneResult", "Result", "Scipy", "SweepResult",
     "Z0_STUDY", "alpha_grid", "basin", "classify_result", "delta_e_percent", "e_housner",
-    "e_mao", "erosion", "fate", "plane", "simulate", "sweep", "thc_from_hb",
+    "e_mao", "erosion", "explore", "fate", "plane", "simulate", "sweep", "thc_from_hb",
 ]
 __version__ = "0.2.0.dev0"

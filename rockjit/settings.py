@@ -264,8 +264,12 @@ class Execution(_Replace):
     store : path, optional
         Directory for finished chunks: a rerun with the same inputs computes only what is
         missing.
-    progress : bool
-        Show progress on stderr.
+    progress : bool or callable
+        Show progress on stderr; or a callable ``progress(done, total)``, called with the
+        cells finished so far once the chunks already stored are counted and after each
+        chunk, instead of the lines on stderr. An exception it raises stops the grid between
+        two chunks and propagates (the chunks finished so far stay in the store, if any): an
+        interactive caller cancels a computation this way.
     message : callable, optional
         ``message(text)`` hears the chunk store's notes (a lock taken over, a damaged chunk
         recomputed); default a line on stderr.
@@ -283,7 +287,7 @@ class Execution(_Replace):
     client: Any = None
     scheduler: str | None = None
     store: Any = None
-    progress: bool = False
+    progress: bool | Callable = False
     message: Callable | None = None
 
     def __post_init__(self):
@@ -305,4 +309,9 @@ class Execution(_Replace):
             raise ValueError(f"store must be a path (got {type(self.store).__name__})")
         if self.message is not None and not callable(self.message):
             raise ValueError("message must be a callable taking one string")
-        _set(self, progress=boolean("progress", self.progress))
+        if not callable(self.progress):
+            try:
+                _set(self, progress=boolean("progress", self.progress))
+            except ValueError:
+                raise ValueError(f"progress must be True, False or a callable "
+                                 f"progress(done, total) (got {self.progress!r})") from None

@@ -77,6 +77,7 @@ SCRIPTS = {
     "bench_lanes.py": (["basin", "grid", "lanes", "cells_per_s", "ns_per_cell_step",
                         "speedup_vs_1", "scalar_steps", "time_vector", "time_scalar", "bound"],
                        ["lanes.png"]),
+    "bench_explore.py": (["measurement", "median_s", "min_s", "max_s", "n", "target_s"], []),
     "bench_stress.py": (
         ["id", "category", "hb", "alpha", "omega", "law", "e", "n_steps", "periods", "forcing",
          "status", "t", "n_impacts", "n_rhs", "work_bound", "wall_s", "failed_checks"],

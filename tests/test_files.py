@@ -683,6 +683,36 @@ def test_progress_on_a_terminal_rewrites_one_line(monkeypatch):
     assert text.count("\r") == len(BOUNDS) and text.count("\n") == 1 and text.endswith("\n")
 
 
+def test_progress_callable_hears_each_chunk_and_can_stop_the_run(capsys):
+    heard = []
+    grid_runner.run_chunks(_runner, (np.arange(N, dtype=float),), N, CHUNK, _outputs(),
+                           progress=lambda done, total: heard.append((done, total)))
+    assert heard == [(0, N)] + [(b, N) for _, b in BOUNDS]
+    assert capsys.readouterr().err == ""  # told to the callable, not to stderr
+
+    class Stop(Exception):
+        pass
+
+    calls = []
+
+    def stop_after_two(done, total):
+        if done >= 2 * CHUNK:
+            raise Stop
+
+    with pytest.raises(Stop):
+        grid_runner.run_chunks(lambda x: _runner(x, calls), (np.arange(N, dtype=float),), N,
+                               CHUNK, _outputs(), progress=stop_after_two)
+    assert calls == BOUNDS[:2]  # stopped between chunks: no third chunk was run
+
+
+def test_execution_takes_a_progress_callable_and_refuses_other_values():
+    from rockjit import Execution
+    hook = lambda done, total: None  # noqa: E731
+    assert Execution(progress=hook).progress is hook
+    with pytest.raises(ValueError, match="progress must be True, False or a callable"):
+        Execution(progress="yes")
+
+
 # ---------------------------------------------------------------------------------------------
 # 4. numba's cache: only the package's own files are deleted
 # ---------------------------------------------------------------------------------------------

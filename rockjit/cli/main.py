@@ -339,6 +339,21 @@ def _paper_run(args, p, out):
     return time.perf_counter() - t0, results
 
 
+def _explore_plan(args):
+    """``rockjit explore``: the explorer's server (:mod:`rockjit.explore`), served until Ctrl-C.
+    It writes no ``--out``: the command ends here, with exit status 0, instead of going on to
+    the file-writing run of the other commands; a bad ``--port`` or ``--address`` is a usage
+    error (exit status 2) like any other."""
+    from ..explore import explore
+    try:
+        explore(port=args.port, address=args.address, browser=not args.no_browser, block=True)
+    except ImportError as exc:  # the explore extra is not installed
+        raise UsageError(str(exc)) from None
+    except KeyboardInterrupt:
+        print(f"\n{PROG}: explore: stopped", file=sys.stderr, flush=True)
+    raise SystemExit(0)
+
+
 def _grid(args, run, plan, name):
     """``run(plan, execution)`` with the command line's progress, Dask client
     (``--scheduler``) and chunk store (``<out>.chunks/name``), the store's notes on stderr
@@ -589,6 +604,20 @@ def build_parser():
                    help="also draw figure 5 as the study computed it: integrated past overturning")
     _add_common(p)
     _add_scheduler(p)
+
+    p = _command(sub, "explore", _explore_plan, None,
+                 "explore the dynamics live in a browser",
+                 "Serve a local web app: the basin of the current parameters (recomputed as "
+                 "they change, 50² then 100² then 200²), a cell's run, the bifurcation diagram "
+                 "along alpha (a box zoom recomputes it), both laws side by side; every view "
+                 "as a PNG and as the Python call that reproduces it. Needs the explore extra: "
+                 "pip install 'rockjit[explore]'. Serves until Ctrl-C.")
+    p.add_argument("--port", type=int, default=0,
+                   help="port to listen on (default 0: a free one; the address is printed)")
+    p.add_argument("--address", default="127.0.0.1",
+                   help="address to bind (default 127.0.0.1: only this machine can connect)")
+    p.add_argument("--no-browser", action="store_true",
+                   help="do not open the system's web browser")
     return parser
 
 

@@ -118,6 +118,22 @@ class _Progress:
         self.stream.flush()
 
 
+class _Callback:
+    """Progress told to a callable ``progress(done, total)`` instead of stderr: once at the
+    start, then after each chunk. What it raises stops the run."""
+
+    def __init__(self, total, progress, done):
+        self.total, self.progress, self.done = total, progress, done
+        progress(done, total)
+
+    def update(self, n):
+        self.done += n
+        self.progress(self.done, self.total)
+
+    def close(self):
+        pass
+
+
 def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, progress=False,
                label="cells", task_prefix="rockjit"):
     """Run ``runner`` over chunks of ``n`` cells and fill ``outputs`` in place.
@@ -140,8 +156,10 @@ def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, pr
         chunk cells-...; recomputing") and computed again. The store's lock is taken for the
         run (if :meth:`ChunkStore.close` gave it back) and released when this function
         returns or raises.
-    progress : bool
-        Report progress on stderr (a rewritten line on a terminal, else throttled lines).
+    progress : bool or callable
+        Report progress on stderr (a rewritten line on a terminal, else throttled lines); or
+        call ``progress(done, total)`` with the cells finished, once before the first chunk
+        and after each; an exception it raises stops the run between two chunks.
     """
     if store is not None:
         store.acquire()
@@ -171,7 +189,11 @@ def _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, labe
                 outputs[k][a:b] = v
         else:
             todo.append((a, b))
-    bar = _Progress(n, label, progress, done=n - sum(b - a for a, b in todo))
+    done = n - sum(b - a for a, b in todo)
+    if callable(progress):
+        bar = _Callback(n, progress, done)
+    else:
+        bar = _Progress(n, label, progress, done=done)
 
     def args(a, b):
         return tuple(x[a:b] if isinstance(x, np.ndarray) and x.ndim and x.shape[0] == n else x

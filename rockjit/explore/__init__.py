@@ -1,0 +1,54 @@
+"""``rockjit explore``: the basin, a cell's run, the bifurcation diagram and both laws, live in a
+browser, recomputed as the parameters change.
+
+The compute side (:mod:`.requests`: parameters, coarse-to-fine stages, the Python call of each
+view; :mod:`.worker`: the worker thread, newer requests superseding older ones) needs nothing
+beyond rockjit; the user interface (:mod:`.app`) and its server (:mod:`.server`) need Bokeh, the
+``explore`` extra: ``pip install 'rockjit[explore]'``.
+
+The module is callable: ``rockjit.explore()`` starts the server (see :func:`explore`).
+"""
+
+from __future__ import annotations
+
+import sys
+import types
+
+__all__ = ["explore"]
+
+
+def explore(*, port=0, address="127.0.0.1", browser=True, block=False, quiet=False):
+    """Start the explorer's web server and return its handle (:class:`.server.Explorer`).
+
+    Parameters
+    ----------
+    port : int
+        Port to listen on; 0 (default) takes a free one.
+    address : str
+        Address to bind; default ``127.0.0.1``, so that only this machine can connect.
+    browser : bool
+        Open the system's web browser on the explorer's address.
+    block : bool
+        Serve until interrupted (Ctrl-C) instead of returning at once. By default the server
+        runs in a background thread and the call returns: a notebook or a shell goes on, and in
+        a notebook the handle shows the explorer inline.
+    quiet : bool
+        Do not print the address.
+
+    Returns
+    -------
+    Explorer
+        ``.url``, ``.stop()``, ``.wait()``; in a notebook it shows the explorer in a frame.
+    """
+    from .server import start
+    return start(port=port, address=address, browser=browser, block=block, quiet=quiet)
+
+
+class _CallableModule(types.ModuleType):
+    """``rockjit.explore`` is this package and, called, :func:`explore`."""
+
+    def __call__(self, *args, **kwargs):
+        return explore(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule
