@@ -250,6 +250,11 @@ class GridResult:
     #: Cells whose outcome changes when their initial state moves by ``settings["uncertainty"]``
     #: (rockjit.grids.grids.uncertain_cells); None when not asked for.
     uncertain: np.ndarray | None = None
+    #: ``lambda1`` of each cell as the finite-window QR average over its classified stretch
+    #: (docs/theory/exponents.md, "Benettin's method"), the study's estimate, shaped like
+    #: ``label``; ``lambda_max`` replaces it by the exact Floquet exponent where the cell
+    #: settled on a periodic orbit. None when no exponents were computed.
+    lambda_window: np.ndarray | None = None
 
     def fractions(self):
         """Percentage of cells per behaviour name."""
@@ -272,8 +277,13 @@ class SweepResult(GridResult):
     period : ndarray of int, shape (n,)
         Period in forcing periods (0 when none).
     lambda_max : ndarray, shape (n,)
-        ``lambda1`` over the classified stretch (``nan`` when not computed or overturned,
-        ``-inf`` when every perturbation dies: rest).
+        The largest Lyapunov exponent: where the run settled on a periodic orbit (symmetric,
+        asymmetric, multiperiodic), its Floquet exponent ``ln|mu1| / (pT)`` from the exact
+        monodromy (``-inf`` through rest); elsewhere ``lambda_window`` (``nan`` when not
+        computed or overturned, ``-inf`` when every perturbation dies: rest).
+    lambda_window : ndarray, shape (n,)
+        ``lambda1`` as the finite-window QR average over the classified stretch, every cell
+        (the study's estimate).
     strobe : ndarray, shape (n, w, 2)
         ``(theta, theta')`` at ``t = kT`` over the classified stretch (``nan``-padded).
     impact_section : ndarray, shape (n, m, 2)
@@ -301,6 +311,8 @@ class SweepResult(GridResult):
                    lambda_max=self.lambda_max, strobe=self.strobe,
                    impact_section=self.impact_section, t_end=self.t_end,
                    names=np.asarray(self.names, dtype=str))
+        if self.lambda_window is not None:
+            out["lambda_window"] = self.lambda_window
         if self.attractor is not None:
             out["attractor"] = self.attractor
         if self.settings.get("stop_at_overturn") is False:
@@ -312,7 +324,9 @@ class SweepResult(GridResult):
 class BasinResult(GridResult):
     """A basin of attraction over ``(theta0, theta0')`` at a fixed forcing phase.
 
-    ``label[i, j]`` belongs to ``theta0[i]``, ``dtheta0[j]``.
+    ``label[i, j]`` belongs to ``theta0[i]``, ``dtheta0[j]``. ``lambda_max`` (when computed)
+    is, as in :class:`SweepResult`, the Floquet exponent of a cell that settled on a periodic
+    orbit and ``lambda_window`` elsewhere.
     """
 
     theta0: np.ndarray
@@ -372,6 +386,8 @@ class PlaneResult(GridResult):
     """Behaviours over the forcing plane ``(alpha, omega)`` from one or more initial states.
 
     ``label[m, i, j]`` belongs to initial state ``z0[m]``, ``alpha[i]``, ``omega[j]``.
+    ``lambda_max`` is, as in :class:`SweepResult`, the Floquet exponent of each cell that
+    settled on a periodic orbit (each cell its own system) and ``lambda_window`` elsewhere.
     """
 
     alpha: np.ndarray
