@@ -173,13 +173,22 @@ class Result:
 
     def summary(self):
         """JSON-ready scalars of the run (its exponents when computed)."""
+        # the first instant |theta| reached theta_over: where a run stopped there, its end
+        t_over = self.t if self.status == "overturned" and math.isnan(self.t_overturn) \
+            else self.t_overturn
         out = dict(status=self.status, message=self.message, t_end=self.t,
                    final_state=self.state, n_impacts=self.n_impacts, n_rest=self.n_rest,
                    restitution=self.block.restitution, n_steps=self.n_steps,
                    max_error_estimate=self.max_error_estimate, method=self.method,
-                   n_locate_unconverged=self.n_locate_unconverged, t_overturn=self.t_overturn)
+                   n_locate_unconverged=self.n_locate_unconverged, t_overturn=t_over)
         if self.lyapunov is not None:
-            out.update(lambda_max=self.lyapunov[0], lyapunov=self.lyapunov, window=self.window,
+            # the averaging window as planned, forwards; a run that ended before it began has
+            # no exponent over it (nan), which window_reached says
+            reached = self.window is not None and self.t > self.window[0]
+            window = self.window if self.window is None or reached else \
+                (float(self.window[0]), float(self.periods * self.period))
+            out.update(lambda_max=self.lyapunov[0], lyapunov=self.lyapunov, window=window,
+                       window_reached=bool(reached),
                        horizon=self.horizon, beyond_horizon=bool(self.beyond_horizon))
         return out
 
