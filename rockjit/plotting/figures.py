@@ -335,8 +335,8 @@ def fig_trajectory(result, behaviour, *, exponent=None, title=None, first=8, las
     S.letter(ax_l, len(axes_t), "running largest Lyapunov exponent")
     ax_p = fig.add_subplot(gs[:, 2])
     in_window = _phase_panel(ax_p, result, colour)
-    S.letter(ax_p, len(axes_t) + 1, "phase portrait, " + ("asymptotic window" if in_window
-                                                          else "whole run"))
+    S.letter(ax_p, len(axes_t) + 1, "phase portrait,\n" + ("asymptotic window" if in_window
+                                                            else "whole run"))
     ax_p.legend(loc="lower right")
     S.suptitle(fig, title or f"{_params(result)}: {_behaviour_words(behaviour)}")
     return fig
@@ -482,7 +482,7 @@ def _is_published(sw):
     return sw.settings.get("stop_at_overturn") is False
 
 
-def _bifurcation_column(fig, gs_col, sw, alpha_limits, show_y, col):
+def _bifurcation_column(fig, gs_col, sw, alpha_limits, show_y, col, short=False):
     ax = fig.add_subplot(gs_col[0])
     ax_s = fig.add_subplot(gs_col[1], sharex=ax)
     ax_l = fig.add_subplot(gs_col[2], sharex=ax)
@@ -508,10 +508,9 @@ def _bifurcation_column(fig, gs_col, sw, alpha_limits, show_y, col):
                    rasterized=True)
     ax.set_ylabel(SYMBOLS["strobe"] if show_y else "")
     published = _is_published(sw)
-    S.letter(ax, col, f"{S.law_name(sw.block)}, $h/b = {sw.block.hb:g}$, "
-                      f"$\\omega = {sw.forcing.omega:g}$"
-                      + (":\nas published (integrated on past overturning)" if published
-                         else ""))
+    S.letter(ax, col, S.law_name(sw.block)
+             + ("" if short else f", $h/b = {sw.block.hb:g}$, $\\omega = {sw.forcing.omega:g}$")
+             + (",\nas published" if published else ""))
     ax.tick_params(labelbottom=False)
 
     # a strip: the behaviour of every alpha, including those without stroboscopic points
@@ -592,7 +591,7 @@ def fig_bifurcation(sweeps, alpha_limits=None, title=None):
     present, any_rest = set(), False
     for c, sw in enumerate(sweeps.values()):
         got, rest = _bifurcation_column(fig, [gs[r, c] for r in range(3)], sw, alpha_limits,
-                                        c == 0, c)
+                                        c == 0, c, short=n > 2)
         present |= set(got)
         any_rest |= rest
     order = [nm for nm in BEHAVIOURS if nm in present]
@@ -1144,7 +1143,7 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
     fig.legend(handles=handles, loc="outside right center", ncols=1)
     b, f = c.block, c.forcing
     fixed = (f"$\\omega = {f.omega:g}$" if pname == "alpha" else f"$\\alpha = {f.alpha:g}$")
-    ax.set_title(title or f"Periodic orbits, {S.law_name(b)}, $h/b = {b.hb:g}$, {fixed}; "
+    ax.set_title(title or f"Periodic orbits, {S.law_name(b)}, $h/b = {b.hb:g}$, {fixed};\n"
                           f"sampled at $t = kT$ at the forcing phase $\\varphi = {c.phase:.4g}$ "
                           f"of the study's $z_0$",
                  fontsize="medium")

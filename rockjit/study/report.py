@@ -164,7 +164,7 @@ def _img(name, alt):
     if name.endswith(".pdf"):
         return (f'<p><a href="{html.escape(name)}">{html.escape(name)}</a> '
                 f'(PDF)</p>')
-    return f'<img src="{html.escape(name)}" alt="{html.escape(alt)}" loading="lazy">'
+    return f'<img src="{html.escape(name)}" alt="{html.escape(alt)}">'
 
 
 def _captions(results, plan):
@@ -259,9 +259,10 @@ def _published_html(pub):
                           _num(r["delta_e"], ".2f")] for r in pub["e_table"]]))
     parts.append("<h3>Where the transitions are</h3><p class='note'>The study describes its "
                  "diagrams in words; the reference values are those located by continuation "
-                 "at <i>N</i> = 384 (docs/theory/study.md), beside this run's nearest "
-                 "located bifurcation of the same type and period (N = 64 here; &ndash;: "
-                 "not located at this run's settings).</p>")
+                 "(docs/theory/study.md, &ldquo;Where the study's transitions are&rdquo;), "
+                 "beside the nearest bifurcation of the same type and period this run located "
+                 "(&ndash;: none, the continuation being seeded by this run's sweeps, whose "
+                 "step may miss a window).</p>")
     parts.append(_table(["h/b", "law", "transition", "α reference", "α this run",
                          "difference"],
                         [[r["hb"], _LAW.get(r["law"], r["law"]), r["transition"],
