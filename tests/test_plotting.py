@@ -143,14 +143,14 @@ def test_gallery_titles_carry_the_classification(ref_run, short_runs):
     runs = {"sym": ref_run, **short_runs}
     beh = {k: rockjit.classify_result(r) for k, r in runs.items()}
     fig = P.fig_gallery(runs, beh)
-    titles = [ax.get_title(loc="left") for ax in fig.axes if ax.get_title(loc="left")]
+    titles = [sub.get_suptitle() for sub in fig.subfigs]
     assert len(titles) == 3
     assert titles[0].startswith("a) sym") and "symmetric" in titles[0]
     assert titles[1].startswith("b) rest") and "at rest from" in titles[1]
     assert titles[2].startswith("c) overturn") and "overturns at" in titles[2]
     # the behaviour given is the one drawn: a figure classifies nothing itself
     fig = P.fig_gallery({"sym": ref_run}, {"sym": ("chaotic", 0)})
-    assert "chaotic" in fig.axes[0].get_title(loc="left")
+    assert "chaotic" in fig.subfigs[0].get_suptitle()
     assert to_hex(fig.axes[0].get_lines()[0].get_color()) == to_hex(
         P.BEHAVIOUR_COLOURS["chaotic"])
 
@@ -187,7 +187,7 @@ def test_bifurcation_draws_every_finite_point_and_clips_rest():
     n_fin = np.isfinite(sw.lambda_max).sum()
     assert sum(len(m) for m in marks) == n_fin + rest.sum()
     legend = [t.get_text() for t in fig.legends[0].get_texts()]
-    assert legend == list(BEHAVIOURS) + [r"$\lambda = -\infty$"]
+    assert legend == list(BEHAVIOURS) + [r"$\lambda = -\infty$ (through rest)"]
 
 
 def test_bifurcation_zoom_and_pair():

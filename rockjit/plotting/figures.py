@@ -161,6 +161,33 @@ def fig_restitution(hb_range=(1.0 / math.sqrt(2.0), 6.0), n=400, marks=(1.0, 2.0
 # time series: windows of a run, impacts as vertical jumps
 # ---------------------------------------------------------------------------------------------
 
+def _wrap(text, fig, fraction=0.95):
+    """``text`` broken into lines that fit ``fraction`` of the figure's width (at the style's
+    font size, about half an em a character; mathtext counted as it is drawn, and never
+    broken)."""
+    import matplotlib
+    size = matplotlib.rcParams["font.size"]
+    per_line = max(20, int(fig.get_figwidth() * fraction * 72 / (0.55 * size)))
+
+    def drawn(w):
+        return len(re.sub(r"\$[^$]*\$", lambda m: "x" * max(1, len(m.group()) // 2), w))
+
+    out = []
+    for para in text.split("\n"):
+        # words, a piece of mathtext with what is glued to it being one word
+        words = re.findall(r"(?:[^\s$]*\$[^$]*\$)+[^\s$]*|\S+", para)
+        line, n = [], 0
+        for w in words:
+            k = drawn(w) + 1
+            if line and n + k > per_line:
+                out.append(" ".join(line))
+                line, n = [], 0
+            line.append(w)
+            n += k
+        out.append(" ".join(line))
+    return "\n".join(out)
+
+
 def _need_traj(result):
     if result.trajectory is None or result.trajectory.shape[0] == 0:
         raise ValueError("the result has no trajectory: simulate with record_stride=...")
@@ -364,17 +391,18 @@ def fig_gallery(results, behaviours, notes=None, *, first=8, last=4):
         raise ValueError("results must hold at least one run")
     n = len(results)
     fig = _figure("double", 0.25 * n + 0.08)
-    gs = fig.add_gridspec(n, 3, width_ratios=(1.5, 1.0, 0.9))
-    for r, (caption, res) in enumerate(results.items()):
+    subs = np.atleast_1d(fig.subfigures(n, 1))
+    for r, ((caption, res), sub) in enumerate(zip(results.items(), subs)):
         _need_traj(res)
         beh = behaviours[caption]
         colour = LINE_COLOURS[beh[0]]
+        gs = sub.add_gridspec(1, 3, width_ratios=(1.5, 1.0, 0.9))
         wins = _windows(res, first, last)
         if len(wins) == 1:
-            axes = [fig.add_subplot(gs[r, :2])]
+            axes = [sub.add_subplot(gs[0, :2])]
         else:
-            axes = [fig.add_subplot(gs[r, 0])]
-            axes.append(fig.add_subplot(gs[r, 1], sharey=axes[0]))
+            axes = [sub.add_subplot(gs[0, 0])]
+            axes.append(sub.add_subplot(gs[0, 1], sharey=axes[0]))
         for ax, (t0, t1, what) in zip(axes, wins):
             _time_panel(ax, res, t0, t1, colour)
             _mark_end(ax, res)
@@ -388,14 +416,14 @@ def fig_gallery(results, behaviours, notes=None, *, first=8, last=4):
         what = (f"overturns at $t = {res.t:.5g}$" if res.status == "overturned" else
                 f"at rest from $t = {res.t:.3g}$" if res.status == "rest" else
                 _behaviour_words(beh))
-        head = (f"{caption}: $\\alpha = {f.alpha:g}$, $\\omega = {f.omega:g}$, "
-                f"$h/b = {b.hb:g}$ $\\rightarrow$ {what}")
-        if res.status == "rest":
-            _rest_inset(axes[0], res, colour)
+        head = (f"{'abcdefghijklmnopqrstuvwxyz'[r]}) {caption}: $\\alpha = {f.alpha:g}$, "
+                f"$\\omega = {f.omega:g}$, $h/b = {b.hb:g}$ $\\rightarrow$ {what}")
         if notes and caption in notes:
             head += "\n" + notes[caption]
-        S.letter(axes[0], r, head)
-        ax_p = fig.add_subplot(gs[r, 2])
+        sub.suptitle(_wrap(head, fig), x=0.01, ha="left", fontsize="medium")
+        if res.status == "rest":
+            _rest_inset(axes[0], res, colour)
+        ax_p = sub.add_subplot(gs[0, 2])
         _phase_panel(ax_p, res, colour)
         if r != n - 1:
             ax_p.set_xlabel("")
@@ -465,7 +493,8 @@ def fig_laws_timeseries(runs, behaviours, captions=None, *, periods=8):
             words.append(w)
         S.letter(ax_first, i, f"from $(\\theta_0, \\theta'_0) = ({z[0]:.4f}, {z[1]:.4f})$")
         cap = captions[i] if captions is not None else "; ".join(words) + "."
-        sub.supxlabel(f"{'abcdefghij'[i]}) {cap}", fontsize="medium", ha="center")
+        sub.supxlabel(_wrap(f"{'abcdefghij'[i]}) {cap}", fig), fontsize="medium",
+                      ha="center")
     r0 = next(iter(runs[0].values()))
     b, f = r0.block, r0.forcing
     S.suptitle(fig, f"Housner against Mao et al. in time: $h/b = {b.hb:g}$, "
@@ -597,9 +626,11 @@ def fig_bifurcation(sweeps, alpha_limits=None, title=None):
     order = [nm for nm in BEHAVIOURS if nm in present]
     handles = _behaviour_handles(order, marker=True)
     if any_rest:
-        handles.append(Line2D([], [], ls="", marker="v", ms=5, color=LINE_COLOURS["rest"],
-                              label=r"$\lambda = -\infty$"))
-    ncols = len(handles) if n > 1 else min(len(handles), 3)
+        handles.append(Line2D([], [], ls="", marker="v", ms=5, color="0.3",
+                              label=r"$\lambda = -\infty$ (through rest)"))
+    width = fig.get_figwidth()
+    ncols = len(handles) if n > 1 and width >= 10 else \
+        min(len(handles), max(2, int(width // 1.7)))
     fig.legend(handles=handles, loc="outside lower center", ncols=max(1, ncols))
     S.suptitle(fig, title)
     return fig
@@ -771,8 +802,10 @@ def _erosion_areas(r):
     brs = [r.branches[i] for i in big]
     colours = S.attractor_colours(brs)
     names = S.attractor_names(brs)
-    areas = [(n, c, fr[i]) for n, c, i in zip(names, colours, big)]
-    for beh in BEHAVIOURS:
+    areas = []
+    for beh in BEHAVIOURS:  # in the behaviours' order, each behaviour's small ones last
+        areas += [(n, c, fr[i]) for n, c, i in zip(names, colours, big)
+                  if r.branches[i]["behaviour"] == beh]
         idx = [i for i in small if r.branches[i]["behaviour"] == beh]
         if idx:
             areas.append((f"{beh}, {len(idx)} small attractor{'s' if len(idx) > 1 else ''} "
@@ -986,11 +1019,12 @@ def _branch_kind(br):
     return f"period {br.period}"
 
 
-def _branch_runs(value, y, stable, t_next, period):
+def _branch_runs(value, y, stable, t_next, period, mu=None):
     """Pieces ``(x, y, stable)`` of one branch line: broken where an impact crosses the
     sampling instant (the time to the next impact jumps by more than a quarter period, and the
-    sampled point jumps) and where the stability changes (the point of change belongs to both
-    pieces, so the line stays connected)."""
+    sampled point jumps) and where the stability changes. There both pieces meet at the point
+    where the largest multiplier's modulus ``mu`` crosses 1, interpolated between the two
+    branch points (without ``mu``: at the first point of the new stability)."""
     n = value.shape[0]
     cut = np.zeros(n, bool)  # cut[i]: no line between i-1 and i
     if n > 1:
@@ -998,11 +1032,26 @@ def _branch_runs(value, y, stable, t_next, period):
         cut[1:] = jump | ~np.isfinite(y[1:]) | ~np.isfinite(y[:-1])
     runs = []
     start = 0
+    head = None  # the crossing point a piece starts from
     for i in range(1, n + 1):
         if i == n or cut[i] or stable[i] != stable[start]:
-            stop = i if (i == n or cut[i]) else i + 1
-            if stop - start >= 2 or (stop - start == 1 and (i == n or cut[i])):
-                runs.append((value[start:stop], y[start:stop], bool(stable[start])))
+            change = i < n and not cut[i]
+            xs, ys = list(value[start:i]), list(y[start:i])
+            if head is not None:
+                xs.insert(0, head[0])
+                ys.insert(0, head[1])
+            head = None
+            if change:
+                w = 1.0
+                if mu is not None and np.isfinite(mu[i - 1]) and np.isfinite(mu[i]) and \
+                        mu[i] != mu[i - 1]:
+                    w = float(np.clip((1.0 - mu[i - 1]) / (mu[i] - mu[i - 1]), 0.0, 1.0))
+                head = (value[i - 1] + w * (value[i] - value[i - 1]),
+                        y[i - 1] + w * (y[i] - y[i - 1]))
+                xs.append(head[0])
+                ys.append(head[1])
+            if len(xs) >= 2 or (len(xs) == 1 and not change):
+                runs.append((np.asarray(xs), np.asarray(ys), bool(stable[start])))
             start = i
     return runs
 
@@ -1075,6 +1124,7 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
     for br in c.branches:
         T = 2.0 * np.pi / np.asarray(br.omega)
         colour = _branch_colour(br)
+        mu_abs = np.abs(np.asarray(br.multipliers)).max(axis=1)
         cycles = [(br.cycle, br.t_next_impact)]
         if mirrors and br.mirror_cycle is not None:
             # the mirror orbit at kT is the orbit at kT + T/2, reflected
@@ -1082,7 +1132,7 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
         for cyc, tn in cycles:
             for k in range(br.period):
                 for x, yv, st in _branch_runs(np.asarray(br.value), cyc[:, k, comp],
-                                              np.asarray(br.stable), tn[:, k], T):
+                                              np.asarray(br.stable), tn[:, k], T, mu_abs):
                     ax.plot(x, yv, ls="-" if st else (0, (3.5, 2.0)), lw=1.3 if st else 1.0,
                             color=colour, zorder=4)
     ends = {}
