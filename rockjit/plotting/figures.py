@@ -699,7 +699,7 @@ def fig_basin_compare(housner_basin, mao_basin, title=None):
                    aspect="auto", cmap=ListedColormap([DISAGREE_COLOUR, AGREE_COLOUR]),
                    vmin=0, vmax=1, extent=_extent(np.asarray(a.theta0), np.asarray(a.dtheta0)))
     axes[2].set_xlabel(SYMBOLS["theta0"])
-    S.letter(axes[2], 2, f"agreement: {pct:.1f} % of cells")
+    S.letter(axes[2], 2, f"agreement: {pct:.1f} % of the {_cells(a)}")
     axes[2].legend(handles=[Patch(facecolor=AGREE_COLOUR, edgecolor="0.5", lw=0.5,
                                   label=f"same behaviour {pct:.1f} %"),
                             Patch(facecolor=DISAGREE_COLOUR, edgecolor="0.5", lw=0.5,
@@ -776,7 +776,8 @@ def fig_attractors(basins, measures=None, title=None):
                         f"$S_{{bb}} = {m['boundary_basin_entropy']:.3f}$,\n"
                         f"GIM $= {m['integrity']['GIM']:.3f}$, "
                         f"IF $= {m['integrity']['IF']:.3f}$")
-        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncols=1)
+        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncols=1,
+                  title=f"of the {_cells(b)}", title_fontsize="small")
     b0 = next(iter(basins.values()))
     blk, frc = b0.block, b0.forcing
     S.suptitle(fig, title or f"Attractors, $h/b = {blk.hb:g}$, $\\alpha = {frc.alpha:g}$, "
@@ -862,7 +863,9 @@ def fig_erosion(profiles, title=None):
         axk.set_xlim(edges[0], edges[-1])
         axk.set_ylabel("% of cells")
         axk.set_xlabel(SYMBOLS["alpha"])
-        S.letter(axk, 2 + k, f"{S.law_name(r.block)}: basin of each attractor")
+        g = r.attractor.shape[1]
+        S.letter(axk, 2 + k, f"{S.law_name(r.block)}: basin of each attractor, ${g} \\times "
+                             f"{g}$ cells every $\\Delta\\alpha = {r.settings.get('alpha_step'):g}$")
         ax_leg.legend(handles=handles, loc="center left", ncols=1, fontsize="small")
     r0 = next(iter(profiles.values()))
     g = r0.attractor.shape[1]

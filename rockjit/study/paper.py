@@ -305,6 +305,14 @@ def floquet_of_run(res, behaviour):
     return float(lam[0])
 
 
+def _exponents(res, behaviour, exact=None):
+    """A run's ``lambda_max`` as the grids report it: the Floquet exponent of the periodic orbit
+    it settled on (exact), else the window's estimate, kept as ``lambda_window``."""
+    exact = floquet_of_run(res, behaviour) if exact is None else exact
+    return dict(lambda_max=exact if math.isfinite(exact) or exact == -math.inf
+                else res.lambda_max, lambda_window=res.lambda_max)
+
+
 def _drawn(res, prefix, first=FIRST_PERIODS, last=LAST_PERIODS):
     """The arrays a time-series figure draws of one run: ``theta(t)`` over its first and last
     periods and the phase portrait's stretch, impacts inserted (``t, theta, dtheta``), and its
@@ -444,8 +452,7 @@ def paper(out, plan=None, *, execution=None, say=None):
                           "figure 2: the reference run's theta(t) (first and last periods), "
                           "running exponent and phase portrait (data: fig2_reference.npz)")]
     results["fig2"] = dict(status=ref.status, behaviour=beh[0], period=beh[1],
-                           lambda_max=ref.lambda_max, lyapunov=ref.lyapunov,
-                           floquet_exponent=exact)
+                           **_exponents(ref, beh, exact), lyapunov=ref.lyapunov)
     done("fig2", t0)
 
     t0 = part(3, "fig3", "behaviour gallery")
@@ -481,7 +488,7 @@ def paper(out, plan=None, *, execution=None, say=None):
                           "(data: fig3_gallery.npz)")]
     results["fig3_fates"] = {forcing: f.to_summary() for forcing, f in fates.items()}
     results["fig3"] = {k: dict(behaviour=gal_beh[k][0], period=gal_beh[k][1], status=r.status,
-                               t_end=r.t, lambda_max=r.lambda_max,
+                               t_end=r.t, **_exponents(r, gal_beh[k]),
                                state0=list(r.trajectory[0, 1:3]))
                        for k, r in gal.items()}
     done("fig3", t0)

@@ -170,9 +170,8 @@ def _img(name, alt):
 def _captions(results, plan):
     """Each figure's caption (the study's words, docs/theory/study.md, and what is drawn)."""
     f2 = results.get("fig2", {})
-    lam = _num(f2.get("lyapunov", [math.nan])[0] if f2.get("lyapunov") is not None
-               else math.nan, ".4f")
-    flo = _num(f2.get("floquet_exponent"), ".4f")
+    lam = _num(f2.get("lambda_window"), ".4f")
+    flo = _num(f2.get("lambda_max"), ".4f")
     fates = results.get("fig3_fates", {})
     fw = "; ".join(f"{k}: " + ", ".join(f"{n} {v:.0%}" for n, v in
                                         f.get("probabilities", {}).items())
