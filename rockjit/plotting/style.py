@@ -150,7 +150,12 @@ def use(name="default"):
         st = STYLES[name]
     else:
         raise ValueError(f"style must be one of {', '.join(STYLES)} (got {name!r})")
+    import logging
+
     import matplotlib
+    # embedding TrueType fonts in a PDF (pdf.fonttype 42, what journals ask for) subsets them
+    # with fontTools, which logs a warning about DejaVu's build date on every figure
+    logging.getLogger("fontTools").setLevel(logging.ERROR)
     token = _CURRENT.set(st)
     try:
         with matplotlib.rc_context(st.rc):
