@@ -40,7 +40,7 @@ import _common as H
 
 import rockjit
 from rockjit.grids.grids import BEHAVIOURS, GRID_N, basin, sweep
-from rockjit.plotting.figures import agreement
+from rockjit.basins.identity import agreement
 
 #: The study's four basins (SPEC.md §7, figure 6).
 BASINS = (
