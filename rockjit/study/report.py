@@ -213,7 +213,10 @@ def _captions(results, plan):
            "triangles at the bottom: &lambda; = &minus;&infin; (rest, or an orbit through "
            "rest). Both laws at <i>h/b</i> = 1 (&omega; = 1.3) and 2 (&omega; = 1.6), and a "
            f"zoom of Housner's <i>h/b</i> = 1 diagram over &alpha; &isin; "
-           f"[{plan.zoom[0]:g}, {plan.zoom[1]:g}] at a step of {plan.zoom_step:g}.",
+           f"[{plan.zoom[0]:g}, {plan.zoom[1]:g}] at a step of {plan.zoom_step:g}."
+           + (" The <code>_as_published</code> figures put beside each law the study's way: "
+              "integrated on past overturning (grey points: what a fallen block did), its "
+              "&lambda;<sub>max</sub> the finite-window estimate." if plan.published else ""),
         "5b": "Beyond the study: the branches of periodic orbits continued in &alpha; over "
               "each diagram's points (stable solid, unstable dashed; the mirror image of "
               "every asymmetric orbit too, so both arms of each pitchfork), each branch in "
