@@ -37,7 +37,11 @@ LINE_COLOURS = dict(BEHAVIOUR_COLOURS, rest="#8C8C8C")
 
 def _figure(width, aspect):
     from matplotlib.figure import Figure
-    return Figure(figsize=S.current().size(width, aspect), layout="constrained")
+    from matplotlib.layout_engine import ConstrainedLayoutEngine
+    # a little more than the default pads (3 points): constrained layout can leave a rotated
+    # axis label a point or two beyond the canvas's edge when a column's tick labels widen
+    return Figure(figsize=S.current().size(width, aspect),
+                  layout=ConstrainedLayoutEngine(w_pad=0.06, h_pad=0.05))
 
 
 def _params(res):
@@ -546,9 +550,9 @@ def _bifurcation_column(fig, gs_col, sw, alpha_limits, show_y, col, short=False)
     cmap, norm = S.behaviour_cmap()
     edges = _edges(alpha)
     ax_s.pcolormesh(edges, [0, 1], label[None, :], cmap=cmap, norm=norm, rasterized=True)
-    ax_s.set_yticks([])
-    if show_y:
-        ax_s.set_ylabel("class", rotation=0, ha="right", va="center", fontsize="small")
+    # the strip's name as its one tick label (a horizontal axis label is laid out badly)
+    ax_s.set_yticks([0.5], ["class"] if show_y else [""])
+    ax_s.tick_params(axis="y", length=0, labelsize="small")
     ax_s.tick_params(labelbottom=False)
 
     lam = np.asarray(sw.lambda_window if published and sw.lambda_window is not None
@@ -699,7 +703,7 @@ def fig_basin_compare(housner_basin, mao_basin, title=None):
                    aspect="auto", cmap=ListedColormap([DISAGREE_COLOUR, AGREE_COLOUR]),
                    vmin=0, vmax=1, extent=_extent(np.asarray(a.theta0), np.asarray(a.dtheta0)))
     axes[2].set_xlabel(SYMBOLS["theta0"])
-    S.letter(axes[2], 2, f"agreement: {pct:.1f} % of the {_cells(a)}")
+    S.letter(axes[2], 2, f"agreement: {pct:.1f} %\nof the {_cells(a)}")
     axes[2].legend(handles=[Patch(facecolor=AGREE_COLOUR, edgecolor="0.5", lw=0.5,
                                   label=f"same behaviour {pct:.1f} %"),
                             Patch(facecolor=DISAGREE_COLOUR, edgecolor="0.5", lw=0.5,
