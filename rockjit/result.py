@@ -192,13 +192,22 @@ class Result:
 
     def summary(self):
         """JSON-ready scalars of the run (its exponents when computed)."""
+        # the first instant |theta| reached theta_over: where a run stopped there, its end
+        t_over = self.t if self.status == "overturned" and math.isnan(self.t_overturn) \
+            else self.t_overturn
         out = dict(status=self.status, message=self.message, t_end=self.t,
                    final_state=self.state, n_impacts=self.n_impacts, n_rest=self.n_rest,
                    restitution=self.block.restitution, n_steps=self.n_steps,
                    max_error_estimate=self.max_error_estimate, method=self.method,
-                   n_locate_unconverged=self.n_locate_unconverged, t_overturn=self.t_overturn)
+                   n_locate_unconverged=self.n_locate_unconverged, t_overturn=t_over)
         if self.lyapunov is not None:
-            out.update(lambda_max=self.lyapunov[0], lyapunov=self.lyapunov, window=self.window,
+            # the averaging window as planned, forwards; a run that ended before it began has
+            # no exponent over it (nan), which window_reached says
+            reached = self.window is not None and self.t > self.window[0]
+            window = self.window if self.window is None or reached else \
+                (float(self.window[0]), float(self.periods * self.period))
+            out.update(lambda_max=self.lyapunov[0], lyapunov=self.lyapunov, window=window,
+                       window_reached=bool(reached),
                        horizon=self.horizon, beyond_horizon=bool(self.beyond_horizon))
         return out
 
@@ -271,6 +280,11 @@ class GridResult:
     #: Cells whose outcome changes when their initial state moves by ``settings["uncertainty"]``
     #: (``Classification(uncertainty=...)``); None when not asked for.
     uncertain: np.ndarray | None = None
+    #: ``lambda1`` of each cell as the finite-window QR average over its classified stretch
+    #: (docs/theory/exponents.md, "Benettin's method"), the study's estimate, shaped like
+    #: ``label``; ``lambda_max`` replaces it by the exact Floquet exponent where the cell
+    #: settled on a periodic orbit. None when no exponents were computed.
+    lambda_window: np.ndarray | None = None
 
     def fractions(self):
         """Percentage of cells per behaviour name."""
@@ -293,8 +307,13 @@ class SweepResult(GridResult):
     period : ndarray of int, shape (n,)
         Period in forcing periods (0 when none).
     lambda_max : ndarray, shape (n,)
-        ``lambda1`` over the classified stretch (``nan`` when not computed or overturned,
-        ``-inf`` when every perturbation dies: rest).
+        The largest Lyapunov exponent: where the run settled on a periodic orbit (symmetric,
+        asymmetric, multiperiodic), its Floquet exponent ``ln|mu1| / (pT)`` from the exact
+        monodromy (``-inf`` through rest); elsewhere ``lambda_window`` (``nan`` when not
+        computed or overturned, ``-inf`` when every perturbation dies: rest).
+    lambda_window : ndarray, shape (n,)
+        ``lambda1`` as the finite-window QR average over the classified stretch, every cell
+        (the study's estimate).
     strobe : ndarray, shape (n, w, 2)
         ``(theta, theta')`` at ``t = kT`` over the classified stretch (``nan``-padded).
     impact_section : ndarray, shape (n, m, 2)
@@ -333,6 +352,8 @@ class SweepResult(GridResult):
                    lambda_max=self.lambda_max, strobe=self.strobe,
                    impact_section=self.impact_section, t_end=self.t_end,
                    names=np.asarray(self.names, dtype=str))
+        if self.lambda_window is not None:
+            out["lambda_window"] = self.lambda_window
         if self.attractor is not None:
             out["attractor"] = self.attractor
         if self.settings.get("stop_at_overturn") is False:
@@ -344,7 +365,9 @@ class SweepResult(GridResult):
 class BasinResult(GridResult):
     """A basin of attraction over ``(theta0, theta0')`` at a fixed forcing phase.
 
-    ``label[i, j]`` belongs to ``theta0[i]``, ``dtheta0[j]``.
+    ``label[i, j]`` belongs to ``theta0[i]``, ``dtheta0[j]``. ``lambda_max`` (when computed)
+    is, as in :class:`SweepResult`, the Floquet exponent of a cell that settled on a periodic
+    orbit and ``lambda_window`` elsewhere.
 
     Attributes
     ----------
@@ -353,7 +376,8 @@ class BasinResult(GridResult):
     label, period : ndarray of int, shape (n, n)
         Behaviour code (``names[label]``) and period of each cell.
     lambda_max : ndarray, shape (n, n) or None
-        ``lambda1`` of each cell, when asked for.
+        The Floquet exponent of a periodic cell, ``lambda_window`` elsewhere (when
+        asked for).
     t_end : ndarray, shape (n, n)
         Time each run stopped.
     block, forcing, settings :
@@ -429,6 +453,9 @@ class PlaneResult(GridResult):
     """Behaviours over the forcing plane ``(alpha, omega)`` from one or more initial states.
 
     ``label[m, i, j]`` belongs to initial state ``z0[m]``, ``alpha[i]``, ``omega[j]``.
+
+    ``lambda_max`` is, as in :class:`SweepResult`, the Floquet exponent of each cell that
+    settled on a periodic orbit (each cell its own system) and ``lambda_window`` elsewhere.
 
     Attributes
     ----------

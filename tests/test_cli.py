@@ -154,7 +154,8 @@ def test_paper_quick(tmp_path):
     s = _summary(out)
     parts = s["wall_s_parts"]
     assert list(parts) == ["fig1", "fig2", "fig3", "fig4", "fig5", "fig6", "fig7", "fig8"]
-    assert sorted(s["files"]) == sorted(p.name for p in out.iterdir())
+    assert sorted(f["name"] for f in s["files"]) == sorted(p.name for p in out.iterdir())
+    assert all(f["holds"] for f in s["files"])  # the manifest says what each file holds
     for case, tag in zip(s["fig6"], ("hb1", "hb2")):
         z = np.load(out / f"fig6_basin_{tag}.npz")
         assert z["label_housner"].shape == (4, 4)

@@ -402,8 +402,12 @@ def test_fig_branches(study):
     ax = fig.axes[0]
     styles = {ln.get_linestyle() for ln in ax.get_lines() if len(ln.get_xdata()) > 1}
     assert "-" in styles and "--" in styles
-    text = "".join(t.get_text() for t in fig.axes[1].texts)
-    assert "PD" in text and "SB" in text
+    # the list of bifurcations is the caption's, not a text table in the axes
+    assert len(fig.axes) == 1 and not ax.texts
+    text = plotting.branch_caption(cont)
+    assert "period doubling" in text and "symmetry-breaking pitchfork" in text
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert "stable orbits: solid" in legend and "unstable orbits: dashed" in legend
     fig2 = plotting.fig_branches(cont, sw, limits=(0.9, 0.96), component=0)
     lo, hi = fig2.axes[0].get_xlim()
     assert (lo, hi) == (0.9, 0.96)

@@ -1,4 +1,5 @@
-"""The study's figures: each draws what its inputs say (data, colours, limits, percentages)."""
+"""The study's figures: each draws what its inputs say (data, colours, limits, percentages),
+with the behaviour it is given (figures classify nothing)."""
 
 import math
 
@@ -12,6 +13,7 @@ from matplotlib.colors import to_hex  # noqa: E402
 
 import rockjit  # noqa: E402
 from rockjit import Block, Harmonic, Integration  # noqa: E402
+from rockjit.basins.identity import agreement  # noqa: E402
 from rockjit.plotting import figures as P  # noqa: E402
 from rockjit.result import BEHAVIOURS, BasinResult, SweepResult, fractions  # noqa: E402
 from rockjit.storage.files import save_figure  # noqa: E402
@@ -88,19 +90,34 @@ def test_restitution_curves_and_marks():
 
 
 def test_trajectory_figure(ref_run, tmp_path):
-    fig = P.fig_trajectory(ref_run)
-    ax_t, ax_l, ax_p = fig.axes[:3]
-    np.testing.assert_array_equal(ax_t.get_lines()[0].get_ydata(), ref_run.trajectory[:, 1])
+    beh = rockjit.classify_result(ref_run)
+    fig = P.fig_trajectory(ref_run, beh)
+    ax_t, ax_last, ax_l, ax_p = fig.axes[:4]
+    # theta(t) over the first periods: the recorded samples there, and every impact inserted
+    # as two points at theta = 0 (the vertical jump)
+    T = ref_run.period
+    t, th, _ = P.with_impacts(ref_run, 0.0, 8 * T)
+    np.testing.assert_array_equal(ax_t.get_lines()[0].get_xdata(), t)
+    np.testing.assert_array_equal(ax_t.get_lines()[0].get_ydata(), th)
+    tr = ref_run.trajectory
+    inside = tr[tr[:, 0] <= 8 * T]
+    assert np.isin(inside[:, 1], th).all()
+    n_imp = np.count_nonzero(ref_run.impacts[:, 0] <= 8 * T)
+    assert th.size == inside.shape[0] + 2 * n_imp and n_imp > 0
+    # ... and over the last periods, up to the end
+    assert ax_last.get_lines()[0].get_xdata().max() == pytest.approx(ref_run.t)
     lam = ax_l.get_lines()[0]
     k = np.arange(1, ref_run.lyapunov_running.shape[0])
     np.testing.assert_allclose(lam.get_xdata(), k * ref_run.period)
     np.testing.assert_array_equal(lam.get_ydata(), ref_run.lyapunov_running[1:, 0])
     # phase portrait: the asymptotic window only
     xs = ax_p.get_lines()[0].get_xdata()
-    w = ref_run.trajectory[ref_run.trajectory[:, 0] >= ref_run.window[0] - 1e-9]
-    np.testing.assert_array_equal(xs, w[:, 1])
+    _, w, _ = P.with_impacts(ref_run, ref_run.window[0])
+    np.testing.assert_array_equal(xs, w)
     assert 0 < len(xs) < ref_run.trajectory.shape[0]
     assert "symmetric" in fig.get_suptitle()
+    # drawn in the behaviour's colour
+    assert to_hex(ax_t.get_lines()[0].get_color()) == to_hex(P.BEHAVIOUR_COLOURS["symmetric"])
     save_figure(fig, tmp_path / "t.png")
     assert (tmp_path / "t.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
@@ -108,24 +125,49 @@ def test_trajectory_figure(ref_run, tmp_path):
 def test_trajectory_needs_a_trajectory(ref_run):
     import dataclasses
     with pytest.raises(ValueError, match="record_stride"):
-        P.fig_trajectory(dataclasses.replace(ref_run, trajectory=None))
+        P.fig_trajectory(dataclasses.replace(ref_run, trajectory=None), ("symmetric", 1))
+
+
+def test_impacts_are_vertical_jumps(ref_run):
+    t, th, dth = P.with_impacts(ref_run)
+    at = np.flatnonzero(np.isin(t, ref_run.impacts[:, 0]))
+    assert at.size == 2 * ref_run.impacts.shape[0]
+    # each impact: two points at theta = 0, the same instant, theta'- then theta'+
+    np.testing.assert_array_equal(th[at], 0.0)
+    np.testing.assert_array_equal(dth[at[0::2]], ref_run.impacts[:, 1])
+    np.testing.assert_array_equal(dth[at[1::2]], ref_run.impacts[:, 2])
+    assert np.all(np.diff(t) >= 0)
 
 
 def test_gallery_titles_carry_the_classification(ref_run, short_runs):
-    fig = P.fig_gallery({"sym": ref_run, **short_runs})
-    titles = [ax.get_title() for ax in fig.axes[:3]]
-    assert "classified: symmetric" in titles[0]
-    assert "classified: rest" in titles[1]
-    assert "classified: overturn" in titles[2]
-    assert len(fig.axes) == 6
+    runs = {"sym": ref_run, **short_runs}
+    beh = {k: rockjit.classify_result(r) for k, r in runs.items()}
+    fig = P.fig_gallery(runs, beh)
+    titles = [sub.get_suptitle() for sub in fig.subfigs]
+    assert len(titles) == 3
+    assert titles[0].startswith("a) sym") and "symmetric" in titles[0]
+    assert titles[1].startswith("b) rest") and "at rest from" in titles[1]
+    assert titles[2].startswith("c) overturn") and "overturns at" in titles[2]
+    # the behaviour given is the one drawn: a figure classifies nothing itself
+    fig = P.fig_gallery({"sym": ref_run}, {"sym": ("chaotic", 0)})
+    assert "chaotic" in fig.subfigs[0].get_suptitle()
+    assert to_hex(fig.axes[0].get_lines()[0].get_color()) == to_hex(
+        P.BEHAVIOUR_COLOURS["chaotic"])
 
 
 def test_laws_timeseries(short_runs, ref_run):
-    fig = P.fig_laws_timeseries([{"housner": ref_run, "mao": short_runs["rest"]}], t_max=20.0)
-    ax_t = fig.axes[0]
-    assert max(ln.get_xdata().max() for ln in ax_t.get_lines()) <= 20.0
-    labels = [t.get_text() for t in ax_t.get_legend().get_texts()]
-    assert labels == ["Housner: symmetric", "Housner: rest"]
+    row = {"housner": ref_run, "mao": short_runs["rest"]}
+    beh = [{law: rockjit.classify_result(r) for law, r in row.items()}]
+    fig = P.fig_laws_timeseries([row], beh, periods=3)
+    ax_h, ax_m = (ax for ax in fig.axes if "\\theta$" in ax.get_ylabel()
+                  and ax.get_ylabel().count("\n"))
+    assert max(np.asarray(ln.get_xdata(), float).max() for ln in ax_h.get_lines()) <= \
+        3 * ref_run.period
+    assert ax_h.get_ylabel().startswith("Housner") and ax_m.get_ylabel().startswith("Housner")
+    cap = fig.subfigs[0].get_supxlabel()
+    assert cap == "a) Housner: symmetric, $p = 1$; Housner: rest."
+    fig = P.fig_laws_timeseries([row], beh, ["both as said"])
+    assert fig.subfigs[0].get_supxlabel() == "a) both as said"
 
 
 def test_bifurcation_draws_every_finite_point_and_clips_rest():
@@ -145,7 +187,7 @@ def test_bifurcation_draws_every_finite_point_and_clips_rest():
     n_fin = np.isfinite(sw.lambda_max).sum()
     assert sum(len(m) for m in marks) == n_fin + rest.sum()
     legend = [t.get_text() for t in fig.legends[0].get_texts()]
-    assert legend == list(BEHAVIOURS) + ["\u03bb = \u2212\u221e (rest)"]
+    assert legend == list(BEHAVIOURS) + [r"$\lambda = -\infty$ (through rest)"]
 
 
 def test_bifurcation_zoom_and_pair():
@@ -177,9 +219,9 @@ def test_basin_compare_agreement():
     a, b = _basin("housner", 1), _basin("mao", 2)
     fig = P.fig_basin_compare(a, b)
     pct = 100.0 * np.mean(a.label == b.label)
-    assert f"{pct:.1f} %" in fig.axes[2].get_title()
+    assert f"{pct:.1f} %" in fig.axes[2].get_title(loc="left")
     np.testing.assert_array_equal(fig.axes[2].images[0].get_array(),
                                   (a.label == b.label).T.astype(int))
-    assert P.agreement(a.label, b.label) == pytest.approx(pct)
+    assert agreement(a.label, b.label) == pytest.approx(pct)
     with pytest.raises(ValueError, match="same grid"):
         P.fig_basin_compare(a, _basin("mao", 2, n=5))

@@ -45,7 +45,7 @@ from ..result import (APERIODIC, ASYMMETRIC, BEHAVIOURS, CHAOTIC, MULTIPERIODIC,
 from .cycles import cycle_distance, cycle_size
 
 __all__ = ["CLOUD_GRID", "CONT_TOL", "MATCH_TOL", "OVERTURN_ID", "UNRESOLVED_ID", "Attractor",
-           "attractor_agreement", "attractor_distance", "cycle_distance", "cycles_differ",
+           "agreement", "attractor_agreement", "attractor_distance", "cycle_distance", "cycles_differ",
            "floquet", "identify", "identify_along", "match_attractors"]
 
 #: Outcome ids of the cells that reach no attractor.
@@ -388,6 +388,23 @@ def match_attractors(a, b, tol=MATCH_TOL, floor=1e-12):
             pairs[i] = j
             used.add(j)
     return pairs
+
+
+def agreement(label_a, label_b):
+    """Percentage of cells where two label arrays (the two laws' behaviour maps of one grid)
+    agree.
+
+    Examples
+    --------
+    >>> from rockjit.basins.identity import agreement
+    >>> agreement([[0, 2], [2, 5]], [[0, 2], [3, 5]])
+    75.0
+    """
+    a = np.asarray(label_a)
+    b = np.asarray(label_b)
+    if a.shape != b.shape:
+        raise ValueError(f"label arrays differ in shape ({a.shape} vs {b.shape})")
+    return 100.0 * np.count_nonzero(a == b) / a.size if a.size else math.nan
 
 
 #: Across laws, the nearest attractor of the same kind within this many times the orbit's size

@@ -422,6 +422,11 @@ def _add_forcing(p):
 
 def _add_common(p, threads=True):
     p.add_argument("--out", required=True, help="output directory (created if missing)")
+    p.add_argument("--style", default="default", choices=("default", "paper"),
+                   help="figures for the screen (default) or for a journal's columns (paper: "
+                        "no figure titles, 3.5 and 7.2 inches wide, 8-point type)")
+    p.add_argument("--format", default="png", choices=("png", "pdf", "svg"),
+                   help="format of the figures (default png)")
     if threads:
         p.add_argument("--threads", type=int, default=None,
                        help="numba threads (default all); results do not depend on it")
@@ -586,7 +591,9 @@ def build_parser():
                  "(7) and the erosion profiles (8). Smaller --grid, "
                  "--periods, --alpha-step give a quick version. An interrupted paper resumes; "
                  "--scheduler runs its grids on Dask.")
-    p.add_argument("--grid", type=int, default=100, help="basin cells per side (default 100)")
+    p.add_argument("--grid", type=int, default=None,
+                   help="cells per side of every basin, the erosion profiles' too (default "
+                        "100 for the study's basins, 40 for the erosion profiles' survey)")
     p.add_argument("--periods", type=int, default=500, help="forcing periods (default 500)")
     p.add_argument("--n-steps", type=int, default=None,
                    help="steps per period (default 160 for single runs, 64 for grids)")
@@ -598,8 +605,9 @@ def build_parser():
                    help="step of the zoom sweep (default alpha-step / 4)")
     p.add_argument("--erosion-step", type=float, default=0.02,
                    help="amplitude step of the erosion profiles (default 0.02)")
-    p.add_argument("--erosion-grid", type=int, default=40,
-                   help="cells per side of the erosion profiles' basins (default 40)")
+    p.add_argument("--erosion-grid", type=int, default=None,
+                   help="cells per side of the erosion profiles' basins (default --grid, or "
+                        "40 without it)")
     p.add_argument("--as-published", action="store_true",
                    help="also draw figure 5 as the study computed it: integrated past overturning")
     _add_common(p)
@@ -678,9 +686,13 @@ def main(argv=None):
             return 130
     import matplotlib
     matplotlib.use("Agg")
+    from ..plotting import style
     out = OutputDir(args.out, command=args.command)
+    out.figure_format = getattr(args, "format", None)
+    out.dpi = style.STYLES[getattr(args, "style", "default")].rc["savefig.dpi"]
     try:
-        with sigterm_interrupts(), warnings.catch_warnings():
+        with sigterm_interrupts(), warnings.catch_warnings(), \
+                style.use(getattr(args, "style", "default")):
             if args.quiet:
                 warnings.simplefilter("ignore")
             wall, results = args.run(args, plan, out)

@@ -1,45 +1,77 @@
 """What each command leaves on disk: its data (``.npz``), its figures and its summary.
 
 One function per kind of result writes it into an output directory object
-(:class:`rockjit.storage.files.OutputDir`, or anything with its ``npz`` and ``figure`` methods) and returns
-the JSON-ready part of ``summary.json`` that describes it. The command line and the paper
-(:func:`rockjit.study.paper`) both write through these, so a sweep or a basin has the same files
-wherever it was computed.
+(:class:`rockjit.storage.files.OutputDir`, or anything with its ``npz``, ``figure`` and
+``describe`` methods) and returns the JSON-ready part of ``summary.json`` that describes it.
+The command line and the paper (:func:`rockjit.study.paper`) both write through these, so a
+sweep or a basin has the same files wherever it was computed. Every file is described
+(``out.describe``): ``summary.json`` lists each with what it holds.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["basins", "erosion", "fate", "orbits", "plane", "sweep", "trajectory"]
+__all__ = ["basins", "erosion", "fate", "manifest", "orbits", "plane", "sweep", "trajectory"]
+
+
+def manifest(out):
+    """``[{"name": ..., "holds": ...}]`` of every file written, ``summary.json`` included."""
+    holds = dict(getattr(out, "holds", {}))
+    holds.setdefault("summary.json", "this manifest, the command, its inputs, rockjit's "
+                                     "version, the wall time and the results in numbers")
+    return [dict(name=n, holds=holds.get(n, "")) for n in sorted(set(out.written)
+                                                                 | {"summary.json"})]
 
 
 def summary(out, command, inputs, wall, **results):
     """``summary.json``'s content: the command and its inputs, rockjit's version, the wall
-    time, the behaviour names, every file written, and the command's ``results``."""
+    time, the behaviour names, every file written with what it holds (``files``), and the
+    command's ``results``."""
     from .. import __version__
     from ..result import BEHAVIOURS
     return dict(command=command, rockjit_version=__version__, inputs=inputs, wall_s=wall,
-                behaviours=list(BEHAVIOURS), files=sorted(out.written + ["summary.json"]),
-                **results)
+                behaviours=list(BEHAVIOURS), files=manifest(out), **results)
+
+
+def _figure(out, name, fig, holds):
+    """Write a figure (in the output's format) and describe it; returns its name."""
+    written = out.figure(name, fig)
+    written = written if isinstance(written, str) else name
+    out.describe(written, holds)
+    return written
+
+
+def _npz(out, name, holds, **arrays):
+    out.npz(name, **arrays)
+    out.describe(name, holds)
+    return name
 
 
 def trajectory(out, res, *, npz="trajectory.npz", png="trajectory.png"):
-    """One run: its arrays (``Result.arrays``) and :func:`rockjit.plotting.figures.fig_trajectory`."""
+    """One run: its arrays (``Result.arrays``) and
+    :func:`rockjit.plotting.figures.fig_trajectory`."""
     from ..single import classify_result
     from ..plotting.figures import fig_trajectory
     name, period = classify_result(res)
-    out.npz(npz, **res.arrays())
-    out.figure(png, fig_trajectory(res))
+    _npz(out, npz, "the run's arrays: t, theta, dtheta, r, s (recorded trajectory), strobe, "
+                   "strobe_half, impacts (t, dtheta-, dtheta+), lyapunov_running", **res.arrays())
+    _figure(out, png, fig_trajectory(res, (name, period)),
+            f"theta(t) over the first and the last periods, the running exponent and the "
+            f"phase portrait (data: {npz})")
     return dict(res.summary(), behaviour=name, period=period)
 
 
 def sweep(out, sw, *, npz="sweep.npz", png="bifurcation.png"):
     """A sweep: its arrays and its bifurcation diagram."""
     from ..plotting.figures import fig_bifurcation
-    out.npz(npz, **sw.arrays())
+    _npz(out, npz, "the sweep: alpha, label (behaviour codes, names), period, lambda_max "
+                   "(exact where periodic), lambda_window (finite-window estimate), strobe "
+                   "(theta, theta' at kT), impact_section, t_end, attractor", **sw.arrays())
     if png:
-        out.figure(png, fig_bifurcation(sw))
+        _figure(out, png, fig_bifurcation(sw),
+                f"bifurcation diagram: theta'(kT) against alpha by behaviour, lambda_max "
+                f"below (data: {npz})")
     summary = dict(n_alpha=int(sw.alpha.size), fractions=sw.fractions(), settings=sw.settings,
                    restitution=sw.block.restitution, attractors=sw.attractor_summary())
     if sw.uncertain is not None:
@@ -51,8 +83,8 @@ def basins(out, res, *, npz="basin.npz", png="basin.png", attractors_png="attrac
     """One basin, or two laws' (a dict ``law: BasinResult``): the labels, attractor maps and
     (when computed) exponents and uncertain cells, per law when there are two; the behaviour
     map (with the two laws' agreement) and the attractor map with its measures."""
-    from ..basins.identity import attractor_agreement
-    from ..plotting.figures import agreement, fig_attractors, fig_basin, fig_basin_compare
+    from ..basins.identity import agreement, attractor_agreement
+    from ..plotting.figures import fig_attractors, fig_basin, fig_basin_compare
     if not isinstance(res, dict):
         res = {res.block.law: res}
     first = next(iter(res.values()))
@@ -61,7 +93,8 @@ def basins(out, res, *, npz="basin.npz", png="basin.png", attractors_png="attrac
 
     def of(b, suffix):
         a = {"label": b.label, "period": b.period, "t_end": b.t_end, "attractor": b.attractor,
-             "lambda_max": b.lambda_max, "uncertain": b.uncertain}
+             "lambda_max": b.lambda_max, "lambda_window": b.lambda_window,
+             "uncertain": b.uncertain}
         return {k + suffix: v for k, v in a.items() if v is not None}
 
     def summary(b):
@@ -83,10 +116,17 @@ def basins(out, res, *, npz="basin.npz", png="basin.png", attractors_png="attrac
         if a.attractor is not None and b.attractor is not None:
             results["attractor_agreement"] = attractor_agreement(a, b)
         fig = fig_basin_compare(a, b)
-    out.npz(npz, **arrays)
-    out.figure(png, fig)
+    laws = " per law (suffix _<law>)" if len(res) > 1 else ""
+    _npz(out, npz, f"theta0, dtheta0 and{laws} label (label[i, j] of theta0[i], dtheta0[j]), "
+                   f"period, t_end, attractor ids, exponents and uncertain cells when "
+                   f"computed", **arrays)
+    _figure(out, png, fig, f"the behaviour of each initial state{laws}"
+                           + (" and where the laws agree" if len(res) > 1 else "")
+                           + f" (data: {npz})")
     if attractors_png and first.attractor is not None:
-        out.figure(attractors_png, fig_attractors(res))
+        _figure(out, attractors_png, fig_attractors(res),
+                f"the attractor each initial state reaches, by name, with basin entropy and "
+                f"integrity (data: {npz}, attractor)")
     results.update(r0=first.settings.get("r0"), s0=first.settings.get("s0"))
     return results
 
@@ -97,11 +137,16 @@ def plane(out, pl, *, npz="plane.npz", png="plane.png"):
     arrays = dict(alpha=pl.alpha, omega=pl.omega, z0=pl.z0, label=pl.label[0],
                   period=pl.period[0], lambda_max=pl.lambda_max[0], t_end=pl.t_end[0],
                   names=np.asarray(pl.names, dtype=str))
+    if pl.lambda_window is not None:
+        arrays["lambda_window"] = pl.lambda_window[0]
     for key in ("attractor", "uncertain"):
         if getattr(pl, key) is not None:
             arrays[key] = getattr(pl, key)[0]
-    out.npz(npz, **arrays)
-    out.figure(png, fig_plane(pl))
+    _npz(out, npz, "alpha, omega, z0, label (label[i, j] of alpha[i], omega[j]), period, "
+                   "lambda_max (exact where periodic), lambda_window, t_end, attractor",
+         **arrays)
+    _figure(out, png, fig_plane(pl), f"behaviour and lambda_max over the forcing plane "
+                                     f"(data: {npz})")
     summary = dict(fractions=pl.fractions(), settings=pl.settings,
                    restitution=pl.block.restitution, attractors=pl.attractor_summary())
     if pl.uncertain is not None:
@@ -114,9 +159,13 @@ def erosion(out, res, *, npz="erosion.npz", png="erosion.png"):
     profile figure."""
     from ..plotting.figures import fig_erosion
     first = next(iter(res.values()))
-    out.npz(npz, alpha=first.alpha, theta0=first.theta0, dtheta0=first.dtheta0,
-            **{k: v for law, r in res.items() for k, v in r.arrays(f"_{law}").items()})
-    out.figure(png, fig_erosion(res))
+    _npz(out, npz, "alpha, theta0, dtheta0 and per law (suffix _<law>): GIM, IF, fractions "
+                   "(each attractor's percent at each alpha), overturn, basin_entropy, the "
+                   "attractor and label maps of every basin",
+         alpha=first.alpha, theta0=first.theta0, dtheta0=first.dtheta0,
+         **{k: v for law, r in res.items() for k, v in r.arrays(f"_{law}").items()})
+    _figure(out, png, fig_erosion(res), f"integrity (GIM, IF) against alpha and the basin of "
+                                        f"each attractor, stacked (data: {npz})")
     return {law: r.to_summary() for law, r in res.items()}
 
 
@@ -124,19 +173,30 @@ def fate(out, fr, *, npz="fate.npz", png="fate.png"):
     """An ensemble's outcomes: the members' initial states, outcomes and end times, and a
     figure of the outcome probabilities and the end times against the horizon."""
     from ..plotting.figures import fig_fate
-    out.npz(npz, initial=fr.initial, outcome=fr.outcome, t_end=fr.t_end)
-    out.figure(png, fig_fate(fr))
+    _npz(out, npz, "the members' initial states, outcome ids (-1 overturn, -2 unresolved, "
+                   "attractors from 0) and end times", initial=fr.initial, outcome=fr.outcome,
+         t_end=fr.t_end)
+    _figure(out, png, fig_fate(fr), f"each outcome's probability and when each member's run "
+                                    f"ended (data: {npz})")
     return fr.to_summary()
 
 
-def orbits(out, res, *, npz="orbits.npz", png="orbits.png"):
+def orbits(out, res, *, npz="orbits.npz", png="orbits.png", caption="orbits.md"):
     """Branches of periodic orbits (``(Continuation, SweepResult)``): the branches' and
-    bifurcations' arrays, the diagram with the branches over the sweep's dots, and the summary
-    (``"bifurcations"``: type, alpha, period, multipliers, state)."""
-    from ..plotting.figures import fig_branches
+    bifurcations' arrays, the diagram with the branches over the sweep's dots, its caption
+    (every bifurcation and where each branch stops) and the summary (``"bifurcations"``: type,
+    alpha, period, multipliers, state)."""
+    from ..plotting.figures import branch_caption, fig_branches
     cont, sw = res
     summary, arrays = cont.to_summary()
-    out.npz(npz, **arrays)
-    out.figure(png, fig_branches(cont, sw))
+    _npz(out, npz, "per branch i: branch{i}_value, _cycle, _multipliers, _stable, ...; the "
+                   "bifurcations: bif_type, bif_value, bif_period, bif_multipliers",
+         **arrays)
+    _figure(out, png, fig_branches(cont, sw), f"branches of periodic orbits over the sweep, "
+                                              f"bifurcations marked (data: {npz}; list: "
+                                              f"{caption})")
+    out.text(caption, branch_caption(cont))
+    out.describe(caption, "the branches' caption: every bifurcation with its multipliers and "
+                          "where and why each branch stops")
     summary["sweep_fractions"] = sw.fractions()
     return summary

@@ -65,7 +65,8 @@ def basin(block, forcing, grid=100, *, integration=None, classification=None, ly
     phi, r0, s0 = forcing.start()
     par, ipar, cpar, settings = gp.common(block, forcing, phi, integration, classification)
     lyapunov = boolean("lyapunov", lyapunov)
-    n_pts = settings["pmax"] if classification.attractors else 0
+    # cycle points: the attractors' identity, and each periodic cell's exact exponent
+    n_pts = settings["pmax"] if classification.attractors or lyapunov else 0
     nbytes = gp.grid_memory(f"grid = {lat.grid}", float(lat.grid) ** 2, settings, execution,
                             n_pts, lyapunov=lyapunov,
                             copies=2 if classification.uncertainty else 1)

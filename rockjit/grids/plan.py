@@ -33,7 +33,7 @@ from ..validate import integer, memory, pair, real
 from . import runner
 
 __all__ = ["GRID_N", "MAX_CELLS", "GridPlan", "alpha_count", "alpha_grid", "common",
-           "grid_memory", "run", "uncertain_cells"]
+           "exponents", "grid_memory", "run", "uncertain_cells"]
 
 #: Steps per period of sweeps, basins and planes: they need labels and lambda_max, not 1e-10
 #: event times. On the study's four basins and its 501-amplitude sweep, N = 64 gives the labels
@@ -208,12 +208,16 @@ def run(plan: GridPlan, execution=None):
     r = kernel.grid_results(out)
     label = r["label"].reshape(p.shape)
     period = r["period"].reshape(p.shape)
-    lam = r["lam1"].reshape(p.shape)
+    window = r["lam1"].reshape(p.shape)
+    exact = {}
+    lam = exponents(p, r, out["pts"], out["n_got"], exact).reshape(p.shape) if p.tangent \
+        else window
     common_ = dict(block=p.block, forcing=p.forcing, settings=dict(p.settings), label=label,
-                   period=period, t_end=r["t_end"].reshape(p.shape))
+                   period=period, t_end=r["t_end"].reshape(p.shape),
+                   lambda_window=window if p.tangent else None)
     if p.attractors:
         common_["attractor"], common_["attractors"] = _identify(p, r, out["pts"],
-                                                               out["n_got"])
+                                                               out["n_got"], exact)
     if p.kind == "sweep":
         result = SweepResult(alpha=p.axes["alpha"], lambda_max=lam, strobe=out["pts"],
                              impact_section=out["imp"], t_overturn=r["t_overturn"],
@@ -265,14 +269,71 @@ def uncertain_cells(plan, result, eps, *, seed=0, execution=None):
     return differ
 
 
-def _identify(p, r, pts, n_got):
+def _cell_forcing(p, cell):
+    """``(alpha, omega, phi)`` of a cell: a basin's cells share the plan's forcing; a sweep's
+    or a plane's each have their own (read from the cell's parameter row)."""
+    if p.kind == "basin":
+        return p.forcing.alpha, p.forcing.omega, p.phi
+    return kernel.forcing_of(p.pars[cell])
+
+
+def _floquet_of(p, integration, alpha, omega, phi, point, period, exact):
+    """:func:`rockjit.basins.identity.floquet` of one cycle, kept in ``exact`` under its exact
+    inputs: a cycle met again with bit-identical inputs reuses the multipliers, any other is
+    computed anew."""
+    point = np.asarray(point, dtype=float)
+    key = (float(alpha), float(omega), float(phi), point.tobytes(), int(period))
+    if key not in exact:
+        exact[key] = floquet(p.block, Harmonic(alpha=alpha, omega=omega), phi, integration,
+                             p.settings["n_steps"], point, int(period))
+    mu, lam = exact[key]
+    return mu.copy(), lam.copy()
+
+
+def _runs_integration(p):
+    return Integration(theta_over=p.settings["theta_over"], rest_speed=p.settings["rest_speed"])
+
+
+def exponents(p, r, pts, n_got, exact=None):
+    """``lambda_max`` of each cell (flat): the Floquet exponent ``ln|mu1| / (pT)`` where the
+    cell settled on a periodic orbit, the finite-window estimate ``lam1`` elsewhere.
+
+    A cell is periodic when its label is symmetric, asymmetric or multiperiodic with a period
+    ``p`` and it kept at least ``p`` samples at ``t = kT``: its cycle point
+    ``pts[cell, n_got - p]`` (the first of its last ``p``) starts a run of ``p`` periods with
+    tangent vectors and no renormalisation, saltation at every impact
+    (:func:`rockjit.basins.identity.floquet`), whose tangent is the monodromy; through a rest
+    phase the monodromy is zero and the exponent ``-inf``. On a periodic orbit the window's
+    QR average converges to this value only as the window grows, slowly and oscillating where
+    the multipliers are a complex pair (docs/theory/exponents.md); the exact value does not
+    depend on when the run stopped. Every cell is its own computation (a sweep's or a plane's
+    cells are each their own system); ``exact`` collects the multipliers by their exact inputs
+    so that :func:`_identify` reuses them for an attractor whose cycle point is bit-identical.
+    """
+    from ..result import ASYMMETRIC, MULTIPERIODIC, SYMMETRIC
+    exact = {} if exact is None else exact
+    lam = np.array(r["lam1"], dtype=float, copy=True)
+    label, period = r["label"], r["period"]
+    periodic = np.isin(label, (SYMMETRIC, ASYMMETRIC, MULTIPERIODIC)) & (period > 0) & \
+        (n_got >= period)
+    integration = _runs_integration(p)
+    for cell in np.flatnonzero(periodic):
+        per = int(period[cell])
+        alpha, omega, phi = _cell_forcing(p, cell)
+        _, lam_c = _floquet_of(p, integration, alpha, omega, phi, pts[cell, n_got[cell] - per],
+                               per, exact)
+        lam[cell] = lam_c[0]
+    return lam
+
+
+def _identify(p, r, pts, n_got, exact=None):
     """Attractor ids (shaped like the labels) and attractors of a plan's cells, with the
-    Floquet multipliers of the periodic ones (:mod:`rockjit.basins.identity`)."""
+    Floquet multipliers of the periodic ones (:mod:`rockjit.basins.identity`; those of a
+    cycle already computed by :func:`exponents` with bit-identical inputs are reused)."""
+    exact = {} if exact is None else exact
     label, period = r["label"], r["period"]
     lam = np.column_stack([r["lam1"], r["lam2"]]) if p.tangent else None
-    n_steps = p.settings["n_steps"]
-    integration = Integration(theta_over=p.settings["theta_over"],
-                              rest_speed=p.settings["rest_speed"])
+    integration = _runs_integration(p)
     if p.kind == "basin":
         ids, found = identify(label, period, pts, n_got, lam)
         forcing = {a.id: (p.forcing.alpha, p.forcing.omega, p.phi) for a in found}
@@ -297,6 +358,6 @@ def _identify(p, r, pts, n_got):
     for a in found:
         if a.period:
             alpha, omega, phi = forcing[a.id]
-            a.multipliers, a.lam = floquet(p.block, Harmonic(alpha=alpha, omega=omega), phi,
-                                           integration, n_steps, a.points[0], a.period)
+            a.multipliers, a.lam = _floquet_of(p, integration, alpha, omega, phi, a.points[0],
+                                               a.period, exact)
     return ids.reshape(p.shape), found

@@ -82,7 +82,8 @@ def plane(block, alpha_range, omega_range, *, grid=(50, 50), state=None, forcing
     first = forcing.replace(alpha=a0, omega=w0)
     par, ipar, cpar, settings = gp.common(block, first, phis[0], integration, classification)
     lyapunov = boolean("lyapunov", lyapunov)
-    n_pts = settings["pmax"] if classification.attractors else 0
+    # cycle points: the attractors' identity, and each periodic cell's exact exponent
+    n_pts = settings["pmax"] if classification.attractors or lyapunov else 0
     nbytes = gp.grid_memory(f"grid = ({na}, {nw})", float(M) * na * nw, settings, execution,
                             n_pts, lyapunov=lyapunov,
                             copies=2 if classification.uncertainty else 1)

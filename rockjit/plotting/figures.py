@@ -1,78 +1,64 @@
-"""The study's figures (SPEC.md §7), one function each; matplotlib is imported lazily.
+"""The study's figures (docs/theory/study.md, "The figures"), one function each.
 
-Every function takes result objects (:class:`rockjit.Result`, :class:`rockjit.grids.grids.SweepResult`,
-:class:`rockjit.grids.grids.BasinResult`) and returns a :class:`matplotlib.figure.Figure` built
-without :mod:`matplotlib.pyplot`, so no GUI backend is needed and nothing is kept in pyplot's
-figure registry; save it with :func:`rockjit.storage.files.save_figure` or ``fig.savefig``.
+Every function takes result objects (:class:`rockjit.result.Result`,
+:class:`~rockjit.result.SweepResult`, :class:`~rockjit.result.BasinResult`, ...) and what was
+computed about them (a run's behaviour, an ensemble's outcomes, a basin's measures), and returns
+a :class:`matplotlib.figure.Figure` built without :mod:`matplotlib.pyplot`, so no GUI backend is
+needed and nothing is kept in pyplot's figure registry; save it with
+:func:`rockjit.storage.files.save_figure` or ``fig.savefig``. Nothing here computes a result:
+behaviours are passed in (``rockjit.classify_result`` gives a run's) or read from a grid's
+labels.
 
-Behaviours have one colour everywhere: :data:`BEHAVIOUR_COLOURS`.
+The visual language (colours, names, symbols, sizes, panel letters) is
+:mod:`rockjit.plotting.style`'s; figures drawn inside ``style.use("paper")`` are sized for a
+journal's columns and have no figure titles.
 """
 
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 
-from ..single import classify_result
-from ..result import BEHAVIOURS, fractions
 from ..model import delta_e_percent, e_housner, e_mao, thc_from_hb
+from ..result import BEHAVIOURS, fractions
+from . import style as S
+from .style import AGREE_COLOUR, BEHAVIOUR_COLOURS, DISAGREE_COLOUR, LAW_LINES, SYMBOLS
 
-__all__ = ["BEHAVIOUR_COLOURS", "LAW_COLOURS", "agreement", "fig_attractors", "fig_basin",
-           "fig_basin_compare", "fig_bifurcation", "fig_erosion", "fig_fate", "fig_gallery",
-           "fig_laws_timeseries", "fig_plane", "fig_restitution", "fig_trajectory"]
+__all__ = ["BEHAVIOUR_COLOURS", "BIFURCATION_MARKERS", "END_MARKERS", "branch_caption",
+           "fig_attractors", "fig_basin", "fig_basin_compare", "fig_bifurcation",
+           "fig_branches", "fig_erosion", "fig_fate", "fig_gallery", "fig_laws_timeseries",
+           "fig_plane", "fig_restitution", "fig_trajectory"]
 
-#: One colour per behaviour name (analysis.BEHAVIOURS), used by every figure.
-BEHAVIOUR_COLOURS = {
-    "overturn": "#3b3b3b",
-    "rest": "#bdbdbd",
-    "symmetric": "#1f77b4",
-    "asymmetric": "#2ca02c",
-    "multiperiodic": "#ff7f0e",
-    "chaotic": "#d62728",
-    "aperiodic": "#9467bd",
-    "unresolved": "#e377c2",
-}
-#: Colours of the restitution laws in comparisons.
-LAW_COLOURS = {"housner": "#1f77b4", "mao": "#d62728", "constant": "#2ca02c"}
-
-_LAW_NAMES = {"housner": "Housner", "mao": "Mao", "constant": "constant e"}
-_GREEK = {"theta": "\u03b8", "dtheta": "\u03b8\u2032", "lambda": "\u03bb", "alpha": "\u03b1",
-          "omega": "\u03c9"}
+#: Lines of a behaviour: its colour, except the pale ones (rest), darkened to be seen as a line.
+LINE_COLOURS = dict(BEHAVIOUR_COLOURS, rest="#8C8C8C")
 
 
-def _figure(**kw):
+def _figure(width, aspect):
     from matplotlib.figure import Figure
-    kw.setdefault("layout", "constrained")
-    return Figure(**kw)
-
-
-def _law(block):
-    if block.law == "constant":
-        return f"e = {block.restitution:g}"
-    return _LAW_NAMES.get(block.law, block.law)
+    from matplotlib.layout_engine import ConstrainedLayoutEngine
+    # a little more than the default pads (3 points): constrained layout can leave a rotated
+    # axis label a point or two beyond the canvas's edge when a column's tick labels widen
+    return Figure(figsize=S.current().size(width, aspect),
+                  layout=ConstrainedLayoutEngine(w_pad=0.06, h_pad=0.05))
 
 
 def _params(res):
     """The block and forcing of a result, in words."""
     b, f = res.block, res.forcing
-    return f"{_law(b)}, h/b = {b.hb:g}, \u03b1 = {f.alpha:g}, \u03c9 = {f.omega:g}"
+    return (f"{S.law_name(b)}, $h/b = {b.hb:g}$, $\\alpha = {f.alpha:g}$, "
+            f"$\\omega = {f.omega:g}$")
 
 
-def agreement(label_a, label_b):
-    """Percentage of cells where two label arrays agree."""
-    a = np.asarray(label_a)
-    b = np.asarray(label_b)
-    if a.shape != b.shape:
-        raise ValueError(f"label arrays differ in shape ({a.shape} vs {b.shape})")
-    return 100.0 * np.count_nonzero(a == b) / a.size if a.size else math.nan
-
-
-def _cmap():
-    from matplotlib.colors import BoundaryNorm, ListedColormap
-    cmap = ListedColormap([BEHAVIOUR_COLOURS[n] for n in BEHAVIOURS])
-    norm = BoundaryNorm(np.arange(len(BEHAVIOURS) + 1) - 0.5, cmap.N)
-    return cmap, norm
+def _behaviour_words(behaviour):
+    """``(name, period)`` in words: ``symmetric``, ``period-2``, ..."""
+    name, p = behaviour
+    if name == "multiperiodic":
+        return f"period-{p} (multiperiodic)"
+    if name in ("symmetric", "asymmetric"):
+        return f"{name}, $p = {p}$"
+    return name
 
 
 def _behaviour_handles(names, labels=None, marker=False):
@@ -83,589 +69,12 @@ def _behaviour_handles(names, labels=None, marker=False):
         lab = n if labels is None else labels[i]
         if marker:
             out.append(Line2D([], [], ls="", marker="o", ms=5, color=BEHAVIOUR_COLOURS[n],
-                              label=lab))
+                              mec="0.45", mew=0.4, label=lab))
         else:
-            out.append(Patch(color=BEHAVIOUR_COLOURS[n], label=lab))
+            out.append(Patch(facecolor=BEHAVIOUR_COLOURS[n], edgecolor="0.6", lw=0.4,
+                             label=lab))
     return out
 
-
-# ---------------------------------------------------------------------------------------------
-# Figure 1: restitution laws
-# ---------------------------------------------------------------------------------------------
-
-def fig_restitution(hb_range=(1.0 / math.sqrt(2.0), 6.0), n=400, marks=(1.0, 2.0)):
-    """Figure 1: ``e_H`` and ``e_M`` against ``thc``, with ``Δe%`` on a twin axis.
-
-    Parameters
-    ----------
-    hb_range : (float, float)
-        Slenderness range; the Housner law needs ``hb >= 1/sqrt(2)``.
-    n : int
-        Number of points.
-    marks : sequence of float
-        Slenderness values marked with a vertical line and their values.
-    """
-    lo, hi = (float(v) for v in hb_range)
-    if not 1.0 / math.sqrt(2.0) - 1e-12 <= lo < hi:
-        raise ValueError(f"hb_range must satisfy 1/sqrt(2) <= start < end (got {lo}, {hi})")
-    thc = np.linspace(thc_from_hb(lo), thc_from_hb(hi), n)
-    eh, em = e_housner(thc), e_mao(thc)
-    de = delta_e_percent(em, eh)
-    fig = _figure(figsize=(7.0, 4.2))
-    ax = fig.add_subplot()
-    deg = np.degrees(thc)
-    ax.plot(deg, eh, color=LAW_COLOURS["housner"], label="$e_H$ (Housner 1963)")
-    ax.plot(deg, em, color=LAW_COLOURS["mao"], label="$e_M$ (Mao et al. 2024)")
-    ax.set_xlabel("$\\theta_c$ = arctan(h/b)  [degrees]")
-    ax.set_ylabel("coefficient of restitution $e$")
-    ax.set_ylim(0, 1.02)
-    ax2 = ax.twinx()
-    ax2.plot(deg, de, color="0.35", ls="--", label="$\\Delta e$ % (right axis)")
-    ax2.set_ylabel("$\\Delta e$  [%]")
-    ax2.set_ylim(0, max(1.0, float(np.nanmax(de))) * 1.05)
-    for hb in marks:
-        t = float(thc_from_hb(hb))
-        h, m = float(e_housner(t)), float(e_mao(t))
-        ax.axvline(np.degrees(t), color="0.6", lw=0.8, ls=":")
-        ax.plot([np.degrees(t)] * 2, [h, m], "o", color="k", ms=3.5, zorder=5)
-        # on the twin axes, which are drawn above the first ones: the box hides the curves
-        ax2.annotate(f"h/b = {hb:g}\n$e_H$ = {h:.3f}\n$e_M$ = {m:.3f}\n"
-                     f"$\\Delta e$ = {float(delta_e_percent(m, h)):.2f} %",
-                     (np.degrees(t), 0.03), xycoords=ax.transData, xytext=(4, 0),
-                     textcoords="offset points", fontsize=8, va="bottom", zorder=6,
-                     bbox=dict(boxstyle="round,pad=0.25", fc="white", ec="0.8"))
-    lines = ax.get_legend_handles_labels()
-    lines2 = ax2.get_legend_handles_labels()
-    ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], loc="center right", fontsize=9)
-    top = ax.secondary_xaxis("top", functions=(
-        lambda d: np.tan(np.radians(np.clip(d, 1e-3, 89.9))),
-        lambda hb: np.degrees(np.arctan(hb))))
-    top.set_xticks([1, 1.5, 2, 3, 4, 6, 10])
-    top.set_xticklabels(["1", "1.5", "2", "3", "4", "6", "10"])
-    top.set_xlabel("h/b")
-    ax.set_title("Coefficient of restitution: Housner vs Mao et al.")
-    return fig
-
-
-# ---------------------------------------------------------------------------------------------
-# Figure 2: one run
-# ---------------------------------------------------------------------------------------------
-
-def _window_start(result):
-    if result.window is not None:
-        return float(result.window[0])
-    return round(0.8 * result.periods) * result.period
-
-
-def _window_traj(result):
-    """Trajectory rows of the asymptotic window; the whole run when the window is empty."""
-    tr = result.trajectory
-    w = tr[tr[:, 0] >= _window_start(result) - 1e-9]
-    return (w, True) if w.shape[0] >= 2 else (tr, False)
-
-
-def _need_traj(result):
-    if result.trajectory is None or result.trajectory.shape[0] == 0:
-        raise ValueError("the result has no trajectory: simulate with record_stride=...")
-
-
-def _phase(ax, result, colour="k", label=None, strobe=True):
-    w, in_window = _window_traj(result)
-    ax.plot(w[:, 1], w[:, 2], lw=0.6, color=colour, label=label)
-    if strobe and in_window:
-        s = result.strobe
-        k0 = int(round(_window_start(result) / result.period))
-        s = s[k0:]
-        if s.shape[0]:
-            ax.plot(s[:, 0], s[:, 1], "o", ms=3.5, mfc="none", color="#d62728",
-                    label="t = kT" if label is None else None)
-    ax.set_xlabel("\u03b8")
-    ax.set_ylabel("\u03b8\u2032")
-    return in_window
-
-
-def fig_trajectory(result, title=None):
-    """Figure 2: ``θ(t)``, ``λ(t)`` and the phase portrait of the window for one run.
-
-    ``result`` needs a trajectory (``record_stride``); ``λ(t)`` is drawn when the run computed
-    Lyapunov exponents (``result.lyapunov_running`` at ``t = kT``).
-    """
-    _need_traj(result)
-    tr = result.trajectory
-    lam = result.lyapunov_running
-    fig = _figure(figsize=(10.5, 6.0))
-    gs = fig.add_gridspec(2, 2, width_ratios=(1.7, 1.0))
-    ax_t = fig.add_subplot(gs[0, 0])
-    ax_l = fig.add_subplot(gs[1, 0], sharex=ax_t)
-    ax_p = fig.add_subplot(gs[:, 1])
-    ax_t.plot(tr[:, 0], tr[:, 1], lw=0.5, color="k")
-    ax_t.set_ylabel("\u03b8  [rad]")
-    t_w = _window_start(result)
-    for ax in (ax_t, ax_l):
-        ax.axvspan(t_w, max(result.t, t_w), color="#1f77b4", alpha=0.08, lw=0)
-    ax_t.set_title("\u03b8(t); shaded: the asymptotic window", fontsize=10)
-    if lam is not None and lam.shape[0] > 1:
-        k = np.arange(1, lam.shape[0])
-        ax_l.plot(k * result.period, lam[1:, 0], color="#d62728", lw=1.0, label="\u03bb\u2081(t)")
-        ax_l.axhline(0, color="0.5", lw=0.6)
-        if result.lyapunov is not None and np.isfinite(result.lyapunov[0]):
-            ax_l.axhline(result.lyapunov[0], color="#d62728", lw=0.8, ls="--",
-                         label=f"\u03bb_max over the window = {result.lyapunov[0]:.4f}")
-        ax_l.legend(fontsize=8, loc="upper right")
-        ax_l.set_ylabel("\u03bb\u2081  (running estimate)")
-    else:
-        ax_l.text(0.5, 0.5, "Lyapunov exponents not computed", ha="center", va="center",
-                  transform=ax_l.transAxes, color="0.4")
-    ax_l.set_xlabel("t  (units of 1/\u03a9\u2080)")
-    in_window = _phase(ax_p, result)
-    ax_p.set_title("phase portrait, " + ("asymptotic window" if in_window else "whole run")
-                   + "\n(circles: stroboscopic points t = kT)", fontsize=10)
-    name, p = classify_result(result)
-    beh = name + (f", period {p}" if name == "multiperiodic" else "")
-    fig.suptitle(title or f"{_params(result)}: {beh} ({result.status})")
-    return fig
-
-
-# ---------------------------------------------------------------------------------------------
-# Figure 3: behaviour gallery
-# ---------------------------------------------------------------------------------------------
-
-def fig_gallery(results, notes=None):
-    """Figure 3: ``θ(t)`` and phase portrait of each run, titled with its behaviour.
-
-    Parameters
-    ----------
-    results : dict of str -> Result
-        Caption -> run (each with a trajectory), one column each.
-    notes : dict of str -> str, optional
-        Caption -> a note printed under that run's time series (e.g. an ensemble's outcome
-        probabilities, for a run whose fate is decided by round-off).
-    """
-    if not results:
-        raise ValueError("results must hold at least one run")
-    n = len(results)
-    fig = _figure(figsize=(3.6 * n, 6.2))
-    axes = fig.subplots(2, n, squeeze=False)
-    for c, (caption, res) in enumerate(results.items()):
-        _need_traj(res)
-        name, p = classify_result(res)
-        colour = BEHAVIOUR_COLOURS[name]
-        tr = res.trajectory
-        ax = axes[0, c]
-        ax.plot(tr[:, 0], tr[:, 1], lw=0.5, color=colour)
-        ax.set_xlabel("t")
-        if c == 0:
-            ax.set_ylabel("\u03b8  [rad]")
-        b, f = res.block, res.forcing
-        beh = name + (f" (period {p})" if name == "multiperiodic" else "")
-        ax.set_title(f"{caption}\n\u03b1={f.alpha:g}, \u03c9={f.omega:g}, h/b={b.hb:g}\n"
-                     f"classified: {beh}", fontsize=9,
-                     bbox=dict(boxstyle="round,pad=0.3", fc=colour, alpha=0.25, lw=0))
-        if res.status == "overturned":
-            ax.axhline(np.sign(tr[-1, 1]) * res.integration.theta_over, color="0.5", ls=":", lw=0.8)
-        if notes and caption in notes:
-            ax.text(0.02, 0.03, notes[caption], transform=ax.transAxes, fontsize=7,
-                    va="bottom", bbox=dict(boxstyle="round,pad=0.3", fc="w", alpha=0.85,
-                                           lw=0.5))
-        in_window = _phase(axes[1, c], res, colour=colour)
-        axes[1, c].set_title("window" if in_window else "whole run", fontsize=8)
-    fig.suptitle(f"Behaviour gallery ({_law(next(iter(results.values())).block)})")
-    return fig
-
-
-# ---------------------------------------------------------------------------------------------
-# Figure 4: Housner vs Mao time series
-# ---------------------------------------------------------------------------------------------
-
-def fig_laws_timeseries(runs, t_max=None):
-    """Figure 4: the two laws from the same initial states.
-
-    Parameters
-    ----------
-    runs : sequence of dict law -> Result
-        One row per initial state; in each row the runs of each law (with trajectories).
-    t_max : float, optional
-        Show ``θ(t)`` up to this time only (default: the whole run).
-    """
-    runs = list(runs)
-    if not runs:
-        raise ValueError("runs must hold at least one initial state")
-    fig = _figure(figsize=(11.0, 2.7 * len(runs) + 0.6))
-    gs = fig.add_gridspec(len(runs), 2, width_ratios=(2.2, 1.0))
-    for i, row in enumerate(runs):
-        ax_t = fig.add_subplot(gs[i, 0])
-        ax_p = fig.add_subplot(gs[i, 1])
-        z = None
-        for law, res in row.items():
-            _need_traj(res)
-            tr = res.trajectory
-            if t_max is not None:
-                tr = tr[tr[:, 0] <= t_max]
-            colour = LAW_COLOURS.get(law, None)
-            name, p = classify_result(res)
-            beh = name + (f" {p}" if name == "multiperiodic" else "")
-            lab = f"{_law(res.block)}: {beh}"
-            ax_t.plot(tr[:, 0], tr[:, 1], lw=0.6, color=colour, label=lab, alpha=0.85)
-            _phase(ax_p, res, colour=colour, strobe=False)
-            z = tr[0, 1:3]
-        ax_t.set_ylabel("\u03b8  [rad]")
-        ax_t.legend(fontsize=8, loc="upper right")
-        ax_t.set_title(f"(\u03b8\u2080, \u03b8\u2080\u2032) = ({z[0]:.4f}, {z[1]:.4f})",
-                       fontsize=10, loc="left")
-        ax_p.set_title("phase portrait: window (whole run if it overturned)", fontsize=9)
-        if i == len(runs) - 1:
-            ax_t.set_xlabel("t  (units of 1/\u03a9\u2080)")
-    r0 = next(iter(runs[0].values()))
-    b, f = r0.block, r0.forcing
-    fig.suptitle(f"Housner vs Mao: h/b = {b.hb:g}, \u03b1 = {f.alpha:g}, \u03c9 = {f.omega:g}")
-    return fig
-
-
-# ---------------------------------------------------------------------------------------------
-# Figure 5: bifurcation diagrams
-# ---------------------------------------------------------------------------------------------
-
-def _bifurcation_column(fig, gs_col, sw, alpha_limits, show_y):
-    ax = fig.add_subplot(gs_col[0])
-    ax_s = fig.add_subplot(gs_col[1], sharex=ax)
-    ax_l = fig.add_subplot(gs_col[2], sharex=ax)
-    alpha = np.asarray(sw.alpha)
-    label = np.asarray(sw.label)
-    sel = np.ones(alpha.shape, bool)
-    if alpha_limits is not None:
-        sel = (alpha >= alpha_limits[0] - 1e-12) & (alpha <= alpha_limits[1] + 1e-12)
-    names = [str(n) for n in sw.names]
-    pts = sw.strobe[:, :, 1]
-    present = []
-    for code, name in enumerate(names):
-        m = sel & (label == code)
-        if not m.any():
-            continue
-        present.append(name)
-        a = np.repeat(alpha[m], pts.shape[1])
-        y = pts[m].ravel()
-        ok = np.isfinite(y)
-        ax.scatter(a[ok], y[ok], s=0.6, color=BEHAVIOUR_COLOURS[name], lw=0, rasterized=True)
-    ax.set_ylabel("\u03b8\u2032(kT)" if show_y else "")
-    published = sw.settings.get("stop_at_overturn") is False
-    ax.set_title(f"{_law(sw.block)}, h/b = {sw.block.hb:g}, \u03c9 = {sw.forcing.omega:g}"
-                 + (" \u2014 as published: integrated past overturning" if published else ""),
-                 fontsize=9 if published else 10)
-    ax.tick_params(labelbottom=False)
-
-    # a strip: the behaviour of every alpha, including those without stroboscopic points
-    cmap, norm = _cmap()
-    if alpha.size > 1:
-        d = np.diff(alpha)
-        edges = np.concatenate([[alpha[0] - d[0] / 2], alpha[:-1] + d / 2,
-                                [alpha[-1] + d[-1] / 2]])
-    else:
-        edges = np.array([alpha[0] - 0.5e-3, alpha[0] + 0.5e-3])
-    ax_s.pcolormesh(edges, [0, 1], label[None, :], cmap=cmap, norm=norm, rasterized=True)
-    ax_s.set_yticks([])
-    ax_s.set_ylabel("class" if show_y else "", rotation=0, ha="right", va="center",
-                    fontsize=8)
-    ax_s.tick_params(labelbottom=False)
-
-    lam = np.asarray(sw.lambda_max, float)
-    if np.isfinite(lam[sel]).any():
-        fin = lam[sel & np.isfinite(lam)]
-        lo, hi = float(fin.min()), float(fin.max())
-        pad = 0.08 * max(hi - lo, 1e-3)
-        lo, hi = min(lo, 0.0) - pad, max(hi, 0.0) + pad
-    else:
-        lo, hi = -1.0, 0.5
-    ax_l.set_ylim(lo, hi)
-    show = sel & ~np.isnan(lam)
-    # a thin line through consecutive finite values, broken where there is none
-    ax_l.plot(alpha[sel], np.where(np.isfinite(lam[sel]), lam[sel], np.nan), lw=0.5,
-              color="0.6", zorder=1)
-    any_rest = False
-    for code, name in enumerate(names):
-        m = show & (label == code)
-        fin = m & np.isfinite(lam)
-        ax_l.scatter(alpha[fin], lam[fin], s=4, color=BEHAVIOUR_COLOURS[name], lw=0, zorder=2)
-        neg = m & np.isneginf(lam)
-        if neg.any():  # rest: lambda = -inf, drawn at the panel's bottom
-            any_rest = True
-            ax_l.scatter(alpha[neg], np.full(neg.sum(), lo), marker="v", s=14,
-                         color=BEHAVIOUR_COLOURS[name], zorder=3, clip_on=False)
-    ax_l.axhline(0, color="k", lw=0.6)
-    ax_l.set_xlabel("\u03b1")
-    ax_l.set_ylabel("\u03bb_max" if show_y else "")
-    if alpha_limits is not None:
-        ax.set_xlim(*alpha_limits)
-    elif alpha.size > 1:
-        ax.set_xlim(edges[0], edges[-1])
-    return present, any_rest
-
-
-def fig_bifurcation(sweeps, alpha_limits=None, title=None):
-    """Figure 5: stroboscopic ``θ'`` against ``α``, coloured by behaviour, ``λ_max`` below.
-
-    Parameters
-    ----------
-    sweeps : SweepResult or dict of str -> SweepResult
-        One sweep, or several drawn side by side (e.g. the two laws).
-    alpha_limits : (float, float), optional
-        Draw only this range of ``α`` (the zoom).
-    title : str, optional
-
-    Notes
-    -----
-    ``λ_max = -inf`` (rest) is drawn as a ``▼`` at the bottom of the lower panel; ``nan``
-    (overturn, or not computed) is skipped. A thin strip between the panels gives the
-    behaviour of every ``α``, including those with no stroboscopic points (rest, overturn).
-    """
-    if not isinstance(sweeps, dict):
-        sweeps = {"": sweeps}
-    if not sweeps:
-        raise ValueError("sweeps must hold at least one sweep")
-    if alpha_limits is not None:
-        alpha_limits = tuple(float(v) for v in alpha_limits)
-    n = len(sweeps)
-    from matplotlib.lines import Line2D
-    fig = _figure(figsize=(6.0 * n + 0.5, 6.6))
-    gs = fig.add_gridspec(3, n, height_ratios=(2.4, 0.12, 1.0), hspace=0.02)
-    present, any_rest = set(), False
-    for c, sw in enumerate(sweeps.values()):
-        got, rest = _bifurcation_column(fig, [gs[r, c] for r in range(3)], sw, alpha_limits, c == 0)
-        present |= set(got)
-        any_rest |= rest
-    order = [nm for nm in BEHAVIOURS if nm in present]
-    handles = _behaviour_handles(order, marker=True)
-    if any_rest:
-        handles.append(Line2D([], [], ls="", marker="v", ms=5, color=BEHAVIOUR_COLOURS["rest"],
-                              label="\u03bb = \u2212\u221e (rest)"))
-    fig.legend(handles=handles, loc="outside lower center", ncols=max(1, len(handles)),
-               fontsize=9, frameon=False)
-    if title:
-        fig.suptitle(title)
-    return fig
-
-
-# ---------------------------------------------------------------------------------------------
-# Figure 6: basins
-# ---------------------------------------------------------------------------------------------
-
-def _basin_axes(ax, b, show_y=True):
-    cmap, norm = _cmap()
-    # label[i, j] belongs to theta0[i], dtheta0[j]: rows of the image are dtheta0
-    ax.imshow(np.asarray(b.label).T, origin="lower", cmap=cmap, norm=norm,
-              interpolation="nearest", aspect="auto",
-              extent=_extent(np.asarray(b.theta0), np.asarray(b.dtheta0)))
-    ax.set_xlabel("\u03b8\u2080")
-    if show_y:
-        ax.set_ylabel("\u03b8\u2080\u2032")
-
-
-def _basin_legend(ax, b):
-    fr = fractions(b.label)
-    names = [n for n in BEHAVIOURS if fr[n] > 0]
-    ax.legend(handles=_behaviour_handles(names, [f"{n} {fr[n]:.1f} %" for n in names]),
-              loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=2, fontsize=8,
-              frameon=False)
-
-
-def fig_basin(basin_result, title=None):
-    """Figure 6 (one law): the behaviour of each ``(θ0, θ0')``, with percentages."""
-    b = basin_result
-    fig = _figure(figsize=(5.2, 5.6))
-    ax = fig.add_subplot()
-    _basin_axes(ax, b)
-    _basin_legend(ax, b)
-    ax.set_title(title or f"Basins: {_params(b)}", fontsize=10)
-    return fig
-
-
-def fig_basin_compare(housner_basin, mao_basin, title=None):
-    """Figure 6: the basins under both laws and their point-wise agreement.
-
-    The third panel shows where the two laws give the same behaviour; its title gives the
-    agreement percentage.
-    """
-    from matplotlib.colors import ListedColormap
-    from matplotlib.patches import Patch
-    a, b = housner_basin, mao_basin
-    if np.shape(a.label) != np.shape(b.label) or not (
-            np.allclose(a.theta0, b.theta0) and np.allclose(a.dtheta0, b.dtheta0)):
-        raise ValueError("the two basins must be computed on the same grid")
-    agree = np.asarray(a.label) == np.asarray(b.label)
-    pct = agreement(a.label, b.label)
-    fig = _figure(figsize=(15.0, 5.8))
-    axes = fig.subplots(1, 3, sharey=True)
-    for i, res in enumerate((a, b)):
-        _basin_axes(axes[i], res, show_y=i == 0)
-        _basin_legend(axes[i], res)
-        axes[i].set_title(_law(res.block), fontsize=11)
-    axes[2].imshow(agree.T.astype(int), origin="lower", interpolation="nearest",
-                   aspect="auto", cmap=ListedColormap(["#7b3294", "#e8e8e8"]), vmin=0, vmax=1,
-                   extent=_extent(np.asarray(a.theta0), np.asarray(a.dtheta0)))
-    axes[2].set_xlabel("\u03b8\u2080")
-    axes[2].set_title(f"agreement: {pct:.1f} % of cells", fontsize=11)
-    axes[2].legend(handles=[Patch(color="#e8e8e8", label=f"same behaviour {pct:.1f} %"),
-                            Patch(color="#7b3294", label=f"different {100 - pct:.1f} %")],
-                   loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=1, fontsize=8,
-                   frameon=False)
-    blk, frc = a.block, a.forcing
-    fig.suptitle(title or f"Basins of attraction, h/b = {blk.hb:g}, \u03b1 = {frc.alpha:g}, "
-                 f"\u03c9 = {frc.omega:g}, (r\u2080, s\u2080) = "
-                 f"({a.settings.get('r0', 0):.4g}, {a.settings.get('s0', 1):.4g})")
-    return fig
-
-
-# ---------------------------------------------------------------------------------------------
-# Attractors, integrity, erosion (issue 12)
-# ---------------------------------------------------------------------------------------------
-
-def _attractor_colours(n):
-    """Distinct colours for attractor ids 0..n-1 (tab10, then tab20b/c)."""
-    from matplotlib import colormaps
-    base = list(colormaps["tab10"].colors) + list(colormaps["tab20b"].colors) + \
-        list(colormaps["tab20c"].colors)
-    return [base[i % len(base)] for i in range(n)]
-
-
-def _attractor_panel(ax, ids, theta0, dtheta0, attractors, show_y=True):
-    """The attractor map (``ids[i, j]`` of ``theta0[i], dtheta0[j]``) with each periodic
-    attractor's cycle marked; returns the legend handles."""
-    from matplotlib.colors import BoundaryNorm, ListedColormap
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
-    n = max(len(attractors), 1)
-    colours = [BEHAVIOUR_COLOURS["unresolved"], BEHAVIOUR_COLOURS["overturn"]] + \
-        _attractor_colours(n)
-    cmap = ListedColormap(colours)
-    norm = BoundaryNorm(np.arange(-2, n + 1) - 0.5, cmap.N)
-    ax.imshow(np.asarray(ids).T, origin="lower", cmap=cmap, norm=norm, interpolation="nearest",
-              aspect="auto", extent=_extent(np.asarray(theta0), np.asarray(dtheta0)))
-    ax.set_xlabel("\u03b8\u2080")
-    if show_y:
-        ax.set_ylabel("\u03b8\u2080\u2032")
-    handles = []
-    for a, c in zip(attractors, colours[2:]):
-        name = f"{a.id}: {a.behaviour}" + (f" p={a.period}" if a.period > 1 else "") + \
-            f", {a.fraction:.1f} %"
-        handles.append(Patch(color=c, label=name))
-        if a.period:
-            ax.plot(a.points[:, 0], a.points[:, 1], ls="", marker="*", ms=11, mfc=c, mec="k",
-                    mew=0.8)
-    over = 100.0 * np.mean(np.asarray(ids) == -1)
-    if over:
-        handles.append(Patch(color=colours[1], label=f"overturn, {over:.1f} %"))
-    unres = 100.0 * np.mean(np.asarray(ids) == -2)
-    if unres:
-        handles.append(Patch(color=colours[0], label=f"unresolved, {unres:.1f} %"))
-    handles.append(Line2D([], [], ls="", marker="*", ms=9, mfc="w", mec="k",
-                          label="cycle points at t = kT"))
-    return handles
-
-
-def fig_attractors(basins, title=None):
-    """Attractor maps of one or two basins (a dict ``law: BasinResult``, or one result), each
-    with its basin entropy and integrity in the panel's title."""
-    if not isinstance(basins, dict):
-        basins = {basins.block.law: basins}
-    fig = _figure(figsize=(6.4 * len(basins), 6.6))
-    axes = np.atleast_1d(fig.subplots(1, len(basins), sharey=True))
-    for i, (ax, b) in enumerate(zip(axes, basins.values())):
-        handles = _attractor_panel(ax, b.attractor, b.theta0, b.dtheta0, b.attractors,
-                                   show_y=i == 0)
-        m = b.measures()
-        ax.set_title(f"{_law(b.block)}: S_b = {m['basin_entropy']:.3f}, "
-                     f"S_bb = {m['boundary_basin_entropy']:.3f}\n"
-                     f"GIM = {m['integrity']['GIM']:.3f}, IF = {m['integrity']['IF']:.3f}",
-                     fontsize=10)
-        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncols=2,
-                  fontsize=7.5, frameon=False)
-    b0 = next(iter(basins.values()))
-    blk, frc = b0.block, b0.forcing
-    fig.suptitle(title or f"Attractors, h/b = {blk.hb:g}, \u03b1 = {frc.alpha:g}, "
-                 f"\u03c9 = {frc.omega:g}", fontsize=11)
-    return fig
-
-
-def fig_erosion(profiles, title=None):
-    """Erosion profiles (a dict ``law: ErosionResult``, or one): GIM and IF against the
-    amplitude for each law on top (the classic erosion profile), and below, for each law, the
-    stacked basin fractions of its attractor branches (overturn on top, in grey)."""
-    if not isinstance(profiles, dict):
-        profiles = {profiles.block.law: profiles}
-    fig = _figure(figsize=(10.0, 3.6 + 3.0 * len(profiles)))
-    gs = fig.add_gridspec(1 + len(profiles), 1, height_ratios=[1.2] + [1] * len(profiles))
-    ax = fig.add_subplot(gs[0])
-    for law, r in profiles.items():
-        c = LAW_COLOURS.get(law, "k")
-        ax.plot(r.alpha, r.GIM, color=c, lw=1.8, label=f"GIM, {_law(r.block)}")
-        ax.plot(r.alpha, r.IF, color=c, lw=1.4, ls="--", label=f"IF, {_law(r.block)}")
-    ax.set_ylim(-0.02, 1.02)
-    ax.set_ylabel("integrity")
-    ax.legend(fontsize=8, ncols=2)
-    ax.grid(alpha=0.3)
-    for k, (law, r) in enumerate(profiles.items()):
-        axk = fig.add_subplot(gs[1 + k], sharex=ax)
-        fr = r.fractions()
-        colours = _attractor_colours(len(r.branches))
-        labels = [f"{b['id']}: {b['behaviour']}" + (f" p={b['period']}" if b["period"] > 1
-                                                     else "") for b in r.branches]
-        if len(fr):
-            axk.stackplot(r.alpha, fr, colors=colours, labels=labels, lw=0)
-        top = fr.sum(axis=0) if len(fr) else np.zeros_like(r.alpha)
-        axk.fill_between(r.alpha, top, 100.0, color=BEHAVIOUR_COLOURS["overturn"], alpha=0.55,
-                         lw=0, label="overturn / unresolved")
-        axk.set_ylim(0, 100)
-        axk.set_ylabel(f"{_law(r.block)}: % of cells")
-        big = [i for i in np.argsort(-fr.max(axis=1))[:8]] if len(fr) else []
-        handles, labs = axk.get_legend_handles_labels()
-        keep = [j for j, lab in enumerate(labs) if lab == "overturn / unresolved" or
-                any(lab == labels[i] for i in big)]
-        axk.legend([handles[j] for j in keep], [labs[j] for j in keep], fontsize=7,
-                   loc="center left", bbox_to_anchor=(1.0, 0.5), frameon=False)
-    fig.axes[-1].set_xlabel("\u03b1")
-    r0 = next(iter(profiles.values()))
-    fig.suptitle(title or f"Erosion profiles, h/b = {r0.block.hb:g}, "
-                 f"\u03c9 = {r0.forcing.omega:g}, {r0.attractor.shape[1]}\u00b2 cells per basin",
-                 fontsize=11)
-    return fig
-
-
-def fig_fate(fate_result, title=None):
-    """An ensemble of nearby runs: each outcome's probability, and when each member stopped
-    against its initial perturbation, with the predictability horizon marked."""
-    fr = fate_result
-    fig = _figure(figsize=(11.0, 4.4))
-    ax, ax_t = fig.subplots(1, 2, width_ratios=(1, 1.5))
-    names = list(fr.probabilities)
-    colours = [BEHAVIOUR_COLOURS.get(n.split()[0], "#7f7f7f") for n in names]
-    ax.barh(range(len(names)), [fr.probabilities[n] for n in names], color=colours)
-    ax.set_yticks(range(len(names)), names, fontsize=8)
-    ax.set_xlim(0, 1)
-    ax.set_xlabel("probability")
-    d = np.abs(fr.initial - fr.initial[0]).max(axis=1)
-    rel = d / max(np.abs(fr.initial[0]).max(), 1e-300)
-    ok = rel > 0
-    for v, c in zip(np.unique(fr.outcome), _attractor_colours(len(np.unique(fr.outcome)))):
-        m = ok & (fr.outcome == v)
-        lab = "overturn" if v == -1 else ("unresolved" if v == -2 else f"attractor {v}")
-        ax_t.scatter(rel[m], fr.t_end[m], s=12, color=BEHAVIOUR_COLOURS["overturn"]
-                     if v == -1 else c, label=lab)
-    ax_t.set_xscale("log")
-    ax_t.set_xlabel("initial perturbation (relative)")
-    ax_t.set_ylabel("t at the end (overturn, rest, or the last period)")
-    if np.isfinite(fr.horizon_rounding):
-        ax_t.axhline(fr.horizon_rounding, color="k", ls="--", lw=0.8,
-                     label=f"horizon of rounding t* = {fr.horizon_rounding:.0f}")
-    ax_t.legend(fontsize=8)
-    b, f = fr.block, fr.forcing
-    fig.suptitle(title or f"Fates of {fr.outcome.size} nearby runs: {_law(b)}, h/b = {b.hb:g}, "
-                 f"\u03b1 = {f.alpha:g}, \u03c9 = {f.omega:g}; \u03bb\u2081 of the "
-                 f"transient {fr.lambda1:.3g}", fontsize=10)
-    return fig
-
-
-# ---------------------------------------------------------------------------------------------
-# Parameter plane (rocking chart)
-# ---------------------------------------------------------------------------------------------
 
 def _extent(x, y):
     """``imshow`` extent of a grid over axes ``x, y``: half a cell beyond the end points (half
@@ -676,8 +85,871 @@ def _extent(x, y):
     return (x[0] - dx, x[-1] + dx, y[0] - dy, y[-1] + dy)
 
 
+def _edges(x):
+    """Cell edges around the points ``x`` (increasing): midpoints, and half a step beyond the
+    ends."""
+    x = np.asarray(x, float)
+    if x.size == 1:
+        return np.array([x[0] - 0.5e-3, x[0] + 0.5e-3])
+    d = np.diff(x)
+    return np.concatenate([[x[0] - d[0] / 2], x[:-1] + d / 2, [x[-1] + d[-1] / 2]])
+
+
+# ---------------------------------------------------------------------------------------------
+# Figure 1: restitution laws
+# ---------------------------------------------------------------------------------------------
+
+def fig_restitution(hb_range=(1.0 / math.sqrt(2.0), 6.0), n=400, marks=(1.0, 2.0)):
+    """Figure 1: ``e_H`` and ``e_M`` against ``theta_c``, with ``Delta e %`` on a twin axis.
+
+    Parameters
+    ----------
+    hb_range : (float, float)
+        Slenderness range; the Housner law needs ``hb >= 1/sqrt(2)``.
+    n : int
+        Number of points.
+    marks : sequence of float
+        Slenderness values marked, with their values in boxes below the curves.
+    """
+    lo, hi = (float(v) for v in hb_range)
+    if not 1.0 / math.sqrt(2.0) - 1e-12 <= lo < hi:
+        raise ValueError(f"hb_range must satisfy 1/sqrt(2) <= start < end (got {lo}, {hi})")
+    thc = np.linspace(thc_from_hb(lo), thc_from_hb(hi), n)
+    eh, em = e_housner(thc), e_mao(thc)
+    de = delta_e_percent(em, eh)
+    fig = _figure("single" if S.current().name == "paper" else 0.64, 0.62)
+    ax = fig.add_subplot()
+    deg = np.degrees(thc)
+    ax.plot(deg, eh, color="k", ls=LAW_LINES["housner"]["ls"], lw=1.5,
+            label=r"$e_H$, Housner (1963)")
+    ax.plot(deg, em, color="k", ls=LAW_LINES["mao"]["ls"], lw=1.5,
+            label=r"$e_M$, Mao et al. (2024)")
+    ax.set_xlabel(r"$\theta_c = \arctan(h/b)$  [degrees]")
+    ax.set_ylabel(r"coefficient of restitution $e$")
+    ax.set_ylim(0, 1.02)
+    ax2 = ax.twinx()
+    ax2.plot(deg, de, color="0.55", ls=":", lw=1.5, label=r"$\Delta e$ (right axis)")
+    ax2.set_ylabel(r"$\Delta e$  [%]")
+    ax2.set_ylim(0, max(1.0, float(np.nanmax(de))) * 1.05)
+    # the values at the marked slendernesses, in boxes in the empty lower right, each joined
+    # to its points by a thin line
+    for k, hb in enumerate(marks):
+        t = float(thc_from_hb(hb))
+        h, m = float(e_housner(t)), float(e_mao(t))
+        x = np.degrees(t)
+        ax.axvline(x, color="0.75", lw=0.8, ls="-", zorder=0)
+        ax.plot([x, x], [h, m], "o", color="k", ms=3.5, zorder=5)
+        ax2.annotate(f"$h/b = {hb:g}$: $e_H = {h:.3f}$, $e_M = {m:.3f}$,\n"
+                     f"$\\Delta e = {float(delta_e_percent(m, h)):.2f}$ %",
+                     xy=(x, h), xycoords=ax.transData,
+                     xytext=(0.97, 0.08 + 0.17 * (len(marks) - 1 - k)),
+                     textcoords="axes fraction", ha="right", va="bottom", fontsize="small",
+                     zorder=6, arrowprops=dict(arrowstyle="-", color="0.5", lw=0.6,
+                                               shrinkA=0, shrinkB=3),
+                     bbox=dict(boxstyle="round,pad=0.25", fc="white", ec="0.75", lw=0.6))
+    lines = ax.get_legend_handles_labels()
+    lines2 = ax2.get_legend_handles_labels()
+    ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], loc="upper center",
+              bbox_to_anchor=(0.40, 1.0))
+    top = ax.secondary_xaxis("top", functions=(
+        lambda d: np.tan(np.radians(np.clip(d, 1e-3, 89.9))),
+        lambda hb: np.degrees(np.arctan(hb))))
+    top.set_xticks([1, 1.5, 2, 3, 4, 6])
+    top.set_xticklabels(["1", "1.5", "2", "3", "4", "6"])
+    top.set_xlabel(r"$h/b$")
+    S.suptitle(fig, "Coefficient of restitution: Housner against Mao et al.")
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# time series: windows of a run, impacts as vertical jumps
+# ---------------------------------------------------------------------------------------------
+
+def _wrap(text, fig, fraction=0.95):
+    """``text`` broken into lines that fit ``fraction`` of the figure's width (at the style's
+    font size, about half an em a character; mathtext counted as it is drawn, and never
+    broken)."""
+    import matplotlib
+    size = matplotlib.rcParams["font.size"]
+    per_line = max(20, int(fig.get_figwidth() * fraction * 72 / (0.55 * size)))
+
+    def drawn(w):
+        return len(re.sub(r"\$[^$]*\$", lambda m: "x" * max(1, len(m.group()) // 2), w))
+
+    out = []
+    for para in text.split("\n"):
+        # words, a piece of mathtext with what is glued to it being one word
+        words = re.findall(r"(?:[^\s$]*\$[^$]*\$)+[^\s$]*|\S+", para)
+        line, n = [], 0
+        for w in words:
+            k = drawn(w) + 1
+            if line and n + k > per_line:
+                out.append(" ".join(line))
+                line, n = [], 0
+            line.append(w)
+            n += k
+        out.append(" ".join(line))
+    return "\n".join(out)
+
+
+def _need_traj(result):
+    if result.trajectory is None or result.trajectory.shape[0] == 0:
+        raise ValueError("the result has no trajectory: simulate with record_stride=...")
+
+
+def _window_start(result):
+    if result.window is not None:
+        return float(result.window[0])
+    return round(0.8 * result.periods) * result.period
+
+
+def with_impacts(result, t0=-math.inf, t1=math.inf):
+    """``(t, theta, theta')`` of the recorded trajectory within ``[t0, t1]`` with every impact
+    inserted as two points at ``theta = 0``, ``theta'-`` then ``theta'+``: a line through them
+    draws the impact as the vertical jump it is, not as a slanted chord between samples."""
+    tr = result.trajectory
+    keep = (tr[:, 0] >= t0) & (tr[:, 0] <= t1)
+    t, th, dth = tr[keep, 0], tr[keep, 1], tr[keep, 2]
+    imp = np.asarray(result.impacts).reshape(-1, 3)
+    imp = imp[(imp[:, 0] >= t0) & (imp[:, 0] <= t1)]
+    if imp.shape[0] == 0:
+        return t, th, dth
+    ti = np.repeat(imp[:, 0], 2)
+    thi = np.zeros(ti.size)
+    dthi = np.column_stack([imp[:, 1], imp[:, 2]]).ravel()
+    order = np.concatenate([np.zeros(t.size), np.tile([1.0, 2.0], imp.shape[0])])
+    tt = np.concatenate([t, ti])
+    idx = np.lexsort((order, tt))
+    return tt[idx], np.concatenate([th, thi])[idx], np.concatenate([dth, dthi])[idx]
+
+
+def _time_panel(ax, result, t0, t1, colour, **kw):
+    t, th, _ = with_impacts(result, t0, t1)
+    ax.plot(t, th, color=colour, lw=kw.pop("lw", 1.0), **kw)
+    ax.axhline(0, color="0.8", lw=0.5, zorder=0)
+    ax.set_xlim(t0, t1)
+
+
+def _phase_panel(ax, result, colour, strobe=True, whole=False, label=None):
+    """The phase portrait of the asymptotic window (the whole run when it ended before the
+    window, or when ``whole``), impacts as vertical jumps, the stroboscopic points circled.
+    Returns whether the window was drawn."""
+    t_w = _window_start(result)
+    in_window = not whole and result.t > t_w + result.period
+    t0 = t_w if in_window else -math.inf
+    _, th, dth = with_impacts(result, t0)
+    ax.plot(th, dth, color=colour, lw=0.9, label=label)
+    if strobe:
+        k0 = int(round(t_w / result.period)) if in_window else 0
+        s = result.strobe[k0:]
+        if s.shape[0]:
+            ax.plot(s[:, 0], s[:, 1], "o", ms=4, mfc="none", mec="k", mew=0.8,
+                    label=r"$t = kT$")
+    ax.set_xlabel(SYMBOLS["theta"])
+    ax.set_ylabel(SYMBOLS["dtheta"])
+    return in_window
+
+
+def _mark_end(ax, result):
+    """A run that overturned: the threshold, and a marker where it fell."""
+    if result.status == "overturned":
+        over = result.integration.theta_over
+        sign = np.sign(result.state[0]) or 1.0
+        ax.axhline(sign * over, color=BEHAVIOUR_COLOURS["overturn"], ls=":", lw=0.8)
+        ax.plot([result.t], [sign * over], marker="v" if sign < 0 else "^", ms=6,
+                color=BEHAVIOUR_COLOURS["overturn"], ls="")
+    elif result.status == "rest":
+        ax.plot([result.t], [0.0], marker="o", ms=5, color=LINE_COLOURS["rest"], ls="")
+
+
+def _rest_inset(ax, result, colour):
+    """An inset of a run that came to rest: its impacts from the first one on, magnified (each
+    impact keeps ``e`` of the speed, so the rocking decays too fast to see at the fall's
+    scale)."""
+    imp = np.asarray(result.impacts).reshape(-1, 3)
+    if imp.shape[0] < 2:
+        return
+    t0 = imp[0, 0]
+    t, th, _ = with_impacts(result, t0, result.t)
+    if t.size < 2:
+        return
+    ins = ax.inset_axes([0.07, 0.12, 0.36, 0.5])
+    ins.plot(t, th, color=colour, lw=0.9)
+    ins.axhline(0, color="0.8", lw=0.5, zorder=0)
+    ins.set_xlim(t0, result.t)
+    lim = max(float(np.abs(th).max()), 1e-12) * 1.15
+    ins.set_ylim(-lim, lim)
+    ins.tick_params(labelsize="x-small")
+    ins.set_title(f"{imp.shape[0]} impacts, magnified", fontsize="x-small")
+    ax.indicate_inset_zoom(ins, edgecolor="0.5")
+
+
+def _windows(result, first, last):
+    """``[(t0, t1, what)]``: the first ``first`` periods and the last ``last`` periods of the
+    run, or the whole run as one window when it is not longer than both."""
+    T = result.period
+    if result.t <= (first + last + 1) * T:
+        return [(0.0, max(result.t, T * 1e-3), "whole run")]
+    return [(0.0, first * T, f"first {first} periods"),
+            (result.t - last * T, result.t, f"last {last} periods")]
+
+
+# ---------------------------------------------------------------------------------------------
+# Figure 2: one run
+# ---------------------------------------------------------------------------------------------
+
+def fig_trajectory(result, behaviour, *, exponent=None, title=None, first=8, last=4):
+    """Figure 2: ``theta(t)`` over the transient's first periods and over the last periods,
+    the running exponent ``lambda_1(t)``, and the phase portrait of the asymptotic window with
+    its stroboscopic points, impacts drawn as vertical jumps.
+
+    Parameters
+    ----------
+    result : Result
+        A run with a trajectory (``record_stride``); ``lambda_1(t)`` is drawn when it computed
+        exponents.
+    behaviour : (str, int)
+        Its behaviour and period (``rockjit.classify_result(result)``): the lines' colour.
+    exponent : float, optional
+        The exact exponent of the orbit it settled on (the Floquet exponent), drawn beside the
+        window's estimate.
+    first, last : int
+        Periods shown at the start and at the end.
+    """
+    _need_traj(result)
+    colour = LINE_COLOURS[behaviour[0]]
+    lam = result.lyapunov_running
+    fig = _figure("double", 0.52)
+    gs = fig.add_gridspec(2, 3, width_ratios=(1.5, 1.0, 1.25))
+    wins = _windows(result, first, last)
+    axes_t = []
+    if len(wins) == 1:
+        axes_t.append(fig.add_subplot(gs[0, :2]))
+    else:
+        axes_t.append(fig.add_subplot(gs[0, 0]))
+        axes_t.append(fig.add_subplot(gs[0, 1], sharey=axes_t[0]))
+    for i, (ax, (t0, t1, what)) in enumerate(zip(axes_t, wins)):
+        _time_panel(ax, result, t0, t1, colour)
+        _mark_end(ax, result)
+        ax.set_xlabel(SYMBOLS["t"])
+        S.letter(ax, i, what)
+    axes_t[0].set_ylabel(r"$\theta$  [rad]")
+    ax_l = fig.add_subplot(gs[1, :2])
+    if lam is not None and lam.shape[0] > 1:
+        k = np.arange(1, lam.shape[0])
+        ax_l.plot(k * result.period, lam[1:, 0], color="k", lw=1.0,
+                  label=r"running $\lambda_1(t)$ from $t = 0$")
+        ax_l.axhline(0, color="0.6", lw=0.6)
+        t_w = _window_start(result)
+        if result.t > t_w:
+            ax_l.axvspan(t_w, result.t, color="0.92", lw=0, zorder=0,
+                         label="asymptotic window")
+        if result.lyapunov is not None and np.isfinite(result.lyapunov[0]):
+            ax_l.axhline(result.lyapunov[0], color=colour, lw=1.0, ls="--",
+                         label=f"$\\lambda_\\mathrm{{max}}$ over the window "
+                               f"$= {result.lyapunov[0]:.4f}$")
+        if exponent is not None and np.isfinite(exponent):
+            ax_l.axhline(exponent, color=colour, lw=1.0, ls=":",
+                         label=f"Floquet exponent of the orbit $= {exponent:.4f}$")
+        fin = lam[1:, 0][np.isfinite(lam[1:, 0])]
+        if fin.size:  # the estimate's range, with room for the legend above it
+            lo, hi = float(fin.min()), float(fin.max())
+            span = max(hi - lo, 0.05 * max(abs(lo), abs(hi), 1e-3))
+            ax_l.set_ylim(lo - 0.1 * span, hi + 0.6 * span)
+        ax_l.legend(loc="upper right", ncols=2)
+        ax_l.set_ylabel(r"$\lambda_1$")
+        ax_l.set_xlim(0, result.t)
+    else:
+        ax_l.text(0.5, 0.5, "Lyapunov exponents not computed", ha="center", va="center",
+                  transform=ax_l.transAxes, color="0.4")
+    ax_l.set_xlabel(SYMBOLS["t"])
+    S.letter(ax_l, len(axes_t), "running largest Lyapunov exponent")
+    ax_p = fig.add_subplot(gs[:, 2])
+    in_window = _phase_panel(ax_p, result, colour)
+    S.letter(ax_p, len(axes_t) + 1, "phase portrait,\n" + ("asymptotic window" if in_window
+                                                            else "whole run"))
+    ax_p.legend(loc="lower right")
+    S.suptitle(fig, title or f"{_params(result)}: {_behaviour_words(behaviour)}")
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# Figure 3: behaviour gallery
+# ---------------------------------------------------------------------------------------------
+
+def fig_gallery(results, behaviours, notes=None, *, first=8, last=4):
+    """Figure 3: one row per run: ``theta(t)`` over its first and its last periods (the whole
+    run when it is short) and its phase portrait, coloured by its behaviour.
+
+    Parameters
+    ----------
+    results : dict of str -> Result
+        Caption -> run (each with a trajectory), one row each, lettered a), b), ...
+    behaviours : dict of str -> (str, int)
+        Caption -> the run's behaviour and period.
+    notes : dict of str -> str, optional
+        Caption -> a line printed with that run's title (e.g. an ensemble's outcome
+        probabilities, for a run whose fate is decided by round-off).
+    """
+    if not results:
+        raise ValueError("results must hold at least one run")
+    n = len(results)
+    fig = _figure("double", 0.25 * n + 0.08)
+    subs = np.atleast_1d(fig.subfigures(n, 1))
+    for r, ((caption, res), sub) in enumerate(zip(results.items(), subs)):
+        _need_traj(res)
+        beh = behaviours[caption]
+        colour = LINE_COLOURS[beh[0]]
+        gs = sub.add_gridspec(1, 3, width_ratios=(1.5, 1.0, 0.9))
+        wins = _windows(res, first, last)
+        if len(wins) == 1:
+            axes = [sub.add_subplot(gs[0, :2])]
+        else:
+            axes = [sub.add_subplot(gs[0, 0])]
+            axes.append(sub.add_subplot(gs[0, 1], sharey=axes[0]))
+        for ax, (t0, t1, what) in zip(axes, wins):
+            _time_panel(ax, res, t0, t1, colour)
+            _mark_end(ax, res)
+            ax.text(0.99, 0.97, what, transform=ax.transAxes, ha="right", va="top",
+                    fontsize="small", color="0.35",
+                    bbox=dict(fc="white", ec="none", alpha=0.8, pad=1.0))
+            if r == n - 1:
+                ax.set_xlabel(SYMBOLS["t"])
+        axes[0].set_ylabel(r"$\theta$")
+        b, f = res.block, res.forcing
+        what = (f"overturns at $t = {res.t:.5g}$" if res.status == "overturned" else
+                f"at rest from $t = {res.t:.3g}$" if res.status == "rest" else
+                _behaviour_words(beh))
+        head = (f"{'abcdefghijklmnopqrstuvwxyz'[r]}) {caption}: $\\alpha = {f.alpha:g}$, "
+                f"$\\omega = {f.omega:g}$, $h/b = {b.hb:g}$ $\\rightarrow$ {what}")
+        if notes and caption in notes:
+            head += "\n" + notes[caption]
+        sub.suptitle(_wrap(head, fig), x=0.01, ha="left", fontsize="medium")
+        if res.status == "rest":
+            _rest_inset(axes[0], res, colour)
+        ax_p = sub.add_subplot(gs[0, 2])
+        _phase_panel(ax_p, res, colour)
+        if r != n - 1:
+            ax_p.set_xlabel("")
+    S.suptitle(fig, f"Behaviour gallery ({S.law_name(next(iter(results.values())).block)}): "
+                    "time series and phase portraits (impacts as vertical jumps, "
+                    "circles at $t = kT$)")
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# Figure 4: Housner vs Mao time series
+# ---------------------------------------------------------------------------------------------
+
+def fig_laws_timeseries(runs, behaviours, captions=None, *, periods=8):
+    """Figure 4: the two laws from the same initial states, one row per initial state: each
+    law's ``theta(t)`` over the first ``periods`` periods (one above the other, so that neither
+    hides the other) and its phase portrait, each run in its behaviour's colour, with a line
+    under the row saying what it shows.
+
+    Parameters
+    ----------
+    runs : sequence of dict law -> Result
+        One row per initial state; in each row the runs of each law (with trajectories).
+    behaviours : sequence of dict law -> (str, int)
+        Each run's behaviour and period.
+    captions : sequence of str, optional
+        The line under each row (default: each law's outcome).
+    periods : int
+        Forcing periods of ``theta(t)`` shown.
+    """
+    runs = list(runs)
+    if not runs:
+        raise ValueError("runs must hold at least one initial state")
+    n = len(runs)
+    fig = _figure("double", 0.30 * n + 0.05)
+    subs = np.atleast_1d(fig.subfigures(n, 1))
+    for i, (row, sub) in enumerate(zip(runs, subs)):
+        laws = list(row)
+        gs = sub.add_gridspec(len(laws), 1 + len(laws), width_ratios=(2.4,) + (1.0,) * len(laws))
+        z = None
+        ax_first = None
+        words = []
+        for k, law in enumerate(laws):
+            res = row[law]
+            _need_traj(res)
+            beh = behaviours[i][law]
+            colour = LINE_COLOURS[beh[0]]
+            ax = sub.add_subplot(gs[k, 0], sharex=ax_first)
+            ax_first = ax_first or ax
+            t1 = periods * res.period
+            _time_panel(ax, res, 0.0, t1, colour)
+            _mark_end(ax, res)
+            ax.set_ylabel(f"{S.law_name(res.block)}\n" + r"$\theta$")
+            if k < len(laws) - 1:
+                ax.tick_params(labelbottom=False)
+            else:
+                ax.set_xlabel(SYMBOLS["t"])
+            ax_p = sub.add_subplot(gs[:, 1 + k])
+            _phase_panel(ax_p, res, colour, strobe=False)
+            ax_p.set_title(S.law_name(res.block), fontsize="medium")
+            if k:
+                ax_p.set_ylabel("")
+            z = res.trajectory[0, 1:3]
+            w = f"{S.law_name(res.block)}: {_behaviour_words(beh)}"
+            if res.status == "overturned":
+                w += f" (overturns at $t = {res.t:.3g}$)"
+            words.append(w)
+        S.letter(ax_first, i, f"from $(\\theta_0, \\theta'_0) = ({z[0]:.4f}, {z[1]:.4f})$")
+        cap = captions[i] if captions is not None else "; ".join(words) + "."
+        sub.supxlabel(_wrap(f"{'abcdefghij'[i]}) {cap}", fig), fontsize="medium",
+                      ha="center")
+    r0 = next(iter(runs[0].values()))
+    b, f = r0.block, r0.forcing
+    S.suptitle(fig, f"Housner against Mao et al. in time: $h/b = {b.hb:g}$, "
+                    f"$\\alpha = {f.alpha:g}$, $\\omega = {f.omega:g}$, "
+                    f"$(r_0, s_0) = (0, 1)$")
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# Figure 5: bifurcation diagrams
+# ---------------------------------------------------------------------------------------------
+
+def _is_published(sw):
+    return sw.settings.get("stop_at_overturn") is False
+
+
+def _bifurcation_column(fig, gs_col, sw, alpha_limits, show_y, col, short=False):
+    ax = fig.add_subplot(gs_col[0])
+    ax_s = fig.add_subplot(gs_col[1], sharex=ax)
+    ax_l = fig.add_subplot(gs_col[2], sharex=ax)
+    alpha = np.asarray(sw.alpha)
+    label = np.asarray(sw.label)
+    sel = np.ones(alpha.shape, bool)
+    if alpha_limits is not None:
+        sel = (alpha >= alpha_limits[0] - 1e-12) & (alpha <= alpha_limits[1] + 1e-12)
+    names = [str(n) for n in sw.names]
+    pts = np.asarray(sw.strobe)[:, :, 1]
+    present = []
+    dense = pts.shape[1] * max(int(sel.sum()), 1)
+    size = 0.8 if dense > 20000 else 2.0
+    for code, name in enumerate(names):
+        m = sel & (label == code)
+        if not m.any():
+            continue
+        present.append(name)
+        a = np.repeat(alpha[m], pts.shape[1])
+        y = pts[m].ravel()
+        ok = np.isfinite(y)
+        ax.scatter(a[ok], y[ok], s=size, color=BEHAVIOUR_COLOURS[name], lw=0,
+                   rasterized=True)
+    ax.set_ylabel(SYMBOLS["strobe"] if show_y else "")
+    published = _is_published(sw)
+    S.letter(ax, col, S.law_name(sw.block)
+             + ("" if short else f", $h/b = {sw.block.hb:g}$, $\\omega = {sw.forcing.omega:g}$")
+             + (",\nas published" if published else ""))
+    ax.tick_params(labelbottom=False)
+
+    # a strip: the behaviour of every alpha, including those without stroboscopic points
+    cmap, norm = S.behaviour_cmap()
+    edges = _edges(alpha)
+    ax_s.pcolormesh(edges, [0, 1], label[None, :], cmap=cmap, norm=norm, rasterized=True)
+    # the strip's name as its one tick label (a horizontal axis label is laid out badly)
+    ax_s.set_yticks([0.5], ["class"] if show_y else [""])
+    ax_s.tick_params(axis="y", length=0, labelsize="small")
+    ax_s.tick_params(labelbottom=False)
+
+    lam = np.asarray(sw.lambda_window if published and sw.lambda_window is not None
+                     else sw.lambda_max, float)
+    if np.isfinite(lam[sel]).any():
+        fin = lam[sel & np.isfinite(lam)]
+        lo, hi = min(float(fin.min()), 0.0), max(float(fin.max()), 0.0)
+        pad = 0.08 * max(hi - lo, 0.1)
+        lo, hi = lo - pad, hi + pad
+    else:
+        lo, hi = -1.0, 0.5
+    ax_l.set_ylim(lo, hi)
+    show = sel & ~np.isnan(lam)
+    # a thin line through consecutive finite values, broken where there is none
+    ax_l.plot(alpha[sel], np.where(np.isfinite(lam[sel]), lam[sel], np.nan), lw=0.5,
+              color="0.65", zorder=1)
+    any_rest = False
+    for code, name in enumerate(names):
+        m = show & (label == code)
+        fin = m & np.isfinite(lam)
+        ax_l.scatter(alpha[fin], lam[fin], s=4, color=BEHAVIOUR_COLOURS[name], lw=0, zorder=2)
+        neg = m & np.isneginf(lam)
+        if neg.any():  # lambda = -inf (rest, or an orbit through rest): the panel's bottom
+            any_rest = True
+            ax_l.scatter(alpha[neg], np.full(neg.sum(), lo), marker="v", s=14,
+                         color=LINE_COLOURS[name], zorder=3, clip_on=False)
+    ax_l.axhline(0, color="k", lw=0.6)
+    ax_l.set_xlabel(SYMBOLS["alpha"])
+    if show_y:
+        ax_l.set_ylabel(SYMBOLS["lambda_max"] + (" (window)" if published else ""))
+    if alpha_limits is not None:
+        ax.set_xlim(*alpha_limits)
+    elif alpha.size > 1:
+        ax.set_xlim(edges[0], edges[-1])
+    return present, any_rest
+
+
+def fig_bifurcation(sweeps, alpha_limits=None, title=None):
+    """Figure 5: stroboscopic ``theta'`` against ``alpha``, coloured by behaviour, a strip with
+    every amplitude's behaviour, and ``lambda_max`` below.
+
+    Parameters
+    ----------
+    sweeps : SweepResult or dict of str -> SweepResult
+        One sweep, or several drawn side by side (e.g. the two laws), lettered a), b), ...
+    alpha_limits : (float, float), optional
+        Draw only this range of ``alpha`` (the zoom).
+    title : str, optional
+
+    Notes
+    -----
+    ``lambda_max`` is the sweep's: exact (the Floquet exponent) where a cell settled on a
+    periodic orbit. A sweep integrated on past overturning (the study's way) shows its
+    finite-window estimate ``lambda_window``, as the study did. ``lambda = -inf`` (rest, or an
+    orbit through rest) is drawn as a triangle at the bottom of the lower panel; ``nan``
+    (overturn, or not computed) is skipped.
+    """
+    if not isinstance(sweeps, dict):
+        sweeps = {"": sweeps}
+    if not sweeps:
+        raise ValueError("sweeps must hold at least one sweep")
+    if alpha_limits is not None:
+        alpha_limits = tuple(float(v) for v in alpha_limits)
+    n = len(sweeps)
+    from matplotlib.lines import Line2D
+    fig = _figure("single" if n == 1 and S.current().name == "paper"
+                  else ("double" if n > 1 else 0.6), 0.95 if n == 1 else 0.58)
+    gs = fig.add_gridspec(3, n, height_ratios=(2.4, 0.12, 1.0))
+    present, any_rest = set(), False
+    for c, sw in enumerate(sweeps.values()):
+        got, rest = _bifurcation_column(fig, [gs[r, c] for r in range(3)], sw, alpha_limits,
+                                        c == 0, c, short=n > 2)
+        present |= set(got)
+        any_rest |= rest
+    order = [nm for nm in BEHAVIOURS if nm in present]
+    handles = _behaviour_handles(order, marker=True)
+    if any_rest:
+        handles.append(Line2D([], [], ls="", marker="v", ms=5, color="0.3",
+                              label=r"$\lambda = -\infty$ (through rest)"))
+    width = fig.get_figwidth()
+    ncols = len(handles) if n > 1 and width >= 10 else \
+        min(len(handles), max(2, int(width // 1.7)))
+    fig.legend(handles=handles, loc="outside lower center", ncols=max(1, ncols))
+    S.suptitle(fig, title)
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# Figure 6: basins
+# ---------------------------------------------------------------------------------------------
+
+def _basin_axes(ax, b, show_y=True):
+    cmap, norm = S.behaviour_cmap()
+    # label[i, j] belongs to theta0[i], dtheta0[j]: rows of the image are dtheta0
+    ax.imshow(np.asarray(b.label).T, origin="lower", cmap=cmap, norm=norm,
+              interpolation="nearest", aspect="auto",
+              extent=_extent(np.asarray(b.theta0), np.asarray(b.dtheta0)))
+    ax.set_xlabel(SYMBOLS["theta0"])
+    if show_y:
+        ax.set_ylabel(SYMBOLS["dtheta0"])
+
+
+def _basin_legend(ax, b):
+    fr = fractions(b.label)
+    names = [n for n in BEHAVIOURS if fr[n] > 0]
+    ax.legend(handles=_behaviour_handles(names, [f"{n} {fr[n]:.1f} %" for n in names]),
+              loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=2)
+
+
+def _cells(b):
+    n = np.shape(b.label)
+    return f"${n[0]} \\times {n[1]}$ initial states"
+
+
+def fig_basin(basin_result, title=None):
+    """Figure 6 (one law): the behaviour of each ``(theta0, theta0')``, with percentages."""
+    b = basin_result
+    fig = _figure("single" if S.current().name == "paper" else 0.48, 1.12)
+    ax = fig.add_subplot()
+    _basin_axes(ax, b)
+    _basin_legend(ax, b)
+    S.letter(ax, 0, f"{S.law_name(b.block)}, {_cells(b)}")
+    S.suptitle(fig, title or f"Basins: {_params(b)}")
+    return fig
+
+
+def fig_basin_compare(housner_basin, mao_basin, title=None):
+    """Figure 6: the basins under both laws and where they agree.
+
+    The third panel shows the cells where the two laws give the same behaviour (white) and
+    where they differ (black); its legend gives the percentages.
+    """
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+    a, b = housner_basin, mao_basin
+    if np.shape(a.label) != np.shape(b.label) or not (
+            np.allclose(a.theta0, b.theta0) and np.allclose(a.dtheta0, b.dtheta0)):
+        raise ValueError("the two basins must be computed on the same grid")
+    agree = np.asarray(a.label) == np.asarray(b.label)
+    pct = 100.0 * float(np.mean(agree)) if agree.size else math.nan
+    fig = _figure("double", 0.46)
+    axes = fig.subplots(1, 3, sharey=True)
+    for i, res in enumerate((a, b)):
+        _basin_axes(axes[i], res, show_y=i == 0)
+        _basin_legend(axes[i], res)
+        S.letter(axes[i], i, S.law_name(res.block))
+    axes[2].imshow(agree.T.astype(int), origin="lower", interpolation="nearest",
+                   aspect="auto", cmap=ListedColormap([DISAGREE_COLOUR, AGREE_COLOUR]),
+                   vmin=0, vmax=1, extent=_extent(np.asarray(a.theta0), np.asarray(a.dtheta0)))
+    axes[2].set_xlabel(SYMBOLS["theta0"])
+    S.letter(axes[2], 2, f"agreement: {pct:.1f} %\nof the {_cells(a)}")
+    axes[2].legend(handles=[Patch(facecolor=AGREE_COLOUR, edgecolor="0.5", lw=0.5,
+                                  label=f"same behaviour {pct:.1f} %"),
+                            Patch(facecolor=DISAGREE_COLOUR, edgecolor="0.5", lw=0.5,
+                                  label=f"different {100 - pct:.1f} %")],
+                   loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=1)
+    blk, frc = a.block, a.forcing
+    S.suptitle(fig, title or f"Basins of attraction, $h/b = {blk.hb:g}$, "
+                             f"$\\alpha = {frc.alpha:g}$, $\\omega = {frc.omega:g}$, "
+                             f"$(r_0, s_0) = ({a.settings.get('r0', 0):.4g}, "
+                             f"{a.settings.get('s0', 1):.4g})$, {_cells(a)}")
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# Figure 7: attractor maps
+# ---------------------------------------------------------------------------------------------
+
+def _attractor_panel(ax, ids, theta0, dtheta0, attractors, show_y=True):
+    """The attractor map (``ids[i, j]`` of ``theta0[i], dtheta0[j]``), each attractor in a tint
+    of its behaviour's colour, each periodic one's cycle starred; returns the legend handles
+    (every coloured area, by name and percentage)."""
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+    n = max(len(attractors), 1)
+    colours = S.attractor_colours(attractors) or [BEHAVIOUR_COLOURS["unresolved"]]
+    cmap = ListedColormap([BEHAVIOUR_COLOURS["unresolved"], BEHAVIOUR_COLOURS["overturn"]]
+                          + colours)
+    norm = BoundaryNorm(np.arange(-2, n + 1) - 0.5, cmap.N)
+    ax.imshow(np.asarray(ids).T, origin="lower", cmap=cmap, norm=norm, interpolation="nearest",
+              aspect="auto", extent=_extent(np.asarray(theta0), np.asarray(dtheta0)))
+    ax.set_xlabel(SYMBOLS["theta0"])
+    if show_y:
+        ax.set_ylabel(SYMBOLS["dtheta0"])
+    handles = []
+    names = S.attractor_names(attractors)
+    ids = np.asarray(ids)
+    for a, c, name in zip(attractors, colours, names):
+        handles.append(Patch(facecolor=c, edgecolor="0.5", lw=0.4,
+                             label=f"{name}, {a.fraction:.1f} %"))
+        if a.period:
+            ax.plot(a.points[:, 0], a.points[:, 1], ls="", marker="*", ms=10, mfc=c, mec="k",
+                    mew=0.8)
+    over = 100.0 * np.mean(ids == -1)
+    if over:
+        handles.append(Patch(facecolor=BEHAVIOUR_COLOURS["overturn"], edgecolor="0.5", lw=0.4,
+                             label=f"overturn, {over:.1f} %"))
+    unres = 100.0 * np.mean(ids == -2)
+    if unres:
+        handles.append(Patch(facecolor=BEHAVIOUR_COLOURS["unresolved"], edgecolor="0.5",
+                             lw=0.4, label=f"unresolved, {unres:.1f} %"))
+    if any(a.period for a in attractors):
+        handles.append(Line2D([], [], ls="", marker="*", ms=8, mfc="w", mec="k",
+                              label=r"cycle points at $t = kT$"))
+    return handles
+
+
+def fig_attractors(basins, measures=None, title=None):
+    """Attractor maps of one or two basins (a dict ``law: BasinResult``, or one result), each
+    with its basin entropy and integrity.
+
+    ``measures`` (a dict ``law: BasinResult.measures()``) are computed when not given.
+    """
+    if not isinstance(basins, dict):
+        basins = {basins.block.law: basins}
+    measures = measures or {law: b.measures() for law, b in basins.items()}
+    fig = _figure("double" if len(basins) > 1 else 0.5, 0.62 if len(basins) > 1 else 1.2)
+    axes = np.atleast_1d(fig.subplots(1, len(basins), sharey=True))
+    for i, (ax, (law, b)) in enumerate(zip(axes, basins.items())):
+        handles = _attractor_panel(ax, b.attractor, b.theta0, b.dtheta0, b.attractors,
+                                   show_y=i == 0)
+        m = measures[law]
+        S.letter(ax, i, f"{S.law_name(b.block)}: $S_b = {m['basin_entropy']:.3f}$, "
+                        f"$S_{{bb}} = {m['boundary_basin_entropy']:.3f}$,\n"
+                        f"GIM $= {m['integrity']['GIM']:.3f}$, "
+                        f"IF $= {m['integrity']['IF']:.3f}$")
+        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncols=1,
+                  title=f"of the {_cells(b)}", title_fontsize="small")
+    b0 = next(iter(basins.values()))
+    blk, frc = b0.block, b0.forcing
+    S.suptitle(fig, title or f"Attractors, $h/b = {blk.hb:g}$, $\\alpha = {frc.alpha:g}$, "
+                             f"$\\omega = {frc.omega:g}$, {_cells(b0)}")
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# Figure 8: erosion profiles
+# ---------------------------------------------------------------------------------------------
+
+#: Branches whose basin never reaches this percent of the cells are drawn together, per
+#: behaviour (one area and one legend entry each).
+SMALL_BRANCH = 1.0
+
+
+def _erosion_areas(r):
+    """``[(label, colour, fractions over alpha)]`` of a profile's stack: each branch that
+    reaches :data:`SMALL_BRANCH` % by name, the smaller ones together per behaviour."""
+    fr = r.fractions()
+    big = [i for i, b in enumerate(r.branches) if fr[i].max() >= SMALL_BRANCH]
+    small = [i for i in range(len(r.branches)) if i not in big]
+    brs = [r.branches[i] for i in big]
+    colours = S.attractor_colours(brs)
+    names = S.attractor_names(brs)
+    areas = []
+    for beh in BEHAVIOURS:  # in the behaviours' order, each behaviour's small ones last
+        areas += [(n, c, fr[i]) for n, c, i in zip(names, colours, big)
+                  if r.branches[i]["behaviour"] == beh]
+        idx = [i for i in small if r.branches[i]["behaviour"] == beh]
+        if idx:
+            areas.append((f"{beh}, {len(idx)} small attractor{'s' if len(idx) > 1 else ''} "
+                          f"(each < {SMALL_BRANCH:g} %)", S.tint(BEHAVIOUR_COLOURS[beh], 0.3),
+                          fr[idx].sum(axis=0)))
+    return areas
+
+
+def fig_erosion(profiles, title=None):
+    """Erosion profiles (a dict ``law: ErosionResult``, or one): the global integrity measure
+    GIM and the integrity factor IF against the amplitude for each law, and below, for each
+    law, the basin fractions of its attractors, stacked as steps over the amplitudes (each
+    basin holds for its amplitude, none is interpolated), overturn on top."""
+    if not isinstance(profiles, dict):
+        profiles = {profiles.block.law: profiles}
+    n = len(profiles)
+    fig = _figure("double", 0.30 + 0.30 * n)
+    gs = fig.add_gridspec(1 + n, 2, height_ratios=[1.0] + [1.15] * n,
+                          width_ratios=(1.0, 1.0))
+    ax_g = fig.add_subplot(gs[0, 0])
+    ax_i = fig.add_subplot(gs[0, 1], sharex=ax_g)
+    for law, r in profiles.items():
+        st = LAW_LINES.get(law, LAW_LINES["constant"])
+        for ax, v in ((ax_g, r.GIM), (ax_i, r.IF)):
+            ax.plot(r.alpha, v, color=st["color"], ls=st["ls"], marker=st["marker"], ms=3,
+                    mfc="white", lw=1.2, label=S.law_name(r.block))
+    for ax, what, i in ((ax_g, "global integrity measure GIM", 0),
+                        (ax_i, "integrity factor IF", 1)):
+        ax.set_ylim(-0.02, 1.02)
+        ax.grid(alpha=0.3)
+        ax.legend(loc="upper right")
+        ax.set_xlabel(SYMBOLS["alpha"])
+        S.letter(ax, i, what)
+    for k, (law, r) in enumerate(profiles.items()):
+        axk = fig.add_subplot(gs[1 + k, 0], sharex=ax_g)
+        ax_leg = fig.add_subplot(gs[1 + k, 1])
+        ax_leg.axis("off")
+        edges = _edges(r.alpha)
+        areas = _erosion_areas(r)
+        bottom = np.zeros(r.alpha.size)
+        from matplotlib.patches import Patch
+        handles = []
+        for name, colour, f in areas:
+            axk.stairs(bottom + f, edges, baseline=bottom.copy(), fill=True, color=colour,
+                       lw=0)
+            handles.append(Patch(facecolor=colour, edgecolor="0.5", lw=0.4,
+                                 label=f"{name}, up to {f.max():.1f} %"))
+            bottom = bottom + f
+        axk.stairs(np.full(r.alpha.size, 100.0), edges, baseline=bottom, fill=True,
+                   color=BEHAVIOUR_COLOURS["overturn"], lw=0)
+        handles.append(Patch(facecolor=BEHAVIOUR_COLOURS["overturn"], edgecolor="0.5", lw=0.4,
+                             label="overturn (and unresolved)"))
+        axk.set_ylim(0, 100)
+        axk.set_xlim(edges[0], edges[-1])
+        axk.set_ylabel("% of cells")
+        axk.set_xlabel(SYMBOLS["alpha"])
+        g = r.attractor.shape[1]
+        S.letter(axk, 2 + k, f"{S.law_name(r.block)}: basin of each attractor, ${g} \\times "
+                             f"{g}$ cells every $\\Delta\\alpha = {r.settings.get('alpha_step'):g}$")
+        ax_leg.legend(handles=handles, loc="center left", ncols=1, fontsize="small")
+    r0 = next(iter(profiles.values()))
+    g = r0.attractor.shape[1]
+    step = r0.settings.get("alpha_step")
+    S.suptitle(fig, title or f"Erosion profiles, $h/b = {r0.block.hb:g}$, "
+                             f"$\\omega = {r0.forcing.omega:g}$: a ${g} \\times {g}$ basin "
+                             f"every $\\Delta\\alpha = {step:g}$")
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# an ensemble's fates
+# ---------------------------------------------------------------------------------------------
+
+_OUTCOME = re.compile(r"^(?P<b>[a-z]+) p=(?P<p>\d+) #(?P<id>-?\d+)$")
+
+
+def _outcome_names(keys):
+    """An ensemble's outcome keys (``"multiperiodic p=7 #3"``) in words (``"period-7"``)."""
+    items = []
+    for k in keys:
+        m = _OUTCOME.match(k)
+        items.append(dict(behaviour=m["b"], period=int(m["p"]), multipliers=None) if m
+                     else dict(behaviour=k, period=0, multipliers=None))
+    return dict(zip(keys, S.attractor_names(items))), {k: it["behaviour"]
+                                                         for k, it in zip(keys, items)}
+
+
+def fig_fate(fate_result, title=None):
+    """An ensemble of nearby runs: each outcome's probability, and when each member stopped
+    against its initial perturbation, with the predictability horizon marked."""
+    fr = fate_result
+    fig = _figure("double", 0.4)
+    ax, ax_t = fig.subplots(1, 2, width_ratios=(1, 1.5))
+    keys = list(fr.probabilities)
+    words, behs = _outcome_names(keys)
+    colours = dict(zip(keys, S.attractor_colours([dict(behaviour=behs[k]) for k in keys])))
+    ax.barh(range(len(keys)), [fr.probabilities[k] for k in keys],
+            color=[colours[k] for k in keys], edgecolor="0.4", lw=0.5)
+    ax.set_yticks(range(len(keys)), [words[k] for k in keys])
+    ax.set_xlim(0, 1)
+    ax.set_xlabel("probability")
+    S.letter(ax, 0, "outcomes")
+    d = np.abs(fr.initial - fr.initial[0]).max(axis=1)
+    rel = d / max(np.abs(fr.initial[0]).max(), 1e-300)
+    ok = rel > 0
+    by_id = {}
+    for k in keys:
+        m = _OUTCOME.match(k)
+        by_id[int(m["id"]) if m else {"overturn": -1, "unresolved": -2}.get(k, -3)] = k
+    for v in np.unique(fr.outcome):
+        key = by_id.get(int(v))
+        if key is None:  # rest: its key has no id
+            key = next((k for k in keys if behs[k] == "rest"), None)
+        m = ok & (fr.outcome == v)
+        ax_t.scatter(rel[m], fr.t_end[m], s=14, color=colours.get(key, "0.5"),
+                     edgecolor="0.3", lw=0.3, label=words.get(key, "other"))
+    ax_t.set_xscale("log")
+    ax_t.set_xlabel("initial perturbation (relative)")
+    ax_t.set_ylabel(r"$t$ at the end (overturn, rest, or the last period)")
+    if np.isfinite(fr.horizon_rounding):
+        ax_t.axhline(fr.horizon_rounding, color="k", ls="--", lw=0.8,
+                     label=f"horizon of rounding $t^* = {fr.horizon_rounding:.0f}$")
+    ax_t.legend(loc="best")
+    S.letter(ax_t, 1, "when each member's run ended")
+    b, f = fr.block, fr.forcing
+    S.suptitle(fig, title or f"Fates of {fr.outcome.size} nearby runs: {S.law_name(b)}, "
+                             f"$h/b = {b.hb:g}$, $\\alpha = {f.alpha:g}$, "
+                             f"$\\omega = {f.omega:g}$; $\\lambda_1$ of the transient "
+                             f"${fr.lambda1:.3g}$")
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# Parameter plane (rocking chart)
+# ---------------------------------------------------------------------------------------------
+
 def fig_plane(plane_result, state=0, title=None):
-    """Behaviour over the forcing plane (omega across, alpha up) and lambda_max beside it.
+    """Behaviour over the forcing plane (``omega`` across, ``alpha`` up) and ``lambda_max``
+    beside it (exact where a cell is periodic).
 
     ``plane_result.label[state, i, j]`` belongs to ``alpha[i]``, ``omega[j]``.
     """
@@ -685,28 +957,30 @@ def fig_plane(plane_result, state=0, title=None):
     lab = np.asarray(p.label)[state]
     lam = np.array(p.lambda_max, dtype=float)[state]
     ext = _extent(np.asarray(p.omega), np.asarray(p.alpha))
-    cmap, norm = _cmap()
-    fig = _figure(figsize=(11.5, 5.6))
+    cmap, norm = S.behaviour_cmap()
+    fig = _figure("double", 0.5)
     ax, axl = fig.subplots(1, 2, sharey=True)
     ax.imshow(lab, origin="lower", cmap=cmap, norm=norm, interpolation="nearest",
               aspect="auto", extent=ext)
-    ax.set_xlabel("\u03c9")
-    ax.set_ylabel("\u03b1")
+    ax.set_xlabel(SYMBOLS["omega"])
+    ax.set_ylabel(SYMBOLS["alpha"])
     fr = fractions(lab)
     names = [n for n in BEHAVIOURS if fr[n] > 0]
     ax.legend(handles=_behaviour_handles(names, [f"{n} {fr[n]:.1f} %" for n in names]),
-              loc="upper center", bbox_to_anchor=(0.5, -0.12), ncols=3, fontsize=8,
-              frameon=False)
+              loc="upper center", bbox_to_anchor=(0.5, -0.13), ncols=3)
+    S.letter(ax, 0, "behaviour")
     finite = lam[np.isfinite(lam)]
     lim = max(float(np.abs(finite).max()), 1e-3) if finite.size else 1.0
     im = axl.imshow(np.where(np.isfinite(lam), lam, np.nan), origin="lower", cmap="RdBu_r",
                     vmin=-lim, vmax=lim, interpolation="nearest", aspect="auto", extent=ext)
-    fig.colorbar(im, ax=axl, label="\u03bb\u2098\u2090\u2093 (blank: overturn, rest, not "
-                 "computed)")
-    axl.set_xlabel("\u03c9")
+    fig.colorbar(im, ax=axl, label=SYMBOLS["lambda_max"] + " (blank: overturn, rest, "
+                                                           "not computed)")
+    axl.set_xlabel(SYMBOLS["omega"])
+    S.letter(axl, 1, SYMBOLS["lambda_max"])
     z = np.asarray(p.z0)[state]
-    fig.suptitle(title or f"{_law(p.block)}, h/b = {p.block.hb:g}, from (\u03b8, \u03b8\u2032,"
-                 f" r, s) = ({z[0]:g}, {z[1]:g}, {z[2]:g}, {z[3]:g})", fontsize=11)
+    S.suptitle(fig, title or f"{S.law_name(p.block)}, $h/b = {p.block.hb:g}$, from "
+                             f"$(\\theta_0, \\theta'_0) = ({z[0]:g}, {z[1]:g})$, "
+                             f"{lab.shape[0]} $\\times$ {lab.shape[1]} forcings")
     return fig
 
 
@@ -717,20 +991,47 @@ def fig_plane(plane_result, state=0, title=None):
 #: Marker of each bifurcation type in :func:`fig_branches`.
 BIFURCATION_MARKERS = {"fold": "o", "symmetry_breaking": "D", "period_doubling": "s",
                        "neimark_sacker": "*", "grazing": "X"}
-_BIF_SHORT = {"fold": "fold", "symmetry_breaking": "SB", "period_doubling": "PD",
-              "neimark_sacker": "NS", "grazing": "graze"}
+_BIF_WORDS = {"fold": "fold", "symmetry_breaking": "symmetry-breaking pitchfork",
+              "period_doubling": "period doubling", "neimark_sacker": "Neimark-Sacker",
+              "grazing": "grazing"}
+#: Where a branch stops, and why: its marker and words (ends at the range, on joining a branch,
+#: at a branch point or closing a loop are not marked: the line goes on, or the range ends).
+END_MARKERS = {"overturn": ("^", "branch ends: the block overturns"),
+               "rest": ("v", "branch ends: the block comes to rest"),
+               "passes_through_rest": ("v", "branch ends: the block comes to rest"),
+               "grazing": ("|", "branch ends: an impact grazes"),
+               "no_convergence": ("x", "branch ends: no convergence"),
+               "max_impacts": ("x", "branch ends: no convergence"),
+               "max_points": ("x", "branch ends: the point budget"),
+               "budget": ("x", "branch ends: the point budget")}
 
 
-#: Colours of the periods of orbit branches (distinct from BEHAVIOUR_COLOURS).
-PERIOD_COLOURS = ("#222222", "#8c564b", "#17becf", "#bcbd22", "#7f7f7f", "#393b79", "#ad494a",
-                  "#637939")
+def _branch_colour(br):
+    """A branch in its behaviour's colour (the behaviour its orbits have while stable),
+    darkened to stand out over the sweep's dots; periods 2, 3, ... in tints and shades of the
+    multiperiodic colour."""
+    if br.period == 1:
+        return S.shade(BEHAVIOUR_COLOURS["symmetric" if br.symmetric else "asymmetric"],
+                        0.0 if br.symmetric else 0.35)
+    kind, amount = {2: ("tint", 0.0), 4: ("shade", 0.45), 8: ("tint", 0.4),
+                    3: ("shade", 0.7), 6: ("tint", 0.2), 7: ("shade", 0.25)}.get(
+        br.period, ("tint", 0.3))
+    colour = BEHAVIOUR_COLOURS["multiperiodic"]
+    return S.tint(colour, amount) if kind == "tint" else S.shade(colour, amount)
 
 
-def _branch_runs(value, y, stable, t_next, period):
+def _branch_kind(br):
+    if br.period == 1:
+        return f"period 1, {'symmetric' if br.symmetric else 'asymmetric'}"
+    return f"period {br.period}"
+
+
+def _branch_runs(value, y, stable, t_next, period, mu=None):
     """Pieces ``(x, y, stable)`` of one branch line: broken where an impact crosses the
     sampling instant (the time to the next impact jumps by more than a quarter period, and the
-    sampled point jumps) and where the stability changes (the point of change belongs to both
-    pieces, so the line stays connected)."""
+    sampled point jumps) and where the stability changes. There both pieces meet at the point
+    where the largest multiplier's modulus ``mu`` crosses 1, interpolated between the two
+    branch points (without ``mu``: at the first point of the new stability)."""
     n = value.shape[0]
     cut = np.zeros(n, bool)  # cut[i]: no line between i-1 and i
     if n > 1:
@@ -738,26 +1039,43 @@ def _branch_runs(value, y, stable, t_next, period):
         cut[1:] = jump | ~np.isfinite(y[1:]) | ~np.isfinite(y[:-1])
     runs = []
     start = 0
+    head = None  # the crossing point a piece starts from
     for i in range(1, n + 1):
         if i == n or cut[i] or stable[i] != stable[start]:
-            stop = i if (i == n or cut[i]) else i + 1
-            if stop - start >= 2 or (stop - start == 1 and (i == n or cut[i])):
-                runs.append((value[start:stop], y[start:stop], bool(stable[start])))
+            change = i < n and not cut[i]
+            xs, ys = list(value[start:i]), list(y[start:i])
+            if head is not None:
+                xs.insert(0, head[0])
+                ys.insert(0, head[1])
+            head = None
+            if change:
+                w = 1.0
+                if mu is not None and np.isfinite(mu[i - 1]) and np.isfinite(mu[i]) and \
+                        mu[i] != mu[i - 1]:
+                    w = float(np.clip((1.0 - mu[i - 1]) / (mu[i] - mu[i - 1]), 0.0, 1.0))
+                head = (value[i - 1] + w * (value[i] - value[i - 1]),
+                        y[i - 1] + w * (y[i] - y[i - 1]))
+                xs.append(head[0])
+                ys.append(head[1])
+            if len(xs) >= 2 or (len(xs) == 1 and not change):
+                runs.append((np.asarray(xs), np.asarray(ys), bool(stable[start])))
             start = i
     return runs
 
 
 def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=None,
-                 mirrors=True, max_listed=32):
-    """Branches of periodic orbits drawn over a sweep's dots, bifurcations marked and listed.
+                 mirrors=True):
+    """Branches of periodic orbits drawn over a sweep's dots, bifurcations and branch ends
+    marked.
 
     Parameters
     ----------
     continuation : rockjit.orbits.Continuation
         From :func:`rockjit.orbits.continue_branches` (or :func:`~rockjit.orbits.continuation`).
     sweep : SweepResult, optional
-        Its stroboscopic points are drawn as dots coloured by behaviour; it must be sampled at
-        the continuation's forcing phase (``continue_branches`` uses the sweep's).
+        Its stroboscopic points are drawn beneath the branches as small dots coloured by
+        behaviour; it must be sampled at the continuation's forcing phase
+        (``continue_branches`` uses the sweep's).
     component : {0, 1}
         Draw ``theta`` (0) or ``theta'`` (1, the bifurcation diagrams' choice) at ``kT``.
     title : str, optional
@@ -765,16 +1083,17 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
         Parameter range drawn.
     mirrors : bool
         Also draw the mirror image ``-x(kT + T/2)`` of every non-symmetric orbit (the same
-        multipliers; a sweep from one initial state shows one of the two).
-    max_listed : int
-        Bifurcations listed beside the plot (the rest are counted).
+        multipliers; a sweep from one initial state shows one of the two): both arms of every
+        symmetry-breaking pitchfork.
 
     Notes
     -----
     Stable orbits (both multipliers inside the unit circle) are solid lines, unstable ones
-    dashed; one colour per period. The line of each cycle point breaks where an impact crosses
-    the sampling instant ``kT``, where the sampled ``theta'`` jumps by the factor ``e``.
-    Bifurcations are numbered in the list in order of the parameter.
+    dashed; each branch in the colour of the behaviour its stable orbits have (period 1
+    symmetric or asymmetric; periods 2, 3, ... in tints of the multiperiodic colour). The line
+    of each cycle point breaks where an impact crosses the sampling instant ``kT``, where the
+    sampled ``theta'`` jumps by the factor ``e``. The list of bifurcations with their
+    multipliers is :func:`branch_caption`'s.
     """
     from matplotlib.lines import Line2D
 
@@ -783,12 +1102,9 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
     if comp not in (0, 1):
         raise ValueError(f"component must be 0 (theta) or 1 (theta') (got {component!r})")
     pname = c.parameter
-    sym = _GREEK.get(pname, pname)
-    fig = _figure(figsize=(13.0, 6.4))
-    gs = fig.add_gridspec(1, 2, width_ratios=(3.2, 1.25))
-    ax = fig.add_subplot(gs[0])
-    ax_l = fig.add_subplot(gs[1])
-    ax_l.axis("off")
+    sym = SYMBOLS.get(pname, pname)
+    fig = _figure("double", 0.5)
+    ax = fig.add_subplot()
     handles = []
     if sweep is not None:
         alpha = np.asarray(sweep.alpha)
@@ -804,50 +1120,67 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
             ok = np.isfinite(yv)
             if not ok.any():
                 continue
-            ax.scatter(a[ok], yv[ok], s=1.6, color=BEHAVIOUR_COLOURS[name], lw=0, alpha=0.7,
-                       rasterized=True, zorder=4)
-            handles.append(Line2D([], [], ls="", marker="o", ms=4, alpha=0.7,
-                                  color=BEHAVIOUR_COLOURS[name], label=f"sweep: {name}"))
-    periods = sorted({br.period for br in c.branches})
-    pcol = {p: PERIOD_COLOURS[i % len(PERIOD_COLOURS)] for i, p in enumerate(periods)}
+            ax.scatter(a[ok], yv[ok], s=2.5, color=S.tint(BEHAVIOUR_COLOURS[name], 0.35), lw=0,
+                       rasterized=True, zorder=2)
+            handles.append(Line2D([], [], ls="", marker="o", ms=4,
+                                  color=S.tint(BEHAVIOUR_COLOURS[name], 0.35),
+                                  label=f"sweep: {name}"))
+    kinds = {}
+    for br in sorted(c.branches, key=lambda b: (b.period, not b.symmetric)):
+        kinds.setdefault(_branch_kind(br), _branch_colour(br))
     for br in c.branches:
         T = 2.0 * np.pi / np.asarray(br.omega)
-        cycles = [(br.cycle, br.t_next_impact, 1.1)]
+        colour = _branch_colour(br)
+        mu_abs = np.abs(np.asarray(br.multipliers)).max(axis=1)
+        cycles = [(br.cycle, br.t_next_impact)]
         if mirrors and br.mirror_cycle is not None:
             # the mirror orbit at kT is the orbit at kT + T/2, reflected
-            cycles.append((br.mirror_cycle, br.t_next_impact_half, 0.8))
-        for cyc, tn, lw in cycles:
+            cycles.append((br.mirror_cycle, br.t_next_impact_half))
+        for cyc, tn in cycles:
             for k in range(br.period):
                 for x, yv, st in _branch_runs(np.asarray(br.value), cyc[:, k, comp],
-                                              np.asarray(br.stable), tn[:, k], T):
-                    ax.plot(x, yv, ls="-" if st else (0, (4, 2.5)), lw=lw,
-                            color=pcol[br.period], zorder=3)
-    for p in periods:
-        handles.append(Line2D([], [], color=pcol[p], lw=1.5, label=f"period {p}"))
-    handles.append(Line2D([], [], color="k", lw=1.3, ls="-", label="stable"))
-    handles.append(Line2D([], [], color="k", lw=1.3, ls="--", label="unstable"))
+                                              np.asarray(br.stable), tn[:, k], T, mu_abs):
+                    ax.plot(x, yv, ls="-" if st else (0, (3.5, 2.0)), lw=1.3 if st else 1.0,
+                            color=colour, zorder=4)
+    ends = {}
+    for br in c.branches:
+        cycles = [br.cycle] + ([br.mirror_cycle] if mirrors and br.mirror_cycle is not None
+                               else [])
+        for side, why in zip((0, -1), br.ends):
+            if why not in END_MARKERS:
+                continue
+            mk, words = END_MARKERS[why]
+            ends.setdefault(words, mk)
+            for cyc in cycles:
+                ax.plot(np.full(br.period, br.value[side]), cyc[side, :, comp], ls="",
+                        marker=mk, ms=6, color="k", mew=1.2, zorder=6)
+    for kind, colour in kinds.items():
+        handles.append(Line2D([], [], color=colour, lw=2.0, label=kind))
+    handles.append(Line2D([], [], color="0.3", lw=1.3, ls="-", label="stable orbits: solid"))
+    handles.append(Line2D([], [], color="0.3", lw=1.0, ls=(0, (3.5, 2.0)),
+                          label="unstable orbits: dashed"))
     bifs = sorted(c.bifurcations, key=lambda b: b.value)
     present = []
-    for i, bf in enumerate(bifs):
+    for bf in bifs:
         mk = BIFURCATION_MARKERS.get(bf.type, "o")
-        cyc = np.asarray(bf.cycle)
-        pts_b = [cyc]
+        pts_b = [np.asarray(bf.cycle)]
         if mirrors and bf.has_mirror and getattr(bf, "cycle_half", None) is not None:
             pts_b.append(-np.asarray(bf.cycle_half))
         for cy in pts_b:
             ax.scatter(np.full(cy.shape[0], bf.value), cy[:, comp], marker=mk,
-                       s=40 if bf.period <= 2 else 18, facecolor="white", edgecolor="k",
+                       s=36 if bf.period <= 2 else 18, facecolor="white", edgecolor="k",
                        lw=1.0, zorder=5)
-        ax.annotate(str(i + 1), (bf.value, cyc[0, comp]), textcoords="offset points",
-                    xytext=(4, 4), fontsize=7, zorder=6)
         if bf.type not in present:
             present.append(bf.type)
     for t in present:
         handles.append(Line2D([], [], ls="", marker=BIFURCATION_MARKERS.get(t, "o"), ms=6,
                               markerfacecolor="white", markeredgecolor="k",
-                              label=t.replace("_", " ")))
+                              label=_BIF_WORDS.get(t, t)))
+    for words, mk in ends.items():
+        handles.append(Line2D([], [], ls="", marker=mk, ms=6, color="k", mew=1.2,
+                              label=words))
     ax.set_xlabel(sym)
-    ax.set_ylabel("\u03b8\u2032(kT)" if comp == 1 else "\u03b8(kT)")
+    ax.set_ylabel(SYMBOLS["strobe"] if comp == 1 else SYMBOLS["strobe_theta"])
     xlim = tuple(float(v) for v in (limits if limits is not None else c.bounds))
     ax.set_xlim(*xlim)
     if limits is not None:  # fit the vertical range to what is drawn in the window
@@ -864,21 +1197,45 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
             lo, hi = float(ys.min()), float(ys.max())
             pad = 0.05 * max(hi - lo, 1e-3)
             ax.set_ylim(lo - pad, hi + pad)
-    ax.legend(handles=handles, loc="best", fontsize=7, ncols=2, framealpha=0.85)
-    lines = [f"{'#':>2}  {'type':<6} {sym:<12} {'p':<2} \u03bc1, \u03bc2"]
-    for i, bf in enumerate(bifs[:max_listed]):
-        mu = [f"{m.real:.4g}" if abs(m.imag) < 1e-12 else f"{m.real:.3g}{m.imag:+.3g}i"
-              for m in np.asarray(bf.multipliers)]
-        lines.append(f"{i + 1:>2}  {_BIF_SHORT.get(bf.type, bf.type):<6} "
-                     f"{bf.value:<12.9f} {bf.period:<2} {', '.join(mu)}")
-    if len(bifs) > max_listed:
-        lines.append(f"... and {len(bifs) - max_listed} more")
-    if not bifs:
-        lines.append("(no bifurcation located)")
-    ax_l.text(0.0, 1.0, "\n".join(lines), va="top", ha="left", family="monospace",
-              fontsize=7.5, transform=ax_l.transAxes)
+    fig.legend(handles=handles, loc="outside right center", ncols=1)
     b, f = c.block, c.forcing
-    fixed = (f"\u03c9 = {f.omega:g}" if pname == "alpha" else f"\u03b1 = {f.alpha:g}")
-    ax.set_title(title or f"Periodic orbits: {_law(b)}, h/b = {b.hb:g}, {fixed}, "
-                 f"phase {c.phase:.4g}", fontsize=10)
+    fixed = (f"$\\omega = {f.omega:g}$" if pname == "alpha" else f"$\\alpha = {f.alpha:g}$")
+    ax.set_title(title or f"Periodic orbits, {S.law_name(b)}, $h/b = {b.hb:g}$, {fixed};\n"
+                          f"sampled at $t = kT$ at the forcing phase $\\varphi = {c.phase:.4g}$ "
+                          f"of the study's $z_0$",
+                 fontsize="medium")
     return fig
+
+
+def branch_caption(continuation, name=None):
+    """A caption in Markdown for :func:`fig_branches`: what is drawn, every located
+    bifurcation (parameter, period, multipliers) and every branch with where and why it
+    stops."""
+    c = continuation
+    b, f = c.block, c.forcing
+    p = "alpha" if c.parameter == "alpha" else "omega"
+    lines = [f"# {name or 'Periodic orbits'}: {S.law_name(b).replace('$', '')}, h/b = {b.hb:g}",
+             "",
+             f"Branches of periodic orbits continued in {p} over {list(c.bounds)} (stable "
+             f"solid, unstable dashed; mirror images of asymmetric orbits drawn too), over the "
+             f"sweep's stroboscopic points. Section t = kT at the forcing phase "
+             f"phi = {c.phase:.6g} (the study's z0: r0 = -0.7778, s0 = 0.6284).", "",
+             "## Bifurcations", ""]
+    bifs = sorted(c.bifurcations, key=lambda x: x.value)
+    if bifs:
+        lines += [f"| # | type | {p} | period | mu1 | mu2 |", "|---|---|---|---|---|---|"]
+        for i, bf in enumerate(bifs):
+            mu = [f"{m.real:.4g}" if abs(m.imag) < 1e-12 else f"{m.real:.3g}{m.imag:+.3g}i"
+                  for m in np.asarray(bf.multipliers)]
+            lines.append(f"| {i + 1} | {_BIF_WORDS.get(bf.type, bf.type)} | {bf.value:.9f} | "
+                         f"{bf.period} | {mu[0]} | {mu[1]} |")
+    else:
+        lines.append("No bifurcation located.")
+    lines += ["", "## Branches", "", f"| # | period | kind | {p} from | to | ends |",
+              "|---|---|---|---|---|---|"]
+    from ..orbits.types import REASONS
+    for i, br in enumerate(c.branches):
+        why = ", ".join(f"{w} ({REASONS.get(w, w)})" if w in REASONS else w for w in br.ends)
+        lines.append(f"| {i} | {br.period} | {'symmetric' if br.symmetric else 'asymmetric'} | "
+                     f"{br.value.min():.6f} | {br.value.max():.6f} | {why} |")
+    return "\n".join(lines) + "\n"

@@ -436,6 +436,12 @@ class OutputDir:
         self.path = Path(path)
         self.command = command
         self.written = []
+        #: What each file holds, in words (:meth:`describe`), for the summary's manifest.
+        self.holds = {}
+        #: Figures' format (``png``, ``pdf``, ``svg``: the suffix of their names is replaced)
+        #: and resolution; ``None`` keeps each name's suffix.
+        self.figure_format = None
+        self.dpi = 150
         self.published = False
         self.interrupted = None
         self.warning = None
@@ -510,11 +516,20 @@ class OutputDir:
         write_npz(self._target(name), **arrays)
         self._add(name)
 
-    def figure(self, name, fig, *, dpi=150):
-        """Stage a matplotlib figure (``save_figure``), then clear it to free its memory."""
-        save_figure(fig, self._target(name), dpi=dpi)
+    def figure(self, name, fig, *, dpi=None):
+        """Stage a matplotlib figure (:func:`save_figure`) in :attr:`figure_format` at
+        :attr:`dpi` (or ``dpi``), then clear it to free its memory; returns the name written
+        (its suffix the format's)."""
+        if self.figure_format:
+            name = f"{Path(name).stem}.{self.figure_format}"
+        save_figure(fig, self._target(name), dpi=dpi or self.dpi)
         self._add(name)
         fig.clear()
+        return name
+
+    def describe(self, name, holds):
+        """Say what file ``name`` holds (one line), for the manifest of ``summary.json``."""
+        self.holds[name] = " ".join(str(holds).split())
 
     def csv(self, name, header, rows):
         """Stage a CSV table (``write_csv``)."""
@@ -549,6 +564,8 @@ class OutputDir:
         files = old.get("files") if isinstance(old.get("files"), list) else []
         kept = []
         for f in files:
+            if isinstance(f, dict):  # the manifest: {"name": ..., "holds": ...}
+                f = f.get("name")
             try:
                 f = _check_name(f)
             except ValueError:
