@@ -16,9 +16,9 @@ The cases (``CASES``, printable with ``pytest --collect-only -q``):
   ``inf``, ``1e308``, ``5e-324``, ``abc``, ``""``, ``1,5``, ``0x10``, ...), required options left
   out, the wrong number of values. Refusal is asserted only where the value is really invalid.
 
-Options the command line does not have today but the issue implies carry ``[guessed --NAME]`` in
-their ids: ``--max-impacts`` (issue 10 §3 asks for it) must exist; ``--xi`` and ``--rest-speed``
-are skipped while the parser does not have them.
+Options the command line did not have but the specification implies carry ``[guessed --NAME]``
+in their ids: ``--max-impacts`` must exist; ``--xi`` cases are skipped while the parser does not
+have it; ``--rest-speed`` is tried only on ``trajectory``, the one command that has it.
 
 Nothing here computes: the entry points of real work (``GUARDED``, the one list to update after a
 refactor) are replaced by a sentinel raising :class:`NotRefused`, so a case that slips past
@@ -288,8 +288,9 @@ def _chunks_case(cmd):
     return [Case(f"{cmd} <out>.chunks is a plain file", cmd, {}, r"chunks", setup="chunks-file")]
 
 
-def _guessed(cmd, required_max_impacts):
-    """Options issue 10 §3 implies and the CLI may not have yet (ids say so)."""
+def _guessed(cmd, required_max_impacts, rest_speed=False):
+    """Options the specification implies and the CLI may not have yet (ids say so);
+    ``--rest-speed`` only where the command has it (a single run's)."""
     c = []
     mi = "[guessed --max-impacts]"
     for v in ["0", "-1", HUGE_INT] + NOT_INT + _malformed(cmd, "--max-impacts"):
@@ -299,7 +300,8 @@ def _guessed(cmd, required_max_impacts):
     for v in ["-1", "-1e-3"] + NONFINITE + _malformed(cmd, "--xi"):
         c.append(Case(_id(cmd, "--xi", [v], "[guessed --xi]"), cmd, {"--xi": [v]},
                       NAMES["--xi"], guessed="--xi"))
-    for v in ["-1", "-1e-8"] + NONFINITE + _malformed(cmd, "--rest-speed"):
+    for v in (["-1", "-1e-8"] + NONFINITE + _malformed(cmd, "--rest-speed")
+              if rest_speed else []):
         c.append(Case(_id(cmd, "--rest-speed", [v], "[guessed --rest-speed]"), cmd,
                       {"--rest-speed": [v]}, NAMES["--rest-speed"], guessed="--rest-speed"))
     return c
@@ -318,7 +320,7 @@ def _trajectory():
                   {"--method": ["scipy"], "--lyapunov": True}, NAMES["--lyapunov"]))
     c += _int_opt(cmd, "--max-points", ["0", "1", "-1"])
     c += _missing(cmd, ["--hb", "--alpha", "--omega", "--out"])
-    c += _out_cases(cmd) + _guessed(cmd, required_max_impacts=True)
+    c += _out_cases(cmd) + _guessed(cmd, required_max_impacts=True, rest_speed=True)
     return c
 
 
