@@ -563,6 +563,87 @@ def test_lock_of_another_host_is_refused(tmp_path):
     assert (store / "lock.json").exists()
 
 
+def _lock(pid, **kw):
+    return json.dumps(dict(pid=pid, host=rio.host_name(), token="t", **kw))
+
+
+def _proc(path):
+    try:
+        return Path(path).read_text()
+    except OSError:
+        return None
+
+
+def _start_ticks(pid):
+    """Field 22 of ``/proc/<pid>/stat`` (read here independently of rockjit)."""
+    text = _proc(f"/proc/{pid}/stat")
+    return None if text is None else int(text[text.rindex(")") + 2:].split()[19])
+
+
+def _boot_id():
+    text = _proc("/proc/sys/kernel/random/boot_id")
+    return None if text is None else text.strip()
+
+
+def _boot_time():
+    text = _proc("/proc/stat") or ""
+    return next(float(line.split()[1]) for line in text.splitlines() if line.startswith("btime"))
+
+
+needs_proc = pytest.mark.skipif(_start_ticks(1) is None or _boot_id() is None,
+                                reason="needs /proc (pid start times, the boot id)")
+
+
+@needs_proc
+@pytest.mark.parametrize("lock, why", [
+    (dict(start="later", boot="this"), "started later"),
+    (dict(start="same", boot="another boot"), "restarted"),
+    (dict(written="before boot"), "started after the lock was written"),
+], ids=["pid-reused", "rebooted", "old-lock-before-boot"])
+def test_a_lock_naming_a_live_pid_of_another_process_is_taken_over(tmp_path, lock, why):
+    # pid 1 is alive, but it is not the process that wrote these locks: such a lock was
+    # refused on every rerun (pids are reused after a reboot, and in containers)
+    store = tmp_path / "s"
+    store.mkdir()
+    start = _start_ticks(1)
+    fields = {}
+    if "start" in lock:
+        fields["start"] = start + 1 if lock["start"] == "later" else start
+        fields["boot"] = _boot_id() if lock["boot"] == "this" else "another boot"
+    (store / "lock.json").write_text(_lock(1, **fields))
+    if lock.get("written") == "before boot":  # rockjit 0.1.0's lock, from before this boot
+        t = _boot_time() - 3600
+        os.utime(store / "lock.json", (t, t))
+    msgs = []
+    s = _open(store, msgs.append)
+    assert s.locked and len(msgs) == 1, msgs
+    assert msgs[0].startswith(f"took over the chunk store {store} from pid 1 on ")
+    assert why in msgs[0]
+    s.close()
+
+
+@needs_proc
+def test_a_live_owners_lock_is_refused_saying_how_to_take_the_store_over(tmp_path):
+    store = tmp_path / "s"
+    store.mkdir()
+    lock = store / "lock.json"
+    for fields in (dict(start=_start_ticks(1), boot=_boot_id()),  # pid 1 itself
+                   {}):  # no start time, written after pid 1 started: cannot tell
+        lock.write_text(_lock(1, **fields))
+        with pytest.raises(ValueError) as refused:
+            _open(store)
+        msg = str(refused.value)
+        assert "in use by another rockjit run (pid 1 on " in msg
+        assert msg.endswith(f"if no rockjit run is using it (pid 1 is another program), "
+                            f"delete {lock}")
+    lock.unlink()
+    s = _open(store)  # the lock it writes names its process exactly
+    mine = json.loads(lock.read_text())
+    assert mine["pid"] == os.getpid() and mine["start"] == _start_ticks(os.getpid())
+    assert mine["boot"] == _boot_id()
+    s.close()
+
+
 CHILD_RUN = """
     import sys
     from pathlib import Path

@@ -45,9 +45,10 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["OutputDir", "atomic_open", "create_temp", "defer_signals", "host_name",
-           "markdown_table", "pid_alive", "save_figure", "sigterm_interrupts", "to_jsonable",
-           "write_csv", "write_json", "write_npz", "write_text"]
+__all__ = ["OutputDir", "atomic_open", "boot_id", "boot_time", "create_temp", "defer_signals",
+           "host_name", "markdown_table", "pid_alive", "process_start", "process_start_time",
+           "save_figure", "sigterm_interrupts", "to_jsonable", "write_csv", "write_json",
+           "write_npz", "write_text"]
 
 TMP_SUFFIX = ".tmp"
 _O_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
@@ -238,6 +239,54 @@ def pid_alive(pid):
     except OSError:
         return True  # cannot tell: assume alive, which never deletes anything
     return True
+
+
+def process_start(pid):
+    """When process ``pid`` started, in clock ticks since boot (``/proc/<pid>/stat``, field
+    22), or ``None`` where that cannot be read (no such process, no ``/proc``). Together with
+    the pid it names one process: a pid reused by a later process has a later start."""
+    try:
+        with open(f"/proc/{int(pid)}/stat", "rb") as fh:
+            stat_line = fh.read()
+        # the command name (field 2) is in parentheses and may hold spaces or ')'
+        return int(stat_line[stat_line.rindex(b")") + 2:].split()[19])
+    except (OSError, ValueError, IndexError):
+        return None
+
+
+def boot_id():
+    """This boot's identifier (``/proc/sys/kernel/random/boot_id``), or ``None`` where there is
+    none: a pid recorded under another boot id names a process of an earlier boot."""
+    try:
+        with open("/proc/sys/kernel/random/boot_id", encoding="ascii") as fh:
+            return fh.read().strip() or None
+    except (OSError, ValueError):
+        return None
+
+
+def boot_time():
+    """When this machine booted (seconds since the epoch; ``btime`` of ``/proc/stat``), or
+    ``None`` where that cannot be read."""
+    try:
+        with open("/proc/stat", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("btime "):
+                    return float(line.split()[1])
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
+
+
+def process_start_time(pid):
+    """When process ``pid`` started, in seconds since the epoch, or ``None`` (see
+    :func:`process_start`)."""
+    ticks, booted = process_start(pid), boot_time()
+    if ticks is None or booted is None:
+        return None
+    try:
+        return booted + ticks / os.sysconf("SC_CLK_TCK")
+    except (AttributeError, ValueError, OSError):
+        return None
 
 
 @contextlib.contextmanager
