@@ -505,6 +505,25 @@ def test_damaged_chunks_are_discarded_and_recomputed(tmp_path, capsys):
     assert calls == []
 
 
+def test_a_chunk_replaced_by_a_directory_is_removed_and_recomputed(tmp_path):
+    # its discard raised IsADirectoryError, so it was never recomputed and every rerun failed
+    store = tmp_path / "s"
+    _run(_open(store))
+    chunk = store / "cells-0000000005-0000000010.npz"
+    chunk.unlink()
+    chunk.mkdir()
+    (chunk / "inside").write_text("x")
+    msgs, calls = [], []
+    _same(_run(_open(store, msgs.append), calls), _direct())
+    assert calls == [(5, 10)] and len(msgs) == 1
+    assert msgs[0].startswith(f"discarded damaged chunk {chunk.name} ") and chunk.is_file()
+    other = store / "cells-0000000010-0000000015.npz"
+    other.unlink()
+    other.mkdir()  # one left for the clean-up: it is rockjit's own, and goes too
+    assert chunks.remove_stores(store, message=msgs.append)
+    assert not store.exists()
+
+
 def test_bit_flip_in_a_chunk_is_caught_by_the_checksum(tmp_path):
     store = tmp_path / "s"
     _run(_open(store))

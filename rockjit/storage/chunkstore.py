@@ -32,6 +32,7 @@ import json
 import os
 import re
 import secrets
+import shutil
 import sys
 import time
 import weakref
@@ -323,7 +324,7 @@ class ChunkStore:
         now = time.time()
         for p in self.dir.iterdir():
             if _OWN_TEMP.fullmatch(p.name):
-                p.unlink(missing_ok=True)
+                _remove(p)
             elif _LOCK_TEMP.fullmatch(p.name):  # another run's, while it takes a lock
                 with contextlib.suppress(OSError):
                     if now - p.stat().st_mtime > 60:
@@ -406,8 +407,18 @@ class ChunkStore:
             np.savez(fh, **out)
 
     def discard(self, a, b):
-        """Delete chunk ``a:b`` (a damaged one, before computing it again)."""
-        self._path(a, b).unlink(missing_ok=True)
+        """Delete chunk ``a:b`` (a damaged one, before computing it again), whatever it is: a
+        directory in its place is removed with its contents (the store is rockjit's own)."""
+        _remove(self._path(a, b))
+
+
+def _remove(path):
+    """Remove ``path``: a file, a link, or a directory with its contents; absent is fine."""
+    path = Path(path)
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path)
+    else:
+        path.unlink(missing_ok=True)
 
 
 def remove_stores(directory, *, message=None, _lock=None):
@@ -433,7 +444,7 @@ def remove_stores(directory, *, message=None, _lock=None):
     """
     d = Path(directory)
     say = _say if message is None else message
-    if not d.is_dir() or d.is_symlink():
+    if not os.path.isdir(d) or os.path.islink(d):  # (os.path: False for a name too long)
         return not os.path.lexists(d)
 
     def is_store(p):
@@ -453,7 +464,7 @@ def remove_stores(directory, *, message=None, _lock=None):
             for p in s.iterdir():
                 if _CHUNK.fullmatch(p.name) or _OWN_TEMP.fullmatch(p.name) or \
                         p.name == ChunkStore.MANIFEST:
-                    p.unlink(missing_ok=True)
+                    _remove(p)
         finally:
             lock.release()
         with contextlib.suppress(OSError):
