@@ -5,15 +5,20 @@ compiled kernel variants (single run with exponents and recording, sweep grid wi
 basin grid without), so that the module stays quick.
 """
 
+import errno
 import json
 import math
+import os
 import subprocess
 import sys
+import tempfile
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import rockjit
+from rockjit.cli import outputs
 from rockjit.grids import grids as analysis
 from rockjit.storage import files as rio
 from rockjit.grids.grids import BEHAVIOURS
@@ -456,3 +461,125 @@ def test_compile_refuses_an_unknown_variant():
     from rockjit._engine.kernel import compile_kernels
     with pytest.raises(ValueError, match="kernel variant must be one of"):
         compile_kernels(["warp-drive"])
+
+
+# ---------------------------------------------------------------------------------------------
+# errors while running: one line, a report, exit status 1, --out as it was
+# ---------------------------------------------------------------------------------------------
+
+@pytest.fixture
+def reports(tmp_path, monkeypatch):
+    """Where the error reports go (the temporary directory, here one of the test's own)."""
+    d = tmp_path / "reports"
+    d.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(d))
+    return d
+
+
+def _error_and_report(err, reports, start):
+    """The one line on stderr starts with ``start`` and names the report, which holds the
+    traceback; returns the line."""
+    assert "Traceback" not in err and err.endswith("\n") and err.count("\n") == 1, err
+    line = err.rstrip("\n")
+    assert line.startswith(start), line
+    found = sorted(reports.glob("rockjit-error-*.txt"))
+    assert len(found) == 1 and f"the traceback is in {found[0]}" in line
+    assert "Traceback (most recent call last)" in found[0].read_text()
+    return line
+
+
+def _stages(root):
+    return [p for p in Path(root).rglob("*") if "rockjit-stage" in p.name]
+
+
+@pytest.mark.parametrize("cause", ["no space left", "a bug"])
+def test_an_error_while_running_is_one_line_and_a_report(tmp_path, monkeypatch, capsys, reports,
+                                                         cause):
+    # _internal_error called tempfile without importing it: every such error ended in a
+    # NameError traceback, and no report
+    if cause == "no space left":
+        def full(path, **arrays):
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
+        monkeypatch.setattr(rio, "write_npz", full)
+        start = "rockjit: error: No space left on device: "
+    else:
+        def bug(*args, **kwargs):
+            raise RuntimeError("something rockjit did not expect")
+        monkeypatch.setattr(outputs, "summary", bug)
+        start = "rockjit: internal error: RuntimeError: something rockjit did not expect; "
+    out = tmp_path / "b"
+    assert main(BASIN + ["--out", str(out)]) == 1
+    line = _error_and_report(capsys.readouterr().err, reports, start)
+    assert "--out is as it was" in line
+    assert not out.exists() and not _stages(tmp_path)
+
+
+def _mount(*args):
+    if os.geteuid() != 0:
+        pytest.skip("mounting a small file system needs root")
+    done = subprocess.run(["mount", *map(str, args)], capture_output=True, text=True)
+    if done.returncode:
+        pytest.skip(f"cannot mount here: {done.stderr.strip()}")
+
+
+@pytest.fixture
+def mounts():
+    """Mount tmpfs file systems for a test (as root, where mounting is allowed; else skip);
+    unmounted afterwards."""
+    made = []
+
+    def tmpfs(where, size="1m"):
+        where.mkdir(parents=True, exist_ok=True)
+        _mount("-t", "tmpfs", "-o", f"size={size}", "tmpfs", where)
+        made.append(where)
+        return where
+
+    yield tmpfs
+    for where in reversed(made):
+        subprocess.run(["umount", "-l", str(where)], capture_output=True)
+
+
+def test_a_full_disk_is_one_line_and_a_report(tmp_path, mounts, capsys, reports):
+    disk = mounts(tmp_path / "disk", size="64k")
+    (disk / "filler").write_bytes(b"\0" * 56 * 1024)  # a few kilobytes left
+    out = disk / "cor"
+    assert main(["cor", "--out", str(out), "--quiet"]) == 1
+    _error_and_report(capsys.readouterr().err, reports, "rockjit: error: No space left on "
+                                                        "device")
+    assert sorted(p.name for p in disk.iterdir()) == ["filler"]  # nothing left behind
+
+
+def test_a_chunk_replaced_by_a_directory_is_recomputed(tmp_path, monkeypatch, capsys):
+    from rockjit._engine import kernel
+    from rockjit.grids import runner
+    out = tmp_path / "b"
+    real_run_chunk, real_run_grid = kernel.run_chunk, runner.run_grid
+    n = []
+
+    def interrupt_at_the_third(*a):
+        if len(n) == 2:
+            raise KeyboardInterrupt
+        n.append(1)
+        return real_run_chunk(*a)
+
+    def small_chunks(*a, **kw):
+        return real_run_grid(*a, **dict(kw, chunk=6))
+
+    monkeypatch.setattr(runner, "run_grid", small_chunks)
+    monkeypatch.setattr(kernel, "run_chunk", interrupt_at_the_third)
+    assert main(BASIN + ["--out", str(out)]) == 130
+    store = tmp_path / "b.chunks" / "housner"  # the store of the one law
+    first = store / "cells-0000000000-0000000006.npz"
+    assert first.is_file()
+    first.unlink()
+    first.mkdir()
+    (first / "x").write_text("")
+    monkeypatch.setattr(kernel, "run_chunk", real_run_chunk)
+    capsys.readouterr()
+    assert main(BASIN[:-1] + ["--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "discarded damaged chunk cells-0000000000-0000000006.npz" in err and "Traceback" \
+        not in err
+    assert not (tmp_path / "b.chunks").exists()
+    whole = analysis.basin(1, 0.66, 1.3, grid=6, periods=20, n_steps=64)
+    np.testing.assert_array_equal(np.load(out / "basin.npz")["label"], whole.label)

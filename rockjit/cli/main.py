@@ -16,6 +16,7 @@ JSON files write non-finite numbers as the strings ``"nan"``, ``"inf"``, ``"-inf
 from __future__ import annotations
 
 import argparse
+import contextlib
 import functools
 import math
 import os
@@ -520,12 +521,31 @@ def _error(msg):
 
 
 def _internal_error(exc):
+    """An error while running (a full disk, a file system refusing a write, a bug): one line on
+    stderr, the traceback in a report file (``rockjit-error-*.txt`` in the temporary
+    directory), exit status 1. Never raises: if the report cannot be written either, the line
+    says why."""
+    import tempfile
     import traceback
-    fd, path = tempfile.mkstemp(prefix=f"{PROG}-error-", suffix=".txt")
-    with os.fdopen(fd, "w") as f:
-        traceback.print_exception(exc, file=f)
-    print(f"{PROG}: internal error: {type(exc).__name__}: {' '.join(str(exc).split())}; --out "
-          f"is as it was; the traceback is in {path} (please report it)", file=sys.stderr)
+    path = None
+    try:
+        fd, path = tempfile.mkstemp(prefix=f"{PROG}-error-", suffix=".txt")
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            traceback.print_exception(type(exc), exc, exc.__traceback__, file=f)
+        report = f"the traceback is in {path}"
+    except Exception as e:  # its disk may be full too
+        if path is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(path)
+        report = f"no report could be written ({type(e).__name__}: {' '.join(str(e).split())})"
+    if isinstance(exc, OSError) and exc.strerror:
+        where = f": {exc.filename}" if exc.filename else ""
+        line = f"{PROG}: error: {exc.strerror}{where}; --out is as it was; {report}"
+    else:
+        line = (f"{PROG}: internal error: {type(exc).__name__}: {' '.join(str(exc).split())}; "
+                f"--out is as it was; {report} (please report it)")
+    with contextlib.suppress(Exception):
+        print(" ".join(line.split()), file=sys.stderr, flush=True)
     return 1
 
 
