@@ -549,6 +549,27 @@ def test_a_full_disk_is_one_line_and_a_report(tmp_path, mounts, capsys, reports)
     assert sorted(p.name for p in disk.iterdir()) == ["filler"]  # nothing left behind
 
 
+def test_a_read_only_out_is_refused_before_any_work(tmp_path, mounts, monkeypatch, capsys):
+    # the probe looked only at --out's parent: the run computed, then failed to stage its
+    # outputs inside --out (a NameError traceback)
+    ro = mounts(tmp_path / "ro")
+    (ro / "inside").mkdir()
+    mounts(ro / "inside", size="1m")  # writable, in a directory that will be read-only
+    _mount("-o", "remount,ro", ro)
+    monkeypatch.setattr(analysis, "run", lambda *a, **k: pytest.fail("not refused before work"))
+    assert main(BASIN + ["--out", str(ro)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"rockjit: error: --out {ro} cannot be created or written (Read-only "
+                          f"file system)") and err.count("\n") == 1
+    # --out writable, but not where a grid command keeps its chunks (beside it)
+    assert main(BASIN + ["--out", str(ro / "inside")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"rockjit: error: {ro / 'inside'}.chunks (where --out's unfinished "
+                          f"chunks wait) cannot be created or written (Read-only file system)")
+    monkeypatch.undo()
+    assert main(["cor", "--out", str(ro / "inside"), "--quiet"]) == 0  # it has no chunks
+
+
 def test_a_chunk_replaced_by_a_directory_is_recomputed(tmp_path, monkeypatch, capsys):
     from rockjit._engine import kernel
     from rockjit.grids import runner
@@ -583,3 +604,70 @@ def test_a_chunk_replaced_by_a_directory_is_recomputed(tmp_path, monkeypatch, ca
     assert not (tmp_path / "b.chunks").exists()
     whole = analysis.basin(1, 0.66, 1.3, grid=6, periods=20, n_steps=64)
     np.testing.assert_array_equal(np.load(out / "basin.npz")["label"], whole.label)
+
+
+def test_long_out_names(tmp_path, capsys):
+    # 230 characters: the name of the staging directory beside --out grew too long, once the
+    # work was done; over 255, check_out raised OSError (a traceback)
+    for name, argv in [("o" * 230, BASIN), ("c" * 250, ["cor", "--quiet"])]:
+        assert main(argv + ["--out", str(tmp_path / name)]) == 0
+        assert (tmp_path / name / "summary.json").is_file()
+    # a grid command keeps its chunks beside --out, in <out>.chunks: 7 bytes more
+    for name, argv, says in [("b" * 250, BASIN, "at most 248"),
+                             ("c" * 256, ["cor", "--quiet"], "at most 255"),
+                             ("d/" * 2100 + "d", ["cor", "--quiet"], "as an absolute path")]:
+        assert main(argv + ["--out", str(tmp_path / name)]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("rockjit: error: --out") and says in err, err
+        assert err.count("\n") == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c" * 250, "o" * 230]
+
+
+# ---------------------------------------------------------------------------------------------
+# every problem with --out, before any work
+# ---------------------------------------------------------------------------------------------
+
+def _dangling(out):
+    out.symlink_to(out.parent / "nowhere")
+
+
+def _looping(out):
+    out.symlink_to(out.name)
+
+
+def _output_named_dir(out):
+    out.mkdir()
+    (out / "basin.npz").mkdir()
+    (out / "basin.npz" / "mine.txt").write_text("a user's file")
+
+
+def _chunks_dangling(out):
+    Path(f"{out}.chunks").symlink_to("nowhere")
+
+
+def _store_is_a_file(out):
+    Path(f"{out}.chunks").mkdir()
+    Path(f"{out}.chunks", "mao").write_text("a user's file")
+
+
+@pytest.mark.parametrize("setup, says", [
+    (_dangling, "is a symbolic link to "),
+    (_looping, "is a symbolic link in a loop"),
+    (_output_named_dir, "holds a directory basin.npz where this command writes a file"),
+    (_chunks_dangling, "chunks wait) is a symbolic link to nowhere, which does not exist"),
+    (_store_is_a_file, "mao, where --out's unfinished chunks of a grid wait, is not a "
+                       "directory"),
+], ids=["dangling-link", "looping-link", "dir-named-like-output", "chunks-dangling-link",
+        "store-is-a-file"])
+def test_out_problems_are_found_before_any_work(tmp_path, monkeypatch, capsys, setup, says):
+    # a dangling or looping --out was refused as "an existing file", and a directory named like
+    # an output file only when publishing: both after the work, with its chunks left behind
+    out = tmp_path / "o"
+    setup(out)
+    before = sorted(str(p) for p in tmp_path.rglob("*"))
+    monkeypatch.setattr(analysis, "run", lambda *a, **k: pytest.fail("not refused before work"))
+    assert main(BASIN + ["--law", "both", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("rockjit: error: ") and err.count("\n") == 1 and "--out" in err
+    assert says in err, err
+    assert sorted(str(p) for p in tmp_path.rglob("*")) == before

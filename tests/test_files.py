@@ -396,6 +396,45 @@ def test_refusals_leave_everything_as_it_was(tmp_path):
     assert _snapshot(tmp_path) == before
 
 
+def test_check_out_finds_what_publishing_would_refuse(tmp_path):
+    # each of these was found only when staging or publishing, after the work
+    (tmp_path / "dangling").symlink_to(tmp_path / "nowhere")
+    (tmp_path / "loop").symlink_to("loop")
+    (tmp_path / "out" / "basin.npz").mkdir(parents=True)
+    (tmp_path / "out.chunks").mkdir()
+    (tmp_path / "out.chunks" / "mao").write_text("mine")
+    (tmp_path / "s" / "summary.json").mkdir(parents=True)
+    before = _snapshot(tmp_path)
+    for out, says in [(tmp_path / "dangling", "is a symbolic link to "),
+                      (tmp_path / "loop", "is a symbolic link in a loop"),
+                      (tmp_path / "dangling" / "sub", "cannot be created: "),
+                      (tmp_path / ("x" * 256), "256 bytes long; at most 255"),
+                      (tmp_path / "a" / ("d/" * 2100), "as an absolute path")]:
+        with pytest.raises(ValueError, match="^--out ") as refused:
+            rio.check_out(out, name="--out")
+        assert says in str(refused.value)
+    with pytest.raises(ValueError, match="holds a directory basin.npz where"):
+        rio.check_out(tmp_path / "out", name="--out", files=("basin.npz",))
+    with pytest.raises(ValueError, match="holds a directory summary.json where"):
+        rio.check_out(tmp_path / "s", name="--out")  # summary.json: every command's
+    with pytest.raises(ValueError, match="mao, where --out's unfinished chunks"):
+        rio.check_out(tmp_path / "out", name="--out", chunks=True)
+    rio.check_out(tmp_path / "out", name="--out")  # without chunks, and without that file
+    with pytest.raises(ValueError, match=r"<name>.chunks, and at most 255 bytes fit"):
+        rio.check_out(tmp_path / ("y" * 250), name="--out", chunks=True)
+    rio.check_out(tmp_path / ("y" * 248), name="--out", chunks=True)
+    assert _snapshot(tmp_path) == before  # the checks leave nothing behind
+
+
+def test_staging_names_stay_short_beside_a_long_out(tmp_path):
+    out = tmp_path / ("o" * 240)  # its staging directory beside it would need 280 bytes
+    with rio.OutputDir(out) as o:
+        o.text("a.txt", "a")
+        stage = o.staging
+        assert len(stage.name) <= 255 and stage.parent == tmp_path
+    assert (out / "a.txt").read_text() == "a" and sorted(os.listdir(tmp_path)) == [out.name]
+
+
 def test_nothing_written_creates_nothing(tmp_path):
     with rio.OutputDir(tmp_path / "a" / "out") as o:
         pass

@@ -65,6 +65,23 @@ def _warn(msg):
 # checks of the command line's own options (the library checks the rest)
 # ---------------------------------------------------------------------------------------------
 
+#: The files each command writes into --out besides summary.json (names or fnmatch patterns):
+#: a directory of one of these names inside --out is refused before any work.
+OUTPUTS = {
+    "trajectory": ("trajectory.npz", "trajectory.png"),
+    "sweep": ("sweep.npz", "bifurcation.png"),
+    "basin": ("basin.npz", "basin.png", "attractors.png"),
+    "plane": ("plane.npz", "plane.png"),
+    "erosion": ("erosion.npz", "erosion.png"),
+    "orbits": ("orbits.npz", "orbits.png"),
+    "fate": ("fate.npz", "fate.png"),
+    "cor": ("restitution.png", "e_table.csv", "e_table.md"),
+    "paper": ("fig*.png", "fig*.npz", "*_table.csv", "*_table.md"),
+}
+#: The commands whose grids keep their finished chunks in <out>.chunks.
+CHUNKED = ("sweep", "basin", "plane", "erosion", "orbits", "paper")
+
+
 def _check_run(args):
     """``--threads`` fits numba's; ``--scheduler`` needs dask; ``--out`` can be written
     (:func:`rockjit.storage.files.check_out`)."""
@@ -78,7 +95,8 @@ def _check_run(args):
         except ImportError:
             raise UsageError("--scheduler needs dask: pip install 'rockjit[dask]'") from None
     from ..storage.files import check_out
-    check_out(args.out, name="--out")
+    check_out(args.out, name="--out", files=OUTPUTS.get(args.command, ()),
+              chunks=args.command in CHUNKED)
 
 
 def _chunk_root(args):
@@ -615,8 +633,9 @@ def main(argv=None):
     try:
         if note:
             _warn(note)
-        from ..storage.chunkstore import remove_stores
-        remove_stores(_chunk_root(args), message=lambda m: _say(args, m))
+        if args.command in CHUNKED:
+            from ..storage.chunkstore import remove_stores
+            remove_stores(_chunk_root(args), message=lambda m: _say(args, m))
         _say(args, f"{args.command}: wrote {args.out}")
     except KeyboardInterrupt:
         pass  # the outputs are published: the command succeeded

@@ -32,6 +32,8 @@ import contextlib
 import csv
 import dataclasses
 import errno
+import fnmatch
+import hashlib
 import io as _io
 import json
 import math
@@ -45,10 +47,10 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["OutputDir", "atomic_open", "boot_id", "boot_time", "create_temp", "defer_signals",
-           "host_name", "markdown_table", "pid_alive", "process_start", "process_start_time",
-           "save_figure", "sigterm_interrupts", "to_jsonable", "write_csv", "write_json",
-           "write_npz", "write_text"]
+__all__ = ["OutputDir", "atomic_open", "boot_id", "boot_time", "check_out", "create_temp",
+           "defer_signals", "host_name", "markdown_table", "pid_alive", "process_start",
+           "process_start_time", "save_figure", "sigterm_interrupts", "to_jsonable", "write_csv",
+           "write_json", "write_npz", "write_text"]
 
 TMP_SUFFIX = ".tmp"
 _O_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
@@ -389,28 +391,178 @@ def chunk_root(out):
     return Path(str(Path(out)) + ".chunks")
 
 
-def check_out(out, *, name="out"):
-    """Refuse (``ValueError`` naming ``name``) an output directory that cannot be written: an
-    empty name, an existing file, a ``<out>.chunks`` that is not a directory, or a place where
-    no directory can be made (probed by making and removing a temporary one where the outputs
-    will be staged)."""
-    if not str(out).strip():
-        raise ValueError(f"{name} must name a directory (got an empty string)")
-    p = Path(out)
-    if p.exists() and not p.is_dir():
-        raise ValueError(f"{name} must be a directory (got {out}, an existing file)")
-    chunks = chunk_root(out)
-    if chunks.exists() and not chunks.is_dir():
-        raise ValueError(f"{chunks} (where {name}'s unfinished chunks wait) exists and is not "
-                         f"a directory; move it away or choose another {name}")
-    q = p.absolute().parent
-    while not q.exists():
-        q = q.parent
+def _name_max(directory):
+    """The longest file name (bytes) the file system of ``directory`` takes (255 if unknown)."""
     try:
-        os.rmdir(_mkdir_unique(q, ".rockjit-probe-"))
+        return int(os.pathconf(directory, "PC_NAME_MAX"))
+    except (OSError, ValueError, AttributeError, TypeError):
+        return 255
+
+
+def _path_max(directory):
+    """The longest path (bytes) the system takes (4096 if unknown)."""
+    try:
+        return int(os.pathconf(directory, "PC_PATH_MAX"))
+    except (OSError, ValueError, AttributeError, TypeError):
+        return 4096
+
+
+def _nearest(path):
+    """``path`` (absolute) or its nearest ancestor that exists (as a link, file or directory)."""
+    q = Path(path).absolute()
+    while not os.path.lexists(q) and q != q.parent:
+        q = q.parent
+    return q
+
+
+def _link_problem(path):
+    """Why the symbolic link ``path`` cannot be followed (it dangles, it loops), or ``None``."""
+    try:
+        os.stat(path)
+        return None
     except OSError as exc:
-        raise ValueError(f"{name} {out} cannot be created or written "
+        try:
+            target = os.readlink(path)
+        except OSError:
+            target = "?"
+        if exc.errno == errno.ELOOP:
+            return f"a symbolic link in a loop ({path} -> {target})"
+        if exc.errno in (errno.ENOENT, errno.ENOTDIR):
+            return f"a symbolic link to {target}, which does not exist"
+        return f"a symbolic link that cannot be followed ({exc.strerror or exc})"
+
+
+def _short(text, keep=200):
+    text = str(text)
+    return text if len(text) <= keep else f"{text[:keep // 2 - 2]}...{text[-(keep // 2 - 2):]}"
+
+
+def _probe(directory):
+    """Make and remove a hidden directory in ``directory``: ``OSError`` if it cannot be written."""
+    os.rmdir(_mkdir_unique(Path(directory), ".rockjit-probe-"))
+
+
+#: Room kept, below the system's longest path, for the names rockjit adds inside ``--out`` and
+#: ``<out>.chunks`` (a staging directory, a file, its temporary name).
+PATH_ROOM = 256
+
+
+def check_out(out, *, name="out", files=(), chunks=False):
+    """Refuse, before any work, an output directory rockjit could not publish into.
+
+    Raises ``ValueError`` naming ``name`` for: an empty name; a name too long for the file
+    system (any of its parts, ``<out>.chunks`` when ``chunks``, or the whole path with room
+    for what is written inside it); an existing file, or a symbolic link that dangles or loops
+    (``--out`` itself or the part of it that exists); a place where no directory can be made or
+    written (probed by making and removing a hidden one where the outputs will be staged:
+    inside ``out`` if it exists, else in its nearest existing parent); a directory inside ``out``
+    named like a file the command writes (``files``: names or ``fnmatch`` patterns;
+    ``summary.json`` always); and, when the command keeps chunks (``chunks``), a
+    ``<out>.chunks`` that is not a writable directory or holds a file where a chunk store would
+    go (a name without a dot).
+    """
+    text = os.fspath(out)
+    if not text.strip():
+        raise ValueError(f"{name} must name a directory (got an empty string)")
+    try:
+        _check_out(Path(text), text, name, (SUMMARY,) + tuple(files), chunks)
+    except OSError as exc:  # what the checks did not foresee, still before any work
+        raise ValueError(f"{name} {_short(text)} cannot be used "
                          f"({exc.strerror or exc})") from None
+
+
+def _check_out(p, out, name, files, chunks):
+    absolute = p.absolute()
+    q = _nearest(absolute)
+    limit = _name_max(q if os.path.isdir(q) else q.parent)
+    for part in absolute.parts:
+        if len(os.fsencode(part)) > limit:
+            raise ValueError(f"{name} {_short(out)}: the name {_short(part, 60)} is "
+                             f"{len(os.fsencode(part))} bytes long; at most {limit} fit on "
+                             f"this file system")
+    if chunks and len(os.fsencode(absolute.name + ".chunks")) > limit:
+        raise ValueError(f"{name}'s last name {_short(absolute.name, 60)} is "
+                         f"{len(os.fsencode(absolute.name))} bytes long: this command keeps "
+                         f"its unfinished chunks beside it in <name>.chunks, and at most "
+                         f"{limit} bytes fit, so {name}'s last name can have at most "
+                         f"{limit - len('.chunks')}")
+    room = _path_max(q if os.path.isdir(q) else q.parent) - PATH_ROOM
+    if len(os.fsencode(str(absolute))) > room:
+        raise ValueError(f"{name} {_short(out)} is {len(os.fsencode(str(absolute)))} bytes "
+                         f"long as an absolute path; at most {room} leave room for the files "
+                         f"written inside it")
+    if q != absolute:  # --out is made inside q
+        if os.path.islink(q) and _link_problem(q):
+            raise ValueError(f"{name} {_short(out)} cannot be created: {q} is "
+                             f"{_link_problem(q)}")
+        if not os.path.isdir(q):
+            raise ValueError(f"{name} {_short(out)} cannot be created: {q} is a file, not a "
+                             f"directory")
+        stage = q
+    else:
+        if os.path.islink(p) and _link_problem(p):
+            raise ValueError(f"{name} {_short(out)} is {_link_problem(p)}; remove the link "
+                             f"or choose another {name}")
+        if not os.path.isdir(p):
+            raise ValueError(f"{name} must be a directory (got {_short(out)}, an existing "
+                             f"file)")
+        stage = p
+        with os.scandir(p) as entries:
+            for e in entries:
+                if any(fnmatch.fnmatchcase(e.name, f) for f in files) and \
+                        e.is_dir(follow_symlinks=False):
+                    raise ValueError(f"{name} {_short(out)} holds a directory {e.name} where "
+                                     f"this command writes a file of that name; move it "
+                                     f"away or choose another {name}")
+    try:
+        _probe(stage)
+    except OSError as exc:
+        raise ValueError(f"{name} {_short(out)} cannot be created or written "
+                         f"({exc.strerror or exc})") from None
+    if chunks:
+        _check_chunk_root(out, name)
+
+
+def _check_chunk_root(out, name):
+    c = chunk_root(out)
+    where = f"{_short(c)} (where {name}'s unfinished chunks wait)"
+    if os.path.lexists(c):
+        if os.path.islink(c) and _link_problem(c):
+            raise ValueError(f"{where} is {_link_problem(c)}; remove it or choose another "
+                             f"{name}")
+        if not os.path.isdir(c):
+            raise ValueError(f"{where} exists and is not a directory; move it away or choose "
+                             f"another {name}")
+        with os.scandir(c) as entries:
+            for e in entries:  # rockjit's stores there: directories, named without a dot
+                if "." not in e.name and not e.is_dir():
+                    raise ValueError(f"{_short(c / e.name)}, where {name}'s unfinished "
+                                     f"chunks of a grid wait, is not a directory; move it "
+                                     f"away or choose another {name}")
+        at = c
+    else:
+        at = _nearest(c.absolute().parent)
+        if not os.path.isdir(at):
+            return  # made with --out (checked above)
+    try:
+        _probe(at)
+    except OSError as exc:
+        raise ValueError(f"{where} cannot be created or written ({exc.strerror or exc})") \
+            from None
+
+
+def _sibling_prefix(out):
+    """The names of ``out``'s staging directories beside it: ``.<name>.rockjit-stage-``, or
+    ``.<hash of the name>.rockjit-stage-`` where the name is too long for the file system to
+    take ``<host>-<pid>-<random>`` after it."""
+    if not out.name:
+        return None
+    prefix = f".{out.name}.{_STAGE}-"
+    longest = len(os.fsencode(prefix + host_name())) + len("-4294967296-") + 8
+    if longest > _name_max(_nearest(out.parent)):
+        digest = hashlib.sha256(os.fsencode(out.name)).hexdigest()[:16]
+        prefix = f".{digest}.{_STAGE}-"
+    return prefix
 
 
 class OutputDir:
@@ -501,7 +653,7 @@ class OutputDir:
             return self._stage
         out = self.path
         host, pid = host_name(), os.getpid()
-        sibling = f".{out.name}.{_STAGE}-" if out.name else None
+        sibling = _sibling_prefix(out)
         if os.path.lexists(out):
             if not out.is_dir():
                 raise ValueError(f"out must be a directory (got {out}, an existing file)")
