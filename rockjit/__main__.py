@@ -1,5 +1,5 @@
 """``python -m rockjit``: the command line (see :mod:`rockjit.cli.main`)."""
 
-from .cli.main import main
+from .cli.main import entry
 
-raise SystemExit(main())
+raise SystemExit(entry())

@@ -5,9 +5,17 @@ Every command parses its options into the library's own plan (:func:`rockjit.sin
 a bad value ends the command with one line ``rockjit: error: ...`` on stderr and exit status 2,
 having written nothing. Then it computes and writes its data, its figure(s) and
 ``summary.json`` into a hidden staging directory, published into ``--out`` as one unit at the
-end (:class:`rockjit.storage.files.OutputDir`). An interrupted command (Ctrl-C: exit status 130) leaves
-``--out`` as it was; the finished chunks of its grids wait in ``<out>.chunks`` so that running
-the same command again resumes.
+end (:class:`rockjit.storage.files.OutputDir`). Every problem with ``--out`` itself (a file, a
+dangling or looping link, a name too long, a directory named like an output file, a place that
+cannot be written) is found before any work, with the rest of the input.
+
+One outcome per run: the exit status says whether ``--out`` was published. A command
+interrupted before that (SIGINT, Ctrl-C: exit status 130; SIGTERM: 143) leaves ``--out`` as it
+was; the finished chunks of its grids wait in ``<out>.chunks`` so that running the same command
+again resumes. A signal once ``--out`` is published changes nothing: exit status 0, and a line
+says so. An error while running (a full disk, a file system that refuses a write, a bug) is one
+line ``rockjit: error: ...`` or ``rockjit: internal error: ...`` on stderr with its traceback in a
+report file, exit status 1, ``--out`` as it was.
 
 JSON files write non-finite numbers as the strings ``"nan"``, ``"inf"``, ``"-inf"``
 (:mod:`rockjit.storage.files`).
@@ -21,6 +29,7 @@ import functools
 import math
 import os
 import re
+import signal
 import sys
 import time
 import warnings
@@ -30,7 +39,7 @@ import numpy as np
 
 from .. import __version__
 
-__all__ = ["build_parser", "main"]
+__all__ = ["build_parser", "entry", "main"]
 
 PROG = "rockjit"
 
@@ -575,17 +584,80 @@ def _compile(args):
     try:
         compile_kernels(names, progress=lambda i, n, name, s: _say(
             args, f"compile: [{i}/{n}] {name} ({VARIANTS[name][0]}): {s:.1f} s"))
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
         print(f"\n{PROG}: interrupted; the variants compiled so far are cached", file=sys.stderr)
-        return 130
+        return 128 + getattr(exc, "signum", 2)
     _say(args, f"compile: done in {time.perf_counter() - t0:.1f} s")
     return 0
 
 
 def main(argv=None):
-    """Run the command line; returns the exit status (0, 2 bad input, 130 interrupted)."""
+    """Run the command line; returns the exit status: 0 done (``--out`` published, also when a
+    signal arrives after that: the line says so), 1 an error while running (one line, the
+    traceback in a report file), 2 bad input, 130 / 143 interrupted by SIGINT / SIGTERM before
+    ``--out`` was published (``--out`` as it was)."""
+    from ..storage.files import command_interrupts
+    with command_interrupts() as sig:
+        try:
+            return _main(argv, sig)
+        except BaseException as exc:
+            sig.final = True
+            # a signal: KeyboardInterrupt, or what it became on its way out (an ImportError
+            # when it interrupted the import of an extension module)
+            if isinstance(exc, KeyboardInterrupt) or (sig.received and
+                                                      not isinstance(exc, SystemExit)):
+                return _interrupted(exc, sig)
+            raise
+        finally:
+            sig.final = True  # from here on a signal changes nothing
+
+
+def entry():
+    """The program (``python -m rockjit``; the console script's ``_rockjit_cli`` does the same
+    from before ``import rockjit``): :func:`main` with SIGINT and SIGTERM handled for the rest
+    of the process's life, so that a signal after the run cannot change its exit status (once
+    it has returned, they are ignored: the interpreter would put their default actions back
+    while it finalizes)."""
+    from ..storage.files import command_interrupts
+    try:
+        with command_interrupts(keep=True) as sig:
+            try:
+                return main()
+            except BaseException as exc:  # a signal in the instants before main handles them
+                sig.final = True
+                if isinstance(exc, KeyboardInterrupt) or (sig.received and
+                                                          not isinstance(exc, SystemExit)):
+                    return _interrupted(exc, sig)
+                raise
+    finally:
+        for s in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(s, signal.SIG_IGN)
+
+
+def _interrupted(exc, sig):
+    """A SIGINT or SIGTERM (``exc.signum``) that interrupted the run: 128 + the signal, unless
+    ``--out`` was published already (0)."""
+    from ..storage.files import chunk_root, signal_name
+    signum = getattr(exc, "signum", None) or (sig.received[-1] if sig.received else 2)
+    out = sig.out
+    if out is not None and out.published:
+        print(f"{PROG}: {signal_name(signum)} arrived after {out.path} was written; the command "
+              f"has completed (exit status 0)", file=sys.stderr, flush=True)
+        return 0
+    where = ""
+    if out is not None:
+        out.discard()
+        chunks = chunk_root(out.path)
+        if os.path.isdir(chunks):
+            where = f" (finished chunks wait in {chunks} for a rerun)"
+    print(f"\n{PROG}: interrupted ({signal_name(signum)}); --out is as it was{where}",
+          file=sys.stderr, flush=True)
+    return 128 + signum
+
+
+def _main(argv, sig):
     from . import outputs
-    from ..storage.files import OutputDir, sigterm_interrupts
+    from ..storage.files import OutputDir, interrupted, pause_for_tests, signal_name
     try:
         args = build_parser().parse_args(argv)
     except UsageError as exc:
@@ -604,32 +676,43 @@ def main(argv=None):
         _say(args, "first run here: numba compiles rockjit's kernels into its cache, about "
                    "10-20 s per kernel variant on two cores, once (`rockjit compile` does it "
                    "ahead of time)")
-        if args.command == "paper" and _compile(args):  # every variant, side by side
-            return 130
+        if args.command == "paper":  # every variant, side by side
+            rc = _compile(args)
+            if rc:
+                return rc
     import matplotlib
     matplotlib.use("Agg")
-    out = OutputDir(args.out, command=args.command)
+    interrupted(sig)  # a signal whose KeyboardInterrupt something swallowed: no work
+    out = sig.out = OutputDir(args.out, command=args.command)
+    n = n0 = len(sig.received)
     try:
-        with sigterm_interrupts(), warnings.catch_warnings():
+        with warnings.catch_warnings():
             if args.quiet:
                 warnings.simplefilter("ignore")
+            pause_for_tests("work", sig)
             wall, results = args.run(args, plan, out)
             inputs = {k: v for k, v in vars(args).items() if not callable(v)}
             out.json("summary.json", outputs.summary(out, args.command, inputs, wall, **results))
+            interrupted(sig)  # likewise: before publication, a signal always interrupts
+            n = len(sig.received)
             note = out.publish()
     except KeyboardInterrupt:
         if not out.published:
-            out.discard()
-            print(f"\n{PROG}: interrupted; --out is as it was (finished chunks wait in "
-                  f"{_chunk_root(args)} for a rerun)", file=sys.stderr)
-            return 130
-        note = out.warning  # finished and published: a late Ctrl-C changes nothing
+            raise  # main: --out as it was, 130 or 143
+        note = out.warning
     except (UsageError, ValueError) as exc:  # a check made only once running
         out.discard()
         return _error(exc)
-    except Exception as exc:  # a bug: one line, the traceback kept for the report
+    except Exception as exc:  # a full disk, a refused write, a bug: one line and a report
         out.discard()
+        if len(sig.received) > n0:
+            raise  # what a signal became (see main)
         return _internal_error(exc)
+    except BaseException:
+        out.discard()
+        raise
+    sig.final = True  # published: from here on a signal changes nothing
+    pause_for_tests("published", sig)
     try:
         if note:
             _warn(note)
@@ -637,6 +720,12 @@ def main(argv=None):
             from ..storage.chunkstore import remove_stores
             remove_stores(_chunk_root(args), message=lambda m: _say(args, m))
         _say(args, f"{args.command}: wrote {args.out}")
-    except KeyboardInterrupt:
-        pass  # the outputs are published: the command succeeded
+    except Exception as exc:  # the outputs are published: the command has succeeded
+        _warn(f"{args.out} was written; cleaning up after it failed ({type(exc).__name__}: "
+              f"{exc})")
+    pause_for_tests("wrote", sig)
+    late = ([out.interrupted] if out.interrupted else []) + sig.received[n:]
+    if late:
+        print(f"{PROG}: {signal_name(late[0])} arrived after {args.out} was written; the "
+              f"command has completed (exit status 0)", file=sys.stderr, flush=True)
     return 0

@@ -42,15 +42,21 @@ import secrets
 import shutil
 import signal
 import socket
+import sys
 import threading
+import time
+import types
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["OutputDir", "atomic_open", "boot_id", "boot_time", "check_out", "create_temp",
-           "defer_signals", "host_name", "markdown_table", "pid_alive", "process_start",
-           "process_start_time", "save_figure", "sigterm_interrupts", "to_jsonable", "write_csv",
-           "write_json", "write_npz", "write_text"]
+__all__ = ["OutputDir", "atomic_open", "boot_id", "boot_time", "check_out",
+           "command_interrupts", "create_temp", "defer_signals", "host_name",
+           "installed_interrupts", "interrupt_handler", "interrupted", "markdown_table",
+           "pause_for_tests", "pid_alive", "process_start", "process_start_time",
+           "quiet_lost_interrupts", "save_figure", "signal_name",
+           "sigterm_interrupts", "to_jsonable", "write_csv", "write_json", "write_npz",
+           "write_text"]
 
 TMP_SUFFIX = ".tmp"
 _O_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
@@ -317,6 +323,124 @@ def defer_signals(signums=(signal.SIGINT, signal.SIGTERM)):
     finally:
         for s, h in old.items():
             signal.signal(s, signal.SIG_DFL if h is None else h)
+
+
+# ---- the signals of a command: one outcome per run -------------------------------------------
+#
+# A command's state is a namespace with ``received`` (the signals that arrived, in order),
+# ``final`` (once true, signals are only recorded) and ``out`` (its OutputDir, or None). Its
+# handler (interrupt_handler) records each SIGINT or SIGTERM and, until ``final`` is set or
+# ``out`` is published, raises KeyboardInterrupt carrying the signal in ``signum``: before
+# publication a signal interrupts the run (exit status 128 + signum, --out as it was); after
+# it, the run has succeeded and the signal changes nothing. The console script's entry point
+# (the top-level module ``_rockjit_cli``) installs the same handler before ``import rockjit``,
+# so that Ctrl-C during the imports is handled too; it marks it with ``rockjit_state``.
+
+def interrupt_handler(state):
+    """The SIGINT and SIGTERM handler of a command's ``state`` (see the comment above)."""
+    def handler(signum, frame):
+        state.received.append(signum)
+        if state.final or getattr(state.out, "published", False):
+            return
+        exc = KeyboardInterrupt()
+        exc.signum = signum
+        raise exc
+    handler.rockjit_state = state
+    return handler
+
+
+def installed_interrupts():
+    """The state of the command handler installed for both SIGINT and SIGTERM, or ``None``."""
+    state = getattr(signal.getsignal(signal.SIGINT), "rockjit_state", None)
+    if state is not None and getattr(signal.getsignal(signal.SIGTERM), "rockjit_state",
+                                     None) is state:
+        return state
+    return None
+
+
+@contextlib.contextmanager
+def command_interrupts(keep=False):
+    """SIGINT and SIGTERM handled for one command (:func:`interrupt_handler`).
+
+    Reuses the handler already installed by the program's entry point, if there is one, and
+    leaves it in place; otherwise installs one for the block and puts the previous handlers
+    back on exit, unless ``keep`` (the program's own entry point: a signal after the run has
+    ended must not change its exit status). Outside the main thread nothing is installed.
+
+    Yields
+    ------
+    namespace
+        The state: ``received``, ``final``, ``out``.
+    """
+    state = installed_interrupts()
+    if state is not None:
+        yield state
+        return
+    state = types.SimpleNamespace(received=[], final=False, out=None)
+    old = {}
+    hook = sys.unraisablehook
+    if threading.current_thread() is threading.main_thread():
+        handler = interrupt_handler(state)
+        for s in (signal.SIGINT, signal.SIGTERM):
+            try:
+                old[s] = signal.signal(s, handler)
+            except (ValueError, OSError):
+                pass
+        sys.unraisablehook = quiet_lost_interrupts(state, hook)
+    try:
+        yield state
+    finally:
+        if not keep:
+            for s, h in old.items():
+                signal.signal(s, signal.SIG_DFL if h is None else h)
+            sys.unraisablehook = hook
+
+
+def quiet_lost_interrupts(state, previous):
+    """A ``sys.unraisablehook`` that drops the KeyboardInterrupt of a signal raised where it
+    cannot propagate (in a finalizer: Python would print "Exception ignored in ..." and a
+    traceback, and go on). The signal is in ``state.received``, and the command acts on it
+    before publishing (see :func:`interrupted`). Anything else goes to ``previous``."""
+    def hook(unraisable):
+        if issubclass(unraisable.exc_type, KeyboardInterrupt) and state.received:
+            return
+        previous(unraisable)
+    return hook
+
+
+def interrupted(state):
+    """Raise the KeyboardInterrupt of a signal that arrived (``state.received``) but whose
+    KeyboardInterrupt did not reach the command: swallowed by a finalizer, or by a library's
+    ``except BaseException``. Called before work and before publishing, so that a signal
+    before publication always interrupts."""
+    if state.received and not state.final:
+        exc = KeyboardInterrupt()
+        exc.signum = state.received[-1]
+        raise exc
+
+
+def signal_name(signum):
+    """``"SIGINT"``, ``"SIGTERM"``, ..."""
+    try:
+        return signal.Signals(signum).name
+    except ValueError:
+        return f"signal {signum}"
+
+
+PAUSE_VARIABLE = "ROCKJIT_TEST_PAUSE"
+
+
+def pause_for_tests(point, state):
+    """Where the environment variable ``ROCKJIT_TEST_PAUSE`` names ``point``: say so on stderr
+    (``rockjit: paused at <point>``) and wait, at most 60 s, for a signal, so that a test can
+    send one at a known moment of a run. Otherwise nothing."""
+    if os.environ.get(PAUSE_VARIABLE) != point:
+        return
+    n = len(state.received)
+    print(f"rockjit: paused at {point}", file=sys.stderr, flush=True)
+    deadline = time.monotonic() + 60.0
+    while len(state.received) == n and time.monotonic() < deadline:
+        time.sleep(0.01)
 
 
 # ---- a command's output directory ------------------------------------------------------------
