@@ -152,9 +152,10 @@ def test_plane_command_resumes_and_cleans_up(tmp_path, monkeypatch, capsys):
     z = np.load(out / "plane.npz")
     local = an.plane(**PLANE)
     np.testing.assert_array_equal(z["label"], local.label[0])
-    assert main(args[:-3] + ["--scheduler", "tcp://127.0.0.1:9", "--out",
-                             str(tmp_path / "x"), "--quiet"]) == 2
-    assert "cannot reach the Dask scheduler" in capsys.readouterr().err
+    assert main(args[:-3] + ["--scheduler", "tcp://127.0.0.1:9", "--scheduler-timeout", "2",
+                             "--out", str(tmp_path / "x"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "rockjit: error: --scheduler tcp://127.0.0.1:9: cannot reach the Dask scheduler" in err
 
 
 def _small_chunks(run_grid):
@@ -277,6 +278,20 @@ def test_a_scheduler_without_workers_is_an_error_after_the_timeout(no_workers, c
 
         with pytest.raises(grid_runner.NoWorkers, match="in 0.5 s"):
             _within(60, basin_in_half_a_second)
+
+
+def test_the_command_line_gives_up_on_a_scheduler_without_workers(no_workers, tmp_path,
+                                                                   capsys):
+    out = tmp_path / "b"
+    argv = ["basin", "--hb", "1", "--alpha", "0.66", "--omega", "1.3", "--grid", "4",
+            "--periods", "20", "--scheduler", no_workers.scheduler_address,
+            "--scheduler-timeout", "1", "--out", str(out)]
+    assert _within(120, main, argv) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert any(line.startswith("rockjit: waiting for a worker") for line in err), err
+    assert err[-1].startswith(f"rockjit: error: --scheduler {no_workers.scheduler_address}: ")
+    assert "had no worker in 1 s" in err[-1] and "--scheduler-timeout" in err[-1]
+    assert not out.exists()
 
 
 def _slow_chunk(x):

@@ -49,16 +49,73 @@ class UsageError(Exception):
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors, and negative numbers in any notation taken as values
-    (``--theta0 -1e-3``, ``--dtheta0 -inf``), not as options."""
+    """argparse with one-line errors; the options declared ``type=float`` and ``type=int``
+    parsed by :func:`_real` and :func:`_int` (exactly ASCII decimal numbers); and anything that
+    starts like a negative number taken as a value (``--theta0 -1e-3``, ``--dtheta0 -inf``, and
+    ``-1_0`` too, for the number parser to refuse), not as an option."""
 
     def __init__(self, *a, **kw):
         super().__init__(*a, **kw)
-        self._negative_number_matcher = re.compile(
-            r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
+        self.register("type", float, _real)
+        self.register("type", int, _int)
+        self._negative_number_matcher = re.compile(r"^-(\.?\d|(inf|infinity|nan)$)",
+                                                   re.IGNORECASE)
 
     def error(self, message):
         raise UsageError(message)
+
+
+# ---------------------------------------------------------------------------------------------
+# the values of options: exactly ASCII decimal numbers, a Dask scheduler's address
+# ---------------------------------------------------------------------------------------------
+
+_DECIMAL = re.compile(r"[+-]?([0-9]+(\.[0-9]*)?|\.[0-9]+)([eE][+-]?[0-9]+)?")
+_NONFINITE = re.compile(r"[+-]?(inf|infinity|nan)", re.IGNORECASE)
+_INTEGER = re.compile(r"[+-]?[0-9]+")
+
+
+def _real(text):
+    """A real number option: ``[+-]digits[.digits][e[+-]digits]`` in ASCII, or ``inf``, ``nan``
+    (the range checks refuse those, naming the option); no ``_``, no other digits or spaces."""
+    if _DECIMAL.fullmatch(text) or _NONFINITE.fullmatch(text):
+        return float(text)
+    raise argparse.ArgumentTypeError(f"must be a number such as 0.5, -2 or 1e-3 (got {text!r})")
+
+
+def _int(text):
+    """An integer option: ``[+-]digits`` in ASCII."""
+    if _INTEGER.fullmatch(text):
+        try:
+            return int(text)
+        except ValueError:  # more digits than Python converts
+            raise argparse.ArgumentTypeError(f"is too large ({len(text)} digits)") from None
+    raise argparse.ArgumentTypeError(f"must be an integer such as 100 (got {text!r})")
+
+
+_ADDRESS = re.compile(r"(?:(?P<scheme>[A-Za-z][A-Za-z0-9+.-]*)://)?"
+                      r"(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+)(?::(?P<port>[0-9]+))?")
+
+
+def _scheduler(text):
+    """``--scheduler``: a Dask scheduler's address, ``tcp://HOST:PORT`` (or ``tls://``, or
+    ``HOST:PORT``) with 1 <= PORT <= 65535, or the path of an existing scheduler file (written by
+    ``dask scheduler --scheduler-file``). Checked before connecting."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("must be a Dask scheduler's address, tcp://HOST:PORT, "
+                                         "or a scheduler file (got an empty string)")
+    if "://" not in text and os.path.isfile(text):
+        return text
+    m = _ADDRESS.fullmatch(text)
+    scheme = (m.group("scheme") or "tcp").lower() if m else None
+    if m is None or scheme not in ("tcp", "tls") or ("://" not in text and not m.group("port")):
+        hint = (" (no such scheduler file)" if "://" not in text and ":" not in text else "")
+        raise argparse.ArgumentTypeError(f"must be a Dask scheduler's address, tcp://HOST:PORT, "
+                                         f"or an existing scheduler file (got {text!r}){hint}")
+    port = m.group("port")
+    if port is not None and not 1 <= int(port) <= 65535:
+        raise argparse.ArgumentTypeError(f"port must be in [1, 65535] (got {int(port)} in "
+                                         f"{text!r})")
+    return text
 
 
 def _say(args, msg):  # progress and notes: silenced by --quiet
@@ -92,12 +149,18 @@ CHUNKED = ("sweep", "basin", "plane", "erosion", "orbits", "paper")
 
 
 def _check_run(args):
-    """``--threads`` fits numba's; ``--scheduler`` needs dask; ``--out`` can be written
-    (:func:`rockjit.storage.files.check_out`)."""
+    """``--threads`` fits numba's; the scipy path's tolerances are valid numbers whatever the
+    method; ``--scheduler`` needs dask and ``--scheduler-timeout`` is a positive time; ``--out``
+    can be written (:func:`rockjit.storage.files.check_out`)."""
+    from ..validate import integer, real
     if getattr(args, "threads", None) is not None:
         import numba
-        from ..validate import integer
         integer("threads", args.threads, 1, numba.config.NUMBA_NUM_THREADS)
+    if getattr(args, "rtol", None) is not None:  # as rockjit.single.plan checks them for scipy
+        real("rtol", args.rtol, 0.0, 1.0, lo_open=True, hi_open=True)
+        real("atol", args.atol, 0.0, None, lo_open=True)
+    if getattr(args, "scheduler_timeout", None) is not None:
+        real("--scheduler-timeout", args.scheduler_timeout, 0.0, 1e6, lo_open=True)
     if getattr(args, "scheduler", None):
         try:
             import dask.distributed  # noqa: F401
@@ -113,15 +176,24 @@ def _chunk_root(args):
     return chunk_root(args.out)
 
 
+#: Seconds to wait for a Dask scheduler to answer (at most; --scheduler-timeout if shorter).
+CONNECT_TIMEOUT = 15.0
+
+
 def _client(args):  # a Dask client for --scheduler, or None
     if not getattr(args, "scheduler", None):
         return None
     from dask.distributed import Client
     _say(args, f"{args.command}: connecting to the Dask scheduler at {args.scheduler}")
+    timeout = min(CONNECT_TIMEOUT, args.scheduler_timeout)
+    file = "://" not in args.scheduler and os.path.isfile(args.scheduler)
     try:
-        return Client(args.scheduler, timeout="15s")
-    except (OSError, TimeoutError) as exc:
-        raise UsageError(f"cannot reach the Dask scheduler at {args.scheduler} ({exc})")
+        if file:
+            return Client(scheduler_file=args.scheduler, timeout=f"{timeout}s")
+        return Client(args.scheduler, timeout=f"{timeout}s")
+    except Exception as exc:  # OSError, TimeoutError, a bad scheduler file, ...
+        raise UsageError(f"--scheduler {args.scheduler}: cannot reach the Dask scheduler "
+                         f"({type(exc).__name__}: {exc})") from None
 
 
 def _block_kw(args):  # these three: the options by their API names
@@ -380,9 +452,12 @@ def _add_grid_run(p, lyapunov_default):
 
 
 def _add_scheduler(p):
-    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                   help="run the chunks of cells on this Dask scheduler (e.g. "
-                        "tcp://host:8786); default in this process")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS", type=_scheduler,
+                   help="run the chunks of cells on this Dask scheduler (tcp://host:8786, or "
+                        "a scheduler file); default in this process")
+    p.add_argument("--scheduler-timeout", type=float, default=60.0, metavar="SECONDS",
+                   help="give up when the scheduler has had no worker for this long "
+                        "(default 60)")
 
 
 def _add_alphas(p, step):
@@ -547,11 +622,11 @@ def _error(msg):
     return 2
 
 
-def _internal_error(exc):
-    """An error while running (a full disk, a file system refusing a write, a bug): one line on
-    stderr, the traceback in a report file (``rockjit-error-*.txt`` in the temporary
-    directory), exit status 1. Never raises: if the report cannot be written either, the line
-    says why."""
+def _internal_error(exc, prefix=""):
+    """An error while running (a full disk, a file system refusing a write, a lost Dask
+    scheduler, a bug): one line on stderr (after ``prefix``), the traceback in a report file
+    (``rockjit-error-*.txt`` in the temporary directory), exit status 1. Never raises: if the
+    report cannot be written either, the line says why."""
     import tempfile
     import traceback
     path = None
@@ -565,7 +640,10 @@ def _internal_error(exc):
             with contextlib.suppress(OSError):
                 os.unlink(path)
         report = f"no report could be written ({type(e).__name__}: {' '.join(str(e).split())})"
-    if isinstance(exc, OSError) and exc.strerror:
+    if prefix:
+        line = (f"{PROG}: error: {prefix}{type(exc).__name__}: {' '.join(str(exc).split())}; "
+                f"--out is as it was; {report}")
+    elif isinstance(exc, OSError) and exc.strerror:
         where = f": {exc.filename}" if exc.filename else ""
         line = f"{PROG}: error: {exc.strerror}{where}; --out is as it was; {report}"
     else:
@@ -574,6 +652,19 @@ def _internal_error(exc):
     with contextlib.suppress(Exception):
         print(" ".join(line.split()), file=sys.stderr, flush=True)
     return 1
+
+
+def _from_dask(exc):
+    """Whether ``exc`` is a connection's failure (``OSError``, ``TimeoutError``) raised inside
+    dask.distributed."""
+    if not isinstance(exc, (OSError, TimeoutError)):
+        return False
+    tb = exc.__traceback__
+    while tb is not None:
+        if f"{os.sep}distributed{os.sep}" in tb.tb_frame.f_code.co_filename:
+            return True
+        tb = tb.tb_next
+    return False
 
 
 def _compile(args):
@@ -683,10 +774,13 @@ def _main(argv, sig):
     import matplotlib
     matplotlib.use("Agg")
     interrupted(sig)  # a signal whose KeyboardInterrupt something swallowed: no work
+    from ..grids.runner import NoWorkers, worker_timeout
+    timeout = getattr(args, "scheduler_timeout", None)
     out = sig.out = OutputDir(args.out, command=args.command)
     n = n0 = len(sig.received)
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), \
+                (worker_timeout(timeout) if timeout else contextlib.nullcontext()):
             if args.quiet:
                 warnings.simplefilter("ignore")
             pause_for_tests("work", sig)
@@ -700,6 +794,9 @@ def _main(argv, sig):
         if not out.published:
             raise  # main: --out as it was, 130 or 143
         note = out.warning
+    except NoWorkers as exc:
+        out.discard()
+        return _error(f"--scheduler {args.scheduler}: {exc} (--scheduler-timeout)")
     except (UsageError, ValueError) as exc:  # a check made only once running
         out.discard()
         return _error(exc)
@@ -707,7 +804,9 @@ def _main(argv, sig):
         out.discard()
         if len(sig.received) > n0:
             raise  # what a signal became (see main)
-        return _internal_error(exc)
+        lost = getattr(args, "scheduler", None) and _from_dask(exc)
+        return _internal_error(exc, f"--scheduler {args.scheduler}: the connection to the Dask "
+                                    f"scheduler failed: " if lost else "")
     except BaseException:
         out.discard()
         raise
