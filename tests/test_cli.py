@@ -6,6 +6,7 @@ basin grid without), so that the module stays quick.
 """
 
 import errno
+import fnmatch
 import json
 import math
 import os
@@ -22,7 +23,7 @@ from rockjit.cli import outputs
 from rockjit.grids import grids as analysis
 from rockjit.storage import files as rio
 from rockjit.grids.grids import BEHAVIOURS
-from rockjit.cli.main import main
+from rockjit.cli.main import OUTPUTS, main
 
 TINY = ["--periods", "20", "--n-steps", "64", "--quiet"]
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -30,7 +31,14 @@ BASIN = ["basin", "--hb", "1", "--alpha", "0.66", "--omega", "1.3", "--grid", "6
 
 
 def _summary(d):
-    return json.loads((d / "summary.json").read_text())
+    s = json.loads((d / "summary.json").read_text())
+    # every file a command writes is one the command line checks for before any work (a
+    # directory of that name inside --out is refused then, not when publishing)
+    declared = OUTPUTS[s["command"]] + ("summary.json",)
+    for name in s["files"]:
+        assert any(fnmatch.fnmatchcase(name, pattern) for pattern in declared), \
+            f"{name}: add it to rockjit.cli.main.OUTPUTS[{s['command']!r}]"
+    return s
 
 
 def _is_png(path):
