@@ -17,7 +17,7 @@ sys.path.insert(0, str(ROOT))
 def main(folder, width=1600, height=1500):
     from playwright.sync_api import sync_playwright
 
-    from rockjit.explore.server import start
+    from rockjit.explorer.server import start
     from test_explore import PIXEL_JS
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)

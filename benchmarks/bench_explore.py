@@ -45,8 +45,8 @@ def _options(p):
 def library_alone(alphas, periods, levels):
     """Each alpha's basin stages through the explorer's worker, no server nor browser:
     seconds from the submission to the 50² and to the 100² result."""
-    from rockjit.explore import requests as R
-    from rockjit.explore.worker import Computer
+    from rockjit.explorer import requests as R
+    from rockjit.explorer.worker import Computer
     marks = {}
 
     def publish(ev):

@@ -1,5 +1,6 @@
-"""``python -m rockjit``: the command line (see :mod:`rockjit.cli.main`)."""
+"""``python -m rockjit``: the command line, through the same entry point as the ``rockjit``
+script (:func:`rockjit.cli.main`)."""
 
-from .cli.main import main
+from .cli import main
 
 raise SystemExit(main())

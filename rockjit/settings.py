@@ -272,7 +272,10 @@ class Execution(_Replace):
         interactive caller cancels a computation this way.
     message : callable, optional
         ``message(text)`` hears the chunk store's notes (a lock taken over, a damaged chunk
-        recomputed); default a line on stderr.
+        recomputed) and the wait for Dask workers; default a line on stderr.
+    worker_timeout : float, optional
+        Seconds a computation on Dask waits for the scheduler to have a worker before it
+        gives up with an error; default 60 (:data:`rockjit.grids.runner.WORKER_TIMEOUT`).
 
     Examples
     --------
@@ -289,6 +292,7 @@ class Execution(_Replace):
     store: Any = None
     progress: bool | Callable = False
     message: Callable | None = None
+    worker_timeout: float | None = None
 
     def __post_init__(self):
         if self.threads is not None:
@@ -315,3 +319,6 @@ class Execution(_Replace):
             except ValueError:
                 raise ValueError(f"progress must be True, False or a callable "
                                  f"progress(done, total) (got {self.progress!r})") from None
+        if self.worker_timeout is not None:
+            _set(self, worker_timeout=real("worker_timeout", self.worker_timeout, 0.0, None,
+                                           lo_open=True))

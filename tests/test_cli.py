@@ -5,19 +5,25 @@ compiled kernel variants (single run with exponents and recording, sweep grid wi
 basin grid without), so that the module stays quick.
 """
 
+import errno
+import fnmatch
 import json
 import math
+import os
 import subprocess
 import sys
+import tempfile
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import rockjit
+from rockjit.cli import outputs
 from rockjit.grids import grids as analysis
 from rockjit.storage import files as rio
 from rockjit.grids.grids import BEHAVIOURS
-from rockjit.cli.main import main
+from rockjit.cli.main import OUTPUTS, main
 
 TINY = ["--periods", "20", "--n-steps", "64", "--quiet"]
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -25,7 +31,14 @@ BASIN = ["basin", "--hb", "1", "--alpha", "0.66", "--omega", "1.3", "--grid", "6
 
 
 def _summary(d):
-    return json.loads((d / "summary.json").read_text())
+    s = json.loads((d / "summary.json").read_text())
+    # every file a command writes is one the command line checks for before any work (a
+    # directory of that name inside --out is refused then, not when publishing)
+    declared = OUTPUTS[s["command"]] + ("summary.json",)
+    for name in s["files"]:
+        assert any(fnmatch.fnmatchcase(name, pattern) for pattern in declared), \
+            f"{name}: add it to rockjit.cli.main.OUTPUTS[{s['command']!r}]"
+    return s
 
 
 def _is_png(path):
@@ -457,3 +470,213 @@ def test_compile_refuses_an_unknown_variant():
     from rockjit._engine.kernel import compile_kernels
     with pytest.raises(ValueError, match="kernel variant must be one of"):
         compile_kernels(["warp-drive"])
+
+
+# ---------------------------------------------------------------------------------------------
+# errors while running: one line, a report, exit status 1, --out as it was
+# ---------------------------------------------------------------------------------------------
+
+@pytest.fixture
+def reports(tmp_path, monkeypatch):
+    """Where the error reports go (the temporary directory, here one of the test's own)."""
+    d = tmp_path / "reports"
+    d.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(d))
+    return d
+
+
+def _error_and_report(err, reports, start):
+    """The one line on stderr starts with ``start`` and names the report, which holds the
+    traceback; returns the line."""
+    assert "Traceback" not in err and err.endswith("\n") and err.count("\n") == 1, err
+    line = err.rstrip("\n")
+    assert line.startswith(start), line
+    found = sorted(reports.glob("rockjit-error-*.txt"))
+    assert len(found) == 1 and f"the traceback is in {found[0]}" in line
+    assert "Traceback (most recent call last)" in found[0].read_text()
+    return line
+
+
+def _stages(root):
+    return [p for p in Path(root).rglob("*") if "rockjit-stage" in p.name]
+
+
+@pytest.mark.parametrize("cause", ["no space left", "a bug"])
+def test_an_error_while_running_is_one_line_and_a_report(tmp_path, monkeypatch, capsys, reports,
+                                                         cause):
+    # _internal_error called tempfile without importing it: every such error ended in a
+    # NameError traceback, and no report
+    if cause == "no space left":
+        def full(path, **arrays):
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
+        monkeypatch.setattr(rio, "write_npz", full)
+        start = "rockjit: error: No space left on device: "
+    else:
+        def bug(*args, **kwargs):
+            raise RuntimeError("something rockjit did not expect")
+        monkeypatch.setattr(outputs, "summary", bug)
+        start = "rockjit: internal error: RuntimeError: something rockjit did not expect; "
+    out = tmp_path / "b"
+    assert main(BASIN + ["--out", str(out)]) == 1
+    line = _error_and_report(capsys.readouterr().err, reports, start)
+    assert "--out is as it was" in line
+    assert not out.exists() and not _stages(tmp_path)
+
+
+def _mount(*args):
+    if os.geteuid() != 0:
+        pytest.skip("mounting a small file system needs root")
+    done = subprocess.run(["mount", *map(str, args)], capture_output=True, text=True)
+    if done.returncode:
+        pytest.skip(f"cannot mount here: {done.stderr.strip()}")
+
+
+@pytest.fixture
+def mounts():
+    """Mount tmpfs file systems for a test (as root, where mounting is allowed; else skip);
+    unmounted afterwards."""
+    made = []
+
+    def tmpfs(where, size="1m"):
+        where.mkdir(parents=True, exist_ok=True)
+        _mount("-t", "tmpfs", "-o", f"size={size}", "tmpfs", where)
+        made.append(where)
+        return where
+
+    yield tmpfs
+    for where in reversed(made):
+        subprocess.run(["umount", "-l", str(where)], capture_output=True)
+
+
+def test_a_full_disk_is_one_line_and_a_report(tmp_path, mounts, capsys, reports):
+    disk = mounts(tmp_path / "disk", size="64k")
+    (disk / "filler").write_bytes(b"\0" * 56 * 1024)  # a few kilobytes left
+    out = disk / "cor"
+    assert main(["cor", "--out", str(out), "--quiet"]) == 1
+    _error_and_report(capsys.readouterr().err, reports, "rockjit: error: No space left on "
+                                                        "device")
+    assert sorted(p.name for p in disk.iterdir()) == ["filler"]  # nothing left behind
+
+
+def test_a_read_only_out_is_refused_before_any_work(tmp_path, mounts, monkeypatch, capsys):
+    # the probe looked only at --out's parent: the run computed, then failed to stage its
+    # outputs inside --out (a NameError traceback)
+    ro = mounts(tmp_path / "ro")
+    (ro / "inside").mkdir()
+    mounts(ro / "inside", size="1m")  # writable, in a directory that will be read-only
+    _mount("-o", "remount,ro", ro)
+    monkeypatch.setattr(analysis, "run", lambda *a, **k: pytest.fail("not refused before work"))
+    assert main(BASIN + ["--out", str(ro)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"rockjit: error: --out {ro} cannot be created or written (Read-only "
+                          f"file system)") and err.count("\n") == 1
+    # --out writable, but not where a grid command keeps its chunks (beside it)
+    assert main(BASIN + ["--out", str(ro / "inside")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"rockjit: error: {ro / 'inside'}.chunks (where --out's unfinished "
+                          f"chunks wait) cannot be created or written (Read-only file system)")
+    monkeypatch.undo()
+    assert main(["cor", "--out", str(ro / "inside"), "--quiet"]) == 0  # it has no chunks
+
+
+def test_a_chunk_replaced_by_a_directory_is_recomputed(tmp_path, monkeypatch, capsys):
+    from rockjit._engine import kernel
+    from rockjit.grids import runner
+    out = tmp_path / "b"
+    real_run_chunk, real_run_grid = kernel.run_chunk, runner.run_grid
+    n = []
+
+    def interrupt_at_the_third(*a):
+        if len(n) == 2:
+            raise KeyboardInterrupt
+        n.append(1)
+        return real_run_chunk(*a)
+
+    def small_chunks(*a, **kw):
+        return real_run_grid(*a, **dict(kw, chunk=6))
+
+    monkeypatch.setattr(runner, "run_grid", small_chunks)
+    monkeypatch.setattr(kernel, "run_chunk", interrupt_at_the_third)
+    assert main(BASIN + ["--out", str(out)]) == 130
+    store = tmp_path / "b.chunks" / "housner"  # the store of the one law
+    first = store / "cells-0000000000-0000000006.npz"
+    assert first.is_file()
+    first.unlink()
+    first.mkdir()
+    (first / "x").write_text("")
+    monkeypatch.setattr(kernel, "run_chunk", real_run_chunk)
+    capsys.readouterr()
+    assert main(BASIN[:-1] + ["--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "discarded damaged chunk cells-0000000000-0000000006.npz" in err and "Traceback" \
+        not in err
+    assert not (tmp_path / "b.chunks").exists()
+    whole = analysis.basin(1, 0.66, 1.3, grid=6, periods=20, n_steps=64)
+    np.testing.assert_array_equal(np.load(out / "basin.npz")["label"], whole.label)
+
+
+def test_long_out_names(tmp_path, capsys):
+    # 230 characters: the name of the staging directory beside --out grew too long, once the
+    # work was done; over 255, check_out raised OSError (a traceback)
+    for name, argv in [("o" * 230, BASIN), ("c" * 250, ["cor", "--quiet"])]:
+        assert main(argv + ["--out", str(tmp_path / name)]) == 0
+        assert (tmp_path / name / "summary.json").is_file()
+    # a grid command keeps its chunks beside --out, in <out>.chunks: 7 bytes more
+    for name, argv, says in [("b" * 250, BASIN, "at most 248"),
+                             ("c" * 256, ["cor", "--quiet"], "at most 255"),
+                             ("d/" * 2100 + "d", ["cor", "--quiet"], "as an absolute path")]:
+        assert main(argv + ["--out", str(tmp_path / name)]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("rockjit: error: --out") and says in err, err
+        assert err.count("\n") == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c" * 250, "o" * 230]
+
+
+# ---------------------------------------------------------------------------------------------
+# every problem with --out, before any work
+# ---------------------------------------------------------------------------------------------
+
+def _dangling(out):
+    out.symlink_to(out.parent / "nowhere")
+
+
+def _looping(out):
+    out.symlink_to(out.name)
+
+
+def _output_named_dir(out):
+    out.mkdir()
+    (out / "basin.npz").mkdir()
+    (out / "basin.npz" / "mine.txt").write_text("a user's file")
+
+
+def _chunks_dangling(out):
+    Path(f"{out}.chunks").symlink_to("nowhere")
+
+
+def _store_is_a_file(out):
+    Path(f"{out}.chunks").mkdir()
+    Path(f"{out}.chunks", "mao").write_text("a user's file")
+
+
+@pytest.mark.parametrize("setup, says", [
+    (_dangling, "is a symbolic link to "),
+    (_looping, "is a symbolic link in a loop"),
+    (_output_named_dir, "holds a directory basin.npz where this command writes a file"),
+    (_chunks_dangling, "chunks wait) is a symbolic link to nowhere, which does not exist"),
+    (_store_is_a_file, "mao, where --out's unfinished chunks of a grid wait, is not a "
+                       "directory"),
+], ids=["dangling-link", "looping-link", "dir-named-like-output", "chunks-dangling-link",
+        "store-is-a-file"])
+def test_out_problems_are_found_before_any_work(tmp_path, monkeypatch, capsys, setup, says):
+    # a dangling or looping --out was refused as "an existing file", and a directory named like
+    # an output file only when publishing: both after the work, with its chunks left behind
+    out = tmp_path / "o"
+    setup(out)
+    before = sorted(str(p) for p in tmp_path.rglob("*"))
+    monkeypatch.setattr(analysis, "run", lambda *a, **k: pytest.fail("not refused before work"))
+    assert main(BASIN + ["--law", "both", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("rockjit: error: ") and err.count("\n") == 1 and "--out" in err
+    assert says in err, err
+    assert sorted(str(p) for p in tmp_path.rglob("*")) == before

@@ -13,12 +13,18 @@ The cases (``CASES``, printable with ``pytest --collect-only -q``):
   refusal the issue asks for;
 - generated: every subcommand, every option that takes a value, given values outside the range
   its documentation states (SPEC.md, the docstrings, ``--help``) and malformed values (``nan``,
-  ``inf``, ``1e308``, ``5e-324``, ``abc``, ``""``, ``1,5``, ``0x10``, ...), required options left
-  out, the wrong number of values. Refusal is asserted only where the value is really invalid.
+  ``inf``, ``1e308``, ``5e-324``, ``abc``, ``""``, ``1,5``, ``0x10``, ...), numbers that are not
+  ASCII decimal (``1_0``, Arabic-Indic or fullwidth digits, spaces), required options left out,
+  the wrong number of values; the scipy tolerances whatever the method; ``--scheduler``
+  addresses of the wrong form (checked before connecting), bad ``--scheduler-timeout`` values;
+  every ``--out`` that cannot be published (dangling or looping links, a directory named like
+  an output file, names too long for the file system). Refusal is asserted only where the value
+  is really invalid.
+- ``numbers: ...``: non-ASCII numbers in single and multi-valued options, literally.
 
-Options the command line does not have today but the issue implies carry ``[guessed --NAME]`` in
-their ids: ``--max-impacts`` (issue 10 §3 asks for it) must exist; ``--xi`` and ``--rest-speed``
-are skipped while the parser does not have them.
+Options the command line did not have but the specification implies carry ``[guessed --NAME]``
+in their ids: ``--max-impacts`` must exist; ``--xi`` cases are skipped while the parser does not
+have it; ``--rest-speed`` is tried only on ``trajectory``, the one command that has it.
 
 Nothing here computes: the entry points of real work (``GUARDED``, the one list to update after a
 refactor) are replaced by a sentinel raising :class:`NotRefused`, so a case that slips past
@@ -119,6 +125,7 @@ NAMES = {
     "--uncertainty": r"\buncertainty\b", "--erosion-step": r"erosion[-_]step",
     "--ensemble": r"\bensemble\b", "--spread": r"\bspread\b", "--seed": r"\bseed\b",
     "--erosion-grid": r"erosion[-_]grid", "--max-period": r"max[-_]period",
+    "--scheduler": r"--scheduler\b(?!-)", "--scheduler-timeout": r"scheduler[-_]timeout",
 }
 
 NARGS = {"--alpha-range": 2, "--omega-range": 2, "--theta-range": 2, "--dtheta-range": 2,
@@ -129,6 +136,10 @@ NONFINITE = ["nan", "inf", "-inf"]
 #: strings no number parser takes; each option gets two of them, rotating from option to option
 #: (they all end in the same type check: all four on every option would only slow the module)
 MALFORMED = ["abc", "", "1,5", "0x10"]
+#: numbers Python's float() and int() take but the command line must not: only ASCII decimal
+#: numbers are numbers (no "_" separators, no other scripts' digits, no spaces); each option
+#: gets two of them, rotating like MALFORMED
+NOT_ASCII = ["1_0", "\u0663", "\uff11", "-\u0663", "+\uff11", " 1", "1 ", "1e1_0", "0.\u0665"]
 #: numbers that are not integers (an integer option must refuse each)
 NOT_INT = ["nan", "inf", "-inf", "1e308", "5e-324", "2.5"]
 HUGE_INT = "99999999999999999999"
@@ -151,7 +162,7 @@ class Case:
     set: dict
     names: str                          # a regular expression the error line must match
     forbid: tuple = ()                  # regular expressions it must not match
-    setup: str | None = None            # "out-file", "out-in-file", "chunks-file"
+    setup: str | None = None            # "out-file", "chunks-file", ... (see _prepare)
     guessed: str | None = None          # an option the CLI may not have yet
     guessed_required: bool = False      # ... which it must have (else: skip while absent)
     memory: bool = False                # must be refused by a memory estimate
@@ -210,6 +221,17 @@ def _out_cases(cmd):
         Case(f"{cmd} --out <inside a file>", cmd, {}, NAMES["--out"], setup="out-in-file"),
         Case(f"{cmd} --frobnicate 1", cmd, {"--frobnicate": ["1"]}, "frobnicate",
              extra_ok=True),
+        # found only after the work (exit 2 after minutes, chunks left behind), or a traceback
+        Case(f"{cmd} --out <a dangling link>", cmd, {}, NAMES["--out"], setup="out-dangling"),
+        Case(f"{cmd} --out <a link to itself>", cmd, {}, NAMES["--out"], setup="out-loop"),
+        Case(f"{cmd} --out <inside a dangling link>", cmd, {}, NAMES["--out"],
+             setup="out-in-dangling"),
+        Case(f"{cmd} --out <holding a directory summary.json>", cmd, {}, NAMES["--out"],
+             setup="out-holds-summary-dir"),
+        Case(f"{cmd} --out <a name of 256 bytes>", cmd, {"--out": ["x" * 256]},
+             NAMES["--out"]),
+        Case(f"{cmd} --out <a path of 4200 bytes>", cmd, {"--out": ["d/" * 2100]},
+             NAMES["--out"]),
     ]
 
 
@@ -219,12 +241,20 @@ def _malformed(cmd, opt):
     return [MALFORMED[k % 4], MALFORMED[(k + 2) % 4]]
 
 
+def _not_ascii(cmd, opt):
+    """Two of :data:`NOT_ASCII`, rotating with the option (fixed: stable ids)."""
+    k = zlib.crc32(f"{opt} {cmd}".encode())
+    n = len(NOT_ASCII)
+    return [NOT_ASCII[k % n], NOT_ASCII[(k + 4) % n]]
+
+
 def _real_opt(cmd, opt, bad, extra=None):
-    return _values(cmd, opt, NONFINITE + bad + _malformed(cmd, opt), extra)
+    return _values(cmd, opt, NONFINITE + bad + _malformed(cmd, opt) + _not_ascii(cmd, opt),
+                   extra)
 
 
 def _int_opt(cmd, opt, bad):
-    cases = _values(cmd, opt, bad + NOT_INT + _malformed(cmd, opt))
+    cases = _values(cmd, opt, bad + NOT_INT + _malformed(cmd, opt) + _not_ascii(cmd, opt))
     for c in cases:
         if c.set[opt] == [HUGE_INT]:  # an integer: too large, not "not an integer" (issue 10)
             c.forbid = (r"must be an integer",)
@@ -285,11 +315,26 @@ def _run_cases(cmd):
 
 def _chunks_case(cmd):
     # issue 10 §1: a plain file where the chunk store goes ended in NotADirectoryError
-    return [Case(f"{cmd} <out>.chunks is a plain file", cmd, {}, r"chunks", setup="chunks-file")]
+    return [Case(f"{cmd} <out>.chunks is a plain file", cmd, {}, r"chunks", setup="chunks-file"),
+            Case(f"{cmd} <out>.chunks is a dangling link", cmd, {}, r"chunks.*--out",
+                 setup="chunks-dangling"),
+            Case(f"{cmd} --out <a name of 250 bytes: no room for .chunks>", cmd,
+                 {"--out": ["x" * 250]}, r"--out.*chunks")]
 
 
-def _guessed(cmd, required_max_impacts):
-    """Options issue 10 §3 implies and the CLI may not have yet (ids say so)."""
+def _scheduler_cases(cmd):
+    """--scheduler is checked before connecting: the address's form (tcp://HOST:PORT, the port
+    in range) or an existing scheduler file; --scheduler-timeout is a positive time."""
+    c = _values(cmd, "--scheduler", ["", " ", "tcp://127.0.0.1:99999", "tcp://127.0.0.1:0",
+                                     "http://127.0.0.1:8786", "tcp://a b:8786",
+                                     "no-such-scheduler-file.json", "tcp://", "127.0.0.1"])
+    c += _real_opt(cmd, "--scheduler-timeout", ["0", "-1", "1e7"])
+    return c
+
+
+def _guessed(cmd, required_max_impacts, rest_speed=False):
+    """Options the specification implies and the CLI may not have yet (ids say so);
+    ``--rest-speed`` only where the command has it (a single run's)."""
     c = []
     mi = "[guessed --max-impacts]"
     for v in ["0", "-1", HUGE_INT] + NOT_INT + _malformed(cmd, "--max-impacts"):
@@ -299,7 +344,8 @@ def _guessed(cmd, required_max_impacts):
     for v in ["-1", "-1e-3"] + NONFINITE + _malformed(cmd, "--xi"):
         c.append(Case(_id(cmd, "--xi", [v], "[guessed --xi]"), cmd, {"--xi": [v]},
                       NAMES["--xi"], guessed="--xi"))
-    for v in ["-1", "-1e-8"] + NONFINITE + _malformed(cmd, "--rest-speed"):
+    for v in (["-1", "-1e-8"] + NONFINITE + _malformed(cmd, "--rest-speed")
+              if rest_speed else []):
         c.append(Case(_id(cmd, "--rest-speed", [v], "[guessed --rest-speed]"), cmd,
                       {"--rest-speed": [v]}, NAMES["--rest-speed"], guessed="--rest-speed"))
     return c
@@ -314,11 +360,15 @@ def _trajectory():
     for tol in ("--rtol", "--atol"):
         for method in ("scipy", "scipy:RK45"):
             c += _real_opt(cmd, tol, ["-1", "-1e-6", "-1e308"], {"--method": [method]})
+        # invalid numbers whatever the method: the compiled one ignores them, but took them
+        bad = ["-1", "0"] + (["1", "2"] if tol == "--rtol" else [])
+        c += _real_opt(cmd, tol, bad)
+        c += _values(cmd, tol, ["-1", "nan"], {"--method": ["rockjit"]})
     c.append(Case(f"{cmd} --method scipy --lyapunov", cmd,
                   {"--method": ["scipy"], "--lyapunov": True}, NAMES["--lyapunov"]))
     c += _int_opt(cmd, "--max-points", ["0", "1", "-1"])
     c += _missing(cmd, ["--hb", "--alpha", "--omega", "--out"])
-    c += _out_cases(cmd) + _guessed(cmd, required_max_impacts=True)
+    c += _out_cases(cmd) + _guessed(cmd, required_max_impacts=True, rest_speed=True)
     return c
 
 
@@ -553,11 +603,43 @@ def _misc():
     ]
 
 
+def _numbers():
+    """Numbers as a hostile user types them: digit separators, other scripts' digits (Arabic-
+    Indic, fullwidth), spaces, in single and multi-valued options; each was taken as a number."""
+    basin = {"--hb": ["1"], "--alpha": ["0.66"], "--omega": ["1.3"], "--out": ["{out}"]}
+
+    def case(text, cmd, opts, names):
+        return Case(f"numbers: {text}", cmd, opts, names, base=False)
+
+    return [
+        case("basin --grid 1_0", "basin", {**basin, "--grid": ["1_0"]}, NAMES["--grid"]),
+        case("basin --grid \u0663", "basin", {**basin, "--grid": ["\u0663"]}, NAMES["--grid"]),
+        case("basin --grid \uff11", "basin", {**basin, "--grid": ["\uff11"]}, NAMES["--grid"]),
+        case("basin --alpha \uff10.\uff16", "basin", {**basin, "--alpha": ["\uff10.\uff16"]},
+             NAMES["--alpha"]),
+        case("basin --theta-range -\u0661 1", "basin",
+             {**basin, "--theta-range": ["-\u0661", "1"]}, NAMES["--theta-range"]),
+        case("plane --grid 5 \u0663", "plane",
+             {"--hb": ["1"], "--alpha-range": ["0.5", "0.6"], "--omega-range": ["1", "2"],
+              "--grid": ["5", "\u0663"], "--out": ["{out}"]}, NAMES["--grid"]),
+        case("sweep --alpha-range 0.5 0.6_0", "sweep",
+             {"--hb": ["1"], "--omega": ["1.3"], "--alpha-range": ["0.5", "0.6_0"],
+              "--out": ["{out}"]}, NAMES["--alpha-range"]),
+        case("cor --hb-values 1 \uff12", "cor", {"--hb-values": ["1", "\uff12"],
+                                               "--out": ["{out}"]}, NAMES["--hb-values"]),
+        case("trajectory --periods '1 0'", "trajectory",
+             {"--hb": ["1"], "--alpha": ["0.6"], "--omega": ["1.3"], "--periods": ["1 0"],
+              "--out": ["{out}"]}, NAMES["--periods"]),
+    ]
+
+
 CASES = (_issue10() + _trajectory() + _sweep() + _basin() + _plane() + _cor() + _paper()
          + _erosion() + _fate() + _orbits() + _grid_extras("sweep") + _grid_extras("basin")
          + _grid_extras("plane") + _real_opt("paper", "--erosion-step", ["0", "-0.01", "5e-324"])
          + _int_opt("paper", "--erosion-grid", ["0", "-1", HUGE_INT])
-         + _misc())
+         + [c for cmd in ("sweep", "basin", "plane", "erosion", "orbits", "paper")
+            for c in _scheduler_cases(cmd)]
+         + _numbers() + _misc())
 
 
 # ---------------------------------------------------------------------------------------------
@@ -699,6 +781,17 @@ def _prepare(case, root):
     elif case.setup == "chunks-file":
         with open(out + ".chunks", "w") as fh:
             fh.write("a user's file named like the chunk store\n")
+    elif case.setup == "out-dangling":
+        os.symlink(os.path.join(root, "nowhere"), out)
+    elif case.setup == "out-loop":
+        os.symlink("out", out)
+    elif case.setup == "out-in-dangling":
+        os.symlink(os.path.join(root, "nowhere"), out)
+        out = os.path.join(out, "sub")
+    elif case.setup == "out-holds-summary-dir":
+        os.makedirs(os.path.join(out, "summary.json"))
+    elif case.setup == "chunks-dangling":
+        os.symlink(os.path.join(root, "nowhere"), out + ".chunks")
     return out
 
 

@@ -1,8 +1,10 @@
 """Grids on a Dask cluster and resumable runs (issue 6).
 
 Checked against the in-process computation of the same grid: identical arrays whether the
-chunks ran here or on two worker processes, after a worker was killed mid-run, and after an
-interrupted run was resumed from its store.
+chunks ran here or on two worker processes, after a worker was killed mid-run, after an
+interrupted run was resumed from its store, and when several computations share one client (in
+a row or at once). A scheduler without workers ends a computation, with a clear error, after
+its timeout.
 """
 
 import os
@@ -150,9 +152,10 @@ def test_plane_command_resumes_and_cleans_up(tmp_path, monkeypatch, capsys):
     z = np.load(out / "plane.npz")
     local = an.plane(**PLANE)
     np.testing.assert_array_equal(z["label"], local.label[0])
-    assert main(args[:-3] + ["--scheduler", "tcp://127.0.0.1:9", "--out",
-                             str(tmp_path / "x"), "--quiet"]) == 2
-    assert "cannot reach the Dask scheduler" in capsys.readouterr().err
+    assert main(args[:-3] + ["--scheduler", "tcp://127.0.0.1:9", "--scheduler-timeout", "2",
+                             "--out", str(tmp_path / "x"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "rockjit: error: --scheduler tcp://127.0.0.1:9: cannot reach the Dask scheduler" in err
 
 
 def _small_chunks(run_grid):
@@ -160,3 +163,170 @@ def _small_chunks(run_grid):
         kw["chunk"] = 8
         return run_grid(*a, **kw)
     return wrapped
+
+
+# ---------------------------------------------------------------------------------------------
+# computations sharing a scheduler; a scheduler without workers
+# ---------------------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def thread_client():
+    """One in-process worker with two threads: quick to start, and enough to run two
+    computations at once."""
+    cluster = distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                       dashboard_address=":0")
+    with distributed.Client(cluster) as c:
+        yield c
+    cluster.close()
+
+
+ALPHAS = (0.62, 0.66, 0.70, 0.74)
+
+
+def _basin_at(alpha, **kw):
+    return an.basin(1, alpha, 1.3, grid=6, periods=30, chunk=6, **kw)
+
+
+def _same_basin(a, b, what):
+    for name in ("label", "period", "t_end"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name),
+                                      err_msg=f"{what}: {name}")
+
+
+def _within(seconds, fn, *args):
+    """``fn(*args)`` in a thread; fails (instead of hanging the suite) if it takes longer."""
+    box = {}
+
+    def run():
+        try:
+            box["value"] = fn(*args)
+        except BaseException as exc:  # noqa: BLE001 - handed to the caller
+            box["error"] = exc
+
+    th = threading.Thread(target=run, daemon=True)
+    th.start()
+    th.join(seconds)
+    assert not th.is_alive(), f"still running after {seconds} s"
+    if "error" in box:
+        raise box["error"]
+    return box["value"]
+
+
+def test_computations_in_a_row_on_one_client_get_their_own_results(thread_client):
+    # task keys used to repeat from one computation to the next: of eight basins in a row,
+    # five came back with an earlier basin's chunks
+    local = {a: _basin_at(a) for a in ALPHAS}
+    for i in range(8):
+        a = ALPHAS[i % len(ALPHAS)]
+        _same_basin(_basin_at(a, client=thread_client), local[a], f"run {i}, alpha {a}")
+
+
+def test_computations_at_once_on_one_client_get_their_own_results(thread_client):
+    local = {a: _basin_at(a) for a in (0.66, 0.70)}
+    for _ in range(3):
+        got = {}
+        start = threading.Barrier(2)
+
+        def run(a):
+            start.wait()
+            got[a] = _basin_at(a, client=thread_client)
+
+        threads = [threading.Thread(target=run, args=(a,)) for a in local]
+        for th in threads:
+            th.start()
+        for th in threads:
+            th.join(300)
+        for a in local:
+            _same_basin(got[a], local[a], f"alpha {a}")
+
+
+def test_a_result_of_another_task_is_refused(thread_client, monkeypatch):
+    def wrong(runner, tag, *args):
+        return "another computation:0:1", runner(*args)
+
+    monkeypatch.setattr(grid_runner, "_tagged", wrong)
+    with pytest.raises(RuntimeError, match="not its chunk's"):
+        _basin_at(0.66, client=thread_client)
+
+
+@pytest.fixture
+def no_workers():
+    """A scheduler without any worker."""
+    cluster = distributed.LocalCluster(n_workers=0, processes=False, protocol="tcp",
+                                       dashboard_address=":0")
+    try:
+        yield cluster
+    finally:
+        cluster.close()
+
+
+def test_a_scheduler_without_workers_is_an_error_after_the_timeout(no_workers, capsys):
+    msgs = []
+    with distributed.Client(no_workers) as c:
+        t0 = time.monotonic()
+        with pytest.raises(grid_runner.NoWorkers, match="had no worker in 1 s"):
+            _within(60, lambda: grid_runner.run_chunks(
+                kernel.run_chunk, (), 4, 2, {}, client=c, message=msgs.append,
+                worker_timeout=1))
+        assert time.monotonic() - t0 < 30
+        assert len(msgs) == 1 and msgs[0].startswith("waiting for a worker on the Dask "
+                                                     "scheduler at ")
+
+        def basin_in_half_a_second():
+            with grid_runner.worker_timeout(0.5):  # the default a block sets (the CLI's)
+                return _basin_at(0.66, client=c)
+
+        with pytest.raises(grid_runner.NoWorkers, match="in 0.5 s"):
+            _within(60, basin_in_half_a_second)
+
+
+def test_the_command_line_gives_up_on_a_scheduler_without_workers(no_workers, tmp_path,
+                                                                   capsys):
+    out = tmp_path / "b"
+    argv = ["basin", "--hb", "1", "--alpha", "0.66", "--omega", "1.3", "--grid", "4",
+            "--periods", "20", "--scheduler", no_workers.scheduler_address,
+            "--scheduler-timeout", "1", "--out", str(out)]
+    assert _within(120, main, argv) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert any(line.startswith("rockjit: waiting for a worker") for line in err), err
+    assert err[-1].startswith(f"rockjit: error: --scheduler {no_workers.scheduler_address}: ")
+    assert "had no worker in 1 s" in err[-1] and "--scheduler-timeout" in err[-1]
+    assert not out.exists()
+
+
+def _slow_chunk(x):
+    time.sleep(0.3)
+    return {"y": x * 2.0}
+
+
+def test_losing_every_worker_mid_run_is_an_error_after_the_timeout():
+    cluster = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                       dashboard_address=":0")
+    try:
+        with distributed.Client(cluster) as c:
+            x = np.arange(40.0)
+            out = {"y": np.zeros(40)}
+            msgs = []
+            box = {}
+
+            def run():
+                try:
+                    grid_runner.run_chunks(_slow_chunk, (x,), 40, 2, out, client=c,
+                                           message=msgs.append, worker_timeout=1)
+                except BaseException as exc:  # noqa: BLE001 - checked below
+                    box["error"] = exc
+
+            th = threading.Thread(target=run, daemon=True)
+            th.start()
+            deadline = time.monotonic() + 60
+            while not out["y"].any() and time.monotonic() < deadline:
+                time.sleep(0.05)
+            assert out["y"].any(), "no chunk finished"
+            cluster.scale(0)
+            th.join(120)
+            assert not th.is_alive()
+            assert isinstance(box.get("error"), grid_runner.NoWorkers), box
+            assert "lost its workers" in str(box["error"])
+            assert any(m.startswith("waiting for a worker") for m in msgs)
+    finally:
+        cluster.close()

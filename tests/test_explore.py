@@ -29,8 +29,8 @@ import pytest
 
 import rockjit
 from rockjit import Block, Harmonic
-from rockjit.explore import requests as R
-from rockjit.explore.worker import Cancelled, Computer
+from rockjit.explorer import requests as R
+from rockjit.explorer.worker import Cancelled, Computer
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -291,7 +291,7 @@ def test_every_view_exports_its_figure_as_a_png():
     pytest.importorskip("bokeh", reason="the explore extra is not installed")
     import base64
 
-    from rockjit.explore.app import _png
+    from rockjit.explorer.app import _png
     p = R.Params(periods=40).check()
     basin = R.basin_stages(p, levels=(10,))[0]()
     views = dict(basin=basin, sweep=R.sweep_stages(p.with_(alpha_range=(0.6, 0.7)))[0](),
@@ -303,9 +303,9 @@ def test_every_view_exports_its_figure_as_a_png():
             assert name.endswith(".png") and "/" not in name
 
 
-def test_rockjit_explore_is_the_package_and_callable():
-    import rockjit.explore as pkg
-    assert callable(rockjit.explore) and rockjit.explore is pkg
+def test_rockjit_explore_is_the_explorers_function():
+    import rockjit.explorer as pkg
+    assert rockjit.explore is pkg.explore and callable(rockjit.explore)
     assert pkg.requests is R
 
 

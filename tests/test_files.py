@@ -396,6 +396,45 @@ def test_refusals_leave_everything_as_it_was(tmp_path):
     assert _snapshot(tmp_path) == before
 
 
+def test_check_out_finds_what_publishing_would_refuse(tmp_path):
+    # each of these was found only when staging or publishing, after the work
+    (tmp_path / "dangling").symlink_to(tmp_path / "nowhere")
+    (tmp_path / "loop").symlink_to("loop")
+    (tmp_path / "out" / "basin.npz").mkdir(parents=True)
+    (tmp_path / "out.chunks").mkdir()
+    (tmp_path / "out.chunks" / "mao").write_text("mine")
+    (tmp_path / "s" / "summary.json").mkdir(parents=True)
+    before = _snapshot(tmp_path)
+    for out, says in [(tmp_path / "dangling", "is a symbolic link to "),
+                      (tmp_path / "loop", "is a symbolic link in a loop"),
+                      (tmp_path / "dangling" / "sub", "cannot be created: "),
+                      (tmp_path / ("x" * 256), "256 bytes long; at most 255"),
+                      (tmp_path / "a" / ("d/" * 2100), "as an absolute path")]:
+        with pytest.raises(ValueError, match="^--out ") as refused:
+            rio.check_out(out, name="--out")
+        assert says in str(refused.value)
+    with pytest.raises(ValueError, match="holds a directory basin.npz where"):
+        rio.check_out(tmp_path / "out", name="--out", files=("basin.npz",))
+    with pytest.raises(ValueError, match="holds a directory summary.json where"):
+        rio.check_out(tmp_path / "s", name="--out")  # summary.json: every command's
+    with pytest.raises(ValueError, match="mao, where --out's unfinished chunks"):
+        rio.check_out(tmp_path / "out", name="--out", chunks=True)
+    rio.check_out(tmp_path / "out", name="--out")  # without chunks, and without that file
+    with pytest.raises(ValueError, match=r"<name>.chunks, and at most 255 bytes fit"):
+        rio.check_out(tmp_path / ("y" * 250), name="--out", chunks=True)
+    rio.check_out(tmp_path / ("y" * 248), name="--out", chunks=True)
+    assert _snapshot(tmp_path) == before  # the checks leave nothing behind
+
+
+def test_staging_names_stay_short_beside_a_long_out(tmp_path):
+    out = tmp_path / ("o" * 240)  # its staging directory beside it would need 280 bytes
+    with rio.OutputDir(out) as o:
+        o.text("a.txt", "a")
+        stage = o.staging
+        assert len(stage.name) <= 255 and stage.parent == tmp_path
+    assert (out / "a.txt").read_text() == "a" and sorted(os.listdir(tmp_path)) == [out.name]
+
+
 def test_nothing_written_creates_nothing(tmp_path):
     with rio.OutputDir(tmp_path / "a" / "out") as o:
         pass
@@ -505,6 +544,25 @@ def test_damaged_chunks_are_discarded_and_recomputed(tmp_path, capsys):
     assert calls == []
 
 
+def test_a_chunk_replaced_by_a_directory_is_removed_and_recomputed(tmp_path):
+    # its discard raised IsADirectoryError, so it was never recomputed and every rerun failed
+    store = tmp_path / "s"
+    _run(_open(store))
+    chunk = store / "cells-0000000005-0000000010.npz"
+    chunk.unlink()
+    chunk.mkdir()
+    (chunk / "inside").write_text("x")
+    msgs, calls = [], []
+    _same(_run(_open(store, msgs.append), calls), _direct())
+    assert calls == [(5, 10)] and len(msgs) == 1
+    assert msgs[0].startswith(f"discarded damaged chunk {chunk.name} ") and chunk.is_file()
+    other = store / "cells-0000000010-0000000015.npz"
+    other.unlink()
+    other.mkdir()  # one left for the clean-up: it is rockjit's own, and goes too
+    assert chunks.remove_stores(store, message=msgs.append)
+    assert not store.exists()
+
+
 def test_bit_flip_in_a_chunk_is_caught_by_the_checksum(tmp_path):
     store = tmp_path / "s"
     _run(_open(store))
@@ -561,6 +619,87 @@ def test_lock_of_another_host_is_refused(tmp_path):
         _open(store)
     assert not chunks.remove_stores(store, message=lambda m: None)
     assert (store / "lock.json").exists()
+
+
+def _lock(pid, **kw):
+    return json.dumps(dict(pid=pid, host=rio.host_name(), token="t", **kw))
+
+
+def _proc(path):
+    try:
+        return Path(path).read_text()
+    except OSError:
+        return None
+
+
+def _start_ticks(pid):
+    """Field 22 of ``/proc/<pid>/stat`` (read here independently of rockjit)."""
+    text = _proc(f"/proc/{pid}/stat")
+    return None if text is None else int(text[text.rindex(")") + 2:].split()[19])
+
+
+def _boot_id():
+    text = _proc("/proc/sys/kernel/random/boot_id")
+    return None if text is None else text.strip()
+
+
+def _boot_time():
+    text = _proc("/proc/stat") or ""
+    return next(float(line.split()[1]) for line in text.splitlines() if line.startswith("btime"))
+
+
+needs_proc = pytest.mark.skipif(_start_ticks(1) is None or _boot_id() is None,
+                                reason="needs /proc (pid start times, the boot id)")
+
+
+@needs_proc
+@pytest.mark.parametrize("lock, why", [
+    (dict(start="later", boot="this"), "started later"),
+    (dict(start="same", boot="another boot"), "restarted"),
+    (dict(written="before boot"), "started after the lock was written"),
+], ids=["pid-reused", "rebooted", "old-lock-before-boot"])
+def test_a_lock_naming_a_live_pid_of_another_process_is_taken_over(tmp_path, lock, why):
+    # pid 1 is alive, but it is not the process that wrote these locks: such a lock was
+    # refused on every rerun (pids are reused after a reboot, and in containers)
+    store = tmp_path / "s"
+    store.mkdir()
+    start = _start_ticks(1)
+    fields = {}
+    if "start" in lock:
+        fields["start"] = start + 1 if lock["start"] == "later" else start
+        fields["boot"] = _boot_id() if lock["boot"] == "this" else "another boot"
+    (store / "lock.json").write_text(_lock(1, **fields))
+    if lock.get("written") == "before boot":  # rockjit 0.1.0's lock, from before this boot
+        t = _boot_time() - 3600
+        os.utime(store / "lock.json", (t, t))
+    msgs = []
+    s = _open(store, msgs.append)
+    assert s.locked and len(msgs) == 1, msgs
+    assert msgs[0].startswith(f"took over the chunk store {store} from pid 1 on ")
+    assert why in msgs[0]
+    s.close()
+
+
+@needs_proc
+def test_a_live_owners_lock_is_refused_saying_how_to_take_the_store_over(tmp_path):
+    store = tmp_path / "s"
+    store.mkdir()
+    lock = store / "lock.json"
+    for fields in (dict(start=_start_ticks(1), boot=_boot_id()),  # pid 1 itself
+                   {}):  # no start time, written after pid 1 started: cannot tell
+        lock.write_text(_lock(1, **fields))
+        with pytest.raises(ValueError) as refused:
+            _open(store)
+        msg = str(refused.value)
+        assert "in use by another rockjit run (pid 1 on " in msg
+        assert msg.endswith(f"if no rockjit run is using it (pid 1 is another program), "
+                            f"delete {lock}")
+    lock.unlink()
+    s = _open(store)  # the lock it writes names its process exactly
+    mine = json.loads(lock.read_text())
+    assert mine["pid"] == os.getpid() and mine["start"] == _start_ticks(os.getpid())
+    assert mine["boot"] == _boot_id()
+    s.close()
 
 
 CHILD_RUN = """

@@ -5,9 +5,17 @@ Every command parses its options into the library's own plan (:func:`rockjit.sin
 a bad value ends the command with one line ``rockjit: error: ...`` on stderr and exit status 2,
 having written nothing. Then it computes and writes its data, its figure(s) and
 ``summary.json`` into a hidden staging directory, published into ``--out`` as one unit at the
-end (:class:`rockjit.storage.files.OutputDir`). An interrupted command (Ctrl-C: exit status 130) leaves
-``--out`` as it was; the finished chunks of its grids wait in ``<out>.chunks`` so that running
-the same command again resumes.
+end (:class:`rockjit.storage.files.OutputDir`). Every problem with ``--out`` itself (a file, a
+dangling or looping link, a name too long, a directory named like an output file, a place that
+cannot be written) is found before any work, with the rest of the input.
+
+One outcome per run: the exit status says whether ``--out`` was published. A command
+interrupted before that (SIGINT, Ctrl-C: exit status 130; SIGTERM: 143) leaves ``--out`` as it
+was; the finished chunks of its grids wait in ``<out>.chunks`` so that running the same command
+again resumes. A signal once ``--out`` is published changes nothing: exit status 0, and a line
+says so. An error while running (a full disk, a file system that refuses a write, a bug) is one
+line ``rockjit: error: ...`` or ``rockjit: internal error: ...`` on stderr with its traceback in a
+report file, exit status 1, ``--out`` as it was.
 
 JSON files write non-finite numbers as the strings ``"nan"``, ``"inf"``, ``"-inf"``
 (:mod:`rockjit.storage.files`).
@@ -16,10 +24,12 @@ JSON files write non-finite numbers as the strings ``"nan"``, ``"inf"``, ``"-inf
 from __future__ import annotations
 
 import argparse
+import contextlib
 import functools
 import math
 import os
 import re
+import signal
 import sys
 import time
 import warnings
@@ -39,16 +49,73 @@ class UsageError(Exception):
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors, and negative numbers in any notation taken as values
-    (``--theta0 -1e-3``, ``--dtheta0 -inf``), not as options."""
+    """argparse with one-line errors; the options declared ``type=float`` and ``type=int``
+    parsed by :func:`_real` and :func:`_int` (exactly ASCII decimal numbers); and anything that
+    starts like a negative number taken as a value (``--theta0 -1e-3``, ``--dtheta0 -inf``, and
+    ``-1_0`` too, for the number parser to refuse), not as an option."""
 
     def __init__(self, *a, **kw):
         super().__init__(*a, **kw)
-        self._negative_number_matcher = re.compile(
-            r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
+        self.register("type", float, _real)
+        self.register("type", int, _int)
+        self._negative_number_matcher = re.compile(r"^-(\.?\d|(inf|infinity|nan)$)",
+                                                   re.IGNORECASE)
 
     def error(self, message):
         raise UsageError(message)
+
+
+# ---------------------------------------------------------------------------------------------
+# the values of options: exactly ASCII decimal numbers, a Dask scheduler's address
+# ---------------------------------------------------------------------------------------------
+
+_DECIMAL = re.compile(r"[+-]?([0-9]+(\.[0-9]*)?|\.[0-9]+)([eE][+-]?[0-9]+)?")
+_NONFINITE = re.compile(r"[+-]?(inf|infinity|nan)", re.IGNORECASE)
+_INTEGER = re.compile(r"[+-]?[0-9]+")
+
+
+def _real(text):
+    """A real number option: ``[+-]digits[.digits][e[+-]digits]`` in ASCII, or ``inf``, ``nan``
+    (the range checks refuse those, naming the option); no ``_``, no other digits or spaces."""
+    if _DECIMAL.fullmatch(text) or _NONFINITE.fullmatch(text):
+        return float(text)
+    raise argparse.ArgumentTypeError(f"must be a number such as 0.5, -2 or 1e-3 (got {text!r})")
+
+
+def _int(text):
+    """An integer option: ``[+-]digits`` in ASCII."""
+    if _INTEGER.fullmatch(text):
+        try:
+            return int(text)
+        except ValueError:  # more digits than Python converts
+            raise argparse.ArgumentTypeError(f"is too large ({len(text)} digits)") from None
+    raise argparse.ArgumentTypeError(f"must be an integer such as 100 (got {text!r})")
+
+
+_ADDRESS = re.compile(r"(?:(?P<scheme>[A-Za-z][A-Za-z0-9+.-]*)://)?"
+                      r"(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+)(?::(?P<port>[0-9]+))?")
+
+
+def _scheduler(text):
+    """``--scheduler``: a Dask scheduler's address, ``tcp://HOST:PORT`` (or ``tls://``, or
+    ``HOST:PORT``) with 1 <= PORT <= 65535, or the path of an existing scheduler file (written by
+    ``dask scheduler --scheduler-file``). Checked before connecting."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("must be a Dask scheduler's address, tcp://HOST:PORT, "
+                                         "or a scheduler file (got an empty string)")
+    if "://" not in text and os.path.isfile(text):
+        return text
+    m = _ADDRESS.fullmatch(text)
+    scheme = (m.group("scheme") or "tcp").lower() if m else None
+    if m is None or scheme not in ("tcp", "tls") or ("://" not in text and not m.group("port")):
+        hint = (" (no such scheduler file)" if "://" not in text and ":" not in text else "")
+        raise argparse.ArgumentTypeError(f"must be a Dask scheduler's address, tcp://HOST:PORT, "
+                                         f"or an existing scheduler file (got {text!r}){hint}")
+    port = m.group("port")
+    if port is not None and not 1 <= int(port) <= 65535:
+        raise argparse.ArgumentTypeError(f"port must be in [1, 65535] (got {int(port)} in "
+                                         f"{text!r})")
+    return text
 
 
 def _say(args, msg):  # progress and notes: silenced by --quiet
@@ -64,20 +131,44 @@ def _warn(msg):
 # checks of the command line's own options (the library checks the rest)
 # ---------------------------------------------------------------------------------------------
 
+#: The files each command writes into --out besides summary.json (names or fnmatch patterns):
+#: a directory of one of these names inside --out is refused before any work.
+OUTPUTS = {
+    "trajectory": ("trajectory.npz", "trajectory.png"),
+    "sweep": ("sweep.npz", "bifurcation.png"),
+    "basin": ("basin.npz", "basin.png", "attractors.png"),
+    "plane": ("plane.npz", "plane.png"),
+    "erosion": ("erosion.npz", "erosion.png"),
+    "orbits": ("orbits.npz", "orbits.png"),
+    "fate": ("fate.npz", "fate.png"),
+    "cor": ("restitution.png", "e_table.csv", "e_table.md"),
+    "paper": ("fig*.png", "fig*.npz", "*_table.csv", "*_table.md"),
+}
+#: The commands whose grids keep their finished chunks in <out>.chunks.
+CHUNKED = ("sweep", "basin", "plane", "erosion", "orbits", "paper")
+
+
 def _check_run(args):
-    """``--threads`` fits numba's; ``--scheduler`` needs dask; ``--out`` can be written
-    (:func:`rockjit.storage.files.check_out`)."""
+    """``--threads`` fits numba's; the scipy path's tolerances are valid numbers whatever the
+    method; ``--scheduler`` needs dask and ``--scheduler-timeout`` is a positive time; ``--out``
+    can be written (:func:`rockjit.storage.files.check_out`)."""
+    from ..validate import integer, real
     if getattr(args, "threads", None) is not None:
         import numba
-        from ..validate import integer
         integer("threads", args.threads, 1, numba.config.NUMBA_NUM_THREADS)
+    if getattr(args, "rtol", None) is not None:  # as rockjit.single.plan checks them for scipy
+        real("rtol", args.rtol, 0.0, 1.0, lo_open=True, hi_open=True)
+        real("atol", args.atol, 0.0, None, lo_open=True)
+    if getattr(args, "scheduler_timeout", None) is not None:
+        real("--scheduler-timeout", args.scheduler_timeout, 0.0, 1e6, lo_open=True)
     if getattr(args, "scheduler", None):
         try:
             import dask.distributed  # noqa: F401
         except ImportError:
             raise UsageError("--scheduler needs dask: pip install 'rockjit[dask]'") from None
     from ..storage.files import check_out
-    check_out(args.out, name="--out")
+    check_out(args.out, name="--out", files=OUTPUTS.get(args.command, ()),
+              chunks=args.command in CHUNKED)
 
 
 def _chunk_root(args):
@@ -85,15 +176,24 @@ def _chunk_root(args):
     return chunk_root(args.out)
 
 
+#: Seconds to wait for a Dask scheduler to answer (at most; --scheduler-timeout if shorter).
+CONNECT_TIMEOUT = 15.0
+
+
 def _client(args):  # a Dask client for --scheduler, or None
     if not getattr(args, "scheduler", None):
         return None
     from dask.distributed import Client
     _say(args, f"{args.command}: connecting to the Dask scheduler at {args.scheduler}")
+    timeout = min(CONNECT_TIMEOUT, args.scheduler_timeout)
+    file = "://" not in args.scheduler and os.path.isfile(args.scheduler)
     try:
-        return Client(args.scheduler, timeout="15s")
-    except (OSError, TimeoutError) as exc:
-        raise UsageError(f"cannot reach the Dask scheduler at {args.scheduler} ({exc})")
+        if file:
+            return Client(scheduler_file=args.scheduler, timeout=f"{timeout}s")
+        return Client(args.scheduler, timeout=f"{timeout}s")
+    except Exception as exc:  # OSError, TimeoutError, a bad scheduler file, ...
+        raise UsageError(f"--scheduler {args.scheduler}: cannot reach the Dask scheduler "
+                         f"({type(exc).__name__}: {exc})") from None
 
 
 def _block(args, law=None):
@@ -340,11 +440,11 @@ def _paper_run(args, p, out):
 
 
 def _explore_plan(args):
-    """``rockjit explore``: the explorer's server (:mod:`rockjit.explore`), served until Ctrl-C.
+    """``rockjit explore``: the explorer's server (:mod:`rockjit.explorer`), served until Ctrl-C.
     It writes no ``--out``: the command ends here, with exit status 0, instead of going on to
     the file-writing run of the other commands; a bad ``--port`` or ``--address`` is a usage
     error (exit status 2) like any other."""
-    from ..explore import explore
+    from ..explorer import explore
     try:
         explore(port=args.port, address=args.address, browser=not args.no_browser, block=True)
     except ImportError as exc:  # the explore extra is not installed
@@ -451,9 +551,12 @@ def _add_grid_run(p, lyapunov_default):
 
 
 def _add_scheduler(p):
-    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                   help="run the chunks of cells on this Dask scheduler (e.g. "
-                        "tcp://host:8786); default in this process")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS", type=_scheduler,
+                   help="run the chunks of cells on this Dask scheduler (tcp://host:8786, or "
+                        "a scheduler file); default in this process")
+    p.add_argument("--scheduler-timeout", type=float, default=60.0, metavar="SECONDS",
+                   help="give up when the scheduler has had no worker for this long "
+                        "(default 60)")
 
 
 def _add_alphas(p, step):
@@ -635,14 +738,49 @@ def _error(msg):
     return 2
 
 
-def _internal_error(exc):
+def _internal_error(exc, prefix=""):
+    """An error while running (a full disk, a file system refusing a write, a lost Dask
+    scheduler, a bug): one line on stderr (after ``prefix``), the traceback in a report file
+    (``rockjit-error-*.txt`` in the temporary directory), exit status 1. Never raises: if the
+    report cannot be written either, the line says why."""
+    import tempfile
     import traceback
-    fd, path = tempfile.mkstemp(prefix=f"{PROG}-error-", suffix=".txt")
-    with os.fdopen(fd, "w") as f:
-        traceback.print_exception(exc, file=f)
-    print(f"{PROG}: internal error: {type(exc).__name__}: {' '.join(str(exc).split())}; --out "
-          f"is as it was; the traceback is in {path} (please report it)", file=sys.stderr)
+    path = None
+    try:
+        fd, path = tempfile.mkstemp(prefix=f"{PROG}-error-", suffix=".txt")
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            traceback.print_exception(type(exc), exc, exc.__traceback__, file=f)
+        report = f"the traceback is in {path}"
+    except Exception as e:  # its disk may be full too
+        if path is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(path)
+        report = f"no report could be written ({type(e).__name__}: {' '.join(str(e).split())})"
+    if prefix:
+        line = (f"{PROG}: error: {prefix}{type(exc).__name__}: {' '.join(str(exc).split())}; "
+                f"--out is as it was; {report}")
+    elif isinstance(exc, OSError) and exc.strerror:
+        where = f": {exc.filename}" if exc.filename else ""
+        line = f"{PROG}: error: {exc.strerror}{where}; --out is as it was; {report}"
+    else:
+        line = (f"{PROG}: internal error: {type(exc).__name__}: {' '.join(str(exc).split())}; "
+                f"--out is as it was; {report} (please report it)")
+    with contextlib.suppress(Exception):
+        print(" ".join(line.split()), file=sys.stderr, flush=True)
     return 1
+
+
+def _from_dask(exc):
+    """Whether ``exc`` is a connection's failure (``OSError``, ``TimeoutError``) raised inside
+    dask.distributed."""
+    if not isinstance(exc, (OSError, TimeoutError)):
+        return False
+    tb = exc.__traceback__
+    while tb is not None:
+        if f"{os.sep}distributed{os.sep}" in tb.tb_frame.f_code.co_filename:
+            return True
+        tb = tb.tb_next
+    return False
 
 
 def _compile(args):
@@ -653,17 +791,58 @@ def _compile(args):
     try:
         compile_kernels(names, progress=lambda i, n, name, s: _say(
             args, f"compile: [{i}/{n}] {name} ({VARIANTS[name][0]}): {s:.1f} s"))
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
         print(f"\n{PROG}: interrupted; the variants compiled so far are cached", file=sys.stderr)
-        return 130
+        return 128 + getattr(exc, "signum", 2)
     _say(args, f"compile: done in {time.perf_counter() - t0:.1f} s")
     return 0
 
 
 def main(argv=None):
-    """Run the command line; returns the exit status (0, 2 bad input, 130 interrupted)."""
+    """Run the command line; returns the exit status: 0 done (``--out`` published, also when a
+    signal arrives after that: the line says so), 1 an error while running (one line, the
+    traceback in a report file), 2 bad input, 130 / 143 interrupted by SIGINT / SIGTERM before
+    ``--out`` was published (``--out`` as it was)."""
+    from ..storage.files import command_interrupts
+    with command_interrupts() as sig:
+        try:
+            return _main(argv, sig)
+        except BaseException as exc:
+            sig.final = True
+            # a signal: KeyboardInterrupt, or what it became on its way out (an ImportError
+            # when it interrupted the import of an extension module)
+            if isinstance(exc, KeyboardInterrupt) or (sig.received and
+                                                      not isinstance(exc, SystemExit)):
+                return _interrupted(exc, sig)
+            raise
+        finally:
+            sig.final = True  # from here on a signal changes nothing
+
+
+def _interrupted(exc, sig):
+    """A SIGINT or SIGTERM (``exc.signum``) that interrupted the run: 128 + the signal, unless
+    ``--out`` was published already (0)."""
+    from ..storage.files import chunk_root, signal_name
+    signum = getattr(exc, "signum", None) or (sig.received[-1] if sig.received else 2)
+    out = sig.out
+    if out is not None and out.published:
+        print(f"{PROG}: {signal_name(signum)} arrived after {out.path} was written; the command "
+              f"has completed (exit status 0)", file=sys.stderr, flush=True)
+        return 0
+    where = ""
+    if out is not None:
+        out.discard()
+        chunks = chunk_root(out.path)
+        if os.path.isdir(chunks):
+            where = f" (finished chunks wait in {chunks} for a rerun)"
+    print(f"\n{PROG}: interrupted ({signal_name(signum)}); --out is as it was{where}",
+          file=sys.stderr, flush=True)
+    return 128 + signum
+
+
+def _main(argv, sig):
     from . import outputs
-    from ..storage.files import OutputDir, sigterm_interrupts
+    from ..storage.files import OutputDir, interrupted, pause_for_tests, signal_name
     try:
         args = build_parser().parse_args(argv)
     except UsageError as exc:
@@ -682,42 +861,67 @@ def main(argv=None):
         _say(args, "first run here: numba compiles rockjit's kernels into its cache, about "
                    "10-20 s per kernel variant on two cores, once (`rockjit compile` does it "
                    "ahead of time)")
-        if args.command == "paper" and _compile(args):  # every variant, side by side
-            return 130
+        if args.command == "paper":  # every variant, side by side
+            rc = _compile(args)
+            if rc:
+                return rc
     import matplotlib
     matplotlib.use("Agg")
+    interrupted(sig)  # a signal whose KeyboardInterrupt something swallowed: no work
+    from ..grids.runner import NoWorkers, worker_timeout
     from ..plotting import style
-    out = OutputDir(args.out, command=args.command)
+    timeout = getattr(args, "scheduler_timeout", None)
+    out = sig.out = OutputDir(args.out, command=args.command)
     out.figure_format = getattr(args, "format", None)
     out.dpi = style.STYLES[getattr(args, "style", "default")].rc["savefig.dpi"]
+    n = n0 = len(sig.received)
     try:
-        with sigterm_interrupts(), warnings.catch_warnings(), \
-                style.use(getattr(args, "style", "default")):
+        with warnings.catch_warnings(), style.use(getattr(args, "style", "default")), \
+                (worker_timeout(timeout) if timeout else contextlib.nullcontext()):
             if args.quiet:
                 warnings.simplefilter("ignore")
+            pause_for_tests("work", sig)
             wall, results = args.run(args, plan, out)
             inputs = {k: v for k, v in vars(args).items() if not callable(v)}
             out.json("summary.json", outputs.summary(out, args.command, inputs, wall, **results))
+            interrupted(sig)  # likewise: before publication, a signal always interrupts
+            n = len(sig.received)
             note = out.publish()
     except KeyboardInterrupt:
         if not out.published:
-            out.discard()
-            print(f"\n{PROG}: interrupted; --out is as it was (finished chunks wait in "
-                  f"{_chunk_root(args)} for a rerun)", file=sys.stderr)
-            return 130
-        note = out.warning  # finished and published: a late Ctrl-C changes nothing
+            raise  # main: --out as it was, 130 or 143
+        note = out.warning
+    except NoWorkers as exc:
+        out.discard()
+        return _error(f"--scheduler {args.scheduler}: {exc} (--scheduler-timeout)")
     except (UsageError, ValueError) as exc:  # a check made only once running
         out.discard()
         return _error(exc)
-    except Exception as exc:  # a bug: one line, the traceback kept for the report
+    except Exception as exc:  # a full disk, a refused write, a bug: one line and a report
         out.discard()
-        return _internal_error(exc)
+        if len(sig.received) > n0:
+            raise  # what a signal became (see main)
+        lost = getattr(args, "scheduler", None) and _from_dask(exc)
+        return _internal_error(exc, f"--scheduler {args.scheduler}: the connection to the Dask "
+                                    f"scheduler failed: " if lost else "")
+    except BaseException:
+        out.discard()
+        raise
+    sig.final = True  # published: from here on a signal changes nothing
+    pause_for_tests("published", sig)
     try:
         if note:
             _warn(note)
-        from ..storage.chunkstore import remove_stores
-        remove_stores(_chunk_root(args), message=lambda m: _say(args, m))
+        if args.command in CHUNKED:
+            from ..storage.chunkstore import remove_stores
+            remove_stores(_chunk_root(args), message=lambda m: _say(args, m))
         _say(args, f"{args.command}: wrote {args.out}")
-    except KeyboardInterrupt:
-        pass  # the outputs are published: the command succeeded
+    except Exception as exc:  # the outputs are published: the command has succeeded
+        _warn(f"{args.out} was written; cleaning up after it failed ({type(exc).__name__}: "
+              f"{exc})")
+    pause_for_tests("wrote", sig)
+    late = ([out.interrupted] if out.interrupted else []) + sig.received[n:]
+    if late:
+        print(f"{PROG}: {signal_name(late[0])} arrived after {args.out} was written; the "
+              f"command has completed (exit status 0)", file=sys.stderr, flush=True)
     return 0

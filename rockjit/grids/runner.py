@@ -7,11 +7,21 @@ compiled parallel kernel on those cells), in this process or as a task on a
 into the full output arrays as chunks arrive; with a store (:class:`rockjit.storage.chunkstore.
 ChunkStore`) every finished chunk is saved, and a rerun computes only what is missing. Dask is
 optional and imported only when a client is given.
+
+On Dask, each chunk is a task whose key is unique to the computation (its fingerprint, the
+chunk's bounds and a nonce of the call), so that computations sharing a scheduler never get
+each other's results; each task returns its tag with its arrays, and a result whose tag is not
+the one sent is refused. A computation waits for the scheduler to have a worker, saying so,
+and gives up with :class:`NoWorkers` after ``worker_timeout`` seconds without one (at the start
+or when every worker is lost mid-run).
 """
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
+import contextvars
+import secrets
 import sys
 import time
 
@@ -21,7 +31,85 @@ from .._engine import kernel
 from ..storage import chunkstore as chunks
 from ..storage.chunkstore import DamagedChunk
 
-__all__ = ["run_chunks", "run_grid"]
+__all__ = ["NoWorkers", "WORKER_TIMEOUT", "run_chunks", "run_grid", "wait_for_workers",
+           "worker_timeout"]
+
+#: Seconds a computation on a Dask client waits for a worker before giving up (the default of
+#: ``worker_timeout``; :func:`worker_timeout` sets another for a block, as ``--scheduler-timeout``
+#: does).
+WORKER_TIMEOUT = 60.0
+_WORKER_TIMEOUT = contextvars.ContextVar("rockjit_worker_timeout", default=None)
+#: Seconds between two looks at the scheduler's workers while no chunk finishes.
+POLL = 1.0
+
+
+class NoWorkers(RuntimeError):
+    """A Dask scheduler had no worker for longer than the timeout; ``address``, ``timeout``."""
+
+    def __init__(self, address, timeout, lost=False):
+        self.address, self.timeout, self.lost = address, timeout, lost
+        what = "lost its workers, and none joined again" if lost else "had no worker"
+        super().__init__(f"the Dask scheduler at {address} {what} in {timeout:g} s")
+
+
+@contextlib.contextmanager
+def worker_timeout(seconds):
+    """Within the block, computations on Dask wait ``seconds`` for a worker (by default)."""
+    token = _WORKER_TIMEOUT.set(float(seconds))
+    try:
+        yield
+    finally:
+        _WORKER_TIMEOUT.reset(token)
+
+
+def _timeout(value):
+    if value is None:
+        value = _WORKER_TIMEOUT.get()
+    return WORKER_TIMEOUT if value is None else float(value)
+
+
+def _address(client):
+    try:
+        return client.scheduler.address
+    except AttributeError:
+        return "?"
+
+
+def _n_workers(client):
+    return len(client.nthreads())
+
+
+def wait_for_workers(client, timeout=None, message=None, lost=False):
+    """Return once ``client``'s scheduler has a worker; raise :class:`NoWorkers` after
+    ``timeout`` seconds (default :data:`WORKER_TIMEOUT`, or :func:`worker_timeout`'s) without
+    one. While it waits, ``message(text)`` (default a line on stderr) hears so once."""
+    if _n_workers(client):
+        return
+    timeout = _timeout(timeout)
+    say = chunks._say if message is None else message
+    address = _address(client)
+    say(f"waiting for a worker on the Dask scheduler at {address} (giving up after "
+        f"{timeout:g} s)")
+    deadline = time.monotonic() + timeout
+    while not _n_workers(client):
+        left = deadline - time.monotonic()
+        if left <= 0:
+            raise NoWorkers(address, timeout, lost)
+        time.sleep(min(0.2, left))
+    say(f"a worker joined the Dask scheduler at {address}")
+
+
+def _tagged(runner, tag, *args):
+    """A chunk's task on a worker: ``runner(*args)`` with ``tag`` (the chunk's identity)."""
+    return tag, runner(*args)
+
+
+def _fingerprint(runner, inputs, n, chunk):
+    """The computation's fingerprint: its arrays' bytes and everything else it is given."""
+    arrays = [x for x in inputs if isinstance(x, np.ndarray)]
+    rest = [None if isinstance(x, np.ndarray) else repr(x) for x in inputs]
+    name = f"{getattr(runner, '__module__', '')}.{getattr(runner, '__qualname__', repr(runner))}"
+    return chunks.fingerprint(arrays, dict(runner=name, rest=rest, n=int(n), chunk=int(chunk)))
 
 
 def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, label, execution):
@@ -30,7 +118,9 @@ def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, label, executi
     process or on a Dask cluster, with a chunk store, with progress.
 
     Returns the outputs by name: ``res`` (the kernels' rows; :func:`rockjit._engine.kernel.
-    grid_results` names them), ``pts``, ``imp``, ``n_got``, ``n_imp_got``.
+    grid_results` names them), ``pts``, ``imp``, ``n_got``, ``n_imp_got``. With a Dask
+    cluster, a scheduler without workers is waited for ``execution.worker_timeout`` seconds
+    (:func:`run_chunks`).
     """
     ex = execution
     n = y0s.shape[0]
@@ -44,7 +134,8 @@ def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, label, executi
     with _client(ex) as client:
         run_chunks(kernel.run_chunk, (bool(tangent), y0s, pars, ipar, cpar, n_pts, n_imp_pts,
                                       ex.threads, ex.lanes), n, chunk, outputs_, client=client,
-                   store=cs, progress=ex.progress, label=label)
+                   store=cs, progress=ex.progress, label=label, message=ex.message,
+                   worker_timeout=ex.worker_timeout)
     return outputs_
 
 
@@ -135,7 +226,7 @@ class _Callback:
 
 
 def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, progress=False,
-               label="cells", task_prefix="rockjit"):
+               label="cells", task_prefix="rockjit", message=None, worker_timeout=None):
     """Run ``runner`` over chunks of ``n`` cells and fill ``outputs`` in place.
 
     Parameters
@@ -149,7 +240,10 @@ def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, pr
     outputs : dict name -> ndarray
         Preallocated results, first axis ``n``; chunk ``a:b`` is written to ``[a:b]``.
     client : dask.distributed.Client, optional
-        Run the chunks as tasks on this cluster (retried if a worker is lost).
+        Run the chunks as tasks on this cluster (retried if a worker is lost). Each task's key
+        holds the computation's fingerprint, the chunk's bounds and a nonce of this call, and
+        its result comes back with that tag: a result of another computation is refused
+        (``RuntimeError``), never placed.
     store : ChunkStore, optional
         Load finished chunks from it and save new ones to it. A stored chunk that cannot be
         read back whole is discarded, reported through ``store.message`` ("discarded damaged
@@ -160,19 +254,28 @@ def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, pr
         Report progress on stderr (a rewritten line on a terminal, else throttled lines); or
         call ``progress(done, total)`` with the cells finished, once before the first chunk
         and after each; an exception it raises stops the run between two chunks.
+    message : callable, optional
+        ``message(text)`` for the wait for Dask workers (default: the store's, else a line on
+        stderr).
+    worker_timeout : float, optional
+        Seconds to wait, with a client, for the scheduler to have a worker, at the start or
+        after losing them all, before raising :class:`NoWorkers` (default
+        :data:`WORKER_TIMEOUT`, or the value :func:`worker_timeout` set).
     """
+    if message is None and store is not None:
+        message = store.message
     if store is not None:
         store.acquire()
     try:
         return _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, label,
-                           task_prefix)
+                           task_prefix, message, _timeout(worker_timeout))
     finally:
         if store is not None:
             store.close()
 
 
 def _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, label,
-                task_prefix):
+                task_prefix, message, timeout):
     bounds = [(a, min(n, a + chunk)) for a in range(0, n, chunk)]
     todo = []
     for a, b in bounds:
@@ -210,16 +313,45 @@ def _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, labe
         if client is None:
             for a, b in todo:
                 place(a, b, runner(*args(a, b)))
-        else:
-            from dask.distributed import as_completed
-
-            futures = {}
-            for a, b in todo:
-                fut = client.submit(runner, *args(a, b), key=f"{task_prefix}-{a}-{b}",
-                                    retries=3, pure=False)
-                futures[fut] = (a, b)
-            for fut in as_completed(futures):
-                place(*futures[fut], fut.result())
+        elif todo:
+            _on_dask(client, runner, inputs, n, chunk, todo, args, place, task_prefix, message,
+                     timeout)
     finally:
         bar.close()
     return outputs
+
+
+def _on_dask(client, runner, inputs, n, chunk, todo, args, place, task_prefix, message,
+             timeout):
+    """The chunks ``todo`` as tasks on ``client``, each placed as it arrives (see
+    :func:`run_chunks`)."""
+    from dask.distributed import wait
+
+    wait_for_workers(client, timeout, message)
+    fp = _fingerprint(runner, inputs, n, chunk)
+    nonce = secrets.token_hex(4)
+    pending = {}
+    for a, b in todo:
+        tag = f"{fp}:{a}:{b}"
+        fut = client.submit(_tagged, runner, tag, *args(a, b), retries=3, pure=False,
+                            key=f"{task_prefix}-{fp[:16]}-{nonce}-{a}-{b}")
+        pending[fut] = (a, b, tag)
+    try:
+        while pending:
+            try:
+                done = wait(list(pending), timeout=POLL, return_when="FIRST_COMPLETED").done
+            except (TimeoutError, asyncio.TimeoutError):
+                if not _n_workers(client):
+                    wait_for_workers(client, timeout, message, lost=True)
+                continue
+            for fut in done:
+                a, b, tag = pending.pop(fut)
+                result = fut.result()
+                if not (isinstance(result, tuple) and len(result) == 2 and result[0] == tag):
+                    raise RuntimeError(f"the Dask task {fut.key} returned a result that is not "
+                                       f"its chunk's (another computation's?); nothing of it "
+                                       f"was used")
+                place(a, b, result[1])
+    finally:
+        if pending:
+            client.cancel(list(pending))

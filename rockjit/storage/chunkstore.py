@@ -11,10 +11,14 @@ and of where it runs. A directory that holds another computation's chunks is ref
 than mixed in. A chunk that cannot be read back whole (truncated, not a zip archive, arrays
 missing or of the wrong shape or type) is discarded and computed again, and the run says so.
 
-A store is used by one run at a time: a lock file (``lock.json``: the owner's pid and host)
-makes a second run on the same store refuse with a ``ValueError`` naming the owner while it is
-alive; the lock of a process that no longer exists on this host is taken over (and the run
-says so). :func:`rockjit.grids.runner.run_chunks` releases the lock when it returns or raises; :func:`remove_stores`
+A store is used by one run at a time: a lock file (``lock.json``: the owner's pid and host,
+and where the system tells them, that process's start time and the boot id) makes a second run
+on the same store refuse with a ``ValueError`` naming the owner while it is alive, and saying
+how to take the store over when it is not. A lock is stale, taken over (and the run says so),
+when its process no longer exists on this host, or when its pid now belongs to another process:
+one that started at another time, or that runs under another boot (pids are reused after a
+reboot, and from one container's life to the next). A lock without a start time (rockjit
+0.1.0's) is stale when its pid's process started after the lock was written. :func:`rockjit.grids.runner.run_chunks` releases the lock when it returns or raises; :func:`remove_stores`
 deletes a store only when it can hold the lock, and only the files rockjit wrote there.
 
 """
@@ -28,6 +32,7 @@ import json
 import os
 import re
 import secrets
+import shutil
 import sys
 import time
 import weakref
@@ -35,7 +40,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .files import atomic_open, create_temp, host_name, pid_alive, write_text
+from .files import (atomic_open, boot_id, create_temp, host_name, pid_alive, process_start,
+                    process_start_time, write_text)
 
 __all__ = ["ChunkStore", "DamagedChunk", "fingerprint", "remove_stores"]
 
@@ -173,7 +179,8 @@ class _Lock:
             return
         token = secrets.token_hex(8)
         me, host = os.getpid(), host_name()
-        data = json.dumps(dict(pid=me, host=host, token=token,
+        data = json.dumps(dict(pid=me, host=host, token=token, start=process_start(me),
+                               boot=boot_id(),
                                since=time.strftime("%Y-%m-%dT%H:%M:%S%z"))).encode()
         for attempt in range(100):
             if self._create(data):
@@ -191,23 +198,51 @@ class _Lock:
                 raise ValueError(f"{self.dir} has an unreadable lock file; if no other rockjit "
                                  f"run is using it, delete {self.path}")
             pid, owner = have["pid"], have["host"]
+            since = f", since {have['since']}" if isinstance(have.get("since"), str) else ""
             if owner != host:
                 raise ValueError(f"{self.dir} is in use by a rockjit run on host {owner} "
-                                 f"(pid {pid}); wait for it to finish, or, if it has ended, "
-                                 f"delete {self.path}")
+                                 f"(pid {pid}{since}); wait for it to finish, or, if no rockjit "
+                                 f"run is using it any more, delete {self.path}")
             if pid == me and have.get("token") == _HELD.get(str(self.path)):
                 raise ValueError(f"{self.dir} is in use by another run in this process "
                                  f"(pid {pid}); one run at a time per store")
-            if pid != me and pid_alive(pid):
+            why = "which is no longer running" if pid == me else self._stale(have)
+            if why is None:
                 raise ValueError(f"{self.dir} is in use by another rockjit run (pid {pid} on "
-                                 f"{owner}); wait for it to finish, or use another output "
-                                 f"directory")
+                                 f"{owner}{since}); wait for it to finish, or use another "
+                                 f"output directory; if no rockjit run is using it (pid {pid} "
+                                 f"is another program), delete {self.path}")
             with _guard(self.dir):  # its owner is gone: take it over, unless another run did
                 if _read_lock(self.path) == have:
                     self.path.unlink(missing_ok=True)
                     self.message(f"took over the chunk store {self.dir} from pid {pid} on "
-                                 f"{owner}, which is no longer running")
+                                 f"{owner}, {why}")
         raise ValueError(f"{self.dir}: could not take the lock {self.path}")
+
+    def _stale(self, have):
+        """Why the lock ``have``, of a process on this host, is stale, or ``None`` when its
+        owner may still be running (see the module docstring)."""
+        pid = have["pid"]
+        if not pid_alive(pid):
+            return "which is no longer running"
+        boot, now = have.get("boot"), boot_id()
+        if isinstance(boot, str) and now is not None and boot != now:
+            return (f"which ran before this machine restarted (pid {pid} is now another "
+                    f"process)")
+        start, now = have.get("start"), process_start(pid)
+        if isinstance(start, int) and not isinstance(start, bool) and now is not None:
+            return None if now == start else (f"which is no longer running (pid {pid} is now "
+                                              f"another process, started later)")
+        if start is None:  # a lock without a start time: compare with when it was written
+            started = process_start_time(pid)
+            try:
+                written = os.stat(self.path).st_mtime
+            except OSError:
+                return None
+            if started is not None and started > written + 1.0:
+                return (f"which is no longer running (pid {pid} is now another process, "
+                        f"started after the lock was written)")
+        return None
 
     def release(self):
         """Give the lock back (removes the lock file if it is still this run's)."""
@@ -289,7 +324,7 @@ class ChunkStore:
         now = time.time()
         for p in self.dir.iterdir():
             if _OWN_TEMP.fullmatch(p.name):
-                p.unlink(missing_ok=True)
+                _remove(p)
             elif _LOCK_TEMP.fullmatch(p.name):  # another run's, while it takes a lock
                 with contextlib.suppress(OSError):
                     if now - p.stat().st_mtime > 60:
@@ -372,8 +407,18 @@ class ChunkStore:
             np.savez(fh, **out)
 
     def discard(self, a, b):
-        """Delete chunk ``a:b`` (a damaged one, before computing it again)."""
-        self._path(a, b).unlink(missing_ok=True)
+        """Delete chunk ``a:b`` (a damaged one, before computing it again), whatever it is: a
+        directory in its place is removed with its contents (the store is rockjit's own)."""
+        _remove(self._path(a, b))
+
+
+def _remove(path):
+    """Remove ``path``: a file, a link, or a directory with its contents; absent is fine."""
+    path = Path(path)
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path)
+    else:
+        path.unlink(missing_ok=True)
 
 
 def remove_stores(directory, *, message=None, _lock=None):
@@ -399,7 +444,7 @@ def remove_stores(directory, *, message=None, _lock=None):
     """
     d = Path(directory)
     say = _say if message is None else message
-    if not d.is_dir() or d.is_symlink():
+    if not os.path.isdir(d) or os.path.islink(d):  # (os.path: False for a name too long)
         return not os.path.lexists(d)
 
     def is_store(p):
@@ -419,7 +464,7 @@ def remove_stores(directory, *, message=None, _lock=None):
             for p in s.iterdir():
                 if _CHUNK.fullmatch(p.name) or _OWN_TEMP.fullmatch(p.name) or \
                         p.name == ChunkStore.MANIFEST:
-                    p.unlink(missing_ok=True)
+                    _remove(p)
         finally:
             lock.release()
         with contextlib.suppress(OSError):

@@ -32,6 +32,8 @@ import contextlib
 import csv
 import dataclasses
 import errno
+import fnmatch
+import hashlib
 import io as _io
 import json
 import math
@@ -40,14 +42,21 @@ import secrets
 import shutil
 import signal
 import socket
+import sys
 import threading
+import time
+import types
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["OutputDir", "atomic_open", "create_temp", "defer_signals", "host_name",
-           "markdown_table", "pid_alive", "save_figure", "sigterm_interrupts", "to_jsonable",
-           "write_csv", "write_json", "write_npz", "write_text"]
+__all__ = ["OutputDir", "atomic_open", "boot_id", "boot_time", "check_out",
+           "command_interrupts", "create_temp", "defer_signals", "host_name",
+           "installed_interrupts", "interrupt_handler", "interrupted", "markdown_table",
+           "pause_for_tests", "pid_alive", "process_start", "process_start_time",
+           "quiet_lost_interrupts", "save_figure", "signal_name",
+           "sigterm_interrupts", "to_jsonable", "write_csv", "write_json", "write_npz",
+           "write_text"]
 
 TMP_SUFFIX = ".tmp"
 _O_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
@@ -240,6 +249,54 @@ def pid_alive(pid):
     return True
 
 
+def process_start(pid):
+    """When process ``pid`` started, in clock ticks since boot (``/proc/<pid>/stat``, field
+    22), or ``None`` where that cannot be read (no such process, no ``/proc``). Together with
+    the pid it names one process: a pid reused by a later process has a later start."""
+    try:
+        with open(f"/proc/{int(pid)}/stat", "rb") as fh:
+            stat_line = fh.read()
+        # the command name (field 2) is in parentheses and may hold spaces or ')'
+        return int(stat_line[stat_line.rindex(b")") + 2:].split()[19])
+    except (OSError, ValueError, IndexError):
+        return None
+
+
+def boot_id():
+    """This boot's identifier (``/proc/sys/kernel/random/boot_id``), or ``None`` where there is
+    none: a pid recorded under another boot id names a process of an earlier boot."""
+    try:
+        with open("/proc/sys/kernel/random/boot_id", encoding="ascii") as fh:
+            return fh.read().strip() or None
+    except (OSError, ValueError):
+        return None
+
+
+def boot_time():
+    """When this machine booted (seconds since the epoch; ``btime`` of ``/proc/stat``), or
+    ``None`` where that cannot be read."""
+    try:
+        with open("/proc/stat", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("btime "):
+                    return float(line.split()[1])
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
+
+
+def process_start_time(pid):
+    """When process ``pid`` started, in seconds since the epoch, or ``None`` (see
+    :func:`process_start`)."""
+    ticks, booted = process_start(pid), boot_time()
+    if ticks is None or booted is None:
+        return None
+    try:
+        return booted + ticks / os.sysconf("SC_CLK_TCK")
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
 @contextlib.contextmanager
 def defer_signals(signums=(signal.SIGINT, signal.SIGTERM)):
     """Hold back ``signums`` for the duration of the block.
@@ -266,6 +323,124 @@ def defer_signals(signums=(signal.SIGINT, signal.SIGTERM)):
     finally:
         for s, h in old.items():
             signal.signal(s, signal.SIG_DFL if h is None else h)
+
+
+# ---- the signals of a command: one outcome per run -------------------------------------------
+#
+# A command's state is a namespace with ``received`` (the signals that arrived, in order),
+# ``final`` (once true, signals are only recorded) and ``out`` (its OutputDir, or None). Its
+# handler (interrupt_handler) records each SIGINT or SIGTERM and, until ``final`` is set or
+# ``out`` is published, raises KeyboardInterrupt carrying the signal in ``signum``: before
+# publication a signal interrupts the run (exit status 128 + signum, --out as it was); after
+# it, the run has succeeded and the signal changes nothing. The console script's entry point
+# (:func:`rockjit.cli.main`) installs the same handler before rockjit's numerical modules load,
+# so that Ctrl-C during the imports is handled too; it marks it with ``rockjit_state``.
+
+def interrupt_handler(state):
+    """The SIGINT and SIGTERM handler of a command's ``state`` (see the comment above)."""
+    def handler(signum, frame):
+        state.received.append(signum)
+        if state.final or getattr(state.out, "published", False):
+            return
+        exc = KeyboardInterrupt()
+        exc.signum = signum
+        raise exc
+    handler.rockjit_state = state
+    return handler
+
+
+def installed_interrupts():
+    """The state of the command handler installed for both SIGINT and SIGTERM, or ``None``."""
+    state = getattr(signal.getsignal(signal.SIGINT), "rockjit_state", None)
+    if state is not None and getattr(signal.getsignal(signal.SIGTERM), "rockjit_state",
+                                     None) is state:
+        return state
+    return None
+
+
+@contextlib.contextmanager
+def command_interrupts(keep=False):
+    """SIGINT and SIGTERM handled for one command (:func:`interrupt_handler`).
+
+    Reuses the handler already installed by the program's entry point, if there is one, and
+    leaves it in place; otherwise installs one for the block and puts the previous handlers
+    back on exit, unless ``keep`` (the program's own entry point: a signal after the run has
+    ended must not change its exit status). Outside the main thread nothing is installed.
+
+    Yields
+    ------
+    namespace
+        The state: ``received``, ``final``, ``out``.
+    """
+    state = installed_interrupts()
+    if state is not None:
+        yield state
+        return
+    state = types.SimpleNamespace(received=[], final=False, out=None)
+    old = {}
+    hook = sys.unraisablehook
+    if threading.current_thread() is threading.main_thread():
+        handler = interrupt_handler(state)
+        for s in (signal.SIGINT, signal.SIGTERM):
+            try:
+                old[s] = signal.signal(s, handler)
+            except (ValueError, OSError):
+                pass
+        sys.unraisablehook = quiet_lost_interrupts(state, hook)
+    try:
+        yield state
+    finally:
+        if not keep:
+            for s, h in old.items():
+                signal.signal(s, signal.SIG_DFL if h is None else h)
+            sys.unraisablehook = hook
+
+
+def quiet_lost_interrupts(state, previous):
+    """A ``sys.unraisablehook`` that drops the KeyboardInterrupt of a signal raised where it
+    cannot propagate (in a finalizer: Python would print "Exception ignored in ..." and a
+    traceback, and go on). The signal is in ``state.received``, and the command acts on it
+    before publishing (see :func:`interrupted`). Anything else goes to ``previous``."""
+    def hook(unraisable):
+        if issubclass(unraisable.exc_type, KeyboardInterrupt) and state.received:
+            return
+        previous(unraisable)
+    return hook
+
+
+def interrupted(state):
+    """Raise the KeyboardInterrupt of a signal that arrived (``state.received``) but whose
+    KeyboardInterrupt did not reach the command: swallowed by a finalizer, or by a library's
+    ``except BaseException``. Called before work and before publishing, so that a signal
+    before publication always interrupts."""
+    if state.received and not state.final:
+        exc = KeyboardInterrupt()
+        exc.signum = state.received[-1]
+        raise exc
+
+
+def signal_name(signum):
+    """``"SIGINT"``, ``"SIGTERM"``, ..."""
+    try:
+        return signal.Signals(signum).name
+    except ValueError:
+        return f"signal {signum}"
+
+
+PAUSE_VARIABLE = "ROCKJIT_TEST_PAUSE"
+
+
+def pause_for_tests(point, state):
+    """Where the environment variable ``ROCKJIT_TEST_PAUSE`` names ``point``: say so on stderr
+    (``rockjit: paused at <point>``) and wait, at most 60 s, for a signal, so that a test can
+    send one at a known moment of a run. Otherwise nothing."""
+    if os.environ.get(PAUSE_VARIABLE) != point:
+        return
+    n = len(state.received)
+    print(f"rockjit: paused at {point}", file=sys.stderr, flush=True)
+    deadline = time.monotonic() + 60.0
+    while len(state.received) == n and time.monotonic() < deadline:
+        time.sleep(0.01)
 
 
 # ---- a command's output directory ------------------------------------------------------------
@@ -340,28 +515,178 @@ def chunk_root(out):
     return Path(str(Path(out)) + ".chunks")
 
 
-def check_out(out, *, name="out"):
-    """Refuse (``ValueError`` naming ``name``) an output directory that cannot be written: an
-    empty name, an existing file, a ``<out>.chunks`` that is not a directory, or a place where
-    no directory can be made (probed by making and removing a temporary one where the outputs
-    will be staged)."""
-    if not str(out).strip():
-        raise ValueError(f"{name} must name a directory (got an empty string)")
-    p = Path(out)
-    if p.exists() and not p.is_dir():
-        raise ValueError(f"{name} must be a directory (got {out}, an existing file)")
-    chunks = chunk_root(out)
-    if chunks.exists() and not chunks.is_dir():
-        raise ValueError(f"{chunks} (where {name}'s unfinished chunks wait) exists and is not "
-                         f"a directory; move it away or choose another {name}")
-    q = p.absolute().parent
-    while not q.exists():
-        q = q.parent
+def _name_max(directory):
+    """The longest file name (bytes) the file system of ``directory`` takes (255 if unknown)."""
     try:
-        os.rmdir(_mkdir_unique(q, ".rockjit-probe-"))
+        return int(os.pathconf(directory, "PC_NAME_MAX"))
+    except (OSError, ValueError, AttributeError, TypeError):
+        return 255
+
+
+def _path_max(directory):
+    """The longest path (bytes) the system takes (4096 if unknown)."""
+    try:
+        return int(os.pathconf(directory, "PC_PATH_MAX"))
+    except (OSError, ValueError, AttributeError, TypeError):
+        return 4096
+
+
+def _nearest(path):
+    """``path`` (absolute) or its nearest ancestor that exists (as a link, file or directory)."""
+    q = Path(path).absolute()
+    while not os.path.lexists(q) and q != q.parent:
+        q = q.parent
+    return q
+
+
+def _link_problem(path):
+    """Why the symbolic link ``path`` cannot be followed (it dangles, it loops), or ``None``."""
+    try:
+        os.stat(path)
+        return None
     except OSError as exc:
-        raise ValueError(f"{name} {out} cannot be created or written "
+        try:
+            target = os.readlink(path)
+        except OSError:
+            target = "?"
+        if exc.errno == errno.ELOOP:
+            return f"a symbolic link in a loop ({path} -> {target})"
+        if exc.errno in (errno.ENOENT, errno.ENOTDIR):
+            return f"a symbolic link to {target}, which does not exist"
+        return f"a symbolic link that cannot be followed ({exc.strerror or exc})"
+
+
+def _short(text, keep=200):
+    text = str(text)
+    return text if len(text) <= keep else f"{text[:keep // 2 - 2]}...{text[-(keep // 2 - 2):]}"
+
+
+def _probe(directory):
+    """Make and remove a hidden directory in ``directory``: ``OSError`` if it cannot be written."""
+    os.rmdir(_mkdir_unique(Path(directory), ".rockjit-probe-"))
+
+
+#: Room kept, below the system's longest path, for the names rockjit adds inside ``--out`` and
+#: ``<out>.chunks`` (a staging directory, a file, its temporary name).
+PATH_ROOM = 256
+
+
+def check_out(out, *, name="out", files=(), chunks=False):
+    """Refuse, before any work, an output directory rockjit could not publish into.
+
+    Raises ``ValueError`` naming ``name`` for: an empty name; a name too long for the file
+    system (any of its parts, ``<out>.chunks`` when ``chunks``, or the whole path with room
+    for what is written inside it); an existing file, or a symbolic link that dangles or loops
+    (``--out`` itself or the part of it that exists); a place where no directory can be made or
+    written (probed by making and removing a hidden one where the outputs will be staged:
+    inside ``out`` if it exists, else in its nearest existing parent); a directory inside ``out``
+    named like a file the command writes (``files``: names or ``fnmatch`` patterns;
+    ``summary.json`` always); and, when the command keeps chunks (``chunks``), a
+    ``<out>.chunks`` that is not a writable directory or holds a file where a chunk store would
+    go (a name without a dot).
+    """
+    text = os.fspath(out)
+    if not text.strip():
+        raise ValueError(f"{name} must name a directory (got an empty string)")
+    try:
+        _check_out(Path(text), text, name, (SUMMARY,) + tuple(files), chunks)
+    except OSError as exc:  # what the checks did not foresee, still before any work
+        raise ValueError(f"{name} {_short(text)} cannot be used "
                          f"({exc.strerror or exc})") from None
+
+
+def _check_out(p, out, name, files, chunks):
+    absolute = p.absolute()
+    q = _nearest(absolute)
+    limit = _name_max(q if os.path.isdir(q) else q.parent)
+    for part in absolute.parts:
+        if len(os.fsencode(part)) > limit:
+            raise ValueError(f"{name} {_short(out)}: the name {_short(part, 60)} is "
+                             f"{len(os.fsencode(part))} bytes long; at most {limit} fit on "
+                             f"this file system")
+    if chunks and len(os.fsencode(absolute.name + ".chunks")) > limit:
+        raise ValueError(f"{name}'s last name {_short(absolute.name, 60)} is "
+                         f"{len(os.fsencode(absolute.name))} bytes long: this command keeps "
+                         f"its unfinished chunks beside it in <name>.chunks, and at most "
+                         f"{limit} bytes fit, so {name}'s last name can have at most "
+                         f"{limit - len('.chunks')}")
+    room = _path_max(q if os.path.isdir(q) else q.parent) - PATH_ROOM
+    if len(os.fsencode(str(absolute))) > room:
+        raise ValueError(f"{name} {_short(out)} is {len(os.fsencode(str(absolute)))} bytes "
+                         f"long as an absolute path; at most {room} leave room for the files "
+                         f"written inside it")
+    if q != absolute:  # --out is made inside q
+        if os.path.islink(q) and _link_problem(q):
+            raise ValueError(f"{name} {_short(out)} cannot be created: {q} is "
+                             f"{_link_problem(q)}")
+        if not os.path.isdir(q):
+            raise ValueError(f"{name} {_short(out)} cannot be created: {q} is a file, not a "
+                             f"directory")
+        stage = q
+    else:
+        if os.path.islink(p) and _link_problem(p):
+            raise ValueError(f"{name} {_short(out)} is {_link_problem(p)}; remove the link "
+                             f"or choose another {name}")
+        if not os.path.isdir(p):
+            raise ValueError(f"{name} must be a directory (got {_short(out)}, an existing "
+                             f"file)")
+        stage = p
+        with os.scandir(p) as entries:
+            for e in entries:
+                if any(fnmatch.fnmatchcase(e.name, f) for f in files) and \
+                        e.is_dir(follow_symlinks=False):
+                    raise ValueError(f"{name} {_short(out)} holds a directory {e.name} where "
+                                     f"this command writes a file of that name; move it "
+                                     f"away or choose another {name}")
+    try:
+        _probe(stage)
+    except OSError as exc:
+        raise ValueError(f"{name} {_short(out)} cannot be created or written "
+                         f"({exc.strerror or exc})") from None
+    if chunks:
+        _check_chunk_root(out, name)
+
+
+def _check_chunk_root(out, name):
+    c = chunk_root(out)
+    where = f"{_short(c)} (where {name}'s unfinished chunks wait)"
+    if os.path.lexists(c):
+        if os.path.islink(c) and _link_problem(c):
+            raise ValueError(f"{where} is {_link_problem(c)}; remove it or choose another "
+                             f"{name}")
+        if not os.path.isdir(c):
+            raise ValueError(f"{where} exists and is not a directory; move it away or choose "
+                             f"another {name}")
+        with os.scandir(c) as entries:
+            for e in entries:  # rockjit's stores there: directories, named without a dot
+                if "." not in e.name and not e.is_dir():
+                    raise ValueError(f"{_short(c / e.name)}, where {name}'s unfinished "
+                                     f"chunks of a grid wait, is not a directory; move it "
+                                     f"away or choose another {name}")
+        at = c
+    else:
+        at = _nearest(c.absolute().parent)
+        if not os.path.isdir(at):
+            return  # made with --out (checked above)
+    try:
+        _probe(at)
+    except OSError as exc:
+        raise ValueError(f"{where} cannot be created or written ({exc.strerror or exc})") \
+            from None
+
+
+def _sibling_prefix(out):
+    """The names of ``out``'s staging directories beside it: ``.<name>.rockjit-stage-``, or
+    ``.<hash of the name>.rockjit-stage-`` where the name is too long for the file system to
+    take ``<host>-<pid>-<random>`` after it."""
+    if not out.name:
+        return None
+    prefix = f".{out.name}.{_STAGE}-"
+    longest = len(os.fsencode(prefix + host_name())) + len("-4294967296-") + 8
+    if longest > _name_max(_nearest(out.parent)):
+        digest = hashlib.sha256(os.fsencode(out.name)).hexdigest()[:16]
+        prefix = f".{digest}.{_STAGE}-"
+    return prefix
 
 
 class OutputDir:
@@ -464,7 +789,7 @@ class OutputDir:
             return self._stage
         out = self.path
         host, pid = host_name(), os.getpid()
-        sibling = f".{out.name}.{_STAGE}-" if out.name else None
+        sibling = _sibling_prefix(out)
         if os.path.lexists(out):
             if not out.is_dir():
                 raise ValueError(f"out must be a directory (got {out}, an existing file)")

@@ -119,7 +119,7 @@ def _serve(address, port, ready, box):
 
 
 def start(*, port=0, address="127.0.0.1", browser=True, block=False, quiet=False):
-    """Start the explorer (see :func:`rockjit.explore.explore`); returns its :class:`Explorer`."""
+    """Start the explorer (see :func:`rockjit.explorer.explore`); returns its :class:`Explorer`."""
     from ..validate import integer
     _need_bokeh()
     port = integer("port", port, 0, 65535)

@@ -1,4 +1,4 @@
-"""``rockjit explore``: the basin, a cell's run, the bifurcation diagram and both laws, live in a
+"""``rockjit explore`` and :func:`rockjit.explore`: the basin, a cell's run, the bifurcation diagram and both laws, live in a
 browser, recomputed as the parameters change.
 
 The compute side (:mod:`.requests`: parameters, coarse-to-fine stages, the Python call of each
@@ -6,13 +6,10 @@ view; :mod:`.worker`: the worker thread, newer requests superseding older ones) 
 beyond rockjit; the user interface (:mod:`.app`) and its server (:mod:`.server`) need Bokeh, the
 ``explore`` extra: ``pip install 'rockjit[explore]'``.
 
-The module is callable: ``rockjit.explore()`` starts the server (see :func:`explore`).
+``rockjit.explore()`` starts the server (:func:`explore`).
 """
 
 from __future__ import annotations
-
-import sys
-import types
 
 __all__ = ["explore"]
 
@@ -42,13 +39,3 @@ def explore(*, port=0, address="127.0.0.1", browser=True, block=False, quiet=Fal
     """
     from .server import start
     return start(port=port, address=address, browser=browser, block=block, quiet=quiet)
-
-
-class _CallableModule(types.ModuleType):
-    """``rockjit.explore`` is this package and, called, :func:`explore`."""
-
-    def __call__(self, *args, **kwargs):
-        return explore(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _CallableModule
