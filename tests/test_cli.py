@@ -20,9 +20,9 @@ import pytest
 
 import rockjit
 from rockjit.cli import outputs
-from rockjit.grids import grids as analysis
+from rockjit.grids import plan as grid_plan
 from rockjit.storage import files as rio
-from rockjit.grids.grids import BEHAVIOURS
+from rockjit import BEHAVIOURS, Block, Harmonic, Integration
 from rockjit.cli.main import OUTPUTS, main
 
 TINY = ["--periods", "20", "--n-steps", "64", "--quiet"]
@@ -35,7 +35,9 @@ def _summary(d):
     # every file a command writes is one the command line checks for before any work (a
     # directory of that name inside --out is refused then, not when publishing)
     declared = OUTPUTS[s["command"]] + ("summary.json",)
-    for name in s["files"]:
+    for entry in s["files"]:
+        name = entry["name"]
+        assert entry["holds"], f"{name}: summary.json says nothing of what it holds"
         assert any(fnmatch.fnmatchcase(name, pattern) for pattern in declared), \
             f"{name}: add it to rockjit.cli.main.OUTPUTS[{s['command']!r}]"
     return s
@@ -130,9 +132,10 @@ def test_basin_both_laws_and_orientation(tmp_path):
              if (lh[i, j] == over) != (lh[j, i] == over)]
     assert cells, "the test needs a basin that is not symmetric under transposition"
     i, j = cells[0]
-    r = rockjit.simulate(1.0, 0.66, 1.3, "housner", theta0=z["theta0"][i],
-                         dtheta0=z["dtheta0"][j], r0=0.0, s0=1.0, periods=20, n_steps=64,
-                         lyapunov=True, record_stride=64)
+    r = rockjit.simulate(Block(1.0, "housner"), Harmonic(alpha=0.66, omega=1.3, r0=0.0, s0=1.0),
+                         (z["theta0"][i], z["dtheta0"][j]),
+                         integration=Integration(periods=20, n_steps=64), lyapunov=True,
+                         record_stride=64)
     assert (r.status == "overturned") == (lh[i, j] == over)
 
 
@@ -263,16 +266,16 @@ def test_python_m_rockjit_help():
 # ---------------------------------------------------------------------------------------------
 
 def test_interrupt_during_computation(tmp_path, monkeypatch, capsys):
-    real = analysis.run
+    real = grid_plan.run
     calls = []
 
-    def basin_then_interrupt(plan, **kw):
+    def basin_then_interrupt(plan, execution=None):
         calls.append(plan.block.law)
         if len(calls) == 2:  # mid-way: the first law done, the second interrupted
             raise KeyboardInterrupt
-        return real(plan, **kw)
+        return real(plan, execution)
 
-    monkeypatch.setattr(analysis, "run", basin_then_interrupt)
+    monkeypatch.setattr(grid_plan, "run", basin_then_interrupt)
     out = tmp_path / "out"
     assert main(BASIN + ["--law", "both", "--out", str(out)]) == 130
     assert calls == ["housner", "mao"]
@@ -565,7 +568,7 @@ def test_a_read_only_out_is_refused_before_any_work(tmp_path, mounts, monkeypatc
     (ro / "inside").mkdir()
     mounts(ro / "inside", size="1m")  # writable, in a directory that will be read-only
     _mount("-o", "remount,ro", ro)
-    monkeypatch.setattr(analysis, "run", lambda *a, **k: pytest.fail("not refused before work"))
+    monkeypatch.setattr(grid_plan, "run", lambda *a, **k: pytest.fail("not refused before work"))
     assert main(BASIN + ["--out", str(ro)]) == 2
     err = capsys.readouterr().err
     assert err.startswith(f"rockjit: error: --out {ro} cannot be created or written (Read-only "
@@ -593,7 +596,7 @@ def test_a_chunk_replaced_by_a_directory_is_recomputed(tmp_path, monkeypatch, ca
         return real_run_chunk(*a)
 
     def small_chunks(*a, **kw):
-        return real_run_grid(*a, **dict(kw, chunk=6))
+        return real_run_grid(*a, **dict(kw, execution=kw["execution"].replace(chunk=6)))
 
     monkeypatch.setattr(runner, "run_grid", small_chunks)
     monkeypatch.setattr(kernel, "run_chunk", interrupt_at_the_third)
@@ -611,7 +614,8 @@ def test_a_chunk_replaced_by_a_directory_is_recomputed(tmp_path, monkeypatch, ca
     assert "discarded damaged chunk cells-0000000000-0000000006.npz" in err and "Traceback" \
         not in err
     assert not (tmp_path / "b.chunks").exists()
-    whole = analysis.basin(1, 0.66, 1.3, grid=6, periods=20, n_steps=64)
+    whole = rockjit.basin(Block(1), Harmonic(alpha=0.66, omega=1.3), 6,
+                          integration=Integration(periods=20, n_steps=64))
     np.testing.assert_array_equal(np.load(out / "basin.npz")["label"], whole.label)
 
 
@@ -674,7 +678,7 @@ def test_out_problems_are_found_before_any_work(tmp_path, monkeypatch, capsys, s
     out = tmp_path / "o"
     setup(out)
     before = sorted(str(p) for p in tmp_path.rglob("*"))
-    monkeypatch.setattr(analysis, "run", lambda *a, **k: pytest.fail("not refused before work"))
+    monkeypatch.setattr(grid_plan, "run", lambda *a, **k: pytest.fail("not refused before work"))
     assert main(BASIN + ["--law", "both", "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert err.startswith("rockjit: error: ") and err.count("\n") == 1 and "--out" in err

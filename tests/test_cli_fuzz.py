@@ -65,11 +65,11 @@ from rockjit.cli.main import build_parser, main
 # ---------------------------------------------------------------------------------------------
 
 GUARDED = (
-    "rockjit.single:simulate",
-    "rockjit.grids.grids:sweep",
-    "rockjit.grids.grids:basin",
-    "rockjit.grids.grids:plane",
-    "rockjit.grids.grids:run",
+    "rockjit.single:run",                  # the run of a single run's plan (`trajectory`)
+    "rockjit.grids.plan:run",              # the run of every grid plan (sweep, basin, plane)
+    "rockjit.basins.erosion:run",
+    "rockjit.basins.fate:run",
+    "rockjit.orbits.arclength:run",        # the work of `orbits`
     "rockjit._engine.kernel:run_chunk",
     "rockjit._engine.integrate:build",
     "rockjit.study.paper:write_e_table",  # the work of `cor` (and of `paper`'s first part)
@@ -83,11 +83,9 @@ GUARDED = (
 )
 #: Patched as well where they exist (names of a refactor in progress); absent ones are ignored.
 GUARDED_IF_PRESENT = (
-    "rockjit.single:run",
     "rockjit._engine.kernel:run_single",
     "rockjit.grids.runner:run_grid",
     "rockjit._engine.kernel:run_chunk",
-    "rockjit.grids.grids:run",
 )
 
 SEED = int(os.environ.get("ROCKJIT_FUZZ_SEED", "20240610"))
@@ -734,7 +732,7 @@ def reached():
     calls = []
     # import every module the CLI may import lazily first: one imported while the patches are
     # in place would keep a sentinel under its own name for the rest of the session
-    for name in ("grids.grids", "basins.identity", "basins.erosion", "basins.fate",
+    for name in ("grids.plan", "basins.identity", "basins.erosion", "basins.fate",
                  "orbits.arclength", "cli.outputs", "plotting.figures", "study.paper"):
         importlib.import_module(f"rockjit.{name}")
     mp = pytest.MonkeyPatch()

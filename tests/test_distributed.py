@@ -1,4 +1,4 @@
-"""Grids on a Dask cluster and resumable runs (issue 6).
+"""Grids on a Dask cluster and resumable runs.
 
 Checked against the in-process computation of the same grid: identical arrays whether the
 chunks ran here or on two worker processes, after a worker was killed mid-run, after an
@@ -15,14 +15,42 @@ import dask.distributed as distributed
 import numpy as np
 import pytest
 
+import rockjit
+from rockjit import Block, Execution, Harmonic, Integration
 from rockjit.grids import runner as grid_runner
-from rockjit.grids import grids as an
 from rockjit.storage import chunkstore as chunks
 from rockjit._engine import kernel
 from rockjit.cli.main import main
 
 
 PLANE = dict(hb=1, alpha_range=(0.4, 1.0), omega_range=(0.9, 1.8), grid=(8, 6), periods=120)
+
+
+class an:
+    """The grids of these tests, from their parameters in a few words: ``execution``'s fields
+    (``chunk``, ``client``, ``store``) as keywords."""
+
+    @staticmethod
+    def _execution(kw):
+        return Execution(**{k: kw.pop(k) for k in ("chunk", "client", "store") if k in kw})
+
+    @staticmethod
+    def plane(hb, alpha_range, omega_range, grid, periods, **kw):
+        return rockjit.plane(Block(hb=hb), alpha_range, omega_range, grid=grid,
+                             integration=Integration(periods=periods),
+                             execution=an._execution(kw))
+
+    @staticmethod
+    def basin(hb, alpha, omega, grid, periods, **kw):
+        return rockjit.basin(Block(hb=hb), Harmonic(alpha=alpha, omega=omega), grid,
+                             integration=Integration(periods=periods),
+                             execution=an._execution(kw))
+
+    @staticmethod
+    def sweep(hb, omega, alphas, periods, **kw):
+        return rockjit.sweep(Block(hb=hb), Harmonic(omega=omega), alphas,
+                             integration=Integration(periods=periods),
+                             execution=an._execution(kw))
 
 
 @pytest.fixture(scope="module")
@@ -160,7 +188,7 @@ def test_plane_command_resumes_and_cleans_up(tmp_path, monkeypatch, capsys):
 
 def _small_chunks(run_grid):
     def wrapped(*a, **kw):
-        kw["chunk"] = 8
+        kw["execution"] = kw["execution"].replace(chunk=8)
         return run_grid(*a, **kw)
     return wrapped
 

@@ -134,15 +134,15 @@ def _warn(msg):
 #: The files each command writes into --out besides summary.json (names or fnmatch patterns):
 #: a directory of one of these names inside --out is refused before any work.
 OUTPUTS = {
-    "trajectory": ("trajectory.npz", "trajectory.png"),
-    "sweep": ("sweep.npz", "bifurcation.png"),
-    "basin": ("basin.npz", "basin.png", "attractors.png"),
-    "plane": ("plane.npz", "plane.png"),
-    "erosion": ("erosion.npz", "erosion.png"),
-    "orbits": ("orbits.npz", "orbits.png"),
-    "fate": ("fate.npz", "fate.png"),
-    "cor": ("restitution.png", "e_table.csv", "e_table.md"),
-    "paper": ("fig*.png", "fig*.npz", "*_table.csv", "*_table.md"),
+    "trajectory": ("trajectory.npz", "trajectory.*"),
+    "sweep": ("sweep.npz", "bifurcation.*"),
+    "basin": ("basin.npz", "basin.*", "attractors.*"),
+    "plane": ("plane.npz", "plane.*"),
+    "erosion": ("erosion.npz", "erosion.*"),
+    "orbits": ("orbits.npz", "orbits.*"),
+    "fate": ("fate.npz", "fate.*"),
+    "cor": ("restitution.*", "e_table.csv", "e_table.md"),
+    "paper": ("fig*", "*_table.csv", "*_table.md", "index.html"),
 }
 #: The commands whose grids keep their finished chunks in <out>.chunks.
 CHUNKED = ("sweep", "basin", "plane", "erosion", "orbits", "paper")
