@@ -11,6 +11,7 @@ from .basins.fate import fate
 from .excitation import Harmonic
 from .grids import alpha_grid, basin, plane, sweep
 from .model import Block, delta_e_percent, e_housner, e_mao, thc_from_hb
+from .orbits.plane_chart import chart
 from .result import BEHAVIOURS, BasinResult, PlaneResult, Result, SweepResult
 from .settings import Classification, Execution, Integration, Lattice
 from .single import DEFAULT_N, Z0_STUDY, Scipy, classify_result, simulate
@@ -18,7 +19,8 @@ from .single import DEFAULT_N, Z0_STUDY, Scipy, classify_result, simulate
 __all__ = [
     "BEHAVIOURS", "BasinResult", "Block", "Classification", "DEFAULT_N", "Execution",
     "Harmonic", "Integration", "Lattice", "PlaneResult", "Result", "Scipy", "SweepResult",
-    "Z0_STUDY", "alpha_grid", "basin", "classify_result", "delta_e_percent", "e_housner",
+    "Z0_STUDY", "alpha_grid", "basin", "chart", "classify_result", "delta_e_percent",
+    "e_housner",
     "e_mao", "erosion", "fate", "plane", "simulate", "sweep", "thc_from_hb",
 ]
 __version__ = "0.2.0.dev0"

@@ -48,6 +48,10 @@ from .types import Bifurcation, OrbitRefused
 __all__: list[str] = []
 
 
+_HOP = ("an excursion that touches down twice at low speed and comes back shrinks to a "
+        "grazing (located on the orbit without those impacts, which meets it there)")
+
+
 class LocateFailed(Exception):
     """A trial point of a located bifurcation could not be corrected onto the branch."""
 
@@ -283,15 +287,12 @@ class Locator:
         Plo, Phi, width = self._bisect(a, b.y - a.y, form, p,
                                        lambda Q: Q.info.nimp == a.info.nimp)
         direction = np.sign(b.y[2] - a.y[2])
-        Q, w2 = None, math.inf
-        if a.info.nimp > b.info.nimp and Phi is not None and form == "full":
-            # from the side without the extra impacts, where the map is smooth up to the
-            # grazing (on the other, the saltation's 1/theta'- makes M blow up)
-            Q, w2 = self.refine_edge(Phi, -direction, p)
-        if w2 == math.inf:
-            Q, w2 = self.refine_edge(Plo, direction, p)
+        Q, w2 = self.refine_edge(Plo, direction, p)
         if w2 < math.inf:
             Plo, width = Q, w2
+        hop = self.hop(Plo, p, direction) if a.info.nimp > b.info.nimp else None
+        if hop is not None:
+            Plo, width = hop
         if Plo is a:
             Plo = None
         P = Plo if Plo is not None else a
@@ -299,6 +300,8 @@ class Locator:
         kind = (f"an impact with |theta'-| -> 0 (now {ms:.2g} of max |theta'|)"
                 if a.info.nimp > b.info.nimp else
                 f"|theta| touches 0 without impact (now {P.info.near_miss:.2g} of max |theta|)")
+        if hop is not None:
+            kind = _HOP
         detail = (f"impacts per cycle {a.info.nimp} -> {b.info.nimp}: {kind}; bracket "
                   f"{width:.1g} wide")
         bifs.append(self._graze_bif(P, a.y[2], b.y[2], a.info.mu, b.info.mu, p, detail,
@@ -317,8 +320,7 @@ class Locator:
         hop = self.hop(Q, p, np.sign(t[2]))
         if hop is not None:
             Q, width = hop
-            what = ("an excursion that touches down twice at low speed shrinks to a grazing "
-                    "(located on the orbit without those impacts, which meets it there)")
+            what = _HOP
         detail = f"{what}; located to a bracket {width:.1g} wide"
         mu_b = np.full(2, np.nan, complex)
         bifs.append(self._graze_bif(Q, a.y[2], Q.y[2] + np.sign(t[2]) * width, a.info.mu,
@@ -369,11 +371,16 @@ class Locator:
         Q, w2 = self.refine_edge(Plo, np.sign(t[2]), p)
         if w2 < math.inf:
             Plo, width = Q, w2
-        P = a if Plo is a else Plo
         what = {"overturn": "max |theta| reaches theta_over (the orbit overturns)",
                 "rest": "the orbit comes to rest",
                 "passes_through_rest": "the orbit enters a rest phase (impact speeds -> 0)",
                 "max_impacts": "impacts accumulate (impact bound)"}[why]
+        hop = self.hop(Plo, p, np.sign(t[2])) if why in ("rest", "passes_through_rest") \
+            else None
+        if hop is not None:
+            Plo, width = hop
+            what = _HOP
+        P = a if Plo is a else Plo
         detail = f"{what}; bracket {width:.1g} wide"
         mu_b = np.full(2, np.nan, complex)
         bifs.append(self._graze_bif(P, a.y[2], a.y[2] + ds_fail * t[2], a.info.mu, mu_b, p,

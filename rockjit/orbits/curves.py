@@ -100,6 +100,7 @@ CURVE_ENDS = {
     "rest": "its orbit comes to rest",
     "branch_point": "its orbit becomes symmetric, or of half the period",
     "closed": "the curve closes on itself",
+    "unstable": "its orbit's largest multiplier exceeds max_multiplier",
     "no_convergence": "the corrector fails at the smallest step",
     "max_points": "the bound on points",
     "budget": "the bound on runs",
@@ -128,6 +129,12 @@ class CurveSettings:
     param_tol : float
         Codimension-two points and curve ends are located to this in the plane, ``> 0``;
         default ``1e-8``.
+    max_multiplier : float
+        A curve is not followed where its orbit's largest ``|mu|`` exceeds this (end
+        ``"unstable"``; a seed beyond it is refused), ``> 1``; default ``1e4``. So unstable an
+        orbit is invisible to the brute-force chart, and its shooting degrades: a state error
+        along the unstable direction grows by ``|mu|`` over the cycle, beyond the reach of the
+        differences of the grazing condition, and the steps shrink without end.
 
     Examples
     --------
@@ -146,8 +153,11 @@ class CurveSettings:
     max_points: int = 1000
     max_calls: int = 200_000
     param_tol: float = 1e-8
+    max_multiplier: float = 1e4
 
     def __post_init__(self):
+        _set(self, max_multiplier=real("max_multiplier", self.max_multiplier, 1.0, None,
+                                       lo_open=True))
         for name in ("ds0", "ds_min", "ds_max", "param_tol"):
             _set(self, **{name: real(name, getattr(self, name), 0.0, None, lo_open=True)})
         if not self.ds_min <= self.ds0 <= self.ds_max:
@@ -218,7 +228,9 @@ class BifurcationCurve:
         The curve.
     state : ndarray, shape (n, 2)
         The orbit's first cycle point at each curve point, at the section ``phase``.
-    cycle : ndarray, shape (n, p, 2)
+    cycle, cycle_half : ndarray, shape (n, p, 2)
+        The cycle at ``kT`` and ``kT + T/2`` (the mirror orbit of a non-symmetric one is
+        ``-cycle_half``).
     multipliers : ndarray of complex, shape (n, 2)
     impacts : ndarray of int, shape (n,)
         Impacts per cycle.
@@ -268,6 +280,7 @@ class BifurcationCurve:
     omega: np.ndarray
     state: np.ndarray
     cycle: np.ndarray
+    cycle_half: np.ndarray
     multipliers: np.ndarray
     impacts: np.ndarray
     condition: np.ndarray
@@ -303,6 +316,25 @@ class BifurcationCurve:
             if not out or abs(a - out[-1]) > 1e-12:  # a point on omega is in two segments
                 out.append(a)
         return out
+
+    def through(self, omega, alpha, cycle, tol=1e-3):
+        """Whether the curve crosses ``omega`` within ``tol`` (relative) of ``alpha``, with an
+        orbit there within 5 % of its size of ``cycle`` (or of its mirror image): the same
+        curve, found again."""
+        from ..basins.cycles import cycle_distance
+        w = self.omega - omega
+        for k in np.nonzero(w[:-1] * w[1:] <= 0)[0]:
+            dw = self.omega[k + 1] - self.omega[k]
+            s = 0.5 if dw == 0 else (omega - self.omega[k]) / dw
+            a = self.alpha[k] + s * (self.alpha[k + 1] - self.alpha[k])
+            if abs(a - alpha) > tol * max(1.0, abs(alpha)):
+                continue
+            scale = max(float(np.abs(cycle).max()), 1e-12)
+            for cyc in (self.cycle, -self.cycle_half):
+                ci = (1 - s) * cyc[k] + s * cyc[k + 1]
+                if cycle_distance(ci, np.asarray(cycle)) <= 0.05 * scale:
+                    return True
+        return False
 
     def to_dict(self, points=True):
         """JSON-ready: type, period, law, ``points`` ``[[alpha, omega], ...]``, ends,
@@ -477,6 +509,7 @@ class Tracer:
         self.max_points = settings.max_points
         self.max_calls = settings.max_calls
         self.param_tol = settings.param_tol
+        self.max_mu = settings.max_multiplier
         self.sym_tol = sym_tol
         self.codim2 = []
         self.grad = None  # the condition's gradient at the last Jacobian
@@ -678,6 +711,8 @@ class Tracer:
             b.iters = iters
             self.watch(a, b, len(pts), ctype)
             pts.append(b)
+            if float(np.abs(b.info.mu).max()) > self.max_mu:
+                return pts, "unstable"
             if at_edge:
                 return pts, "range"
             if len(pts) > 10 and np.linalg.norm(b.y - start.y) < ds and \
@@ -1018,6 +1053,10 @@ def continue_curve(block, seed, *, phase, alpha_range, omega_range, n_steps=N_OR
                                       f"{alpha:.10g}: the seed's branch ends otherwise")
     start = tracer.point(y, j, ev)
     start.g, start.res = float(ev.g), float(np.abs(ev.F).max())
+    if float(np.abs(start.info.mu).max()) > settings.max_multiplier:
+        raise OrbitRefused("unstable", f"the seed's orbit has |mu| = "
+                                       f"{float(np.abs(start.info.mu).max()):.3g} > "
+                                       f"max_multiplier = {settings.max_multiplier:g}")
     t = tracer.tangent(start)
     if t is None:
         raise OrbitRefused("singular", "no tangent to the curve at the seed")
@@ -1043,6 +1082,7 @@ def continue_curve(block, seed, *, phase, alpha_range, omega_range, n_steps=N_OR
         type=seed.type, period=p, law=block.law, symmetric=symmetric, grazing=kind,
         alpha=A, omega=W, state=np.array([P.info.cycle[0] for P in pts]),
         cycle=np.array([P.info.cycle for P in pts]),
+        cycle_half=np.array([P.info.half for P in pts]),
         multipliers=np.array([P.info.mu for P in pts]),
         impacts=np.array([P.info.nimp for P in pts], np.int64),
         condition=np.array([P.g for P in pts]), residual=np.array([P.res for P in pts]),
