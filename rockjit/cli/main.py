@@ -296,7 +296,6 @@ def _chart_plan(args):
     plans = {law: chart.plan(_block(args, law), tuple(args.alpha_range),
                              tuple(args.omega_range), grid=tuple(args.grid),
                              seed_omegas=args.seed_omegas, max_period=args.max_period,
-                             state=_state(args), forcing=_forcing(args, alpha=False, omega=False),
                              integration=_integration(args), lyapunov=args.lyapunov,
                              execution=_execution(args))
              for law in _laws(args)}
@@ -569,7 +568,8 @@ def build_parser():
 
     p = _command(sub, "chart", _chart_plan, _chart_run,
                  "the (alpha, omega) plane with its bifurcation curves",
-                 "The brute-force chart of behaviours over the forcing plane and the fold, "
+                 "The brute-force chart of behaviours from the study's z0 over the forcing "
+                 "plane and the fold, "
                  "symmetry-breaking, period-doubling and grazing curves across it, followed by "
                  "continuation from the bifurcations located along alpha on a few omega lines; "
                  "write chart.npz, chart.png (with --law both: both laws side by side and "
@@ -592,7 +592,6 @@ def build_parser():
                    help="forcing periods of the chart's runs (default 500)")
     p.add_argument("--n-steps", type=int, default=None,
                    help="steps per forcing period of the chart's runs (default 64)")
-    _add_state(p, "default: the study's z0")
     _add_common(p)
     _add_scheduler(p)
 
