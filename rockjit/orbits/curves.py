@@ -57,8 +57,10 @@ Codimension two
     are located by Brent's method along the chord, each trial a corrected point
     (``fold_flip``, ``resonance_1_1``, ``resonance_1_2`` on the multiplier curves;
     ``grazing_fold``, ``grazing_symmetry_breaking``, ``grazing_period_doubling`` on a grazing
-    curve). A fold curve whose projection on the plane turns back marks a ``cusp``; a curve
-    that ends on a grazing curve, the grazing point of its type; an asymmetric fold curve
+    curve). A fold curve whose projection on the plane turns back marks a ``cusp`` (located
+    to the step); a curve that ends on a grazing curve, the grazing point of its type
+    (``grazing_<type>``; a grazing curve ending where another excursion of its orbit grazes,
+    a ``double_grazing``); an asymmetric fold curve
     that ends on its orbit's symmetric parent, a ``degenerate_pitchfork``, and a
     period-``2p`` fold curve on its period-``p`` parent, a ``degenerate_flip``. In this
     dissipative model ``|det M| < 1`` (:mod:`.bifurcations`, "Neimark–Sacker"), so a fold
@@ -89,7 +91,7 @@ CURVE_TYPES = ("fold", "symmetry_breaking", "period_doubling", "grazing")
 
 #: The codimension-two points a curve reports (module docstring, "Codimension two").
 CODIM2_TYPES = ("fold_flip", "resonance_1_1", "resonance_1_2", "cusp", "grazing_fold",
-                "grazing_symmetry_breaking", "grazing_period_doubling",
+                "grazing_symmetry_breaking", "grazing_period_doubling", "double_grazing",
                 "degenerate_pitchfork", "degenerate_flip")
 
 #: Why a curve ends at either end.
@@ -295,6 +297,7 @@ class BifurcationCurve:
     n_steps: int
     block: object = None
     shooting: object = None
+    count: int = 0  # the impacts the extended system keeps (over the half map's stretch)
 
     @property
     def points(self) -> np.ndarray:
@@ -316,6 +319,52 @@ class BifurcationCurve:
             if not out or abs(a - out[-1]) > 1e-12:  # a point on omega is in two segments
                 out.append(a)
         return out
+
+    def solve_at(self, omega):
+        """The curve's ``alpha`` where it crosses ``omega``, solved there (not interpolated):
+        the extended system corrected at fixed ``omega`` from each crossing of the curve's
+        points, one value per crossing (``nan`` where the corrector fails).
+
+        Examples
+        --------
+        >>> from rockjit import Block, Harmonic
+        >>> from rockjit.orbits import ContinuationSettings, continuation, continue_curve
+        >>> c = continuation(Block(hb=1), Harmonic(omega=1.3), [(0.8, (-0.44, -0.36), 1)],
+        ...                  bounds=(0.77, 0.8), settings=ContinuationSettings(switch=False))
+        >>> curve = continue_curve(Block(hb=1), c.bifurcations[0], phase=c.phase,
+        ...                        alpha_range=(0.7, 0.85), omega_range=(1.2, 1.4))
+        >>> [round(a, 9) for a in curve.solve_at(1.25)]
+        [0.806781978]
+        """
+        omega = real("omega", omega, *OMEGA_RANGE)
+        box = (0.0, ALPHA_MAX, OMEGA_RANGE[0], OMEGA_RANGE[1])
+        flow, solver, ext, tracer = _system(self.block, self.type, self.period, self.symmetric,
+                                            self.grazing, self.count, self.phase, self.n_steps,
+                                            self.shooting, box, CurveSettings())
+        w = self.omega - omega
+        out = []
+        for k in np.nonzero(w[:-1] * w[1:] <= 0)[0]:
+            dw = self.omega[k + 1] - self.omega[k]
+            s = 0.5 if dw == 0 else (omega - self.omega[k]) / dw
+            a = float(self.alpha[k] + s * (self.alpha[k + 1] - self.alpha[k]))
+            if out and abs(a - out[-1][0]) < 1e-12:
+                continue
+            x = self.state[k] + s * (self.state[k + 1] - self.state[k])
+            lam = (a, omega)
+            try:
+                j, xj = _section(solver, x, lam, self.period)
+            except OrbitRefused:
+                out.append((a, math.nan))
+                continue
+            y0 = np.r_[xj, lam]
+            ev0 = ext(y0, j)
+            if not ev0.ok and ext.depth is not None:
+                ev0 = tracer.enter_side(y0, j, ev0)
+                y0 = y0 if ev0 is None or not ev0.ok else ev0.y
+            ok, y, _, _, _ = tracer.correct(y0, np.array([0.0, 0.0, 0.0, 1.0]), j,
+                                            max_iter=40, max_jac=40)
+            out.append((a, float(y[2]) if ok else math.nan))
+        return [v for _, v in out]
 
     def through(self, omega, alpha, cycle, tol=1e-3):
         """Whether the curve crosses ``omega`` within ``tol`` (relative) of ``alpha``, with an
@@ -786,7 +835,10 @@ class Tracer:
         """A fold curve whose projection on the plane turns back: a cusp between a and b."""
         po, pn = t_old[2:], t_new[2:]
         if float(po @ pn) < 0 and np.linalg.norm(po) > 0 and np.linalg.norm(pn) > 0:
-            # the point of the two where the planar tangent is shortest
+            last = next((c for c in reversed(self.codim2) if c.type == "cusp"), None)
+            if last is not None and math.hypot(last.alpha - b.y[2],
+                                               last.omega - b.y[3]) < 1e-3:
+                return  # the same cusp (near it the planar tangent is small and noisy)
             self.add("cusp", b, index, False,
                      "the curve's projection on the plane turns back between two points")
 
@@ -822,6 +874,10 @@ class Tracer:
 
     def ends_on_grazing(self, P, index):
         if self.ext.depth is not None:
+            self.add("double_grazing", P, index, False,
+                     f"another excursion of the grazing orbit grazes (near miss "
+                     f"{P.info.near_miss:.2g}, slowest impact {P.info.min_speed:.2g} of the "
+                     f"orbit's size at the last point continued)")
             return
         self.add(f"grazing_{self.ext.type}", P, index, True,
                  f"the curve meets a grazing curve: impacts per cycle change from "
@@ -929,6 +985,16 @@ def seed_block(flow):
     return flow.block
 
 
+def _system(block, ctype, p, symmetric, kind, count, phase, n_steps, shooting, box, settings,
+            flow=None, solver=None):
+    """The flow, solver, extended system and tracer of a curve."""
+    flow = PlaneFlow(block, phase, n_steps, shooting) if flow is None else flow
+    solver = Solver(flow, shooting) if solver is None else solver
+    depth = None if kind is None else Depth(block, flow, kind, p, symmetric)
+    ext = Extended(solver, ctype, p, "sym" if symmetric else "full", count, depth)
+    return flow, solver, ext, Tracer(ext, box, settings, shooting.sym_tol)
+
+
 def continue_curve(block, seed, *, phase, alpha_range, omega_range, n_steps=N_ORBIT,
                    shooting=None, settings=None) -> BifurcationCurve:
     """Follow a located bifurcation in the forcing plane ``(alpha, omega)``.
@@ -1016,23 +1082,23 @@ def continue_curve(block, seed, *, phase, alpha_range, omega_range, n_steps=N_OR
     if seed.type == "grazing":
         kind, x, info, lam0, count = _grazing_seed(solver, seed, lam0, shooting)
         symmetric = bool(info.symmetric) and p % 2 == 1
-        depth = Depth(block, flow, kind, p, symmetric)
+        if symmetric and count is not None:
+            count //= 2  # counted over the half map's stretch
     else:
         x = np.array(seed.state, float)
         symmetric = seed.type == "symmetry_breaking" or (seed.type == "fold" and
                                                           not seed.has_mirror)
-        depth = None
-    form = "sym" if symmetric else "full"
+        kind = count = None
     j, xj = _section(solver, x, lam0, p)
     r = flow.run(xj, lam0, p, j, True)
     if failure(r):
         raise OrbitRefused(failure(r), "at the seed")
-    if depth is None:
-        count = int(r.n_impacts)
-    elif count is None:
-        count = depth.count(r, lam0)
-    ext = Extended(solver, seed.type, p, form, count, depth)
-    tracer = Tracer(ext, (a0, a1, w0, w1), settings, shooting.sym_tol)
+    if count is None:
+        count = int(r.n_impacts) if kind is None else \
+            Depth(block, flow, kind, p, symmetric).count(r, lam0)
+    _, _, ext, tracer = _system(block, seed.type, p, symmetric, kind, count, phase, n_steps,
+                                shooting, (a0, a1, w0, w1), settings, flow, solver)
+    depth = ext.depth
     if depth is not None:
         ev0 = ext(np.r_[xj, lam0], j)
         if not ev0.ok:
@@ -1089,7 +1155,7 @@ def continue_curve(block, seed, *, phase, alpha_range, omega_range, n_steps=N_OR
         critical=np.array(crit),
         ends=(end_m, end_p), codim2=codim2, phase=phase, seed=seed_rec,
         n_simulate=flow.calls, wall_s=time.perf_counter() - t0, n_steps=n_steps,
-        block=block, shooting=shooting)
+        block=block, shooting=shooting, count=count)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -70,7 +70,7 @@ def _curves(ax, res, colour, halo, lw1=2.0, labels=True):
     for c in res.curves:
         lw = lw1 if c.period == 1 else 0.7 * lw1
         ax.plot(c.omega, c.alpha, ls=CURVE_STYLES[c.type], lw=lw, color=colour, zorder=5,
-                path_effects=fx, solid_capstyle="butt")
+                path_effects=fx, solid_capstyle="butt", gid=f"{c.type}:{c.period}:{c.law}")
         for c2 in c.codim2:
             ax.plot(c2.omega, c2.alpha, marker="*", ms=9, color=colour, mec="w", mew=0.6,
                     zorder=7, ls="")

@@ -457,6 +457,43 @@ def paper(out, plan=None, *, execution=None, say=None):
         results["fig8"][f"hb{hb}"] = {law: r.to_summary() for law, r in prof.items()}
     done("fig8", t0)
 
+    # ---- extra figure: the forcing plane with exact boundaries (rockjit.chart) --------------
+    t0 = time.perf_counter()
+    say("paper [extra] fig9: the forcing plane with its bifurcation curves, both laws")
+    results["fig9"] = _fig9_charts(out, integration, within, say)
+    done("fig9", t0)
+    # ---- end of the extra figure ----------------------------------------------------------
+
     results.update(wall_s_parts=walls, zoom_step=p.zoom_step, record_stride=p.stride,
                    total_s=time.perf_counter() - t_all)
     return results
+
+
+# ---- extra figure: the forcing plane with exact boundaries (rockjit.chart) ------------------
+#: The paper's charts: coarse (a survey, as the erosion profiles: `rockjit chart` computes the
+#: 200 x 200 chart and the period-2 curves), over the plane around both slendernesses' study
+#: frequencies.
+CHART = dict(alpha_range=(0.2, 1.2), omega_range=(0.8, 3.0), grid=(40, 40),
+             seed_omegas=(1.3, 2.4), max_period=1, sweep_step=0.01)
+
+
+def _fig9_charts(out, integration, within, say):
+    """Figure 9: per slenderness, both laws' charts with their curves, side by side and
+    overlaid; returns the curves (type, period, law, points) per slenderness."""
+    from ..orbits.plane_chart import chart
+    from ..plotting.chart import fig_chart
+    found = {}
+    for hb in STUDY:
+        res = {}
+        for law in ("housner", "mao"):
+            say(f"paper: chart {law} hb={hb:g}")
+            try:
+                res[law] = chart(Block(hb=float(hb), law=law), **CHART, integration=integration,
+                                 execution=within(f"chart_hb{hb}_{law}"))
+            except ValueError as exc:  # no seed on the lines (a quick paper's short runs)
+                found[f"hb{hb}_{law}_refused"] = str(exc)
+        if res:
+            out.figure(f"fig9_chart_hb{hb}.png", fig_chart(res))
+        found[f"hb{hb}"] = [c.to_dict() for r in res.values() for c in r.curves]
+    return found
+# ---- end of the extra figure ----------------------------------------------------------------
