@@ -247,9 +247,11 @@ class Locator:
                 return None
             # an orbit, not a point stuck against the grazing: beyond it, Newton converges to
             # within the tolerance (which grows with |M|) on the side without the impact, but
-            # cannot take the residual down to round-off, as it does on an orbit
-            ev = s.polish(ev, lam, p, P.j)
-            return ev if float(np.abs(ev.F).max()) <= 0.01 * s.tol_for(ev) else None
+            # cannot take the residual down to round-off, as it does on an orbit (Newton's
+            # point is kept: the polished one only tells the two apart)
+            polished = s.polish(ev, lam, p, P.j)
+            return ev if float(np.abs(polished.F).max()) <= 0.01 * s.tol_for(polished) \
+                else None
 
         def based(lam, ev):
             return lam, ev.x, slope(lam, ev.x, ev.F, ev.M)
