@@ -20,7 +20,6 @@ __all__ = [
     "BEHAVIOURS", "BasinResult", "Block", "Classification", "DEFAULT_N", "Execution",
     "Harmonic", "Integration", "Lattice", "PlaneResult", "Result", "Scipy", "SweepResult",
     "Z0_STUDY", "alpha_grid", "basin", "chart", "classify_result", "delta_e_percent",
-    "e_housner",
-    "e_mao", "erosion", "fate", "plane", "simulate", "sweep", "thc_from_hb",
+    "e_housner", "e_mao", "erosion", "fate", "plane", "simulate", "sweep", "thc_from_hb",
 ]
 __version__ = "0.2.0.dev0"

@@ -197,6 +197,14 @@ class Codim2Point:
     located : bool
         Located by Brent's method to ``param_tol`` (False: the nearest curve point).
     detail : str
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rockjit.orbits import Codim2Point
+    >>> c = Codim2Point("cusp", 0.65, 3.8, np.zeros(2), np.array([1.0, 0.48]), 12, False)
+    >>> c.to_dict()["type"], c.to_dict()["multipliers"]
+    ('cusp', [[1.0, 0.0], [0.48, 0.0]])
     """
 
     type: str

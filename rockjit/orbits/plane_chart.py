@@ -106,6 +106,17 @@ class ChartResult:
     timing : dict
         ``chart_s`` (the plane), ``seeds_s`` (the seed lines' sweeps and continuations),
         ``curves_s``.
+
+    Examples
+    --------
+    >>> from rockjit import Block, chart
+    >>> res = chart(Block(hb=1), (0.7, 0.95), (1.25, 1.35), grid=(6, 5), seed_omegas=[1.3],
+    ...             types=("period_doubling",), max_period=1)
+    >>> res.label().shape, [s["type"] for s in res.seeds], res.refused
+    ((6, 5), ['period_doubling'], [])
+    >>> summary, arrays = res.to_summary()
+    >>> summary["law"], sorted(arrays)[:3]
+    ('housner', ['alpha', 'label', 'names'])
     """
 
     block: object
@@ -195,6 +206,16 @@ def run(plan: ChartPlan, execution=None) -> ChartResult:
     ------
     ValueError
         When no bifurcation is located on any seed line: the ranges contain no seed.
+
+    Examples
+    --------
+    >>> from rockjit import Block, Execution
+    >>> from rockjit.orbits import chart, plane_chart
+    >>> plan = chart.plan(Block(hb=1), (0.75, 0.8), (1.28, 1.32), grid=(3, 3),
+    ...                   seed_omegas=[1.3], max_period=1)
+    >>> res = plane_chart.run(plan, Execution(progress=False))
+    >>> [(c.type, c.ends) for c in res.curves]
+    [('symmetry_breaking', ('range', 'range'))]
     """
     execution = Execution() if execution is None else execution
     timing = {}
