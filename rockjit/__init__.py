@@ -17,6 +17,7 @@ _HOMES = {
     "erosion": "rockjit.basins.erosion",
     "fate": "rockjit.basins.fate",
     "Harmonic": "rockjit.excitation",
+    "chart": "rockjit.orbits.plane_chart",
     "alpha_grid": "rockjit.grids", "basin": "rockjit.grids", "plane": "rockjit.grids",
     "sweep": "rockjit.grids",
     "Block": "rockjit.model", "delta_e_percent": "rockjit.model", "e_housner": "rockjit.model",

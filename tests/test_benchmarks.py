@@ -83,6 +83,9 @@ SCRIPTS = {
         ["id", "category", "hb", "alpha", "omega", "law", "e", "n_steps", "periods", "forcing",
          "status", "t", "n_impacts", "n_rhs", "work_bound", "wall_s", "failed_checks"],
         ["stress.png"]),
+    "bench_chart.py": (
+        ["run", "chart_s", "seeds_s", "curves_s", "total_s", "cpu_s", "cells", "curves",
+         "curve_points", "load1"], ["chart.png", "chart_laws.png"]),
 }
 
 #: bench_stress.py exits with this status when the suite ran and its checks found failures
@@ -171,6 +174,13 @@ LAWS = ("housner", "mao", "constant")
 #: numbers must be numbers of the right kind and in a sane range. Columns with no rule are
 #: free text.
 VALUES = {
+    "bench_chart.py": (
+        dict(run=count(0), chart_s=positive, seeds_s=positive, curves_s=positive,
+             total_s=positive, cpu_s=positive, cells=count(1), curves=count(1),
+             curve_points=count(2), load1=nonneg),
+        [("the parts fit in the total", lambda r: num(r, "chart_s") + num(r, "seeds_s")
+          + num(r, "curves_s") <= num(r, "total_s") + 1e-6),
+         ("each curve has points", lambda r: num(r, "curve_points") >= 2 * num(r, "curves"))]),
     "bench_reference_run.py": (
         dict(method=one_of("rockjit", "scipy BDF (the study's)"), n_steps_or_tol=text,
              forcing=one_of("closed", "embedded"), wall_median_s=positive,

@@ -70,6 +70,7 @@ GUARDED = (
     "rockjit.basins.erosion:run",
     "rockjit.basins.fate:run",
     "rockjit.orbits.arclength:run",        # the work of `orbits`
+    "rockjit.orbits.plane_chart:run",      # the work of `chart`
     "rockjit._engine.kernel:run_chunk",
     "rockjit._engine.integrate:build",
     "rockjit.study.paper:write_e_table",  # the work of `cor` (and of `paper`'s first part)
@@ -124,10 +125,11 @@ NAMES = {
     "--ensemble": r"\bensemble\b", "--spread": r"\bspread\b", "--seed": r"\bseed\b",
     "--erosion-grid": r"erosion[-_]grid", "--max-period": r"max[-_]period",
     "--scheduler": r"--scheduler\b(?!-)", "--scheduler-timeout": r"scheduler[-_]timeout",
+    "--seed-omegas": r"seed[-_]omegas",
 }
 
 NARGS = {"--alpha-range": 2, "--omega-range": 2, "--theta-range": 2, "--dtheta-range": 2,
-         "--zoom": 2, "--hb-values": "+", "--spread": 2}
+         "--zoom": 2, "--hb-values": "+", "--spread": 2, "--seed-omegas": "+"}
 FLAGS = {"--quiet", "--lyapunov", "--no-lyapunov", "--full-length"}
 
 NONFINITE = ["nan", "inf", "-inf"]
@@ -571,6 +573,36 @@ def _orbits():
     return c
 
 
+def _chart():
+    """``rockjit chart``: the plane's options (from the study's z0: no state), the seed lines
+    (inside --omega-range), the longest period followed."""
+    cmd = "chart"
+    c = _block_cases(cmd, alpha=False, omega=False,
+                     laws_ok=("housner", "mao", "constant", "both"))
+    c.append(Case("chart --law both --e 0.5", cmd, {"--law": ["both"], "--e": ["0.5"]},
+                  NAMES["--e"]))
+    c += _run_cases(cmd)
+    c += _pairs(cmd, "--alpha-range", [
+        ["0.5"], ["0.5", "0.6", "0.7"], ["0.6", "0.5"], ["0.5", "0.5"], ["-0.1", "0.5"],
+        ["nan", "0.5"], ["0.5", "inf"], ["-inf", "0.5"], ["abc", "0.5"], ["", "0.5"]])
+    c += _pairs(cmd, "--omega-range", [
+        ["1"], ["1", "1.5", "2"], ["2", "1"], ["1.3", "1.3"], ["0", "1"], ["-1", "1"],
+        ["nan", "1"], ["1", "inf"], ["5e-324", "1"], ["1", "1e308"], ["abc", "1"], ["1", ""]])
+    for vals in [["5"], ["5", "5", "5"], ["0", "5"], ["5", "0"], ["-1", "5"], [HUGE_INT, "2"],
+                 ["abc", "5"], ["5", "2.5"], ["nan", "5"], ["1e308", "5"]]:
+        extra = len(vals) > 2
+        c.append(Case(_id(cmd, "--grid", vals), cmd, {"--grid": vals},
+                      NAMES["--grid"] if not extra else re.escape(vals[-1]),
+                      nargs_ok=len(vals) != 2, extra_ok=extra))
+    # the seed lines must lie inside --omega-range (a base's range is within [0.8, 3])
+    c += _pairs(cmd, "--seed-omegas", [[], ["0.1"], ["1.3", "9"], ["-1"], ["nan"], ["inf"],
+                                       ["abc"], [""], ["1,5"]])
+    c += _int_opt(cmd, "--max-period", ["0", "-1", "17", HUGE_INT])
+    c += _missing(cmd, ["--hb", "--alpha-range", "--omega-range", "--out"])
+    c += _out_cases(cmd) + _chunks_case(cmd)
+    return c
+
+
 def _fate():
     cmd = "fate"
     c = _block_cases(cmd) + _state_cases(cmd) + _run_cases(cmd)
@@ -632,7 +664,8 @@ def _numbers():
 
 
 CASES = (_issue10() + _trajectory() + _sweep() + _basin() + _plane() + _cor() + _paper()
-         + _erosion() + _fate() + _orbits() + _grid_extras("sweep") + _grid_extras("basin")
+         + _erosion() + _fate() + _orbits() + _chart() + _grid_extras("sweep")
+         + _grid_extras("basin")
          + _grid_extras("plane") + _real_opt("paper", "--erosion-step", ["0", "-0.01", "5e-324"])
          + _int_opt("paper", "--erosion-grid", ["0", "-1", HUGE_INT])
          + [c for cmd in ("sweep", "basin", "plane", "erosion", "orbits", "paper")
@@ -669,6 +702,10 @@ BASES = {
     "orbits": {"--hb": ["1", "2"], "--omega": ["1.3", "1.6"],
                "--alpha-range": [("0.5", "0.6"), ("0.1", "0.2")],
                "--alpha-step": [None, "0.01"], "--law": [None, "housner", "mao"]},
+    "chart": {"--hb": ["1", "2"], "--alpha-range": [("0.2", "1.2"), ("0.5", "1")],
+              "--omega-range": [("0.8", "3"), ("1", "1.6")], "--grid": [None, ("4", "5")],
+              "--law": [None, "housner", "mao", "both"], "--periods": [None, "5", "20"],
+              "--max-period": [None, "1", "2"]},
     "fate": {"--hb": ["1", "2"], "--alpha": ["0.6", "0.969"], "--omega": ["1.3", "1.6"],
              "--ensemble": [None, "8"], "--periods": [None, "5"], "--n-steps": [None, "64"]},
 }
@@ -733,7 +770,8 @@ def reached():
     # import every module the CLI may import lazily first: one imported while the patches are
     # in place would keep a sentinel under its own name for the rest of the session
     for name in ("grids.plan", "basins.identity", "basins.erosion", "basins.fate",
-                 "orbits.arclength", "cli.outputs", "plotting.figures", "study.paper"):
+                 "orbits.arclength", "orbits.plane_chart", "cli.outputs", "plotting.figures",
+                 "study.paper"):
         importlib.import_module(f"rockjit.{name}")
     mp = pytest.MonkeyPatch()
     for target in GUARDED + GUARDED_IF_PRESENT:

@@ -143,6 +143,7 @@ OUTPUTS = {
     "fate": ("fate.npz", "fate.*"),
     "cor": ("restitution.*", "e_table.csv", "e_table.md"),
     "paper": ("fig*", "*_table.csv", "*_table.md", "index.html"),
+    "chart": ("chart.npz", "chart.*"),
 }
 #: The commands whose grids keep their finished chunks in <out>.chunks.
 CHUNKED = ("sweep", "basin", "plane", "erosion", "orbits", "paper")
@@ -387,6 +388,37 @@ def _orbits_plan(args):
                                 integration=Integration(periods=args.periods),
                                 settings=ContinuationSettings(max_period=args.max_period),
                                 execution=_execution(args))
+
+
+def _chart_plan(args):
+    """``rockjit chart``: one :func:`rockjit.chart` plan per law (``--law both``: two)."""
+    from ..orbits.plane_chart import chart
+    from ..validate import memory
+    plans = {law: chart.plan(_block(args, law), tuple(args.alpha_range),
+                             tuple(args.omega_range), grid=tuple(args.grid),
+                             seed_omegas=args.seed_omegas, max_period=args.max_period,
+                             integration=_integration(args), lyapunov=args.lyapunov,
+                             execution=_execution(args))
+             for law in _laws(args)}
+    memory(f"--grid {args.grid[0]} {args.grid[1]} for {len(plans)} laws",
+           sum(p.plane_plan.memory_bytes for p in plans.values()))
+    return plans
+
+
+def _chart_run(args, plans, out):
+    from . import outputs
+    from ..orbits.plane_chart import run
+    t0 = time.perf_counter()
+    res = {}
+    for law, p in plans.items():
+        _say(args, f"chart: {law}, {p.plane_plan.shape[1]} x {p.plane_plan.shape[2]} cells, "
+                   f"then the curves from {len(p.seed_omegas)} omega lines")
+        res[law] = _grid(args, run, p, f"chart_{law}")
+        _say(args, f"chart: {law}: {len(res[law].curves)} curves "
+                   f"({', '.join(f'{k} {v:.1f} s' for k, v in res[law].timing.items())})")
+    results = outputs.chart(out, res)
+    results.pop("figure")
+    return time.perf_counter() - t0, results
 
 
 def _fate_plan(args):
@@ -657,6 +689,35 @@ def build_parser():
     _add_alphas(p, 0.001)
     p.add_argument("--periods", type=int, default=500, help="periods of the seeding sweep")
     p.add_argument("--max-period", type=int, default=8, help="longest period followed")
+    _add_common(p)
+    _add_scheduler(p)
+
+    p = _command(sub, "chart", _chart_plan, _chart_run,
+                 "the (alpha, omega) plane with its bifurcation curves",
+                 "The brute-force chart of behaviours from the study's z0 over the forcing "
+                 "plane and the fold, "
+                 "symmetry-breaking, period-doubling and grazing curves across it, followed by "
+                 "continuation from the bifurcations located along alpha on a few omega lines; "
+                 "write chart.npz, chart.png (with --law both: both laws side by side and "
+                 "their curves on one chart) and summary.json (\"curves\": type, period, law, "
+                 "points).")
+    _add_block(p, alpha=False, omega=False, laws="housner, mao, constant or both")
+    _add_alphas(p, None)
+    p.add_argument("--omega-range", type=float, nargs=2, required=True,
+                   metavar=("START", "END"), help="frequencies (ends included)")
+    p.add_argument("--grid", type=int, nargs=2, default=(200, 200), metavar=("NA", "NW"),
+                   help="chart points along alpha and omega (default 200 200)")
+    p.add_argument("--seed-omegas", type=float, nargs="+", default=None, metavar="OMEGA",
+                   help="the omega lines whose bifurcations seed the curves (default five, "
+                        "evenly spaced inside --omega-range)")
+    p.add_argument("--max-period", type=int, default=2,
+                   help="longest period of the bifurcations followed (default 2)")
+    p.add_argument("--lyapunov", action="store_true",
+                   help="the chart's exponents (tell chaotic from aperiodic; 3x its cost)")
+    p.add_argument("--periods", type=int, default=500,
+                   help="forcing periods of the chart's runs (default 500)")
+    p.add_argument("--n-steps", type=int, default=None,
+                   help="steps per forcing period of the chart's runs (default 64)")
     _add_common(p)
     _add_scheduler(p)
 

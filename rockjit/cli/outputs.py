@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["basins", "erosion", "fate", "manifest", "orbits", "plane", "sweep", "trajectory"]
+__all__ = ["basins", "chart", "erosion", "fate", "manifest", "orbits", "plane", "sweep", "trajectory"]
 
 
 def manifest(out):
@@ -200,3 +200,32 @@ def orbits(out, res, *, npz="orbits.npz", png="orbits.png", caption="orbits.md")
                           "where and why each branch stops")
     summary["sweep_fractions"] = sw.fractions()
     return summary
+
+
+def chart(out, res, *, npz="chart.npz", png="chart.png"):
+    """Charts with their bifurcation curves (a dict ``law: ChartResult``): the charts' labels
+    and every curve's arrays (``curve{i}_alpha``, ``_omega``, ``_state``, ``_multipliers``,
+    ``_condition``, ...; ``curve_type``, ``curve_period``, ``curve_law``), the figure
+    (:func:`rockjit.plotting.chart.fig_chart`), and the summary: ``"curves"`` (type, period,
+    law, points ``[[alpha, omega], ...]``, ends, codimension-two points, residuals) and, per
+    law, the chart's fractions, seeds, refusals and timing."""
+    from ..plotting.chart import fig_chart
+    arrays, charts, curves = {}, {}, []
+    two = len(res) > 1
+    for law, r in res.items():
+        summary, a = r.to_summary(suffix=f"_{law}" if two else "")
+        arrays.update(a)
+        charts[law] = summary
+        for c in r.curves:
+            arrays.update(c.arrays(f"curve{len(curves)}_"))
+            curves.append(c)
+    arrays["curve_type"] = np.array([c.type for c in curves], dtype="U24")
+    arrays["curve_period"] = np.array([c.period for c in curves], np.int64)
+    arrays["curve_law"] = np.array([c.law for c in curves], dtype="U16")
+    _npz(out, npz, "the charts' labels, periods and axes (suffix _<law> with two laws) and "
+                   "every bifurcation curve: curve{i}_alpha, _omega, _state, _multipliers, "
+                   "_condition; curve_type, curve_period, curve_law", **arrays)
+    figure = _figure(out, png, fig_chart(res), f"the behaviour chart over (alpha, omega) with "
+                                               f"its bifurcation curves, per law and both "
+                                               f"overlaid (data: {npz})")
+    return dict(curves=[c.to_dict() for c in curves], charts=charts, figure=figure)

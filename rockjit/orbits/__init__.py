@@ -20,14 +20,29 @@ What lives where
     Detection between two branch points and location: fold, symmetry breaking, period
     doubling, Neimark–Sacker (test functions, Brent's method) and grazing, overturning and
     rest (bisection).
+:mod:`.grazing`
+    The grazing condition: the depth of an excursion's turning point near ``theta = 0`` (or
+    ``theta_over``), refined by quintic Hermite interpolation, and how far a run that crossed
+    went beyond.
 :mod:`.arclength`
     Pseudo-arclength continuation and branch switching: :func:`continuation`,
     :func:`continue_branches` (the branches of a sweep's periodic attractors) and the entry
     point :func:`orbits_of_sweep` (the sweep and its branches; its ``.plan`` validates, and
     :func:`rockjit.orbits.arclength.run` executes a plan).
+:mod:`.curves`
+    Codimension-one curves in the forcing plane ``(alpha, omega)``: a located fold, symmetry
+    breaking, period doubling or grazing followed in both forcing parameters by
+    pseudo-arclength continuation of an extended system (:func:`continue_curve`,
+    :class:`BifurcationCurve`, the codimension-two points met, :func:`relocate` to check a
+    point against the one-parameter location).
+:mod:`.plane_chart`
+    The entry point :func:`chart`: the brute-force chart of behaviours over ``(alpha, omega)``
+    and every curve seeded from the bifurcations located on a few ``omega`` lines of it (its
+    ``.plan`` validates, :func:`rockjit.orbits.plane_chart.run` executes a plan).
 
-The imports go one way: ``types`` <- ``shooting`` <- ``bifurcations`` <- ``arclength``. Cycles
-are compared with :func:`rockjit.basins.cycles.cycle_distance`, as the attractors of the grids.
+The imports go one way: ``types`` <- ``shooting`` <- ``grazing`` <- ``bifurcations`` <-
+``arclength`` <- ``curves`` <- ``plane_chart``. Cycles are compared with
+:func:`rockjit.basins.cycles.cycle_distance`, as the attractors of the grids.
 
 Examples
 --------
@@ -48,10 +63,16 @@ and nonlinear eigenvalue problems", in *Applications of Bifurcation Theory*, Aca
 """
 
 from .arclength import continuation, continue_branches, orbits_of_sweep
+from .curves import (CODIM2_TYPES, CURVE_ENDS, CURVE_TYPES, BifurcationCurve, Codim2Point,
+                     CurveSettings, continue_curve, relocate)
+from .plane_chart import ChartResult, chart
 from .shooting import N_ORBIT, periodic_orbit
 from .types import (BIFURCATION_TYPES, REASONS, Bifurcation, Branch, Continuation,
                     ContinuationSettings, OrbitRefused, PeriodicOrbit, Shooting)
 
-__all__ = ["BIFURCATION_TYPES", "N_ORBIT", "REASONS", "Bifurcation", "Branch", "Continuation",
-           "ContinuationSettings", "OrbitRefused", "PeriodicOrbit", "Shooting", "continuation",
-           "continue_branches", "orbits_of_sweep", "periodic_orbit"]
+__all__ = ["BIFURCATION_TYPES", "CODIM2_TYPES", "CURVE_ENDS", "CURVE_TYPES", "N_ORBIT",
+           "REASONS", "Bifurcation", "BifurcationCurve", "Branch", "ChartResult",
+           "Codim2Point", "Continuation", "ContinuationSettings", "CurveSettings",
+           "OrbitRefused", "PeriodicOrbit", "Shooting", "chart", "continuation",
+           "continue_branches", "continue_curve", "orbits_of_sweep", "periodic_orbit",
+           "relocate"]

@@ -337,14 +337,19 @@ class Solver:
         return False, y, None, max_iter, reason
 
     # -- natural-parameter Newton (shooting) --------------------------------------------------
-    def newton(self, x, lam, p, j, scale, max_iter=40, near=1e-6):
+    def newton(self, x, lam, p, j, scale, max_iter=40, near=1e-6, count=None):
         """Damped Newton on ``P^p(x) = x`` at fixed ``lambda``; returns ``(ev, iterations)``.
 
-        Raises :class:`OrbitRefused`.
+        ``count``: the orbit with this many impacts per cycle only (followed up to a
+        grazing): the seed must have it, and a trial step with another count is halved like
+        one that does not decrease ``|F|``. Raises :class:`OrbitRefused`.
         """
         ev = self.full(x, lam, p, j)
         if not ev.ok:
             raise OrbitRefused(ev.reason, "at the seed")
+        if count is not None and ev.nimp != count:
+            raise OrbitRefused("grazing", f"the seed has {ev.nimp} impacts per cycle, not "
+                                          f"{count}")
         res = float(np.abs(ev.F).max())
         I2 = np.eye(2)
         for it in range(max_iter):
@@ -361,7 +366,7 @@ class Solver:
             step = 1.0
             for _ in range(12):
                 et = self.full(ev.x + step * dx, lam, p, j)
-                if et.ok:
+                if et.ok and (count is None or et.nimp == count):
                     rt = float(np.abs(et.F).max())
                     if rt < (1.0 - 1e-4 * step) * res:
                         break
@@ -443,6 +448,13 @@ class Solver:
         lo = (mid <= a[:-2]) & (mid <= a[2:]) & (th[:-2] * th[1:-1] > 0) & \
              (th[1:-1] * th[2:] > 0)
         nm = math.inf
+        if lo.any() and imp.shape[0]:
+            # not where an excursion touched down twice and came back between grid points
+            tt = r.trajectory[:, 0]
+            k = np.nonzero(lo)[0] + 1
+            hit = ((imp[None, :, 0] > tt[k - 1, None]) &
+                   (imp[None, :, 0] <= tt[k + 1, None])).any(1)
+            lo[k[hit] - 1] = False
         if lo.any():
             k = np.nonzero(lo)[0] + 1
             den = a[k + 1] - 2 * a[k] + a[k - 1]

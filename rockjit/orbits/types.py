@@ -33,6 +33,7 @@ REASONS = {
     "no_convergence": "Newton's method did not converge",
     "grazing": "the orbit grazes",
     "singular": "the Jacobian is singular",
+    "unstable": "the orbit is too unstable to be followed",
 }
 
 _TWO_PI = 2.0 * math.pi

@@ -723,6 +723,14 @@ def paper(out, plan=None, *, execution=None, say=None):
             r.branches)) for law, r in prof.items()}
     done("fig8", t0)
 
+    # ---- extra figure: the forcing plane with exact boundaries (rockjit.chart) --------------
+    t0 = time.perf_counter()
+    say("paper [extra] fig9: the forcing plane with its bifurcation curves, both laws")
+    results["fig9"], figures[9] = _fig9_charts(out, integration, within, say)
+    results["fig9_wall_s"] = time.perf_counter() - t0  # (apart from the study's parts)
+    say(f"paper: fig9 done in {results['fig9_wall_s']:.1f} s")
+    # ---- end of the extra figure ----------------------------------------------------------
+
     results.update(wall_s_parts=walls, zoom_step=p.zoom_step, record_stride=p.stride,
                    grid=p.grid, erosion_grid=p.erosion_grid, erosion_step=p.erosion_step,
                    total_s=time.perf_counter() - t_all)
@@ -735,3 +743,36 @@ def _finite(a, fn):
     a = np.asarray(a, float) if a is not None else np.zeros(0)
     a = a[np.isfinite(a)]
     return float(fn(a)) if a.size else math.nan
+
+
+# ---- extra figure: the forcing plane with exact boundaries (rockjit.chart) ------------------
+#: The paper's charts: coarse (a survey, as the erosion profiles: `rockjit chart` computes the
+#: 200 x 200 chart and the period-2 curves), over the plane around both slendernesses' study
+#: frequencies.
+CHART = dict(alpha_range=(0.2, 1.2), omega_range=(0.8, 3.0), grid=(40, 40),
+             seed_omegas=(1.3, 2.4), max_period=1, sweep_step=0.01)
+
+
+def _fig9_charts(out, integration, within, say):
+    """Figure 9: per slenderness, both laws' charts with their curves, side by side and
+    overlaid; returns the curves (type, period, law, points) per slenderness."""
+    from ..orbits.plane_chart import chart
+    from ..plotting.chart import fig_chart
+    from ..cli.outputs import chart as write_chart
+    found, names = {}, []
+    for hb in STUDY:
+        res = {}
+        for law in ("housner", "mao"):
+            say(f"paper: chart {law} hb={hb:g}")
+            try:
+                res[law] = chart(Block(hb=float(hb), law=law), **CHART, integration=integration,
+                                 execution=within(f"chart_hb{hb}_{law}"))
+            except ValueError as exc:  # no seed on the lines (a quick paper's short runs)
+                found[f"hb{hb}_{law}_refused"] = str(exc)
+        if res:
+            written = write_chart(out, res, npz=f"fig9_chart_hb{hb}.npz",
+                                  png=f"fig9_chart_hb{hb}.png")
+            names.append(written.pop("figure"))
+            found[f"hb{hb}"] = written["curves"]
+    return found, names
+# ---- end of the extra figure ----------------------------------------------------------------

@@ -240,6 +240,14 @@ def _captions(results, plan):
            "the basin of each attractor followed across the amplitudes, stacked as steps "
            "(each basin holds for its own amplitude), overturn on top. Attractors whose "
            "basin never reaches 1 % are drawn together per behaviour.",
+        9: "Beyond the study: the forcing plane (&alpha;, &omega;) of both laws at <i>h/b</i> "
+           "= 1 and 2, from the study's <i>z</i><sub>0</sub>, a coarse brute-force chart of "
+           "behaviours with the bifurcation curves of the period-1 orbits followed across it "
+           "by two-parameter continuation (fold solid, symmetry breaking dashed, period "
+           "doubling dash-dotted, grazing dotted), seeded on the lines &omega; = 1.3 and 2.4; "
+           "left and middle each law alone, right both laws' curves overlaid. "
+           "<code>rockjit chart</code> computes the 200 &times; 200 chart and the period-2 "
+           "curves.",
     }
 
 
@@ -247,7 +255,7 @@ _TITLES = {1: "Figure 1. Restitution laws", 2: "Figure 2. The reference symmetri
            3: "Figure 3. The behaviour gallery", 4: "Figure 4. Housner against Mao in time",
            5: "Figure 5. Bifurcation diagrams", "5b": "Figure 5, continued: periodic orbits",
            6: "Figure 6. Basins of attraction", 7: "Figure 7. Attractor maps",
-           8: "Figure 8. Erosion profiles"}
+           8: "Figure 8. Erosion profiles", 9: "Figure 9. The forcing plane"}
 
 
 def _published_html(pub):
