@@ -10,6 +10,7 @@ from .basins.erosion import erosion
 from .basins.fate import fate
 from .excitation import Harmonic
 from .grids import alpha_grid, basin, plane, sweep
+from .ground import Pulse, Record, Transient, fragility, spectrum
 from .model import Block, delta_e_percent, e_housner, e_mao, thc_from_hb
 from .result import BEHAVIOURS, BasinResult, PlaneResult, Result, SweepResult
 from .settings import Classification, Execution, Integration, Lattice
@@ -17,8 +18,9 @@ from .single import DEFAULT_N, Z0_STUDY, Scipy, classify_result, simulate
 
 __all__ = [
     "BEHAVIOURS", "BasinResult", "Block", "Classification", "DEFAULT_N", "Execution",
-    "Harmonic", "Integration", "Lattice", "PlaneResult", "Result", "Scipy", "SweepResult",
-    "Z0_STUDY", "alpha_grid", "basin", "classify_result", "delta_e_percent", "e_housner",
-    "e_mao", "erosion", "fate", "plane", "simulate", "sweep", "thc_from_hb",
+    "Harmonic", "Integration", "Lattice", "PlaneResult", "Pulse", "Record", "Result", "Scipy",
+    "SweepResult", "Transient", "Z0_STUDY", "alpha_grid", "basin", "classify_result",
+    "delta_e_percent", "e_housner", "e_mao", "erosion", "fate", "fragility", "plane",
+    "simulate", "spectrum", "sweep", "thc_from_hb",
 ]
 __version__ = "0.2.0.dev0"

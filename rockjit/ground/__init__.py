@@ -22,10 +22,14 @@ docs/theory/ground-motions.md has the theory, docs/guide/earthquakes.md the guid
 """
 
 from .fema import fema_set
+from .fitting import LognormalFit, fit_capacities, fit_lognormal
+from .fragility import FragilityResult, fragility
 from .pulses import Pulse
 from .records import Record, read_at2, read_record, read_table
 from .response import OUTCOMES, TransientResult
 from .settings import Transient
+from .spectrum import SpectrumResult, spectrum
 
-__all__ = ["OUTCOMES", "Pulse", "Record", "Transient", "TransientResult", "fema_set",
-           "read_at2", "read_record", "read_table"]
+__all__ = ["FragilityResult", "LognormalFit", "OUTCOMES", "Pulse", "Record", "SpectrumResult",
+           "Transient", "TransientResult", "fema_set", "fit_capacities", "fit_lognormal",
+           "fragility", "read_at2", "read_record", "read_table", "spectrum"]

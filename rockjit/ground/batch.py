@@ -40,8 +40,8 @@ import numpy as np
 from .plan import COMPILED_NOT_YET
 from .response import STATUSES
 
-__all__ = ["Batch", "KERNELS", "OUTPUTS", "STATUS_CODES", "kernel_for", "run_batch",
-           "scipy_kernel"]
+__all__ = ["Batch", "KERNELS", "OUTPUTS", "STATUS_CODES", "grid_method", "kernel_for",
+           "run_batch", "scipy_kernel"]
 
 #: A kernel's outputs: name -> dtype.
 OUTPUTS = {"outcome": np.int8, "max_rotation": np.float64, "t_overturn": np.float64,
@@ -117,6 +117,19 @@ def kernel_for(method):
     if name not in KERNELS:
         raise ValueError(COMPILED_NOT_YET)
     return KERNELS[name]
+
+
+def grid_method(method):
+    """The method of a grid: ``"rockjit"`` when a compiled kernel is registered (refused
+    otherwise, :data:`rockjit.ground.plan.COMPILED_NOT_YET`), else the :class:`rockjit.Scipy`
+    of ``method`` (default DOP853 at ``rtol = 1e-10, atol = 1e-12``)."""
+    from .plan import check_method, transient_scipy
+    if method is None:
+        return transient_scipy()
+    if method == "rockjit":
+        kernel_for(method)
+        return method
+    return check_method(method)
 
 
 def default_chunk(n):

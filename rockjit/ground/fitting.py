@@ -22,7 +22,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize
 from scipy.special import log_ndtr, ndtr
 
 __all__ = ["LognormalFit", "fit_capacities", "fit_lognormal"]
@@ -150,6 +149,8 @@ def fit_lognormal(x, overturned, runs) -> LognormalFit:
     mu0 = float(np.interp(0.5, np.maximum.accumulate(frac[order]), lx[order]))
     beta0 = max(0.1, float(np.std(lx)) if lx.size > 1 else 0.3)
 
+    from scipy.optimize import minimize
+
     def f(q):  # q = (mu, ln beta)
         return _nll(q[0], math.exp(q[1]), lx, k, n)
 
@@ -178,8 +179,10 @@ def fit_lognormal(x, overturned, runs) -> LognormalFit:
 def fit_capacities(capacities) -> LognormalFit:
     """The lognormal fit to one collapse capacity per record (docs/theory/ground-motions.md):
     ``ln theta_m`` the mean of ``ln x_i``, ``beta^2`` their variance (divided by ``n``);
-    standard errors ``beta / sqrt(n)`` and ``beta / sqrt(2 n)``. Infinite capacities (records
-    that never overturned the block) are left out and counted in ``n_runs`` only."""
+    standard errors ``beta / sqrt(n)`` and ``beta / sqrt(2 n)``. Capacities that are not finite
+    (``inf``: a record that never overturned the block; ``nan``: one whose capacity lies below
+    the intensities tried) are left out: ``n_runs`` counts every record, ``n_overturned`` those
+    used."""
     c = np.asarray(capacities, dtype=float).ravel()
     fin = c[np.isfinite(c)]
     if np.any(fin <= 0):

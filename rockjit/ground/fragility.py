@@ -30,9 +30,9 @@ import numpy as np
 from ..entry import entry_point
 from ..model import LAWS, Block
 from ..validate import choice, memory, real, real_array
-from .batch import Batch, run_batch
+from .batch import Batch, grid_method, run_batch
 from .fitting import fit_capacities, fit_lognormal
-from .plan import check_method, grid_settings, transient_scipy
+from .plan import grid_settings
 from .records import SIZE_RANGE, Record
 from .response import OVERTURN_IMPACT, OVERTURN_NO_IMPACT, UNRESOLVED
 
@@ -119,10 +119,12 @@ class FragilityResult:
 
     def capacities(self, law, size):
         """Each record's collapse capacity: the smallest intensity of the list at which it
-        overturned the block (``inf``: it never did)."""
+        overturned the block; ``inf`` where it never did, ``nan`` where it did already at the
+        smallest (the capacity lies below the list). Resolved to the list's spacing."""
         l, s = self.laws.index(law), int(np.flatnonzero(self.sizes == size)[0])
         over = self.overturned[l, s]
-        return np.array([self.intensity[np.argmax(o)] if o.any() else np.inf for o in over])
+        return np.array([(self.intensity[np.argmax(o)] if np.argmax(o) > 0 else np.nan)
+                         if o.any() else np.inf for o in over])
 
     def median_ratio(self, a="mao", b="housner"):
         """``median(a) / median(b)`` of the overturning fits at each size (``nan`` where
@@ -300,7 +302,7 @@ def fragility(block, records, sizes, intensities, *, measure="pga", laws=None,
     if n > MAX_RUNS:
         raise ValueError(f"an analysis may have at most {MAX_RUNS:.0e} runs (got {n:.3g})")
     memory(f"{n:.3g} runs", n * 64.0)
-    method = transient_scipy() if method is None else check_method(method)
+    method = grid_method(method)
     return FragilityPlan(blocks=blocks, records=recs, sizes=sz, intensities=x,
                          measure=measure, integration=grid_settings(integration),
                          method=method)

@@ -16,7 +16,6 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..excitation import ACCEL_MAX, Excitation
 from ..model import HB_RANGE
@@ -207,6 +206,7 @@ class Pulse(Excitation):
                     (2.0 * math.pi - c, 2.0 * math.pi, 1.0)]
             return np.array([(t0 / w, t1 / w, sg) for t0, t1, sg in rows])
         # Ricker: shape g(u) = (1 - 2u^2) exp(-u^2), t = t0 + 2u / omega_p
+        from scipy.optimize import brentq
         g = lambda u: (1.0 - 2.0 * u * u) * math.exp(-u * u)  # noqa: E731
         tol = 4 * np.finfo(float).eps
         u_main = brentq(lambda u: g(u) - r, 0.0, math.sqrt(0.5), xtol=tol)

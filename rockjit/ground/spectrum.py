@@ -31,8 +31,8 @@ import numpy as np
 from ..entry import entry_point
 from ..model import Block
 from ..validate import memory, real, real_array
-from .batch import Batch, run_batch
-from .plan import check_method, grid_settings, transient_scipy
+from .batch import Batch, grid_method, run_batch
+from .plan import grid_settings
 from .pulses import AMPLITUDE_MAX, RATIO_RANGE, Pulse
 from .response import (MODE_NAMES, OUTCOMES, OVERTURN_IMPACT, OVERTURN_NO_IMPACT, SAFE,
                        UNRESOLVED)
@@ -163,13 +163,19 @@ def run(p: SpectrumPlan, execution=None) -> SpectrumResult:
     min_mode = np.full(nr, UNRESOLVED, dtype=np.int8)
     min_ni = np.full(nr, np.nan)
     if p.locate:
+        # the bisections' batches are small and many: one line for all of them
+        quiet = None if execution is None else execution.replace(progress=False)
         over = np.isin(outcome, (OVERTURN_IMPACT, OVERTURN_NO_IMPACT))
         min_k, min_mode, n1 = _bisect(p, sources, over, outcome,
                                       lambda o: (o == OVERTURN_IMPACT) | (o == OVERTURN_NO_IMPACT),
-                                      execution)
+                                      quiet)
         min_ni, _, n2 = _bisect(p, sources, outcome == OVERTURN_NO_IMPACT, outcome,
-                                lambda o: o == OVERTURN_NO_IMPACT, execution)
+                                lambda o: o == OVERTURN_NO_IMPACT, quiet)
         runs += n1 + n2
+        if execution is not None and execution.progress and execution.message is not None:
+            found = int(np.isfinite(min_k).sum() + np.isfinite(min_ni).sum())
+            execution.message(f"spectrum: {found} boundaries located to {p.tol:g} "
+                              f"(relative) in {n1 + n2} more runs")
     return SpectrumResult(
         block=block, pulse=p.pulse, ratio=p.ratios.copy(), amplitude=p.amplitudes.copy(),
         outcome=outcome, max_rotation=out["max_rotation"].reshape(shape),
@@ -277,7 +283,7 @@ def spectrum(block, pulse, ratios, amplitudes, *, integration=None, method=None,
     tol = real("tol", tol, 1e-12, 0.1)
     from ..validate import boolean
     locate = boolean("locate", locate)
-    method = transient_scipy() if method is None else check_method(method)
+    method = grid_method(method)
     return SpectrumPlan(block=block, pulse=Pulse(pulse.kind), ratios=ratios,
                         amplitudes=amplitudes, integration=grid_settings(integration),
                         method=method, tol=tol, locate=locate)
