@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["basins", "erosion", "fate", "orbits", "plane", "sweep", "trajectory"]
+__all__ = ["basins", "erosion", "fate", "fragility", "orbits", "plane", "spectrum", "sweep",
+           "trajectory"]
 
 
 def summary(out, command, inputs, wall, **results):
@@ -140,3 +141,39 @@ def orbits(out, res, *, npz="orbits.npz", png="orbits.png"):
     out.figure(png, fig_branches(cont, sw))
     summary["sweep_fractions"] = sw.fractions()
     return summary
+
+
+def spectrum(out, res, *, npz="spectrum.npz", png="spectrum.png"):
+    """Overturning spectra (a dict ``law: SpectrumResult``): the grid and, per law (suffixed
+    ``_<law>`` with two laws), the outcomes, demands and located boundaries; the figure; the
+    summary (``min_overturn`` per law, and where two laws differ)."""
+    from ..ground.figures import fig_spectrum
+    from ..ground.response import OUTCOMES
+    from ..ground.spectrum import compare
+    first = next(iter(res.values()))
+    arrays = dict(ratio=first.ratio, amplitude=first.amplitude,
+                  outcomes=np.asarray(OUTCOMES, dtype=str))
+    two = len(res) == 2
+    for law, sp in res.items():
+        arrays.update(sp.arrays(f"_{law}" if len(res) > 1 else ""))
+    out.npz(npz, **arrays)
+    comparison = compare(*res.values()) if two else None
+    out.figure(png, fig_spectrum(res, comparison))
+    if len(res) == 1:
+        return dict(first.summary(), outcomes=list(OUTCOMES))
+    summary = {law: sp.summary() for law, sp in res.items()}
+    summary["outcomes"] = list(OUTCOMES)
+    if comparison is not None:
+        summary["comparison"] = comparison
+    return summary
+
+
+def fragility(out, fr, *, npz="fragility.npz", png="fragility.png", rotation_png="rotation.png"):
+    """An incremental dynamic analysis: every run's outcome and demand, the fitted curves'
+    figures and their summary."""
+    from ..ground.figures import fig_fragility, fig_rotation
+    from ..ground.response import OUTCOMES
+    out.npz(npz, outcomes=np.asarray(OUTCOMES, dtype=str), **fr.arrays())
+    out.figure(png, fig_fragility(fr))
+    out.figure(rotation_png, fig_rotation(fr))
+    return dict(fr.summary(), outcomes=list(OUTCOMES))
