@@ -989,6 +989,19 @@ def test_cases_are_distinct_and_many():
                 opt == "--frobnicate" or c.extra_ok, (c.id, opt)  # extra_ok: must not exist
 
 
+@pytest.mark.parametrize("argv", [
+    ["spectrum", "--hb", "4", "--law", "both", "--ratio-range", "1", "4", "--amplitude-range",
+     "1", "6", "--grid", "3", "3"],
+    ["fragility", "--hb", "2", "--size", "1", "--records", RECORD_OK, "--intensities", "1.5"]],
+    ids=["spectrum", "fragility"])
+def test_guard_stops_valid_ground_motion_commands(argv, reached, tmp_path):
+    # a valid spectrum or fragility gets through validation to its (guarded) work
+    rc, exc, _, err, _, _ = run_main(argv + ["--quiet", "--out", str(tmp_path / "o")],
+                                     reached, tmp_path)
+    assert isinstance(exc, NotRefused) and reached[0] in GUARDED, (rc, exc, err)
+    assert err == "" and not (tmp_path / "o").exists()
+
+
 def test_guard_stops_a_valid_command(reached, tmp_path):
     # the sentinel does fire on a valid command line: the refusal test can tell the difference
     rc, exc, _, err, _, _ = run_main(["basin", "--hb", "1", "--alpha", "0.66", "--omega", "1.3",
