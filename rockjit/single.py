@@ -277,7 +277,7 @@ def simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
     if getattr(forcing, "transient", False) and not isinstance(forcing, Harmonic):
         from .ground.plan import plan_transient
         return plan_transient(block, forcing, state, integration, lyapunov, record_stride,
-                              method)
+                              _method(method))
     if not isinstance(forcing, Harmonic):
         raise ValueError(f"forcing must be a rockjit excitation: Harmonic, Pulse or Record "
                          f"(got {type(forcing).__name__})")

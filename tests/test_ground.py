@@ -23,6 +23,7 @@ import pytest
 import rockjit
 from rockjit import Block, Integration, Pulse, Scipy, Transient
 from rockjit.ground import batch as B
+from rockjit.ground.methods import transient_scipy
 from rockjit.ground.closed_forms import cosine_no_impact, sine_no_impact, sine_phi
 from rockjit.ground.response import OVERTURN_IMPACT, OVERTURN_NO_IMPACT, SAFE
 
@@ -242,10 +243,10 @@ def test_spectrum_grid_and_bisection():
         j = int(np.argmax(np.isin(sp.outcome[i], (1, 2))))
         assert (amps[j - 1] if j else 1.0) <= k <= amps[j]
         hit = rockjit.simulate(block, Pulse("sine", ratio=ratios[i], amplitude=k),
-                               method=rockjit.ground.plan.transient_scipy(), integration=tight)
+                               method=transient_scipy(), integration=tight)
         miss = rockjit.simulate(block, Pulse("sine", ratio=ratios[i],
                                              amplitude=k * (1 - 2e-6)),
-                                method=rockjit.ground.plan.transient_scipy(),
+                                method=transient_scipy(),
                                 integration=tight)
         assert hit.overturned and not miss.overturned
         assert {1: "with impact", 2: "without impact"}[hit.outcome] == row["mode"]
@@ -278,7 +279,7 @@ def test_a_registered_compiled_kernel_takes_the_batches(monkeypatch):
     def stand_in(blocks, sources, block_of, source_of, gain, settings, method):
         seen.append(len(gain))
         return B.scipy_kernel(blocks, sources, block_of, source_of, gain, settings,
-                              rockjit.ground.plan.transient_scipy())
+                              transient_scipy())
 
     args = (Block(hb=3), Pulse("cosine"), [1.0, 2.0], [1.5, 4.0])
     with pytest.raises(ValueError, match="compiled path for pulses and records is not "

@@ -10,10 +10,8 @@ per law and size; the compiled path is refused for now with exit status 2 and on
 from __future__ import annotations
 
 import json
-import math
 
 import numpy as np
-import pytest
 
 import rockjit
 from rockjit import Block, Pulse

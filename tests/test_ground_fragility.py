@@ -22,7 +22,7 @@ from scipy.special import ndtr
 import rockjit
 from rockjit import Block, Record, Transient
 from rockjit.ground import fit_capacities, fit_lognormal
-from rockjit.ground.plan import transient_scipy
+from rockjit.ground.methods import transient_scipy
 from rockjit.ground.response import SAFE, UNRESOLVED
 
 MEDIAN, BETA = 2.0, 0.35

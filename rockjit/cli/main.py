@@ -342,7 +342,7 @@ def _paper_run(args, p, out):
 def _transient_method(args):
     """The scipy path of ``--method --rtol --atol`` for pulses and records (the compiled path
     is refused until it supports them)."""
-    from ..ground.plan import check_method
+    from ..ground.methods import check_method
     from ..single import Scipy
     method = check_method(args.method)
     name = "DOP853" if args.method == "scipy" else method.method  # explicit: non-stiff

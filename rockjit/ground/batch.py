@@ -123,7 +123,7 @@ def grid_method(method):
     """The method of a grid: ``"rockjit"`` when a compiled kernel is registered (refused
     otherwise, :data:`rockjit.ground.plan.COMPILED_NOT_YET`), else the :class:`rockjit.Scipy`
     of ``method`` (default DOP853 at ``rtol = 1e-10, atol = 1e-12``)."""
-    from .plan import check_method, transient_scipy
+    from .methods import check_method, transient_scipy
     if method is None:
         return transient_scipy()
     if method == "rockjit":

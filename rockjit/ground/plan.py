@@ -15,16 +15,8 @@ from ..model import Block
 from ..validate import real, real_array
 from .settings import Transient
 
-__all__ = ["COMPILED_NOT_YET", "TransientPlan", "check_method", "grid_settings",
-           "plan_transient", "run_transient", "transient_scipy"]
-
-def transient_scipy():
-    """The scipy path the spectra and fragility curves use by default: DOP853 at
-    ``rtol = 1e-10, atol = 1e-12`` (an explicit method suits the non-stiff block; the tight
-    tolerances keep the bisections' outcomes a property of the model, not of the solver)."""
-    from ..single import Scipy
-    return Scipy("DOP853", rtol=1e-10, atol=1e-12)
-
+__all__ = ["COMPILED_NOT_YET", "TransientPlan", "grid_settings", "plan_transient",
+           "run_transient"]
 
 COMPILED_NOT_YET = ("the compiled path for pulses and records is not available yet: use "
                     "method='scipy' or a rockjit.Scipy(...)")
@@ -39,16 +31,6 @@ class TransientPlan:
     state: tuple         # (theta0, theta0')
     settings: Transient
     method: object       # a Scipy
-
-
-def check_method(method):
-    """The :class:`rockjit.Scipy` of ``method`` (``"scipy"``, ``"scipy:<M>"`` or a Scipy);
-    ``"rockjit"`` is refused for now (:data:`COMPILED_NOT_YET`)."""
-    from ..single import _method
-    m = _method(method)
-    if m == "rockjit":
-        raise ValueError(COMPILED_NOT_YET)
-    return m
 
 
 def grid_settings(integration):
@@ -90,7 +72,8 @@ def initial_state(state, settings):
 
 
 def plan_transient(block, forcing, state, integration, lyapunov, record_stride, method):
-    """The plan of :func:`rockjit.simulate` for a pulse or a record."""
+    """The plan of :func:`rockjit.simulate` for a pulse or a record; ``method`` is
+    ``"rockjit"`` (refused for now) or a :class:`rockjit.Scipy`."""
     from ..settings import Integration
     if integration is None:
         integration = Transient()
@@ -106,7 +89,8 @@ def plan_transient(block, forcing, state, integration, lyapunov, record_stride, 
     if record_stride is not None:
         raise ValueError("record_stride counts the steps of a forcing period; a run under a "
                          "pulse or a record keeps the solver's points (Transient(record=...))")
-    method = check_method(method)
+    if method == "rockjit":
+        raise ValueError(COMPILED_NOT_YET)
     excitation = bind(forcing, block)
     return TransientPlan(block=block, excitation=excitation,
                          state=initial_state(state, integration), settings=integration,
