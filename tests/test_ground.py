@@ -344,3 +344,13 @@ def test_a_given_state_and_the_time_limit():
                          method=TIGHT, integration=Transient(duration=30.0))
     assert r.status == "time_limit" and r.t == 30.0 and r.n_impacts > 3
     assert r.max_theta == pytest.approx(0.2, rel=1e-9)
+
+
+def test_transient_figure():
+    from rockjit.ground.figures import fig_transient
+    r = rockjit.simulate(Block(hb=4), Pulse("ricker", ratio=2.0, amplitude=2.0),
+                         method=TIGHT, integration=Transient(free_time=20.0))
+    fig = fig_transient(r)
+    assert len(fig.axes) == 2 and "with impact" in fig.axes[0].get_title()
+    line = fig.axes[0].get_lines()[0]
+    np.testing.assert_allclose(line.get_ydata(), r.trajectory[:, 1] / r.alpha_s)
