@@ -270,3 +270,14 @@ def test_fema_p695_sets():
     assert all(r.dt > 0 and r.n > 100 and r.size == 1.0 for r in far)
     with pytest.raises(ValueError, match="record set must be one of"):
         fema_set("nearby")
+
+
+def test_a_pickled_record_is_the_same_read_only_record():
+    import pickle
+    r = Record(_accel(), 0.01, size=2.0, scale=1.5, name="mine")
+    q = pickle.loads(pickle.dumps(r))
+    assert (q.name, q.dt, q.size, q.scale) == (r.name, r.dt, r.size, r.scale)
+    np.testing.assert_array_equal(q.accel, r.accel)
+    assert not q.accel.flags.writeable
+    with pytest.raises(ValueError):
+        q.accel[0] = 1.0

@@ -140,6 +140,11 @@ class Record(Excitation):
             object.__setattr__(self, "p", p)
             object.__setattr__(self, "size", 3.0 * G / (4.0 * p * p))
 
+    def __reduce__(self):
+        # rebuilt through the constructor, so that a copy (Dask, pickle) is validated and
+        # read-only again
+        return (Record, (self.accel, self.dt, self.size, None, self.scale, self.name))
+
     @classmethod
     def from_arrays(cls, t, accel, *, size=None, p=None, name="record", source=None):
         """A record from its sample times (s, increasing, evenly spaced; the first is taken as
