@@ -354,3 +354,12 @@ def test_transient_figure():
     assert len(fig.axes) == 2 and "with impact" in fig.axes[0].get_title()
     line = fig.axes[0].get_lines()[0]
     np.testing.assert_allclose(line.get_ydata(), r.trajectory[:, 1] / r.alpha_s)
+
+
+@pytest.mark.parametrize("module", ["pulses", "records", "settings", "spectrum", "fitting"])
+def test_the_examples_in_the_docstrings_run(module):
+    import doctest
+    import importlib
+    mod = importlib.import_module(f"rockjit.ground.{module}")
+    result = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert result.attempted > 0 and result.failed == 0

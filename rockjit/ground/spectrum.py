@@ -263,7 +263,7 @@ def spectrum(block, pulse, ratios, amplitudes, *, integration=None, method=None,
     >>> from rockjit import Block, Pulse
     >>> sp = rockjit.spectrum(Block(hb=4, xi=0.0), Pulse("cosine"), [2.0], [4.0, 6.0],
     ...                       tol=1e-4)
-    >>> [round(k, 2) for k in sp.min_no_impact]
+    >>> [round(float(k), 2) for k in sp.min_no_impact]
     [5.19]
     """
     if not isinstance(block, Block):
