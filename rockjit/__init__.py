@@ -17,6 +17,8 @@ _HOMES = {
     "erosion": "rockjit.basins.erosion",
     "fate": "rockjit.basins.fate",
     "Harmonic": "rockjit.excitation",
+    "Pulse": "rockjit.ground", "Record": "rockjit.ground", "Transient": "rockjit.ground",
+    "fragility": "rockjit.ground", "spectrum": "rockjit.ground",
     "chart": "rockjit.orbits.plane_chart",
     "alpha_grid": "rockjit.grids", "basin": "rockjit.grids", "plane": "rockjit.grids",
     "sweep": "rockjit.grids",

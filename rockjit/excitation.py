@@ -4,8 +4,9 @@ An excitation is a small frozen object, validated once in its constructor. Today
 harmonic forcing of the study (:class:`Harmonic`): the base acceleration ``f(t) = alpha omega^2
 sin(omega t + phi)`` in units of ``g`` (docs/theory/model.md), written either in closed form or
 through the autonomous oscillator that the study's own code integrated. Every entry point takes
-an excitation beside the block; further excitation types (acceleration pulses, recorded ground
-motions) are further subclasses of :class:`Excitation`.
+an excitation beside the block. The transient excitations, acceleration pulses and recorded
+ground motions, are further subclasses of :class:`Excitation` in :mod:`rockjit.ground`
+(:class:`rockjit.Pulse`, :class:`rockjit.Record`).
 """
 
 from __future__ import annotations
@@ -34,7 +35,19 @@ CIRCLE_TOL = 1e-3
 
 
 class Excitation:
-    """The base of every excitation: a frozen, validated description of the base's motion."""
+    """The base of every excitation: a frozen, validated description of the base's motion.
+
+    Every excitation evaluates ``f(t)``, the base acceleration in ``g`` at model time ``t``,
+    and says when it ends (``end``; ``inf`` for the harmonic forcing). A transient one
+    (``transient = True``: :class:`rockjit.Pulse`, :class:`rockjit.Record`) also gives, once
+    bound to a block (``bind``), ``scalar()`` (``f`` as a function of one float), ``peak``
+    (``max |f|``), ``breaks`` (the instants where ``f`` or its derivative jumps),
+    ``windows(threshold)`` (the intervals where ``|f| > threshold``, which is where a block at
+    rest lifts off) and ``scaled(gain)`` (the same motion, ``gain`` times stronger).
+    """
+
+    #: Whether the excitation ends (pulses, records) rather than repeats.
+    transient = False
 
     def replace(self, **changes):
         """A copy with some fields changed (validated again)."""
@@ -138,6 +151,17 @@ class Harmonic(Excitation):
     def aw2(self) -> float:
         """The acceleration amplitude ``alpha omega^2`` (in ``g``)."""
         return self.alpha * self.omega**2
+
+    #: The harmonic forcing never ends.
+    end = math.inf
+
+    def f(self, t):
+        """The base acceleration ``alpha omega^2 sin(omega t + phi)`` in ``g`` at model time(s)
+        ``t``, at the phase given (0 when none was)."""
+        import numpy as np
+        phi = self.start()[0]
+        out = self.aw2 * np.sin(self.omega * np.asarray(t, dtype=float) + phi)
+        return float(out) if out.ndim == 0 else out
 
 
 def check_acceleration(alpha, omega):

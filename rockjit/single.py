@@ -212,7 +212,11 @@ class RunPlan:
 
 
 def run(p: RunPlan, execution=None) -> Result:
-    """Execute a :class:`RunPlan` on its path (compiled or scipy)."""
+    """Execute a :class:`RunPlan` on its path (compiled or scipy); a plan under a pulse or a
+    record (:class:`rockjit.ground.plan.TransientPlan`) runs on the transient path."""
+    if not isinstance(p, RunPlan):
+        from .ground.plan import run_transient
+        return run_transient(p)
     if p.method != "rockjit":
         from .reference import simulate_scipy  # scipy.integrate only when asked for
         return simulate_scipy(p)
@@ -228,15 +232,21 @@ def simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
     ----------
     block : Block
         The block: slenderness, restitution law, damping.
-    forcing : Harmonic
-        The excitation, with its amplitude ``alpha`` and frequency ``omega`` (and phase, or
-        the study's).
+    forcing : Harmonic, Pulse or Record
+        The excitation: harmonic, with its amplitude ``alpha`` and frequency ``omega`` (and
+        phase, or the study's); or a transient one, a :class:`rockjit.Pulse` (with its
+        ``ratio`` and ``amplitude``) or a :class:`rockjit.Record` (with the block's ``size``),
+        which runs on the scipy path only for now and returns a
+        :class:`rockjit.ground.TransientResult` (docs/guide/earthquakes.md).
     state : pair of float, optional
         The initial ``(theta0, theta0')``, ``|theta0| < theta_over``. Default: the study's
-        ``z0`` (docs/theory/study.md), at the study's forcing phase unless ``forcing`` gives one.
-    integration : Integration, optional
+        ``z0`` (docs/theory/study.md), at the study's forcing phase unless ``forcing`` gives
+        one; at rest, ``(0, 0)``, under a pulse or a record.
+    integration : Integration or Transient, optional
         Steps per period, periods, window, impact bound, Zeno cut-off, overturning threshold
-        (:class:`rockjit.Integration`; default N here is :data:`rockjit.DEFAULT_N`).
+        (:class:`rockjit.Integration`; default N here is :data:`rockjit.DEFAULT_N`); for a pulse or a
+        record, a :class:`rockjit.Transient` (free rocking time or a duration, in model
+        units).
     lyapunov : bool
         Compute the block's Lyapunov exponents (docs/theory/exponents.md); compiled path only.
     record_stride : int, optional
@@ -273,8 +283,12 @@ def simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
     """
     if not isinstance(block, Block):
         raise ValueError(f"block must be a rockjit.Block (got {type(block).__name__})")
+    if getattr(forcing, "transient", False) and not isinstance(forcing, Harmonic):
+        from .ground.plan import plan_transient
+        return plan_transient(block, forcing, state, integration, lyapunov, record_stride,
+                              _method(method))
     if not isinstance(forcing, Harmonic):
-        raise ValueError(f"forcing must be a rockjit excitation such as Harmonic "
+        raise ValueError(f"forcing must be a rockjit excitation: Harmonic, Pulse or Record "
                          f"(got {type(forcing).__name__})")
     forcing.require("alpha", "omega", why="a single run")
     integration = Integration() if integration is None else integration

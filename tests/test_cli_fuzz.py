@@ -73,6 +73,10 @@ GUARDED = (
     "rockjit.orbits.plane_chart:run",      # the work of `chart`
     "rockjit._engine.kernel:run_chunk",
     "rockjit._engine.integrate:build",
+    "rockjit.ground.batch:run_batch",     # every run of `spectrum` and `fragility`
+    "rockjit.ground.spectrum:run",
+    "rockjit.ground.fragility:run",
+    "rockjit.ground.reference:run_scipy",
     "rockjit.study.paper:write_e_table",  # the work of `cor` (and of `paper`'s first part)
     "rockjit.study.paper:paper",
     "rockjit.storage.files:atomic_open",       # every file the CLI writes goes through these
@@ -126,10 +130,16 @@ NAMES = {
     "--erosion-grid": r"erosion[-_]grid", "--max-period": r"max[-_]period",
     "--scheduler": r"--scheduler\b(?!-)", "--scheduler-timeout": r"scheduler[-_]timeout",
     "--seed-omegas": r"seed[-_]omegas",
+    "--pulse": r"--pulse\b", "--ratio-range": r"\bratio", "--amplitude-range": r"\bamplitude",
+    "--tol": r"\btol\b", "--free-time": r"free[-_]time", "--size": r"\bsizes?\b",
+    "--records": r"\brecords?\b", "--measure": r"\bmeasure\b",
+    "--intensities": r"\bintensit(y|ies)\b",
 }
 
 NARGS = {"--alpha-range": 2, "--omega-range": 2, "--theta-range": 2, "--dtheta-range": 2,
-         "--zoom": 2, "--hb-values": "+", "--spread": 2, "--seed-omegas": "+"}
+         "--zoom": 2, "--hb-values": "+", "--spread": 2, "--seed-omegas": "+",
+         "--ratio-range": 2, "--amplitude-range": 2, "--size": "+", "--records": "+",
+         "--intensities": "+"}
 FLAGS = {"--quiet", "--lyapunov", "--no-lyapunov", "--full-length"}
 
 NONFINITE = ["nan", "inf", "-inf"]
@@ -143,6 +153,33 @@ NOT_ASCII = ["1_0", "\u0663", "\uff11", "-\u0663", "+\uff11", " 1", "1 ", "1e1_0
 #: numbers that are not integers (an integer option must refuse each)
 NOT_INT = ["nan", "inf", "-inf", "1e308", "5e-324", "2.5"]
 HUGE_INT = "99999999999999999999"
+
+
+# Record files for `rockjit fragility`: a valid one for the base command lines and bad ones
+# (written once, outside the cases' working directories, which must stay empty).
+_RECORD_DIR = tempfile.mkdtemp(prefix="rockjit-fuzz-records-")
+
+
+def _record_file(name, text):
+    path = os.path.join(_RECORD_DIR, name)
+    with open(path, "w") as fh:
+        fh.write(text)
+    return path
+
+
+RECORD_OK = _record_file("ok.csv", "time (s),acc (g)\n" + "".join(
+    f"{0.01 * k:.2f},{0.3 * math.sin(0.5 * k):.6f}\n" for k in range(50)))
+_BAD_RECORDS = {
+    "empty": _record_file("empty.csv", ""),
+    "nan": _record_file("nan.csv", "0,0\n0.01,nan\n0.02,0.1\n"),
+    "time goes back": _record_file("back.csv", "0,0\n0.02,0.1\n0.01,0\n"),
+    "uneven": _record_file("uneven.csv", "0,0\n0.01,0.1\n0.03,0.1\n0.04,0\n"),
+    "m/s^2": _record_file("units.csv", "time (s),acc (m/s^2)\n0,0\n0.01,1\n"),
+    "AT2 in cm/s/s": _record_file("cms.AT2", "PEER\nx\nACCELERATION TIME SERIES IN UNITS OF "
+                                             "CM/S/S\nNPTS=  2, DT=   .0100 SEC\n 1.0 2.0\n"),
+    "AT2 NPTS": _record_file("npts.AT2", "PEER\nx\nACCELERATION TIME SERIES IN UNITS OF G\n"
+                                         "NPTS=  3, DT=   .0100 SEC\n 0.1 0.2\n"),
+}
 
 
 # ---------------------------------------------------------------------------------------------
@@ -617,6 +654,71 @@ def _fate():
     return c
 
 
+def _transient_cases(cmd):
+    """Options of the commands on pulses and records (spectrum, fragility)."""
+    c = _real_opt(cmd, "--free-time", ["-1", "-1e-3", "1e10", "1e308"])
+    c += _values(cmd, "--method", ["abc", "", "rockjit", "scipy:FOO", "SCIPY", "scipy:rk45"])
+    c += _real_opt(cmd, "--rtol", ["0", "-1", "-1e-6", "-1e308", "1", "2"])
+    c += _real_opt(cmd, "--atol", ["0", "-1", "-1e-6", "-1e308"])
+    c += _real_opt(cmd, "--xi", ["-1", "-1e-3", "1e5", "1e308"])
+    # no --threads: the scipy path runs its cells one after another
+    c.append(Case(f"{cmd} --threads 2", cmd, {"--threads": ["2"]}, r"--threads",
+                  extra_ok=True))
+    return c
+
+
+def _spectrum():
+    cmd = "spectrum"
+    c = _block_cases(cmd, alpha=False, omega=False,
+                     laws_ok=("housner", "mao", "constant", "both"))
+    c.append(Case("spectrum --law both --e 0.5", cmd, {"--law": ["both"], "--e": ["0.5"]},
+                  NAMES["--e"]))
+    c += _values(cmd, "--pulse", ["abc", "", "SINE", "square", "0"])
+    c += _pairs(cmd, "--ratio-range", [
+        ["1"], ["1", "2", "3"], ["2", "1"], ["1", "1"], ["0", "2"], ["-1", "2"],
+        ["1", "1e4"], ["1e-4", "1"], ["5e-324", "1"], ["nan", "2"], ["1", "inf"],
+        ["-inf", "1"], ["1", "1e308"], ["abc", "2"], ["", "2"], ["1", "1,5"], ["0x10", "2"]])
+    c += _pairs(cmd, "--amplitude-range", [
+        ["1"], ["1", "2", "3"], ["3", "1"], ["2", "2"], ["-1", "2"], ["-1e-3", "2"],
+        ["1", "1e7"], ["1", "1e308"], ["nan", "2"], ["1", "inf"], ["-inf", "1"],
+        ["abc", "2"], ["", "2"], ["1", "1,5"], ["0x10", "2"]])
+    grid_pairs = [["5"], ["5", "5", "5"], ["0", "5"], ["5", "0"], ["-1", "5"], ["5", "-3"],
+                  [HUGE_INT, "2"], ["20000", "2"], ["abc", "5"], ["5", "2.5"], ["nan", "5"],
+                  ["1e308", "5"], ["", "5"]]
+    for vals in grid_pairs:
+        extra = len(vals) > 2
+        c.append(Case(_id(cmd, "--grid", vals), cmd, {"--grid": vals},
+                      NAMES["--grid"] if not extra else re.escape(vals[-1]),
+                      nargs_ok=len(vals) != 2, extra_ok=extra))
+    c += _real_opt(cmd, "--tol", ["0", "-1e-6", "0.5", "1", "1e-13", "5e-324", "1e308"])
+    c += _transient_cases(cmd)
+    c += _missing(cmd, ["--hb", "--ratio-range", "--amplitude-range", "--out"])
+    c += _out_cases(cmd)
+    return c
+
+
+def _fragility():
+    cmd = "fragility"
+    c = _block_cases(cmd, alpha=False, omega=False,
+                     laws_ok=("housner", "mao", "constant", "both"))
+    c += _pairs(cmd, "--size", [
+        [], ["0"], ["-1"], ["-1e-3"], ["1e-4"], ["1e5"], ["1e308"], ["5e-324"], ["nan"],
+        ["inf"], ["-inf"], ["1", "1"], ["1", "nan"], ["abc"], [""], ["1,5"], ["0x10"]])
+    c += _pairs(cmd, "--records", [
+        [], ["nearby"], ["FARFIELD"], [""], ["no-such-file.AT2"], ["farfield.csv"]])
+    c += _pairs(cmd, "--intensities", [
+        [], ["0"], ["-1"], ["2", "1"], ["1", "1"], ["nan"], ["inf"], ["-inf"], ["1e7"],
+        ["1e308"], ["1", "abc"], [""], ["1,5"], ["0x10"], ["5e-324", "-1"]])
+    c += _values(cmd, "--measure", ["abc", "", "PGA", "sa", "0"])
+    c += [Case(f"{cmd} --records {name} (a bad record file)", cmd, {"--records": [path]},
+               r"\brecord\b.*" + re.escape(path) if not path.endswith(".AT2") else
+               re.escape(path)) for name, path in _BAD_RECORDS.items()]
+    c += _transient_cases(cmd)
+    c += _missing(cmd, ["--hb", "--size", "--records", "--out"])
+    c += _out_cases(cmd)
+    return c
+
+
 def _misc():
     return [
         Case("(no command)", "", {}, r"COMMAND|command", base=False),
@@ -670,7 +772,7 @@ CASES = (_issue10() + _trajectory() + _sweep() + _basin() + _plane() + _cor() + 
          + _int_opt("paper", "--erosion-grid", ["0", "-1", HUGE_INT])
          + [c for cmd in ("sweep", "basin", "plane", "erosion", "orbits", "paper")
             for c in _scheduler_cases(cmd)]
-         + _numbers() + _misc())
+         + _numbers() + _spectrum() + _fragility() + _misc())
 
 
 # ---------------------------------------------------------------------------------------------
@@ -708,6 +810,14 @@ BASES = {
               "--max-period": [None, "1", "2"]},
     "fate": {"--hb": ["1", "2"], "--alpha": ["0.6", "0.969"], "--omega": ["1.3", "1.6"],
              "--ensemble": [None, "8"], "--periods": [None, "5"], "--n-steps": [None, "64"]},
+    "spectrum": {"--hb": ["1", "2", "4"], "--law": [None, "housner", "mao", "both"],
+                 "--pulse": [None, "sine", "cosine", "ricker"],
+                 "--ratio-range": [("1", "4"), ("0.5", "8")],
+                 "--amplitude-range": [("1", "5"), ("1.5", "12")],
+                 "--grid": [None, ("3", "4")], "--tol": [None, "1e-4"]},
+    "fragility": {"--hb": ["2", "3"], "--law": [None, "mao", "both"],
+                  "--size": [("1",), ("0.5", "2")], "--records": [(RECORD_OK,)],
+                  "--intensities": [None, ("1.5", "3")], "--measure": [None, "pga"]},
 }
 
 
@@ -769,7 +879,8 @@ def reached():
     calls = []
     # import every module the CLI may import lazily first: one imported while the patches are
     # in place would keep a sentinel under its own name for the rest of the session
-    for name in ("grids.plan", "basins.identity", "basins.erosion", "basins.fate",
+    for name in ("grids.plan", "ground.batch", "ground.spectrum", "ground.fragility",
+                 "ground.reference", "basins.identity", "basins.erosion", "basins.fate",
                  "orbits.arclength", "orbits.plane_chart", "cli.outputs", "plotting.figures",
                  "study.paper"):
         importlib.import_module(f"rockjit.{name}")
@@ -783,6 +894,9 @@ def reached():
             calls.append(_target)
             raise NotRefused(f"{_target} was called")
 
+        # an entry point plans through its .plan (validation only): that stays reachable
+        if hasattr(getattr(mod, attr), "plan"):
+            sentinel.plan = getattr(mod, attr).plan
         mp.setattr(mod, attr, sentinel)
     yield calls
     mp.undo()
@@ -1007,6 +1121,19 @@ def test_cases_are_distinct_and_many():
         for opt in c.set:
             assert opt in NAMES or opt in FLAGS or opt.startswith("--rtol=") or \
                 opt == "--frobnicate" or c.extra_ok, (c.id, opt)  # extra_ok: must not exist
+
+
+@pytest.mark.parametrize("argv", [
+    ["spectrum", "--hb", "4", "--law", "both", "--ratio-range", "1", "4", "--amplitude-range",
+     "1", "6", "--grid", "3", "3"],
+    ["fragility", "--hb", "2", "--size", "1", "--records", RECORD_OK, "--intensities", "1.5"]],
+    ids=["spectrum", "fragility"])
+def test_guard_stops_valid_ground_motion_commands(argv, reached, tmp_path):
+    # a valid spectrum or fragility gets through validation to its (guarded) work
+    rc, exc, _, err, _, _ = run_main(argv + ["--quiet", "--out", str(tmp_path / "o")],
+                                     reached, tmp_path)
+    assert isinstance(exc, NotRefused) and reached[0] in GUARDED, (rc, exc, err)
+    assert err == "" and not (tmp_path / "o").exists()
 
 
 def test_guard_stops_a_valid_command(reached, tmp_path):

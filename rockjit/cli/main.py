@@ -144,6 +144,8 @@ OUTPUTS = {
     "cor": ("restitution.*", "e_table.csv", "e_table.md"),
     "paper": ("fig*", "*_table.csv", "*_table.md", "index.html"),
     "chart": ("chart.npz", "chart.*"),
+    "spectrum": ("spectrum.npz", "spectrum.*"),
+    "fragility": ("fragility.npz", "fragility.*", "rotation.*"),
 }
 #: The commands whose grids keep their finished chunks in <out>.chunks.
 CHUNKED = ("sweep", "basin", "plane", "erosion", "orbits", "paper")
@@ -486,6 +488,96 @@ def _explore_plan(args):
     raise SystemExit(0)
 
 
+def _transient_method(args):
+    """The scipy path of ``--method --rtol --atol`` for pulses and records (the compiled path
+    is refused until it supports them)."""
+    from ..ground.methods import check_method
+    from ..single import Scipy
+    method = check_method(args.method)
+    name = "DOP853" if args.method == "scipy" else method.method  # explicit: non-stiff
+    return Scipy(name, rtol=args.rtol, atol=args.atol)
+
+
+def _transient(args):
+    from ..ground.settings import Transient
+    return Transient(free_time=args.free_time)
+
+
+def _spectrum_plan(args):
+    from ..ground.pulses import RATIO_RANGE, Pulse
+    from ..ground.spectrum import spectrum
+    from ..validate import integer, pair
+    nr, nk = (integer("grid", v, 1, 10**4) for v in args.grid)
+    r0, r1 = pair("ratio-range", args.ratio_range, *RATIO_RANGE)
+    k0, k1 = pair("amplitude-range", args.amplitude_range, 0.0, 1e6)
+    for name, (a, b), n in (("ratio-range", (r0, r1), nr), ("amplitude-range", (k0, k1), nk)):
+        if n > 1 and not a < b:
+            raise ValueError(f"{name} must satisfy start < end for {n} grid points "
+                             f"(got {a:g}, {b:g})")
+    ratios, amplitudes = np.linspace(r0, r1, nr), np.linspace(k0, k1, nk)
+    method, integration = _transient_method(args), _transient(args)
+    return {law: spectrum.plan(_block(args, law), Pulse(args.pulse), ratios, amplitudes,
+                               integration=integration, method=method, tol=args.tol,
+                               execution=_execution(args))
+            for law in _laws(args)}
+
+
+def _spectrum_run(args, plans, out):
+    from . import outputs
+    from ..ground.spectrum import run
+    t0 = time.perf_counter()
+    res = {law: _grid(args, run, p, f"spectrum-{law}") for law, p in plans.items()}
+    wall = time.perf_counter() - t0
+    _say(args, f"spectrum: computed in {wall:.1f} s")
+    return wall, outputs.spectrum(out, res)
+
+
+def _records_of(args):
+    """The records of ``--records``: FEMA P695 set names and files, in order."""
+    from ..ground.fema import SETS, fema_set
+    from ..ground.records import read_record
+    recs = []
+    for item in args.records:
+        if item in SETS:
+            recs.extend(fema_set(item))
+        elif os.path.exists(item):
+            recs.append(read_record(item))
+        else:
+            raise ValueError(f"--records: {item!r} is neither a record set "
+                             f"({', '.join(SETS)}) nor a file")
+    return recs
+
+
+#: Default intensities of `rockjit fragility` by measure.
+_INTENSITIES = {"pga": np.round(np.arange(1.25, 6.001, 0.25), 10).tolist(),
+                "pgv": np.round(np.arange(0.05, 1.0001, 0.05), 10).tolist()}
+
+
+def _fragility_plan(args):
+    from ..ground.fragility import fragility
+    from ..validate import choice
+    choice("measure", args.measure, ("pga", "pgv"))
+    x = args.intensities if args.intensities is not None else _INTENSITIES[args.measure]
+    laws = _laws(args)
+    block = _block(args, laws[0])
+    return fragility.plan(block, _records_of(args), args.size, x, measure=args.measure,
+                          laws=laws, integration=_transient(args),
+                          method=_transient_method(args), execution=_execution(args))
+
+
+def _fragility_run(args, p, out):
+    from . import outputs
+    from ..ground.fragility import run
+    _say(args, f"fragility: {p.runs} runs ({len(p.records)} records x "
+               f"{p.intensities.size} intensities x {p.sizes.size} sizes x "
+               f"{len(p.blocks)} laws) on the scipy path")
+    t0 = time.perf_counter()
+    res = _grid(args, run, p, "fragility")
+    wall = time.perf_counter() - t0
+    _say(args, f"fragility: computed in {wall:.1f} s")
+    return wall, outputs.fragility(out, res)
+
+
 def _grid(args, run, plan, name):
     """``run(plan, execution)`` with the command line's progress, Dask client
     (``--scheduler``) and chunk store (``<out>.chunks/name``), the store's notes on stderr
@@ -589,6 +681,18 @@ def _add_scheduler(p):
     p.add_argument("--scheduler-timeout", type=float, default=60.0, metavar="SECONDS",
                    help="give up when the scheduler has had no worker for this long "
                         "(default 60)")
+
+
+def _add_transient(p):
+    """Options of the commands on pulses and records (spectrum, fragility)."""
+    p.add_argument("--free-time", type=float, default=100.0,
+                   help="model time units of free rocking after the excitation (default 100; "
+                        "each run stops earlier once its outcome is decided)")
+    p.add_argument("--method", default="scipy",
+                   help="scipy or scipy:<solve_ivp method> (default scipy: DOP853); the "
+                        "compiled path for pulses and records is not available yet")
+    p.add_argument("--rtol", type=float, default=1e-10, help="scipy tolerance (default 1e-10)")
+    p.add_argument("--atol", type=float, default=1e-12, help="scipy tolerance (default 1e-12)")
 
 
 def _add_alphas(p, step):
@@ -734,6 +838,51 @@ def build_parser():
                    help="relative perturbations, log-uniform (default 8.9e-16 1e-10)")
     p.add_argument("--seed", type=int, default=0, help="seed of the perturbations")
     _add_common(p)
+
+    p = _command(sub, "spectrum", _spectrum_plan, _spectrum_run,
+                 "overturning spectrum of a pulse",
+                 "Run the block from rest under a pulse at every (omega_p/p, a_p/(g tan "
+                 "alpha)) of a grid: each cell's outcome (safe, overturned after an impact, "
+                 "overturned without one) and max|theta|/alpha; at every ratio the minimum "
+                 "overturning amplitude and the boundary of overturning without impact, "
+                 "located by bisection to --tol. Writes spectrum.npz, spectrum.png and "
+                 "summary.json (\"min_overturn\", per law with --law both). Scipy path.")
+    _add_block(p, alpha=False, omega=False, laws="housner, mao, constant or both")
+    p.add_argument("--pulse", default="sine", choices=("sine", "cosine", "ricker"),
+                   help="the pulse (default sine)")
+    p.add_argument("--ratio-range", type=float, nargs=2, required=True,
+                   metavar=("START", "END"), help="frequency ratios omega_p/p (ends included)")
+    p.add_argument("--amplitude-range", type=float, nargs=2, required=True,
+                   metavar=("START", "END"),
+                   help="amplitude ratios a_p/(g tan alpha) (ends included; 1 is uplift)")
+    p.add_argument("--grid", type=int, nargs=2, default=(16, 16), metavar=("NR", "NK"),
+                   help="points along the ratios and the amplitudes (default 16 16)")
+    p.add_argument("--tol", type=float, default=1e-6,
+                   help="relative width of the located boundaries (default 1e-6)")
+    _add_transient(p)
+    _add_common(p, threads=False)
+    _add_scheduler(p)
+
+    p = _command(sub, "fragility", _fragility_plan, _fragility_run,
+                 "fragility curves by incremental dynamic analysis",
+                 "Scale every record to each intensity, run the block from rest for each "
+                 "size and law, and fit lognormal fragility curves (median and dispersion by "
+                 "maximum likelihood) to overturning and to max|theta|/alpha >= 0.5, 1. Writes "
+                 "fragility.npz, fragility.png, rotation.png and summary.json. Scipy path.")
+    _add_block(p, alpha=False, omega=False, laws="housner, mao, constant or both")
+    p.add_argument("--size", type=float, nargs="+", required=True, metavar="R",
+                   help="the block's half-diagonal R in metres (several: the size effect)")
+    p.add_argument("--records", nargs="+", required=True, metavar="SET|FILE",
+                   help="farfield, nearfield, nearfield-pulse, nearfield-no-pulse (FEMA P695: "
+                        "pip install 'rockjit[records]') or .AT2 / two-column (s, g) files")
+    p.add_argument("--measure", default="pga", choices=("pga", "pgv"),
+                   help="intensity measure: PGA/(g tan alpha) (default) or PGV in m/s")
+    p.add_argument("--intensities", type=float, nargs="+", default=None, metavar="X",
+                   help="the intensities every record is scaled to (default 1.25 to 6 by "
+                        "0.25 for pga, 0.05 to 1 m/s by 0.05 for pgv)")
+    _add_transient(p)
+    _add_common(p, threads=False)
+    _add_scheduler(p)
 
     p = sub.add_parser("compile", help="compile every kernel into numba's cache", description=
                        "Compile the kernel variants the commands use into numba's cache, in "

@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["basins", "chart", "erosion", "fate", "manifest", "orbits", "plane", "sweep", "trajectory"]
+__all__ = ["basins", "chart", "erosion", "fate", "fragility", "manifest", "orbits", "plane",
+           "spectrum", "sweep", "trajectory"]
 
 
 def manifest(out):
@@ -229,3 +230,49 @@ def chart(out, res, *, npz="chart.npz", png="chart.png"):
                                                f"its bifurcation curves, per law and both "
                                                f"overlaid (data: {npz})")
     return dict(curves=[c.to_dict() for c in curves], charts=charts, figure=figure)
+
+
+def spectrum(out, res, *, npz="spectrum.npz", png="spectrum.png"):
+    """Overturning spectra (a dict ``law: SpectrumResult``): the grid and, per law (suffixed
+    ``_<law>`` with two laws), the outcomes, demands and located boundaries; the figure; the
+    summary (``min_overturn`` per law, and where two laws differ)."""
+    from ..ground.figures import fig_spectrum
+    from ..ground.response import OUTCOMES
+    from ..ground.spectrum import compare
+    first = next(iter(res.values()))
+    arrays = dict(ratio=first.ratio, amplitude=first.amplitude,
+                  outcomes=np.asarray(OUTCOMES, dtype=str))
+    two = len(res) == 2
+    for law, sp in res.items():
+        arrays.update(sp.arrays(f"_{law}" if len(res) > 1 else ""))
+    _npz(out, npz, "the spectrum's axes ratio (omega_p/p) and amplitude (a_p/(g tan alpha)) "
+                   "and, per law (suffix _<law> with two laws), every cell's outcome (index "
+                   "into outcomes), max rotation and the located minimum overturning amplitude "
+                   "per ratio with its mode", **arrays)
+    comparison = compare(*res.values()) if two else None
+    _figure(out, png, fig_spectrum(res, comparison), f"the overturning spectrum: the two modes "
+                                                     f"of overturning and the safe region, per "
+                                                     f"law (data: {npz})")
+    if len(res) == 1:
+        return dict(first.summary(), outcomes=list(OUTCOMES))
+    summary = {law: sp.summary() for law, sp in res.items()}
+    summary["outcomes"] = list(OUTCOMES)
+    if comparison is not None:
+        summary["comparison"] = comparison
+    return summary
+
+
+def fragility(out, fr, *, npz="fragility.npz", png="fragility.png", rotation_png="rotation.png"):
+    """An incremental dynamic analysis: every run's outcome and demand, the fitted curves'
+    figures and their summary."""
+    from ..ground.figures import fig_fragility, fig_rotation
+    from ..ground.response import OUTCOMES
+    _npz(out, npz, "every run of the incremental dynamic analysis: record, size, intensity, "
+                   "law, outcome (index into outcomes), max rotation; the fitted fragility "
+                   "curves' medians and dispersions", outcomes=np.asarray(OUTCOMES, dtype=str),
+         **fr.arrays())
+    _figure(out, png, fig_fragility(fr), f"the overturning fraction against intensity with "
+                                         f"the lognormal fragility fits, both laws (data: {npz})")
+    _figure(out, rotation_png, fig_rotation(fr), f"rotation exceedance (max|theta|/alpha_s >= "
+                                                 f"0.5 and 1) against intensity (data: {npz})")
+    return dict(fr.summary(), outcomes=list(OUTCOMES))

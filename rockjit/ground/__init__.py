@@ -1,0 +1,36 @@
+"""Ground motions: the block under acceleration pulses and recorded earthquakes.
+
+One concept per module:
+
+- :mod:`~rockjit.ground.pulses`: :class:`Pulse`, the one-sine, one-cosine and Ricker pulses in
+  the literature's ratios;
+- :mod:`~rockjit.ground.records`: :class:`Record`, a recorded motion, and its readers
+  (arrays, PEER ``.AT2``, two-column text or CSV);
+- :mod:`~rockjit.ground.fema`: the FEMA P695 record sets (the ``records`` extra);
+- :mod:`~rockjit.ground.settings`: :class:`Transient`, how a transient run is integrated;
+- :mod:`~rockjit.ground.response`: :class:`TransientResult` and the outcome codes;
+- :mod:`~rockjit.ground.reference`: one run on the scipy reference path;
+- :mod:`~rockjit.ground.plan`: a single run's plan (what :func:`rockjit.simulate` builds);
+- :mod:`~rockjit.ground.methods`: the scipy path's default method, the compiled path's refusal;
+- :mod:`~rockjit.ground.batch`: a batch of cells and the kernels that compute their outcomes;
+- :mod:`~rockjit.ground.spectrum`: overturning spectra of pulses;
+- :mod:`~rockjit.ground.fitting`: lognormal fragility fits by maximum likelihood;
+- :mod:`~rockjit.ground.fragility`: incremental dynamic analysis over a record set;
+- :mod:`~rockjit.ground.closed_forms`: the slender linearised block's closed forms;
+- :mod:`~rockjit.ground.figures`: the spectra's and fragility curves' figures.
+
+docs/theory/ground-motions.md has the theory, docs/guide/earthquakes.md the guide.
+"""
+
+from .fema import fema_set
+from .fitting import LognormalFit, fit_capacities, fit_lognormal
+from .fragility import FragilityResult, fragility
+from .pulses import Pulse
+from .records import Record, read_at2, read_record, read_table
+from .response import OUTCOMES, TransientResult
+from .settings import Transient
+from .spectrum import SpectrumResult, spectrum
+
+__all__ = ["FragilityResult", "LognormalFit", "OUTCOMES", "Pulse", "Record", "SpectrumResult",
+           "Transient", "TransientResult", "fema_set", "fit_capacities", "fit_lognormal",
+           "fragility", "read_at2", "read_record", "read_table", "spectrum"]

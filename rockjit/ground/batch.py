@@ -1,0 +1,160 @@
+"""A batch of cells under transient excitations, and the kernels that compute their outcomes.
+
+Every grid of this package (a pulse's overturning spectrum, each step of its bisections, an
+incremental dynamic analysis) is a :class:`Batch`: cell ``i`` is the block
+``blocks[block_of[i]]``, at rest at ``t = 0``, under the excitation
+``sources[source_of[i]].scaled(gain[i])``. A source is a bound transient excitation at unit
+gain: a pulse of one kind and frequency ratio on one block (``gain`` is then its amplitude
+ratio), or a record played on one block size (``gain`` is then its scale factor). The
+integration settings (:class:`rockjit.Transient`, with ``stop_when_decided`` on) and the method
+are the batch's.
+
+A **kernel** computes a chunk of cells::
+
+    kernel(blocks, sources, block_of, source_of, gain, settings, method) -> dict
+
+returning one array per name of :data:`OUTPUTS`, each of the chunk's length:
+
+- ``outcome`` (int8): :data:`rockjit.ground.response.OUTCOMES`' code;
+- ``max_rotation`` (float64): ``max |theta| / alpha_s``;
+- ``t_overturn`` (float64): when ``|theta|`` reached ``theta_over``, ``nan`` if never;
+- ``t_end`` (float64): the model time the run stopped;
+- ``n_impacts`` (int64): the impacts before it stopped;
+- ``status`` (int8): the index of the run's status in :data:`STATUS_CODES`.
+
+Today's kernel, :func:`scipy_kernel`, runs the cells one after another on the scipy reference
+path. The compiled kernel registers itself in :data:`KERNELS` under ``"rockjit"``; until it
+does, :func:`kernel_for` refuses ``method="rockjit"`` for pulses and records. :func:`run_batch`
+cuts a batch into chunks and runs them through a kernel, in this process or on a Dask cluster
+(``Execution.client`` or ``Execution.scheduler``), with progress.
+"""
+
+from __future__ import annotations
+
+import math
+import uuid
+from dataclasses import dataclass
+
+import numpy as np
+
+from .plan import COMPILED_NOT_YET
+from .response import STATUSES
+
+__all__ = ["Batch", "KERNELS", "OUTPUTS", "STATUS_CODES", "grid_method", "kernel_for",
+           "run_batch", "scipy_kernel"]
+
+#: A kernel's outputs: name -> dtype.
+OUTPUTS = {"outcome": np.int8, "max_rotation": np.float64, "t_overturn": np.float64,
+           "t_end": np.float64, "n_impacts": np.int64, "status": np.int8}
+#: The statuses a kernel reports, in the order of their codes.
+STATUS_CODES = tuple(STATUSES)
+
+
+@dataclass(frozen=True, eq=False)
+class Batch:
+    """Cells to compute: cell ``i`` is ``blocks[block_of[i]]`` under
+    ``sources[source_of[i]].scaled(gain[i])``, from rest."""
+
+    blocks: tuple
+    sources: tuple
+    block_of: np.ndarray
+    source_of: np.ndarray
+    gain: np.ndarray
+
+    def __post_init__(self):
+        n = len(self.gain)
+        for name in ("block_of", "source_of"):
+            a = np.asarray(getattr(self, name), dtype=np.int64)
+            if a.shape != (n,):
+                raise ValueError(f"{name} must have one entry per cell ({n})")
+            object.__setattr__(self, name, a)
+        object.__setattr__(self, "gain", np.asarray(self.gain, dtype=float))
+        object.__setattr__(self, "blocks", tuple(self.blocks))
+        object.__setattr__(self, "sources", tuple(self.sources))
+
+    def __len__(self):
+        return int(self.gain.size)
+
+    def cell(self, i):
+        """``(block, excitation)`` of cell ``i``."""
+        return (self.blocks[self.block_of[i]],
+                self.sources[self.source_of[i]].scaled(float(self.gain[i])))
+
+
+def empty_outputs(n):
+    """The output arrays of ``n`` cells, filled as a kernel fills them for no run."""
+    return {k: (np.full(n, np.nan) if np.dtype(t).kind == "f" else np.zeros(n, dtype=t))
+            for k, t in OUTPUTS.items()}
+
+
+def scipy_kernel(blocks, sources, block_of, source_of, gain, settings, method):
+    """The scipy reference path on each cell in turn (:func:`rockjit.ground.reference.
+    run_scipy`), from rest."""
+    from .reference import run_scipy
+    n = len(gain)
+    out = empty_outputs(n)
+    for i in range(n):
+        block = blocks[block_of[i]]
+        exc = sources[source_of[i]].scaled(float(gain[i]))
+        r = run_scipy(block, exc, (0.0, 0.0), settings, method)
+        out["outcome"][i] = r.outcome
+        out["max_rotation"][i] = r.max_rotation
+        out["t_overturn"][i] = r.t_overturn
+        out["t_end"][i] = r.t
+        out["n_impacts"][i] = r.n_impacts
+        out["status"][i] = STATUS_CODES.index(r.status)
+    return out
+
+
+#: The kernels by method: ``"scipy"`` (any :class:`rockjit.Scipy`) today; the compiled path
+#: adds ``"rockjit"``.
+KERNELS = {"scipy": scipy_kernel}
+
+
+def kernel_for(method):
+    """The kernel of ``method`` (``"rockjit"`` or a :class:`rockjit.Scipy`)."""
+    name = "rockjit" if method == "rockjit" else "scipy"
+    if name not in KERNELS:
+        raise ValueError(COMPILED_NOT_YET)
+    return KERNELS[name]
+
+
+def grid_method(method):
+    """The method of a grid: ``"rockjit"`` when a compiled kernel is registered (refused
+    otherwise, :data:`rockjit.ground.plan.COMPILED_NOT_YET`), else the :class:`rockjit.Scipy`
+    of ``method`` (default DOP853 at ``rtol = 1e-10, atol = 1e-12``)."""
+    from .methods import check_method, transient_scipy
+    if method is None:
+        return transient_scipy()
+    if method == "rockjit":
+        kernel_for(method)
+        return method
+    return check_method(method)
+
+
+def default_chunk(n):
+    """Cells per chunk: about a twentieth of the batch (the unit of progress and of Dask
+    tasks), at least one."""
+    return max(1, math.ceil(n / 20))
+
+
+def run_batch(batch, settings, method, execution=None, label="cells"):
+    """Every cell of ``batch`` through the kernel of ``method``, chunk by chunk, as
+    ``execution`` (a :class:`rockjit.Execution`) says: in this process or on a Dask cluster,
+    with progress. Returns the outputs by name (:data:`OUTPUTS`)."""
+    from ..grids.runner import _client, run_chunks
+    from ..settings import Execution
+    ex = Execution() if execution is None else execution
+    kernel = kernel_for(method)
+    n = len(batch)
+    outputs = empty_outputs(n)
+    if n == 0:
+        return outputs
+    chunk = default_chunk(n) if ex.chunk is None else ex.chunk
+    # task keys unique to this call: a bisection runs many batches on one cluster
+    prefix = f"rockjit-{label.replace(' ', '-')}-{uuid.uuid4().hex[:12]}"
+    with _client(ex) as client:
+        run_chunks(kernel, (batch.blocks, batch.sources, batch.block_of, batch.source_of,
+                            batch.gain, settings, method), n, chunk, outputs, client=client,
+                   progress=ex.progress, label=label, task_prefix=prefix)
+    return outputs

@@ -1,0 +1,505 @@
+"""Recorded ground motions: an acceleration history in ``g`` at a fixed time step in seconds.
+
+A record becomes a forcing of the dimensionless model only on a block of a given size: model
+time is ``t sqrt(g/R)`` (docs/theory/ground-motions.md, "Recorded motions, scaled to the
+block"), so a :class:`Record` carries the block's half-diagonal ``R`` in metres (``size``), or its
+frequency parameter ``p = sqrt(3 g / 4 R)`` in rad/s. Between samples the acceleration is
+linear; after the last sample the base is still.
+
+Records come from arrays (:class:`Record`, :meth:`Record.from_arrays`), from a PEER NGA
+``.AT2`` file (:func:`read_at2`), from a two-column text or CSV file of time in seconds and
+acceleration in ``g`` (:func:`read_table`), or from the FEMA P695 record sets
+(:func:`rockjit.ground.fema.fema_set`). A bad record (empty, not finite, time not increasing or
+unevenly spaced, acceleration not in ``g``) is refused with one ``ValueError`` line that names the
+file and the problem.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, replace
+from functools import cached_property
+from pathlib import Path
+
+import numpy as np
+
+from ..excitation import ACCEL_MAX, Excitation
+from ..validate import real
+
+__all__ = ["G", "Record", "SIZE_RANGE", "read_at2", "read_record", "read_table"]
+
+#: Gravity in m/s^2, as in the model's own scaling (docs/theory/model.md).
+G = 9.81
+#: Allowed half-diagonals (m): from a figurine to a tower.
+SIZE_RANGE = (1e-3, 1e4)
+#: Allowed time steps (s).
+DT_RANGE = (1e-6, 10.0)
+#: Relative spread of the time steps a time column may have and still count as even (a
+#: column written with 4 to 6 digits varies by that much).
+EVEN_TOL = 1e-4
+#: Most samples a record may hold (a day at 1 kHz).
+MAX_SAMPLES = 10**8
+
+
+def _refuse(source, problem):
+    raise ValueError(f"record {source}: {problem}")
+
+
+def _p_of(size):
+    return math.sqrt(3.0 * G / (4.0 * size))
+
+
+@dataclass(frozen=True, eq=False)
+class Record(Excitation):
+    """A recorded ground motion: accelerations in ``g`` at a fixed step ``dt`` in seconds.
+
+    Parameters
+    ----------
+    accel : array of float
+        The horizontal ground acceleration in ``g`` at ``t_k = k dt`` (at least two samples,
+        all finite). Positive throws the block onto the corner of ``theta > 0``
+        (docs/theory/model.md, "The forcing").
+    dt : float
+        The time step in seconds, in ``[1e-6, 10]``.
+    size : float, optional
+        The block's half-diagonal ``R`` in metres, in ``[1e-3, 1e4]``; or give ``p``. Needed
+        to play the record in model time (:func:`rockjit.simulate`; :func:`rockjit.fragility`
+        binds each of its sizes).
+    p : float, optional
+        The block's frequency parameter ``sqrt(3 g / 4 R)`` in rad/s, instead of ``size``.
+    scale : float
+        A factor on every acceleration (``>= 0``), default 1: the scaled record of an
+        incremental dynamic analysis.
+    name : str
+        What the record is called in messages and outputs.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rockjit import Record
+    >>> rec = Record(np.array([0.0, 0.1, -0.2, 0.05, 0.0]), 0.01, size=1.0)
+    >>> round(rec.pga, 3), round(rec.end, 4), round(rec.f(0.5 * rec.dt_model), 3)
+    (0.2, 0.1253, 0.05)
+    """
+
+    accel: np.ndarray
+    dt: float
+    size: float | None = None
+    p: float | None = None
+    scale: float = 1.0
+    name: str = "record"
+
+    def __post_init__(self):
+        name = self.name if isinstance(self.name, str) and self.name else "record"
+        object.__setattr__(self, "name", name)
+        src = repr(name)
+        a = self.accel
+        if not isinstance(a, np.ndarray) or a.dtype != np.float64 or a.flags.writeable:
+            try:
+                a = np.asarray(a)
+            except (TypeError, ValueError):
+                _refuse(src, "the accelerations are not numbers")
+            if a.dtype.kind not in "iuf":
+                _refuse(src, f"the accelerations are not numbers (got {a.dtype})")
+            a = np.array(a, dtype=float)  # a copy, made read-only below
+        if a.ndim != 1:
+            _refuse(src, f"the accelerations must be one column (got shape {a.shape})")
+        if a.size == 0:
+            _refuse(src, "it holds no samples")
+        if a.size < 2:
+            _refuse(src, "it holds one sample: at least two are needed")
+        if a.size > MAX_SAMPLES:
+            _refuse(src, f"it holds {a.size} samples, more than {MAX_SAMPLES}")
+        bad = ~np.isfinite(a)
+        if bad.any():
+            k = int(np.argmax(bad))
+            _refuse(src, f"sample {k} is not finite ({a[k]})")
+        if a.flags.writeable:
+            a.flags.writeable = False
+        object.__setattr__(self, "accel", a)
+        try:
+            dt = real("dt", self.dt, *DT_RANGE)
+        except ValueError as exc:
+            _refuse(src, str(exc))
+        object.__setattr__(self, "dt", dt)
+        scale = real("scale", self.scale, 0.0, None)
+        if scale * float(np.max(np.abs(a))) > ACCEL_MAX:
+            raise ValueError(f"record {src}: scale * PGA must be <= {ACCEL_MAX:g} g "
+                             f"(got scale = {scale:g})")
+        object.__setattr__(self, "scale", scale)
+        if self.size is not None and self.p is not None:
+            raise ValueError("give the block's size R or its frequency parameter p, not both")
+        if self.size is not None:
+            size = real("size", self.size, *SIZE_RANGE)
+            object.__setattr__(self, "size", size)
+            object.__setattr__(self, "p", _p_of(size))
+        elif self.p is not None:
+            lo, hi = _p_of(SIZE_RANGE[1]), _p_of(SIZE_RANGE[0])
+            p = real("p", self.p, lo, hi)
+            object.__setattr__(self, "p", p)
+            object.__setattr__(self, "size", 3.0 * G / (4.0 * p * p))
+
+    def __reduce__(self):
+        # rebuilt through the constructor, so that a copy (Dask, pickle) is validated and
+        # read-only again
+        return (Record, (self.accel, self.dt, self.size, None, self.scale, self.name))
+
+    @classmethod
+    def from_arrays(cls, t, accel, *, size=None, p=None, name="record", source=None):
+        """A record from its sample times (s, increasing, evenly spaced; the first is taken as
+        0) and accelerations (``g``). ``source`` names the data in messages (a file)."""
+        src = source or repr(name)
+        t = _numbers(src, t, "time")
+        a = _numbers(src, accel, "acceleration")
+        if t.shape != a.shape:
+            _refuse(src, f"{t.size} times for {a.size} accelerations")
+        dt = _even_step(src, t)
+        return _named(src, name, lambda: cls(a, dt, size=size, p=p, name=name))
+
+    # ---- what every transient excitation says ---------------------------------------------
+    transient = True
+
+    def bind(self, block=None, *, size=None):
+        """This record played on a block of half-diagonal ``size`` (m); without ``size``, the
+        record as it is, which must already have one (``block`` has no size: its shape only)."""
+        if size is not None:
+            return replace(self, size=size, p=None)
+        if self.size is None:
+            raise ValueError(f"record {self.name!r} needs the block's size to become a "
+                             f"forcing: Record(..., size=R in metres) or record.bind(size=R)")
+        return self
+
+    def scaled(self, gain):
+        """The same record with every acceleration multiplied by ``gain``."""
+        return replace(self, scale=self.scale * gain, p=None)
+
+    @property
+    def n(self) -> int:
+        """Number of samples."""
+        return int(self.accel.size)
+
+    @property
+    def duration(self) -> float:
+        """The record's length in seconds, ``(n - 1) dt``."""
+        return (self.n - 1) * self.dt
+
+    @cached_property
+    def pga(self) -> float:
+        """Peak ground acceleration in ``g``, scale included."""
+        return self.scale * float(np.max(np.abs(self.accel)))
+
+    @cached_property
+    def pgv(self) -> float:
+        """Peak ground velocity in m/s, scale included: the largest ``|v|`` of the exact
+        integral of the piecewise-linear acceleration from rest."""
+        a = self.accel
+        v = np.concatenate(([0.0], np.cumsum(0.5 * (a[1:] + a[:-1])) * self.dt))
+        return self.scale * G * float(np.max(np.abs(v)))
+
+    @property
+    def peak(self) -> float:
+        """The largest ``|f|`` (in ``g``): the PGA."""
+        return self.pga
+
+    def _need_size(self):
+        if self.size is None:
+            self.bind()
+
+    @property
+    def time_factor(self) -> float:
+        """Model time units per second, ``sqrt(g / R)``."""
+        self._need_size()
+        return math.sqrt(G / self.size)
+
+    @property
+    def dt_model(self) -> float:
+        """The time step in model units, ``dt sqrt(g / R)``."""
+        return self.dt * self.time_factor
+
+    @property
+    def end(self) -> float:
+        """Model time of the last sample, after which the base is still."""
+        return (self.n - 1) * self.dt_model
+
+    @property
+    def breaks(self) -> np.ndarray:
+        """Model times of the samples: the acceleration's slope jumps at each."""
+        return np.arange(self.n) * self.dt_model
+
+    @property
+    def max_step(self) -> float:
+        """The longest solver step that steps over no sample: the sample step."""
+        return self.dt_model
+
+    def f(self, t):
+        """The base acceleration in ``g`` at model time(s) ``t``: linear between samples, zero
+        before the first and after the last."""
+        t = np.asarray(t, dtype=float)
+        out = self.scale * np.interp(t, self.breaks, self.accel, left=0.0, right=0.0)
+        out = np.where((t < 0.0) | (t > self.end), 0.0, out)
+        return float(out) if out.ndim == 0 else out
+
+    def scalar(self):
+        """``f`` as a fast function of one float (the scipy path's right-hand side)."""
+        y = (self.scale * self.accel).tolist()
+        h = self.dt_model
+        last = self.n - 1
+        end = self.end
+
+        def f(t):
+            if not 0.0 <= t <= end:
+                return 0.0
+            x = t / h
+            k = int(x)
+            if k >= last:
+                return y[last]
+            w = x - k
+            return y[k] + w * (y[k + 1] - y[k])
+        return f
+
+    def windows(self, threshold):
+        """The intervals where ``|f| > threshold``: rows ``(t_start, t_end, sign of f)`` in
+        order, each end located exactly on its linear piece."""
+        y = self.scale * self.accel
+        tk = self.breaks
+        rows = []
+        for sign in (1.0, -1.0):
+            s = sign * y - threshold
+            inside = s > 0.0
+            if not inside.any():
+                continue
+            d = np.diff(inside.astype(np.int8))
+            up = np.flatnonzero(d == 1)      # s[k] <= 0 < s[k+1]
+            down = np.flatnonzero(d == -1)   # s[k] > 0 >= s[k+1]
+            starts = tk[up] + (-s[up]) / (s[up + 1] - s[up]) * self.dt_model
+            ends = tk[down] + s[down] / (s[down] - s[down + 1]) * self.dt_model
+            if inside[0]:
+                starts = np.concatenate(([tk[0]], starts))
+            if inside[-1]:
+                ends = np.concatenate((ends, [tk[-1]]))
+            rows.append(np.column_stack((starts, ends, np.full(starts.size, sign))))
+        if not rows:
+            return np.zeros((0, 3))
+        w = np.vstack(rows)
+        return w[np.argsort(w[:, 0], kind="stable")]
+
+    def describe(self) -> str:
+        """One line: the record, its length and its peak."""
+        return (f"{self.name}: {self.n} samples at dt = {self.dt:g} s ({self.duration:g} s), "
+                f"PGA {self.pga:.3g} g")
+
+    def __repr__(self):
+        size = "" if self.size is None else f", size={self.size:g}"
+        scale = "" if self.scale == 1.0 else f", scale={self.scale:g}"
+        return f"Record({self.name!r}, n={self.n}, dt={self.dt:g}{size}{scale})"
+
+
+# ---- reading files ----------------------------------------------------------------------------
+
+def _numbers(src, values, what):
+    try:
+        a = np.asarray(values)
+    except (TypeError, ValueError):
+        a = None
+    if a is None or a.dtype.kind not in "iuf":
+        _refuse(src, f"the {what} column is not numbers")
+    a = a.astype(float).ravel()
+    if a.size == 0:
+        _refuse(src, "it holds no samples")
+    bad = ~np.isfinite(a)
+    if bad.any():
+        k = int(np.argmax(bad))
+        _refuse(src, f"{what} {k} is not finite ({a[k]})")
+    return a
+
+
+def _even_step(src, t):
+    """The step of an increasing, evenly spaced time column."""
+    if t.size < 2:
+        _refuse(src, "it holds one sample: at least two are needed")
+    d = np.diff(t)
+    if not np.all(d > 0):
+        k = int(np.argmax(~(d > 0)))
+        _refuse(src, f"the time does not increase at sample {k + 1} "
+                     f"({t[k]:g} s, then {t[k + 1]:g} s)")
+    dt = (t[-1] - t[0]) / (t.size - 1)
+    spread = np.max(np.abs(d - dt)) / dt
+    if spread > EVEN_TOL:
+        k = int(np.argmax(np.abs(d - dt)))
+        _refuse(src, f"the time step is uneven (step {k + 1} is {d[k]:g} s, the mean "
+                     f"{dt:g} s): resample it to an even step first")
+    return float(dt)
+
+
+def _read_text(path):
+    src = str(path)
+    try:
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            return fh.read()
+    except OSError as exc:
+        raise ValueError(f"record {src}: cannot be read ({exc.strerror or exc})") from None
+
+
+_FLOAT = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?"
+
+
+def read_at2(path, *, size=None, p=None, name=None) -> Record:
+    """A PEER NGA ``.AT2`` record: four header lines (the third states the units, which must
+    be ``g``; the fourth ``NPTS`` and ``DT``, in either of the database's two layouts), then
+    the accelerations."""
+    src = str(path)
+    lines = _read_text(path).splitlines()
+    if len(lines) < 4:
+        _refuse(src, "not a PEER .AT2 file (fewer than four header lines)")
+    units = lines[2].upper()
+    if "UNITS OF" in units or "UNITS" in units:
+        m = re.search(r"UNITS\s+(?:OF\s+)?([A-Z/0-9*^. ]+)", units)
+        unit = m.group(1).strip().split()[0] if m and m.group(1).strip() else ""
+        if unit != "G":
+            _refuse(src, f"the accelerations are in {unit or 'unstated units'}, not g "
+                         f"(header line 3: {lines[2].strip()!r})")
+    else:
+        _refuse(src, f"the header does not state the units (line 3: {lines[2].strip()!r}); "
+                     f"an .AT2 record must be in units of g")
+    head = lines[3].upper()
+    m_n = re.search(r"NPTS\s*=\s*(\d+)", head)
+    m_dt = re.search(r"DT\s*=\s*(" + _FLOAT + ")", head)
+    if m_n and m_dt:
+        npts, dt = int(m_n.group(1)), float(m_dt.group(1).replace("D", "E"))
+    else:  # the older layout: "  2999   0.0100   NPTS, DT"
+        nums = re.findall(_FLOAT, head)
+        if len(nums) >= 2 and "NPTS" in head:
+            try:
+                npts, dt = int(float(nums[0])), float(nums[1].replace("D", "E"))
+            except ValueError:
+                npts = dt = None
+        else:
+            npts = dt = None
+        if npts is None:
+            _refuse(src, f"line 4 does not give NPTS and DT ({lines[3].strip()!r})")
+    body = " ".join(lines[4:]).replace("D", "E").replace("d", "e")
+    tokens = body.split()
+    try:
+        values = np.array([float(x) for x in tokens], dtype=float)
+    except ValueError:
+        bad = next(x for x in tokens if not _is_float(x))
+        _refuse(src, f"{bad!r} among the accelerations is not a number")
+    if values.size == 0:
+        _refuse(src, "it holds no samples")
+    if values.size != npts:
+        _refuse(src, f"the header says NPTS = {npts} but the file holds {values.size} values")
+    if not math.isfinite(dt) or dt <= 0:
+        _refuse(src, f"the time step DT = {dt:g} is not positive")
+    bad = ~np.isfinite(values)
+    if bad.any():
+        k = int(np.argmax(bad))
+        _refuse(src, f"sample {k} is not finite ({values[k]})")
+    name = name or Path(path).stem
+    return _named(src, name, lambda: Record(values, dt, size=size, p=p, name=name))
+
+
+def _named(src, name, make):
+    """``make()``, its refusals naming ``src`` (the file) instead of the record's name."""
+    try:
+        return make()
+    except ValueError as exc:
+        msg = str(exc)
+        prefix = f"record {name!r}: "
+        if msg.startswith(prefix):
+            msg = f"record {src}: " + msg[len(prefix):]
+        raise ValueError(msg) from None
+
+
+def _is_float(x):
+    try:
+        float(x)
+        return True
+    except ValueError:
+        return False
+
+
+_UNIT = re.compile(r"[\(\[]\s*([^\)\]]*?)\s*[\)\]]")
+_ACCEL_UNITS = {"g", "g0", "gs"}
+_TIME_UNITS = {"s", "sec", "second", "seconds"}
+
+
+def _header_units(src, header):
+    """Check a header's column names: time in seconds, acceleration in ``g`` where a unit is
+    written; returns the number of columns named."""
+    cols = [c.strip() for c in re.split(r"[,;\t]|\s{2,}", header.strip()) if c.strip()]
+    if len(cols) == 1:
+        cols = header.split()
+    for k, col in enumerate(cols):
+        m = _UNIT.search(col)
+        unit = m.group(1).strip().lower() if m else None
+        if unit is None:
+            m2 = re.search(r"[_ ]in[_ ](\S+)$|_(\w+)$", col.lower())
+            unit = (m2.group(1) or m2.group(2)) if m2 else None
+            if unit not in _ACCEL_UNITS | _TIME_UNITS | {"ms2", "mps2", "cms2", "gal"}:
+                unit = None
+        if unit is None:
+            continue
+        if k == 0 and unit not in _TIME_UNITS:
+            _refuse(src, f"the time column is in {unit!r}, not seconds (header {col!r})")
+        if k == 1 and unit not in _ACCEL_UNITS:
+            _refuse(src, f"the acceleration column is in {unit!r}, not g (header {col!r}); "
+                         f"divide by 9.81 m/s^2 first")
+    return cols
+
+
+def read_table(path, *, size=None, p=None, name=None) -> Record:
+    """A record from a text or CSV file of two columns, time (s) and acceleration (``g``),
+    separated by commas, semicolons, tabs or spaces; ``#`` starts a comment; one header line
+    of column names is allowed, and a unit written in it (``acc (g)``, ``a [m/s^2]``) must be
+    ``g`` for the acceleration and seconds for the time. A third column named ``unit(s)`` must
+    say ``g`` on every row."""
+    src = str(path)
+    text = _read_text(path)
+    rows = []
+    header = None
+    units_col = None
+    for lineno, line in enumerate(text.splitlines(), 1):
+        line = line.split("#", 1)[0].strip()
+        if not line:
+            continue
+        fields = [x for x in re.split(r"[,;\s]+", line) if x]
+        if not rows and header is None and not all(_is_float(x) for x in fields[:2]):
+            header = line
+            cols = _header_units(src, header)
+            for k, col in enumerate(cols):
+                if re.fullmatch(r"units?", col.strip().lower()):
+                    units_col = k
+            continue
+        if units_col is not None:
+            if len(fields) <= units_col:
+                _refuse(src, f"line {lineno} has no value in its units column")
+            unit = fields[units_col].lower()
+            if unit not in _ACCEL_UNITS:
+                _refuse(src, f"line {lineno} gives the acceleration in {fields[units_col]!r}, "
+                             f"not g")
+            fields = fields[:units_col] + fields[units_col + 1:]
+        if len(fields) < 2:
+            _refuse(src, f"line {lineno} has {len(fields)} column: two are needed "
+                         f"(time in s, acceleration in g)")
+        if len(fields) > 2:
+            _refuse(src, f"line {lineno} has {len(fields)} columns: two are expected "
+                         f"(time in s, acceleration in g)")
+        try:
+            rows.append((float(fields[0]), float(fields[1])))
+        except ValueError:
+            bad = fields[0] if not _is_float(fields[0]) else fields[1]
+            _refuse(src, f"line {lineno}: {bad!r} is not a number")
+    if not rows:
+        _refuse(src, "it holds no samples")
+    data = np.array(rows, dtype=float)
+    return Record.from_arrays(data[:, 0], data[:, 1], size=size, p=p,
+                              name=name or Path(path).stem, source=src)
+
+
+def read_record(path, *, size=None, p=None, name=None) -> Record:
+    """A record from a file: ``.AT2`` (PEER NGA) by its suffix, anything else as a two-column
+    table (:func:`read_table`)."""
+    if Path(path).suffix.lower() == ".at2":
+        return read_at2(path, size=size, p=p, name=name)
+    return read_table(path, size=size, p=p, name=name)
