@@ -185,7 +185,7 @@ def initial_state(state, forcing, integration):
         th, dth = float(z[0]), float(z[1])
         default = (0.0, 1.0)
     th = check_theta0(th, integration, "state[0] (theta0)")
-    dth = real("state[1] (theta0')", dth, -1e6, 1e6)
+    dth = real("state[1] (dtheta0)", dth, -1e6, 1e6)
     return (th, dth) + forcing.start(default)
 
 

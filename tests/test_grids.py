@@ -114,7 +114,9 @@ def test_sweep_matches_single_runs():
     integration = Integration(periods=PERIODS, n_steps=GRID_N)
     sw = rockjit.sweep(Block(1), Harmonic(omega=1.3), alphas, integration=integration,
                        classification=Classification(early_stop=False))
-    for a, lab, lam, pts in zip(alphas, sw.label, sw.lambda_max, sw.strobe):
+    # lambda_window is the finite-window estimate a single run averages (lambda_max is the
+    # exact Floquet exponent where a cell is periodic: tests/test_exact_exponents.py)
+    for a, lab, lam, pts in zip(alphas, sw.label, sw.lambda_window, sw.strobe):
         res = rockjit.simulate(Block(1), Harmonic(alpha=a, omega=1.3), integration=integration,
                                lyapunov=True)
         assert BEHAVIOURS[lab] == slow_classify(res, int(0.8 * PERIODS))[0]
@@ -134,6 +136,7 @@ def test_threads_do_not_change_results():
     np.testing.assert_array_equal(one.label, two.label)
     np.testing.assert_array_equal(one.t_end, two.t_end)
     np.testing.assert_array_equal(one.lambda_max, two.lambda_max)
+    np.testing.assert_array_equal(one.lambda_window, two.lambda_window)
 
 
 def test_basin_mirror_symmetry():

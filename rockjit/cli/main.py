@@ -148,7 +148,7 @@ OUTPUTS = {
     "fragility": ("fragility.npz", "fragility.*", "rotation.*"),
 }
 #: The commands whose grids keep their finished chunks in <out>.chunks.
-CHUNKED = ("sweep", "basin", "plane", "erosion", "orbits", "paper")
+CHUNKED = ("sweep", "basin", "plane", "erosion", "orbits", "chart", "paper")
 
 
 def _check_run(args):
@@ -220,10 +220,19 @@ def _laws(args):
 def _forcing(args, alpha=True, omega=True):
     """The harmonic forcing of ``--alpha --omega --phase/--r0 --s0 --forcing``."""
     from ..excitation import Harmonic
-    return Harmonic(alpha=args.alpha if alpha else None, omega=args.omega if omega else None,
-                    phase=getattr(args, "phase", None), r0=getattr(args, "r0", None),
-                    s0=getattr(args, "s0", None),
-                    embedded=getattr(args, "forcing", "closed") == "embedded")
+    try:
+        return Harmonic(alpha=args.alpha if alpha else None,
+                        omega=args.omega if omega else None, phase=getattr(args, "phase", None),
+                        r0=getattr(args, "r0", None), s0=getattr(args, "s0", None),
+                        embedded=getattr(args, "forcing", "closed") == "embedded")
+    except ValueError as exc:  # the library's hint, in the options this command has
+        text = str(exc)
+        hint = "; use Harmonic(..., embedded=True) for a start off the circle"
+        if hint in text:
+            text = text.replace(hint, "; use --forcing embedded for a start off the circle"
+                                if hasattr(args, "forcing") else
+                                "; give a point on the circle, or --phase")
+        raise ValueError(text) from None
 
 
 def _state(args):

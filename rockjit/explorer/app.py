@@ -6,7 +6,7 @@ One :class:`ExplorerApp` per browser tab. A change of a control is checked by th
 changes); an accepted change marks the views it affects as updating and submits their
 computations to the tab's worker thread; results come back through the document's next-tick
 callbacks and are shown only while their request is still the newest (:meth:`Computer.
-is_current`). Behaviour colours come from :data:`rockjit.plotting.figures.BEHAVIOUR_COLOURS`,
+is_current`). Behaviour colours come from :data:`rockjit.plotting.style.BEHAVIOUR_COLOURS`,
 read when a view is drawn.
 """
 
@@ -26,6 +26,7 @@ from bokeh.models import (Button, ColumnDataSource, CustomJS, Div, NumericInput,
                           RadioButtonGroup, Range1d, Select, Slider, Span, Toggle)
 from bokeh.plotting import figure
 
+from ..plotting import style
 from ..result import BEHAVIOURS
 from . import requests as R
 from .worker import Computer
@@ -33,7 +34,7 @@ from .worker import Computer
 __all__ = ["ExplorerApp", "document"]
 
 #: Colours of the agreement map (as in rockjit.plotting.figures.fig_basin_compare).
-AGREE_COLOURS = {"same": "#e8e8e8", "different": "#7b3294"}
+AGREE_COLOURS = {"same": style.AGREE_COLOUR, "different": style.DISAGREE_COLOUR}
 #: Opacity of a view whose parameters changed and whose new result is not there yet.
 STALE_ALPHA = 0.35
 BASIN_SIZE = 400
@@ -41,17 +42,15 @@ LAW_NAMES = {"housner": "Housner", "mao": "Mao", "constant": "constant e"}
 
 
 def behaviour_colours():
-    """The project's behaviour palette, read where it lives today."""
-    from ..plotting import figures
-    return dict(figures.BEHAVIOUR_COLOURS)
+    """The project's behaviour palette (:mod:`rockjit.plotting.style`)."""
+    return dict(style.BEHAVIOUR_COLOURS)
 
 
-def attractor_colours(n):
-    """Colours of attractor ids 0..n-1, as the attractor figures draw them."""
+def attractor_colours(attractors):
+    """Colours of the attractors (by id), as the attractor figures draw them: tints of their
+    behaviours' colours."""
     from matplotlib.colors import to_hex
-
-    from ..plotting import figures
-    return [to_hex(c) for c in figures._attractor_colours(n)]
+    return [to_hex(c) for c in style.attractor_colours(attractors)] or ["#999999"]
 
 
 def _rgba(hex_colour):
@@ -334,8 +333,8 @@ class ExplorerApp:
         res = view.result
         if self.colour_by == "attractor" and res.attractor is not None:
             colours = behaviour_colours()
-            n = max(len(res.attractors), 1)
-            lut = [colours["unresolved"], colours["overturn"]] + attractor_colours(n)
+            lut = [colours["unresolved"], colours["overturn"]] + \
+                attractor_colours(res.attractors)
             img = rgba_image(res.attractor, lut, offset=2)
             pts = [(a.points[:, 0], a.points[:, 1], lut[2 + a.id]) for a in res.attractors
                    if a.period]
@@ -359,15 +358,14 @@ class ExplorerApp:
                        f"{fr[n]:.1f} %</td></tr>" for n in BEHAVIOURS if fr[n] > 0)
         out = f"<b>behaviours</b><table style='font-size:12px'>{rows}</table>"
         if res.attractor is not None:
-            n = max(len(res.attractors), 1)
-            acol = attractor_colours(n)
+            acol = attractor_colours(res.attractors)
+            names = style.attractor_names(res.attractors)
             lim = m.get("integrity", {}).get("LIM", {})
             arows = "".join(
-                f"<tr><td>{_swatch(acol[a.id])}{a.id}: {a.behaviour}"
-                f"{' p=' + str(a.period) if a.period > 1 else ''}</td>"
+                f"<tr><td>{_swatch(acol[a.id])}{names[i]}</td>"
                 f"<td style='text-align:right'>{a.fraction:.1f} %</td>"
                 f"<td style='text-align:right'>LIM {_fmt(lim.get(a.id), 3)}</td></tr>"
-                for a in res.attractors)
+                for i, a in enumerate(res.attractors))
             out += f"<b>attractors</b><table style='font-size:12px'>{arows}</table>"
             integ = m.get("integrity", {})
             out += ("<b>measures</b><table style='font-size:12px'>"
@@ -808,7 +806,7 @@ def _png(view, shown, colour_by):
             F.fig_basin(shown.result)
         name = f"basin_{p.law}_hb{p.hb:g}_alpha{p.alpha:g}_omega{p.omega:g}.png"
     elif view == "run":
-        fig = F.fig_trajectory(shown.result)
+        fig = F.fig_trajectory(shown.result, (shown.behaviour, shown.period))
         name = f"run_{p.law}_theta{shown.state[0]:.4g}_dtheta{shown.state[1]:.4g}.png"
     elif view == "sweep":
         fig = F.fig_bifurcation(shown.result)

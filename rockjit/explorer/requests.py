@@ -187,7 +187,7 @@ def compare_call(params, grid):
     """Python that reproduces the two laws side by side and their agreement."""
     p = params
     extra = ("Integration",) if p.integration_source() else ()
-    text = _header(*extra) + "from rockjit.plotting.figures import agreement\n"
+    text = _header(*extra) + "from rockjit.basins.identity import agreement\n"
     for name, law in (("housner", "housner"), ("mao", "mao")):
         text += (f"{name} = rockjit.basin({p.block_source(law)}, {p.forcing_source()}, "
                  f"grid={grid}{p.integration_source()})\n")

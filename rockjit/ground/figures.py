@@ -2,7 +2,7 @@
 
 Each function takes result objects and returns a :class:`matplotlib.figure.Figure` built
 without :mod:`matplotlib.pyplot` (as :mod:`rockjit.plotting.figures` does); the restitution laws
-keep their colours (:data:`rockjit.plotting.figures.LAW_COLOURS`).
+keep their colours (:data:`rockjit.plotting.style.LAW_COLOURS`).
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ def _figure(**kw):
 
 
 def _law_colour(law):
-    from ..plotting.figures import LAW_COLOURS
+    from ..plotting.style import LAW_COLOURS
     return LAW_COLOURS.get(law, "k")
 
 

@@ -68,7 +68,7 @@ def initial_state(state, settings):
         raise ValueError(f"state[0] (theta0) must satisfy |theta0| < theta_over = "
                          f"{settings.theta_over:.6g} (got {th:g}): the block would start "
                          f"overturned")
-    return (th, real("state[1] (theta0')", float(z[1]), -1e6, 1e6))
+    return (th, real("state[1] (dtheta0)", float(z[1]), -1e6, 1e6))
 
 
 def plan_transient(block, forcing, state, integration, lyapunov, record_stride, method):

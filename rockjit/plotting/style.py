@@ -37,7 +37,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["AGREE_COLOUR", "BEHAVIOUR_COLOURS", "DISAGREE_COLOUR", "FORMATS", "LAW_LINES",
+__all__ = ["AGREE_COLOUR", "BEHAVIOUR_COLOURS", "DISAGREE_COLOUR", "FORMATS", "LAW_COLOURS",
+           "LAW_LINES",
            "LAW_NAMES", "STYLES", "SYMBOLS", "Style", "attractor_colours", "attractor_names",
            "behaviour_cmap", "current", "cvd_distances", "law_name", "letter", "shade",
            "suptitle", "texts_outside", "tint", "use", "variant"]
@@ -62,6 +63,11 @@ LAW_NAMES = {"housner": "Housner", "mao": "Mao et al.", "constant": "constant $e
 LAW_LINES = {"housner": dict(color="k", ls="-", marker="o"),
              "mao": dict(color="k", ls=(0, (5, 2)), marker="s"),
              "constant": dict(color="k", ls=":", marker="^")}
+
+#: The laws' colours where a figure shows no behaviour and compares the laws in colour (the
+#: ground-motion spectra and fragility curves): Okabe and Ito's blue and vermillion, apart under
+#: every colour-vision deficiency.
+LAW_COLOURS = {"housner": "#0072B2", "mao": "#D55E00", "constant": "#009E73"}
 
 #: Mathtext of the quantities on the axes.
 SYMBOLS = {"theta": r"$\theta$", "dtheta": r"$\theta'$", "theta0": r"$\theta_0$",
