@@ -5,8 +5,8 @@ and return rows) and a ``main()`` that runs them and hands the rows to :meth:`Be
 module is all they share:
 
 - :class:`Bench` parses the common options (``--quick``, ``--out DIR``), records what the numbers
-  were measured on, and writes the report: the Markdown table (``.md``, also pasted into its block
-  of benchmarks/README.md by a full run), the ``.csv``, the ``.json`` and the plots, every file
+  were measured on, and writes the report: the Markdown table (``.md``, also pasted into its
+  marked block of any page that carries one), the ``.csv``, the ``.json`` and the plots, every file
   through :mod:`rockjit.storage.files`'s atomic writers (so the JSON is strict, with non-finite
   floats written as the strings ``"nan"``, ``"inf"``, ``"-inf"``, rockjit's one convention);
 - :func:`side_by_side` times cases interleaved in rotating order (medians of repeats, every ratio
@@ -17,7 +17,7 @@ module is all they share:
   compare versions);
 - :func:`impact_time_error` compares the impact times of two runs.
 
-House rules (benchmarks/README.md): every quoted time is a median of repeats taken side by side;
+House rules: every quoted time is a median of repeats taken side by side;
 compile time is reported apart; a ``--quick`` run is a smoke test that never writes to
 benchmarks/results/ and never touches the README.
 """

@@ -80,7 +80,7 @@ def paper_out(request):
 @pytest.mark.slow
 def test_every_paper_figure_keeps_its_text_on_the_canvas(paper_out):
     out, _ = paper_out
-    assert len(out.figures) == 20  # figures 1-8, the as-published pair and the branches
+    assert len(out.figures) == 22  # figures 1-9, the as-published pair and the branches
     _assert_fits(out)
 
 
