@@ -163,6 +163,8 @@ def run_single(block, y0, phi, *, n_steps, periods, window, max_impacts, record_
         n_locate_unconverged=int(iout[ig.O_UNCONVERGED]),
         t_overturn=float(fout[ig.F_TOVER]),
     )
+    # events located by genuine steps because the step's interpolant was not trusted
+    res.extra["locate_resteps"] = int(iout[ig.O_RESTEP])
     if lyapunov:
         # the tangent matrix at the end: the flow's Jacobian since the last renormalisation;
         # with qr_every = 0 that is the whole run's, and zero once a perturbation died (a rest

@@ -268,7 +268,7 @@ def _bank(periods, n_per, cap):
                 np.zeros((W, n_st, 2)), np.zeros((W, 4, 2)), np.zeros((W, 4)),
                 np.zeros((W, ig.N_TAB, n_st)), np.zeros((W, ig.N_TAB, n_st)),
                 np.zeros((W, n_st)), np.zeros((W, n_st)), np.zeros((W, 4)),
-                np.zeros((W, n_per, n_st)))
+                np.zeros((W, n_per, ig.N_FTAB)))
 
 
 @jit(nrt=False, inline=True)
