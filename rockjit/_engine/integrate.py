@@ -1018,28 +1018,47 @@ def _run(EMBED4, TANGENT, y0, side0, par_in, ipar, out):
     return _loop(EMBED4, TANGENT, record, y0, side0, par, ipar, out, w)
 
 
-@jit(nrt=False, inline=True)
-def start(EMBED4, TANGENT, y0, side0, par, ipar, out, w):
-    """Before the first step: the step tables, the initial state and its samples, the field at
-    the start. Returns the status (overturned already, or running)."""
-    NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
+@jit(nrt=False)
+def tables(EMBED4, par, ipar, w):
+    """The step table of a grid step (``w.tab_h``) and, with the closed-form forcing, the
+    forcing table ``w.ftab`` of a period (columns ``FT_*``): the grid repeats, so the forcing at
+    stage ``i`` of grid step ``j``, phase ``phi + 2 pi (j + c_i) / N``, is made once per run, as
+    the phase at the step's start rotated by the stage's advance ``2 pi c_i / N`` (one sine and
+    cosine per grid step)."""
     n_per = ipar[I_N]
     step_table(par[P_OMEGA], par[P_H], w.tab_h)
-    # The forcing acceleration at the stages of the grid steps of a period (the grid repeats):
-    # phase phi + 2 pi (j + c_i) / N at stage i of step j, sines made once per run; with its
-    # derivative at the steps' ends and the phase's sine and cosine at their starts (FT_*).
     if EMBED4 is None:
-        aw3 = par[P_AW2] * par[P_OMEGA]
+        aw2 = par[P_AW2]
+        aw3 = aw2 * par[P_OMEGA]
+        ftab = w.ftab
         for j in range(n_per):
+            ph0 = par[P_PHI] + 2.0 * math.pi * j / n_per
+            s0 = math.sin(ph0)
+            c0 = math.cos(ph0)
+            ftab[j, FT_SIN] = s0
+            ftab[j, FT_COS] = c0
+            ftab[j, FT_DF0] = aw3 * c0
             for i in range(N_STAGES + 1):
                 c = C[i] if i < N_STAGES else 1.0
-                w.ftab[j, i] = par[P_AW2] * math.sin(par[P_PHI] + 2.0 * math.pi * (j + c)
-                                                     / n_per)
-            ph0 = par[P_PHI] + 2.0 * math.pi * j / n_per
-            w.ftab[j, FT_DF0] = aw3 * math.cos(ph0)
-            w.ftab[j, FT_DF1] = aw3 * math.cos(par[P_PHI] + 2.0 * math.pi * (j + 1) / n_per)
-            w.ftab[j, FT_SIN] = math.sin(ph0)
-            w.ftab[j, FT_COS] = math.cos(ph0)
+                sd, cd = sincos(2.0 * math.pi * c / n_per)
+                ftab[j, i] = aw2 * fma(s0, cd, c0 * sd)
+                if i == N_STAGES:
+                    ftab[j, FT_DF1] = aw3 * fma(c0, cd, -(s0 * sd))
+
+
+@jit(nrt=False, inline=True)
+def start(EMBED4, TANGENT, y0, side0, par, ipar, out, w):
+    """Before the first step: the step tables (:func:`tables`), the initial state and its
+    samples, the field at the start. Returns the status (overturned already, or running)."""
+    tables(EMBED4, par, ipar, w)
+    return start_state(EMBED4, TANGENT, y0, side0, par, ipar, out, w)
+
+
+@jit(nrt=False, inline=True)
+def start_state(EMBED4, TANGENT, y0, side0, par, ipar, out, w):
+    """:func:`start` less the tables (the lanes keep a lane's tables for its next cell when
+    the forcing and the grid are the same)."""
+    NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
     y = w.y
     for m in range(NS):
         y[m] = y0[m]

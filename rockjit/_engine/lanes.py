@@ -207,7 +207,9 @@ def block_step_lanes(n, j, lin, lout, ftl):
  S_CELL) = range(11)
 N_ST = 11
 F_TT, F_MAXERR, F_TLIFT = range(3)
-N_FS = 3
+# the forcing and grid the lane's tables were made for: alpha omega^2, omega, phi, h, N
+F_KEY = 3
+N_FS = F_KEY + 5
 
 
 @jit(nrt=False)
@@ -304,12 +306,10 @@ def _load(l, i, y0s, pars, ipar, b):
     _zero(b.K[l])
     _zero(b.states[l])
     _zero(b.lam[l])
-    _zero(b.tab_h[l])
     _zero(b.tab[l])
     _zero(b.fr[l])
     _zero(b.jac[l])
     _zero(b.trig[l])
-    _zero(b.ftab[l])
     _zero(b.per_imp[l])
     _zero(b.iout[l])
     par = b.par[l]
@@ -323,9 +323,27 @@ def _load(l, i, y0s, pars, ipar, b):
     w = lane_work(b, l)
     y0 = y0s[i]
     side0 = initial_side(y0[0], y0[1])
-    status = ig.start(None, None, y0, side0, par, ipar, out, w)
     st = b.st[l]
     fs = b.fs[l]
+    # the lane's tables serve the next cell too when its forcing and grid are the same (every
+    # cell of a basin): they are made by the same code from the same numbers
+    same = (fs[F_KEY] == par[ig.P_AW2] and fs[F_KEY + 1] == par[ig.P_OMEGA]
+            and fs[F_KEY + 2] == par[ig.P_PHI] and fs[F_KEY + 3] == par[ig.P_H]
+            and fs[F_KEY + 4] == ipar[ig.I_N])
+    if not same:
+        _zero(b.tab_h[l])
+        _zero(b.ftab[l])
+        ig.tables(None, par, ipar, w)
+        lane_tables(w.tab_h, b.lin, l)
+        for jj in range(ipar[ig.I_N]):
+            for s in range(ig.N_STAGES + 1):
+                b.ftl[(jj * (ig.N_STAGES + 1) + s) * W + l] = w.ftab[jj, s]
+        fs[F_KEY] = par[ig.P_AW2]
+        fs[F_KEY + 1] = par[ig.P_OMEGA]
+        fs[F_KEY + 2] = par[ig.P_PHI]
+        fs[F_KEY + 3] = par[ig.P_H]
+        fs[F_KEY + 4] = ipar[ig.I_N]
+    status = ig.start_state(None, None, y0, side0, par, ipar, out, w)
     for m in range(N_ST):
         st[m] = 0
     st[S_STATUS] = status
@@ -336,10 +354,6 @@ def _load(l, i, y0s, pars, ipar, b):
     fs[F_TT] = 0.0
     fs[F_MAXERR] = 0.0
     fs[F_TLIFT] = -math.inf
-    lane_tables(w.tab_h, b.lin, l)
-    for jj in range(ipar[ig.I_N]):
-        for s in range(ig.N_STAGES + 1):
-            b.ftl[(jj * (ig.N_STAGES + 1) + s) * W + l] = w.ftab[jj, s]
     b.lin[I_STHC * W + l] = par[ig.P_STHC]
     b.lin[I_CTHC * W + l] = par[ig.P_CTHC]
     b.lin[I_XI * W + l] = par[ig.P_XI]
