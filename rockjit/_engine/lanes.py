@@ -25,7 +25,7 @@ from . import integrate as ig
 from . import cell
 from .._jit import cycles, fma, jit
 from ..model import (NEAR_RANGE, SINCOS_RANGE, accel_near, corner, initial_side, rotate,
-                    sincos_poly)
+                    sincos_poly, uplift_time)
 
 __all__ = ["W", "bank", "block_step_lanes", "lane_tables", "run_lanes", "scalar_step"]
 
@@ -206,9 +206,10 @@ def block_step_lanes(n, j, lin, lout, ftl):
 (S_STATUS, S_SIDE, S_NIMP, S_STEP, S_JPER, S_KPER, S_JQR, S_JREC, S_NCOL, S_NCOLWIN,
  S_CELL) = range(11)
 N_ST = 11
-F_TT, F_MAXERR, F_TLIFT = range(3)
+F_TT, F_MAXERR, F_TLIFT, F_TUP = range(4)
+# F_TUP: at rest, the instant the forcing lifts the block (rockjit.model.uplift_time)
 # the forcing and grid the lane's tables were made for: alpha omega^2, omega, phi, h, N
-F_KEY = 3
+F_KEY = 4
 N_FS = F_KEY + 5
 
 
@@ -354,11 +355,26 @@ def _load(l, i, y0s, pars, ipar, b):
     fs[F_TT] = 0.0
     fs[F_MAXERR] = 0.0
     fs[F_TLIFT] = -math.inf
+    fs[F_TUP] = _uplift(st, fs, par)
     b.lin[I_STHC * W + l] = par[ig.P_STHC]
     b.lin[I_CTHC * W + l] = par[ig.P_CTHC]
     b.lin[I_XI * W + l] = par[ig.P_XI]
     _refresh(l, b)
     return status == ig.RUNNING and ipar[ig.I_N] * ipar[ig.I_PERIODS] > 0
+
+
+#: A lane at rest skips its scalar steps while the uplift lies this many steps' lengths
+#: beyond the grid point (margin for the rounding of uplift_time at another instant): the
+#: single-lane code holds it at rest there (REST_HOLD), and so do the lanes, bit for bit.
+REST_MARGIN = 1e-9
+
+
+@jit(nrt=False, inline=True)
+def _uplift(st, fs, par):
+    """At rest (``side`` 0): the next uplift after the lane's time; else -inf."""
+    if st[S_SIDE] != 0 or st[S_STATUS] != ig.RUNNING:
+        return -math.inf
+    return uplift_time(fs[F_TT], par[ig.P_AW2], par[ig.P_COT], par[ig.P_OMEGA], par[ig.P_PHI])
 
 
 @jit(nrt=False, inline=True)
@@ -432,11 +448,13 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
     :func:`rockjit._engine.kernel._grid`'s.
 
     Each grid step: :func:`block_step_lanes` for all lanes at once, which accepts the step of
-    every lane in flight whose step has no event, stays in the polynomials' range; every other
-    lane's step (an event, a rest phase) is taken again by :func:`scalar_step`, the single-lane
-    code. A lane's arithmetic is the single-lane kernel's either way, so its results are bit for
+    every lane in flight whose step has no event, stays in the polynomials' range; a lane at
+    rest whose uplift (computed once when it came to rest) lies beyond the grid point is held
+    there, as the single-lane code would hold it; every other lane's step (an event, the end of
+    a rest phase) is taken again by :func:`scalar_step`, the single-lane code. A lane's arithmetic is the single-lane kernel's either way, so its results are bit for
     bit those of :func:`rockjit._engine.kernel._grid` (the running error estimate ``max_err`` is not
-    kept on the fast path: no grid output reads it). ``counts``: the fast and the scalar steps,
+    kept on the fast path: no grid output reads it). ``counts``: the fast steps (with the steps
+    held at rest) and the scalar steps,
     the vector steps taken, and with ``prof`` the cycles (``readcyclecounter``) spent in the
     vector steps, in the scalar steps, and in all, then the parts of the scalar steps
     (:func:`scalar_step`); without, the cycle counter is not read (its reads cost ~10 % of a
@@ -483,11 +501,18 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
             st = b.st[l]
             if st[S_CELL] < 0:
                 continue
-            if lout[O_FAST * W + l] != 0.0:
+            fast = lout[O_FAST * W + l] != 0.0
+            hl = b.par[l, ig.P_H]
+            # at rest with the uplift beyond the grid point: held there, as the scalar step
+            # would (rockjit._engine.integrate.leave_rest), without taking it
+            held = (st[S_SIDE] == 0
+                    and b.fs[l, F_TUP] - (st[S_STEP] + 1) * hl > REST_MARGIN * hl)
+            if fast or held:
                 counts[0] += 1
-                iout = b.iout[l]
-                iout[ig.O_RHS] += ig.N_STAGES
-                iout[ig.O_SUBSTEPS] += 1
+                if fast:
+                    iout = b.iout[l]
+                    iout[ig.O_RHS] += ig.N_STAGES
+                    iout[ig.O_SUBSTEPS] += 1
                 step = st[S_STEP] + 1
                 st[S_STEP] = step
                 t = step * b.par[l, ig.P_H]
@@ -518,6 +543,7 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
                 scalar_step(None, st, b.fs[l], b.par[l], ipar, lane_outputs(b, l),
                             lane_work(b, l), pre, prof, counts)
                 _refresh(l, b)
+                b.fs[l, F_TUP] = _uplift(st, b.fs[l], b.par[l])
                 counts[4] += (cycles() - c0) if prof else 0
             if st[S_STATUS] != ig.RUNNING or st[S_STEP] >= total:
                 _sync(l, b)
