@@ -656,11 +656,17 @@ def hermite7(p0, p1, p2, p3, q0, q1, q2, q3):
 
 @jit(nrt=False, inline=True)
 def poly7(c0, c1, c2, c3, c4, c5, c6, c7, x):
-    """``sum_k c_k x^k`` and its derivative in ``x`` (Horner)."""
-    v = fma(fma(fma(fma(fma(fma(fma(c7, x, c6), x, c5), x, c4), x, c3), x, c2), x, c1), x, c0)
-    d = fma(fma(fma(fma(fma(fma(7.0 * c7, x, 6.0 * c6), x, 5.0 * c5), x, 4.0 * c4), x,
-                    3.0 * c3), x, 2.0 * c2), x, c1)
-    return v, d
+    """``sum_k c_k x^k`` (Estrin's scheme: half the dependency depth of Horner's)."""
+    x2 = x * x
+    return fma(fma(fma(c7, x, c6), x2, fma(c5, x, c4)), x2 * x2,
+               fma(fma(c3, x, c2), x2, fma(c1, x, c0)))
+
+
+@jit(nrt=False, inline=True)
+def poly6(c0, c1, c2, c3, c4, c5, c6, x):
+    """``sum_k c_k x^k`` (Estrin's scheme)."""
+    x2 = x * x
+    return fma(fma(c6, x2, fma(c5, x, c4)), x2 * x2, fma(fma(c3, x, c2), x2, fma(c1, x, c0)))
 
 
 @jit(nrt=False)
@@ -673,8 +679,10 @@ def locate_interp(kind, y, ynew, hh, lo, hi, K, side, par, trig, f0, df0, f1, df
     its derivative at the ends, ``trig`` the sines and cosines of theta there). Each matches
     the ends' data to degree 7, so within the step it carries the error of the end state (the
     step's own, of order h^6) plus an interpolation error of order h^8. A safeguarded Newton
-    iteration (regula falsi to start, bisection when a step leaves the bracket) finds the root
-    of the event function on it.
+    iteration finds the root of the event function on it, started from the root of the step's
+    start's quadratic Taylor polynomial (2.5 iterations an event on the study's basin; from
+    regula falsi, 7.8: a flight that starts on theta = 0 is bracketed from its apex, where
+    Newton's steps leave the bracket).
 
     Its error at the root is estimated from the step's own data (below): the interpolation
     error, and the end state's error weighted by the septic's basis function of the end value.
@@ -715,30 +723,59 @@ def locate_interp(kind, y, ynew, hh, lo, hi, K, side, par, trig, f0, df0, f1, df
     v4, v5, v6, v7, ve0, ve1 = hermite7(v0, u1, u2, u3, v1, w1, h2 * j1, h3 * s1)
     v2 = 0.5 * u2
     v3 = u3 / 6.0
+    # the event function g (positive before the event) on the interpolant, as a polynomial:
+    # sg theta + g_off, and its derivative's coefficients
+    sg = float(side) if kind == EV_IMPACT else -float(side)
+    g0 = fma(sg, th0, par[P_THOVER] if kind == EV_OVERTURN else 0.0)
+    g1 = sg * p1
+    g2 = sg * t2
+    g3 = sg * t3
+    g4 = sg * t4
+    g5 = sg * t5
+    g6 = sg * t6
+    g7 = sg * t7
+    d2 = 2.0 * g2
+    d3 = 3.0 * g3
+    d4 = 4.0 * g4
+    d5 = 5.0 * g5
+    d6 = 6.0 * g6
+    d7 = 7.0 * g7
     a = lo / hh
     b = hi / hh
-    th, dth = poly7(th0, p1, t2, t3, t4, t5, t6, t7, a)
-    ga, _ = event_g(kind, th, dth, side, par)
-    th, dth = poly7(th0, p1, t2, t3, t4, t5, t6, t7, b)
-    gb, _ = event_g(kind, th, dth, side, par)
+    ga = poly7(g0, g1, g2, g3, g4, g5, g6, g7, a)
+    gb = poly7(g0, g1, g2, g3, g4, g5, g6, g7, b)
     if not (ga > 0.0 and gb <= 0.0):
         return -1, 0.0, 0.0, 0.0
-    x = a + ga * (b - a) / (ga - gb)
-    if not (a < x < b):
-        x = 0.5 * (a + b)
+    # a start: the root in the bracket of the quadratic g0 + g1 x + g2 x^2 (the step's start's
+    # Taylor polynomial: it finds the far root of a flight that starts on g = 0), else regula
+    # falsi; then Newton, stopped once its step is below 1e-9 (the next would be below 1e-17:
+    # it converges quadratically); a step that leaves the bracket bisects it
+    x = -1.0
+    disc = fma(g1, g1, -4.0 * g0 * g2)
+    if disc >= 0.0 and g2 != 0.0:
+        qq = -0.5 * (g1 + math.copysign(math.sqrt(disc), g1))
+        if qq != 0.0:
+            r1 = qq / g2
+            r2 = g0 / qq
+            if a < r2 < b:
+                x = r2
+            elif a < r1 < b:
+                x = r1
+    if x < 0.0:
+        x = a + ga * (b - a) / (ga - gb)
+        if not (a < x < b):
+            x = 0.5 * (a + b)
     for _ in range(BISECT_ITERS):
-        th, dth = poly7(th0, p1, t2, t3, t4, t5, t6, t7, x)
-        g, dg = event_g(kind, th, dth, side, par)
+        g = poly7(g0, g1, g2, g3, g4, g5, g6, g7, x)
         if g > 0.0:
             a = x
         elif g < 0.0:
             b = x
         else:
             break
+        dg = poly6(g1, d2, d3, d4, d5, d6, d7, x)
         xn = x - g / dg if dg != 0.0 else 0.5 * (a + b)
-        # converged (Newton's step within rounding: it may land on a bracket's end), or else
-        # safeguarded: a step that leaves the bracket bisects it
-        if abs(xn - x) <= 1e-15 and a <= xn <= b:
+        if abs(xn - x) <= 1e-9 and a <= xn <= b:
             x = xn
             break
         if not (a < xn < b):
@@ -747,8 +784,8 @@ def locate_interp(kind, y, ynew, hh, lo, hi, K, side, par, trig, f0, df0, f1, df
             x = xn
             break
         x = xn
-    th, _ = poly7(th0, p1, t2, t3, t4, t5, t6, t7, x)
-    v, _ = poly7(v0, u1, v2, v3, v4, v5, v6, v7, x)
+    th = poly7(th0, p1, t2, t3, t4, t5, t6, t7, x)
+    v = poly7(v0, u1, v2, v3, v4, v5, v6, v7, x)
     # The interpolant's error at x: its own (the septic less the quintic) and the end state's,
     # weighted by the septic's basis function of the end value, x^4 (35 - 84 x + 70 x^2 - 20 x^3).
     # The end state's error is estimated by the defect of theta's end value against the
