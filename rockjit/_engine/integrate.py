@@ -642,16 +642,14 @@ def hermite7(p0, p1, p2, p3, q0, q1, q2, q3):
     """``c4 .. c7`` of the two-point Hermite polynomial ``sum_k c_k x^k`` of degree 7 on
     ``[0, 1]`` whose value and first three derivatives are ``p0 .. p3`` at 0 and ``q0 .. q3``
     at 1 (derivatives in ``x``: ``h^k`` times those in time); ``c0 .. c3`` are
-    ``p0, p1, p2 / 2, p3 / 6``. Also ``e0, e1``: the polynomial less the quintic Hermite
-    polynomial of the values and first two derivatives is ``x^3 (1 - x)^3 (e0 + e1 x)``."""
+    ``p0, p1, p2 / 2, p3 / 6``."""
     d = q0 - p0
     c4 = (210.0 * d - 120.0 * p1 - 30.0 * p2 - 4.0 * p3 - 90.0 * q1 + 15.0 * q2 - q3) / 6.0
     c5 = (-168.0 * d + 90.0 * p1 + 20.0 * p2 + 2.0 * p3 + 78.0 * q1 - 14.0 * q2 + q3) / 2.0
     c6 = (420.0 * d - 216.0 * p1 - 45.0 * p2 - 4.0 * p3 - 204.0 * q1 + 39.0 * q2
           - 3.0 * q3) / 6.0
     c7 = (-120.0 * d + 60.0 * p1 + 12.0 * p2 + p3 + 60.0 * q1 - 12.0 * q2 + q3) / 6.0
-    e0 = -10.0 * d + 6.0 * p1 + 1.5 * p2 + p3 / 6.0 + 4.0 * q1 - 0.5 * q2
-    return c4, c5, c6, c7, e0, -c7
+    return c4, c5, c6, c7
 
 
 @jit(nrt=False, inline=True)
@@ -667,6 +665,78 @@ def poly6(c0, c1, c2, c3, c4, c5, c6, x):
     """``sum_k c_k x^k`` (Estrin's scheme)."""
     x2 = x * x
     return fma(fma(c6, x2, fma(c5, x, c4)), x2 * x2, fma(fma(c3, x, c2), x2, fma(c1, x, c0)))
+
+
+@jit(nrt=False, inline=True)
+def interpolant(y, ynew, hh, K, side, par, trig, f0, df0, f1, df1):
+    """The step's own interpolant: Hermite polynomials in ``x = tau / hh`` of degree 7 through
+    the step's ends (``y`` at ``x = 0``, ``ynew`` at 1; stages in ``K``, sines and cosines of
+    theta at the ends in ``trig``; ``f0, df0`` and ``f1, df1`` the forcing and its time
+    derivative at the ends).
+
+    Returns ``(tc, vc, cint, dfc)``: the coefficients ``c0 .. c7`` of theta (through theta and
+    its first three derivatives at both ends, :func:`end_derivs`) and of theta' (through theta'
+    and its first three derivatives); ``cint``, the estimated constant ``C`` of theta's
+    interpolation error ``C x^4 (1 - x)^4`` (Hermite's remainder, ``h^8 theta^(8) / 8!``): the
+    septic's fourth derivative less the snap at each end is ``-24 C`` there, the larger taken;
+    and ``dfc``, the defect of theta's end value against the integral of theta' by the
+    Hermite-Obreschkoff quadrature of the ends' derivatives (exact to degree 7),
+    ``th1 - th0 - h (v0 + v1) / 2 - 3/28 h^2 (a0 - a1) - h^3 / 84 (j0 + j1)
+    - h^4 / 1680 (s0 - s1)``: of order h^6, an estimate of the end value's error (measured
+    within a factor 1.2 of it on a smooth segment from N = 16 on, and within a factor 2 on the
+    steps before impacts from N = 64 on; the embedded estimate is of order h^5 and 50-200
+    times larger).
+    """
+    th0 = y[0]
+    th1 = ynew[0]
+    v0 = y[1]
+    v1 = ynew[1]
+    a0 = K[0, 1]
+    a1 = K[N_STAGES, 1]
+    j0, s0 = end_derivs(f0, df0, side, trig[0], trig[1], v0, a0, par)
+    j1, s1 = end_derivs(f1, df1, side, trig[2], trig[3], v1, a1, par)
+    h2 = hh * hh
+    h3 = h2 * hh
+    p1 = hh * v0
+    p2 = h2 * a0
+    p3 = h3 * j0
+    q1 = hh * v1
+    t4, t5, t6, t7 = hermite7(th0, p1, p2, p3, th1, q1, h2 * a1, h3 * j1)
+    u1 = hh * a0
+    u2 = h2 * j0
+    u3 = h3 * s0
+    w3 = h3 * s1
+    v4, v5, v6, v7 = hermite7(v0, u1, u2, u3, v1, hh * a1, h2 * j1, w3)
+    dfc = th1 - th0 - (0.5 * (p1 + q1) + (3.0 / 28.0) * (p2 - h2 * a1)
+                       + (1.0 / 84.0) * (p3 + h3 * j1) + (hh / 1680.0) * (u3 - w3))
+    # theta's fourth derivative in x at the ends, on the septic, against the snaps there
+    d40 = fma(24.0, t4, -(hh * u3))
+    d41 = fma(24.0, t4, fma(120.0, t5, fma(360.0, t6, fma(840.0, t7, -(hh * w3)))))
+    cint = max(abs(d40), abs(d41)) / 24.0
+    return ((th0, p1, 0.5 * p2, p3 / 6.0, t4, t5, t6, t7),
+            (v0, u1, 0.5 * u2, u3 / 6.0, v4, v5, v6, v7), cint, dfc)
+
+
+@jit(nrt=False, inline=True)
+def interp_error(cint, dfc, x):
+    """The error estimate of theta on the interpolant at ``x`` (:func:`interpolant`'s
+    ``cint, dfc``): the interpolation error ``cint x^4 (1 - x)^4`` plus the end state's,
+    ``|dfc|`` weighted by the septic's basis function of the end value,
+    ``x^4 (35 - 84 x + 70 x^2 - 20 x^3)``."""
+    xx = x * (1.0 - x)
+    x4 = (x * x) * (x * x)
+    w = x4 * fma(fma(fma(-20.0, x, 70.0), x, -84.0), x, 35.0)
+    return fma(cint, (xx * xx) * (xx * xx), w * abs(dfc))
+
+
+@jit(nrt=False)
+def interp_at(y, ynew, hh, K, side, par, trig, f0, df0, f1, df1, x):
+    """theta, theta' and the error estimate of the step's interpolant at ``x`` (for tests and
+    benchmarks: :func:`interpolant`, :func:`interp_error`)."""
+    tc, vc, cint, dfc = interpolant(y, ynew, hh, K, side, par, trig, f0, df0, f1, df1)
+    return (poly7(tc[0], tc[1], tc[2], tc[3], tc[4], tc[5], tc[6], tc[7], x),
+            poly7(vc[0], vc[1], vc[2], vc[3], vc[4], vc[5], vc[6], vc[7], x),
+            interp_error(cint, dfc, x))
 
 
 @jit(nrt=False)
@@ -688,52 +758,30 @@ def locate_interp(kind, y, ynew, hh, lo, hi, K, side, par, trig, f0, df0, f1, df
     error, and the end state's error weighted by the septic's basis function of the end value.
     Divided by ``|theta'|`` there, it is an estimate of the event time's error; the interpolant
     is trusted when that is at most ``LOCATE_TOL * hh`` (1e-8 h, the size of the last Newton
-    correction that the genuine steps carry along the field, :data:`DELTA_EULER`). Measured on
-    the study's basin at N = 64, 99.98 % of its events pass, and every event of the
-    event-accuracy orbits at N = 160; the events that fail are those early in a coarse step
-    with a slow crossing, where a genuine step of the event's own (short) length is the more
-    accurate (tests/test_integrate.py, the dips through 0 at N = 16).
+    correction that the genuine steps carry along the field, :data:`DELTA_EULER`). Measured:
+    on a smooth segment the estimate is 1.0-1.7 times the true error of theta from N = 16 on;
+    on the study's basin at N = 64 all but 2 in 100 000 events pass, and every event of the
+    event-accuracy orbits from N = 32 on; at N = 16 most of them fail, and so do the events
+    early in a coarse step with a slow crossing, where a genuine step of the event's own (short)
+    length is the more accurate (tests/test_integrate.py: the dips through 0 at N = 16).
 
     Returns ``(ok, x, theta, theta')``: ``x = tau / hh`` and the state there; ``ok`` is 1 when
     trusted, 0 when not (``x`` then starts the genuine steps' Newton iteration,
     :func:`locate_step`), -1 when the interpolant does not bracket the event as the step's
     data did.
     """
-    th0 = y[0]
-    th1 = ynew[0]
-    v0 = y[1]
-    v1 = ynew[1]
-    a0 = K[0, 1]
-    a1 = K[N_STAGES, 1]
-    j0, s0 = end_derivs(f0, df0, side, trig[0], trig[1], v0, a0, par)
-    j1, s1 = end_derivs(f1, df1, side, trig[2], trig[3], v1, a1, par)
-    h2 = hh * hh
-    h3 = h2 * hh
-    p1 = hh * v0
-    p2 = h2 * a0
-    p3 = h3 * j0
-    q1 = hh * v1
-    t4, t5, t6, t7, te0, te1 = hermite7(th0, p1, p2, p3, th1, q1, h2 * a1, h3 * j1)
-    t2 = 0.5 * p2
-    t3 = p3 / 6.0
-    u1 = hh * a0
-    u2 = h2 * j0
-    u3 = h3 * s0
-    w1 = hh * a1
-    v4, v5, v6, v7, ve0, ve1 = hermite7(v0, u1, u2, u3, v1, w1, h2 * j1, h3 * s1)
-    v2 = 0.5 * u2
-    v3 = u3 / 6.0
+    tc, vc, cint, dfc = interpolant(y, ynew, hh, K, side, par, trig, f0, df0, f1, df1)
     # the event function g (positive before the event) on the interpolant, as a polynomial:
     # sg theta + g_off, and its derivative's coefficients
     sg = float(side) if kind == EV_IMPACT else -float(side)
-    g0 = fma(sg, th0, par[P_THOVER] if kind == EV_OVERTURN else 0.0)
-    g1 = sg * p1
-    g2 = sg * t2
-    g3 = sg * t3
-    g4 = sg * t4
-    g5 = sg * t5
-    g6 = sg * t6
-    g7 = sg * t7
+    g0 = fma(sg, tc[0], par[P_THOVER] if kind == EV_OVERTURN else 0.0)
+    g1 = sg * tc[1]
+    g2 = sg * tc[2]
+    g3 = sg * tc[3]
+    g4 = sg * tc[4]
+    g5 = sg * tc[5]
+    g6 = sg * tc[6]
+    g7 = sg * tc[7]
     d2 = 2.0 * g2
     d3 = 3.0 * g3
     d4 = 4.0 * g4
@@ -784,23 +832,9 @@ def locate_interp(kind, y, ynew, hh, lo, hi, K, side, par, trig, f0, df0, f1, df
             x = xn
             break
         x = xn
-    th = poly7(th0, p1, t2, t3, t4, t5, t6, t7, x)
-    v = poly7(v0, u1, v2, v3, v4, v5, v6, v7, x)
-    # The interpolant's error at x: its own (the septic less the quintic) and the end state's,
-    # weighted by the septic's basis function of the end value, x^4 (35 - 84 x + 70 x^2 - 20 x^3).
-    # The end state's error is estimated by the defect of theta's end value against the
-    # integral of theta' (Hermite-Obreschkoff quadrature of the ends' derivatives, exact to
-    # degree 7): th1 - th0 - h (v0 + v1) / 2 - 3/28 h^2 (a0 - a1) - h^3 / 84 (j0 + j1)
-    # - h^4 / 1680 (s0 - s1), of order h^6 and, measured, within a factor 2 of the end value's
-    # true error from N = 64 on (the embedded estimate is of order h^5 and 50-200 times larger).
-    xx = x * (1.0 - x)
-    b3 = xx * xx * xx
-    est = max(abs(b3 * fma(te1, x, te0)), abs(b3 * fma(ve1, x, ve0)))
-    dfc = th1 - th0 - (0.5 * (p1 + q1) + (3.0 / 28.0) * (p2 - h2 * a1)
-                       + (1.0 / 84.0) * (p3 + h3 * j1) + (hh / 1680.0) * (u3 - h3 * s1))
-    x4 = (x * x) * (x * x)
-    w = x4 * fma(fma(fma(-20.0, x, 70.0), x, -84.0), x, 35.0)
-    err = est + w * abs(dfc)
+    th = poly7(tc[0], tc[1], tc[2], tc[3], tc[4], tc[5], tc[6], tc[7], x)
+    v = poly7(vc[0], vc[1], vc[2], vc[3], vc[4], vc[5], vc[6], vc[7], x)
+    err = interp_error(cint, dfc, x)
     return 1 if err <= LOCATE_TOL * hh * abs(v) else 0, x, th, v
 
 
