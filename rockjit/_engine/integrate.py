@@ -25,7 +25,10 @@ straight from the accelerations (Nyström's form of the tableau), and enters onl
 polynomial (:func:`rockjit.model.accel_near`); the forcing at the stages of a grid step is
 tabulated once per run. The step's pieces are inlined into :func:`_loop` by LLVM (they are
 marked ``alwaysinline``: :func:`rockjit._jit.jit`), which is compiled without numba's reference
-counting.
+counting. So are the pieces of an event (:func:`locate`, :func:`impact`, the step after it):
+called out of line, each passed its dozen arrays as seven scalars apiece, and the calls, not
+the arithmetic, were a third of an event's cost (the study's basin takes 0.70x the time with
+them inlined; a cold compile of a variant, 2-6 % longer).
 
 The state lives in one array ``y``: ``theta, theta'``, then ``r, s`` when the oscillator
 embedding is integrated, then the 2×2 tangent matrix (column-major) when Lyapunov exponents are
@@ -238,7 +241,7 @@ def _nystrom():
 _AA, _BA = _nystrom()
 
 
-@jit(nrt=False)
+@jit(nrt=False, inline=True)
 def step_table(omega, h, tab):
     """Fill ``tab`` for a step of length ``h`` (layout above). Only the lower triangles are
     written (an event costs two of these): the entries above are zero from allocation on."""
@@ -288,7 +291,7 @@ def block_stage(FAST, SLOPE, x0, d, v, f, side, par, s0, c0):
     return accel_pq(P, Q, s, c, v, par[P_XI]), slope_pq(P, Q, s, c)
 
 
-@jit(nrt=False)
+@jit(nrt=False, inline=True)
 def rhs(EMBED4, r, y, side, par, K, jac, trig):
     """The field at the step's start into ``K[0]``, the slope into ``jac[0]``, and the sine and
     cosine of theta into ``trig[0:2]``; ``r`` is the closed-form forcing value (ignored with the
@@ -506,7 +509,7 @@ def rk_step(EMBED4, TANGENT, tabulated, sp, cp, y, K, side, par, ytmp, ynew, tab
         tangent_step(NS, y, K, ynew, tab, par, jac)
 
 
-@jit(nrt=False)
+@jit(nrt=False, inline=True)
 def dense_coeffs(K, m):
     """Coefficients of the continuous extension of component m (scipy's ``Q = K.T P``)."""
     q0 = 0.0
@@ -522,7 +525,7 @@ def dense_coeffs(K, m):
     return q0, q1, q2, q3
 
 
-@jit(nrt=False)
+@jit(nrt=False, inline=True)
 def event_g(kind, v, dv, side, par):
     """The event function ``g`` (positive before the event) and its derivative, from the value
     ``v`` of the component it watches (theta; r for an uplift) and that value's derivative
@@ -545,14 +548,14 @@ def event_value(kind, y, side, par):
     return event_g(kind, y[0], y[1], side, par)
 
 
-@jit(nrt=False)
+@jit(nrt=False, inline=True)
 def dense_event(kind, y0m, h, q0, q1, q2, q3, side, par, x):
     """Event function evaluated on the continuous extension at x = tau/h."""
     g, _ = dense_event_slope(kind, y0m, h, q0, q1, q2, q3, side, par, x)
     return g
 
 
-@jit(nrt=False)
+@jit(nrt=False, inline=True)
 def turning_point(q0, q1, q2, q3, sgn, want_max):
     """x in [0, 1] where sgn * d/dx of the extension changes sign.
 
@@ -597,7 +600,7 @@ def turning_point(q0, q1, q2, q3, sgn, want_max):
     return 0.5 * (lo + hi)
 
 
-@jit(nrt=False)
+@jit(nrt=False, inline=True)
 def dense_event_slope(kind, y0m, h, q0, q1, q2, q3, side, par, x):
     """``(g, dg/dx)`` of :func:`event_g` on the continuous extension at ``x = tau/h``."""
     v = y0m + h * x * (q0 + x * (q1 + x * (q2 + x * q3)))
@@ -739,7 +742,7 @@ def interp_at(y, ynew, hh, K, side, par, trig, f0, df0, f1, df1, x):
             interp_error(cint, dfc, x))
 
 
-@jit(nrt=False)
+@jit(nrt=False, inline=True)
 def locate_interp(kind, y, ynew, hh, lo, hi, K, side, par, trig, f0, df0, f1, df1):
     """The event in ``[lo, hi]`` on the step's own interpolant, without a field evaluation.
 
@@ -838,7 +841,7 @@ def locate_interp(kind, y, ynew, hh, lo, hi, K, side, par, trig, f0, df0, f1, df
     return 1 if err <= LOCATE_TOL * hh * abs(v) else 0, x, th, v
 
 
-@jit(nrt=False)
+@jit(nrt=False, inline=True)
 def locate(EMBED4, TANGENT, kind, y, ynew, hh, lo, hi, K, side, par, ytmp, yev, counts, tab,
            fr, jac, trig, sp, cp, f0, df0, f1, df1):
     """Time ``tau`` in ``(lo, hi]`` of the event found in the step just taken (of length
@@ -1223,7 +1226,7 @@ def accept(EMBED4, TANGENT, side, hh, max_err, w):
     return max_err
 
 
-@jit(nrt=False)
+@jit(nrt=False, inline=True)
 def impact(EMBED4, TANGENT, t, r, t_lift, side, n_imp, in_window, par, out, w):
     """The jump at an impact (SPEC.md §2), the saltation of the tangent vectors (§5), the
     impact's record, and the Zeno cut-off (§3). ``r``: the closed-form forcing

@@ -213,7 +213,7 @@ F_KEY = 4
 N_FS = F_KEY + 5
 
 
-@jit(nrt=False)
+@jit(nrt=False, inline=True)
 def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, prof, counts):
     """One grid step of a lane on the scalar path: :func:`rockjit._engine.integrate.grid_step`, the
     single-lane loop's own step (closed-form forcing, no trajectory), with the lane's loop
