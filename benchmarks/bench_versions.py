@@ -11,6 +11,12 @@ the ratio of the medians is taken side by side on one noisy machine:
   nanoseconds per step; ``run+lyapunov``: the same with the exponents;
 - ``basin``: the study's 100x100 hb=1 Housner basin (alpha=0.66, omega=1.3, (r0, s0) = (0, 1),
   early stopping, no exponents; attractor identification off where the version has it);
+- ``basin-full``: the same basin at full length (``early_stop=False``, 500 periods);
+- ``rk4-basin``: the same basin computed by the plain RK4 reference of
+  ``benchmarks/reference_rk4.py`` (this checkout's, in both workers: its two timings are one
+  program measured twice) at full length over 100 periods (500 would take a minute a call),
+  the yardstick of the full-length basin: the report compares their throughputs in
+  cell-periods per second, each version's own in the same run;
 - ``sweep``: hb=1 Housner over alpha in [0.5, 1.0] every 0.005 with exponents.
 
 Each case also reports whether both versions returned the same numbers, bit for bit (the final
@@ -45,19 +51,36 @@ CASES = {
     "run+lyapunov": ("simulate", dict(H.REFERENCE_RUN, periods=500, lyapunov=True)),
     "basin": ("basin", dict(hb=1.0, alpha=0.66, omega=1.3, law="housner", grid=100, r0=0.0,
                             s0=1.0, attractors=False)),
+    "basin-full": ("basin", dict(hb=1.0, alpha=0.66, omega=1.3, law="housner", grid=100,
+                                 r0=0.0, s0=1.0, attractors=False, early_stop=False)),
+    "rk4-basin": ("rk4basin", dict(hb=1.0, alpha=0.66, omega=1.3, law="housner", grid=100,
+                                   r0=0.0, s0=1.0, periods=100)),
     "sweep": ("sweep", dict(hb=1.0, omega=1.3, law="housner", alpha_range=(0.5, 1.0),
                             alpha_step=0.005, lyapunov=True, attractors=False)),
 }
 QUICK = {"run": dict(periods=50), "run+lyapunov": dict(periods=50), "basin": dict(grid=20,
-         periods=50), "sweep": dict(alpha_step=0.05, periods=50)}
+         periods=50), "basin-full": dict(grid=12, periods=50),
+         "rk4-basin": dict(grid=12, periods=20), "sweep": dict(alpha_step=0.05, periods=50)}
+#: The cases a plain run measures (``--cases`` names others): the two long ones are asked for.
+DEFAULT_CASES = ("run", "run+lyapunov", "basin", "sweep")
 
 #: The worker: reads one JSON request per line, answers one JSON line (seconds and a digest).
 _WORKER = textwrap.dedent("""
-    import hashlib, inspect, json, sys, time
+    import hashlib, inspect, json, os, sys, time
     import numpy as np
     import rockjit
     from rockjit.grids import grids as analysis
-    FN = dict(simulate=rockjit.simulate, basin=analysis.basin, sweep=analysis.sweep)
+    sys.path.insert(0, os.environ["ROCKJIT_BENCH_DIR"])
+
+    def rk4basin(grid, periods, **kw):
+        import reference_rk4  # this checkout's, compiled once per worker
+        plan = analysis.plan_basin(**kw, grid=grid, periods=periods, early_stop=False)
+        class Labels:
+            label = reference_rk4.basin_rk4(plan.y0s, plan.pars, plan.ipar, plan.cpar)
+        return Labels
+
+    FN = dict(simulate=rockjit.simulate, basin=analysis.basin, sweep=analysis.sweep,
+              rk4basin=rk4basin)
 
     def digest(res):
         h = hashlib.sha256()
@@ -72,8 +95,9 @@ _WORKER = textwrap.dedent("""
     for line in sys.stdin:
         fn_name, kw = json.loads(line)
         fn = FN[fn_name]
-        known = inspect.signature(fn).parameters
-        kw = {k: v for k, v in kw.items() if k in known}
+        if fn_name != "rk4basin":
+            known = inspect.signature(fn).parameters
+            kw = {k: v for k, v in kw.items() if k in known}
         c0, t0 = time.process_time(), time.perf_counter()
         res = fn(**kw)
         wall, cpu = time.perf_counter() - t0, time.process_time() - c0
@@ -87,7 +111,7 @@ class Worker:
     """One Python process importing the rockjit under ``src``."""
 
     def __init__(self, src):
-        env = dict(os.environ, PYTHONPATH=str(src))
+        env = dict(os.environ, PYTHONPATH=str(src), ROCKJIT_BENCH_DIR=str(H.HERE))
         self.proc = subprocess.Popen([sys.executable, "-c", _WORKER], env=env, cwd=str(src),
                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
 
@@ -110,9 +134,9 @@ def options(p):
     p.add_argument("--repeats", type=int, default=None, help="rounds (default 15; quick 3)")
     p.add_argument("--processes", type=int, default=None,
                    help="fresh worker pairs the rounds are shared out over (default 3; quick 1)")
-    p.add_argument("--cases", default=",".join(CASES),
-                   help=f"comma-separated subset of {', '.join(CASES)} (default: all), e.g. to "
-                        f"bisect one case's change quickly")
+    p.add_argument("--cases", default=",".join(DEFAULT_CASES),
+                   help=f"comma-separated subset of {', '.join(CASES)} (default: "
+                        f"{', '.join(DEFAULT_CASES)}), e.g. to bisect one case's change quickly")
 
 
 def measure(bench, base_src, cases, repeats, processes=1):
@@ -163,6 +187,32 @@ def measure(bench, base_src, cases, repeats, processes=1):
                   for (c, v), ts in d.items()}
 
 
+def yardstick(rows, cases):
+    """Lines comparing the full-length basin with the plain RK4 reference, when both ran: each
+    version's throughput (cell-periods per second) over the reference's in the same run, and
+    the full-length basin's speed-up of this over base."""
+    by = {r["case"]: r for r in rows}
+    if "basin-full" not in by or "rk4-basin" not in by:
+        return []
+    full, rk4 = by["basin-full"], by["rk4-basin"]
+    cells = cases["basin-full"][1]["grid"] ** 2
+    assert cases["rk4-basin"][1]["grid"] ** 2 == cells
+    p_full = cases["basin-full"][1].get("periods", 500)
+    p_rk4 = cases["rk4-basin"][1]["periods"]
+    out = ["", "Full-length basin against the plain RK4 reference (`reference_rk4.py`), "
+           "throughput in cell-periods per second, each version against the reference's own "
+           "timing in its worker:", "",
+           "| version | rockjit full length | RK4 reference | rockjit / RK4 |", "|---|---|---|---|"]
+    for v in ("base", "this"):
+        a = cells * p_full / full[f"{v}_s"]
+        b = cells * p_rk4 / rk4[f"{v}_s"]
+        out.append(f"| {v} | {a:.4g} | {b:.4g} | {a / b:.2f} |")
+    out += ["", f"Full-length basin, this over base: {1.0 / full['ratio']:.2f}x the cells per "
+                f"second (pairs of processes: {1.0 / full['pair_max']:.2f}-"
+                f"{1.0 / full['pair_min']:.2f}x)."]
+    return out
+
+
 def main(argv=None):
     bench = H.Bench(__doc__, argv, options=options)
     a = bench.args
@@ -209,6 +259,7 @@ def main(argv=None):
                      f"{r['ratio']:.3f} | {r['pair_min']:.2f}-{r['pair_max']:.2f} | "
                      f"{r['cpu_ratio']:.3f} | {ns[0]} | {ns[1]} | "
                      f"{'yes' if r['identical'] else 'no'} |")
+    lines += yardstick(rows, cases)
     markdown = "\n".join(lines) + "\n"
     plt = H.pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.2))
