@@ -316,8 +316,9 @@ N_LANE_COUNTS = 13
 LANES_MAX = 8
 #: Cells per thread in lockstep by default, for grids without tangent vectors (basins, erosion,
 #: fates; the grids with exponents run one cell at a time). Measured (benchmarks/bench_lanes.py,
-#: the study's basin, 2 threads): 8 lanes 1.18x the cells per second of one full length, 1.40x
-#: early-stopped; 2 lanes lose, 4 about even. The same outputs bit for bit whatever the count.
+#: the study's basin, 2 threads): 8 lanes 1.86x the cells per second of one full length, 2.08x
+#: early-stopped; 2 lanes lose, 4 about even full length. The same outputs bit for bit whatever
+#: the count.
 #: The lanes' kernel replaces the single-lane one in the ``grid`` variant (a cold compile ~20 s).
 DEFAULT_LANES = 8
 
