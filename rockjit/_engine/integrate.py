@@ -743,6 +743,28 @@ def interp_at(y, ynew, hh, K, side, par, trig, f0, df0, f1, df1, x):
 
 
 @jit(nrt=False, inline=True)
+def newton_bracketed(x, g, dg, a, b, conv):
+    """One step of the safeguarded Newton iteration for the root of ``g`` in the bracket
+    ``[a, b]`` (``g > 0`` at ``a``, ``g <= 0`` at ``b``), from ``x`` where ``g`` and its
+    derivative are ``g, dg``. Returns ``(x, a, b, done)``: the bracket narrowed to ``x``; done
+    when ``g`` is 0 there, when Newton's step is below ``conv`` and stays in the bracket (it may
+    land on its end), or when the bracket has shrunk to 1e-15; a step that leaves the bracket
+    bisects it instead."""
+    if g > 0.0:
+        a = x
+    elif g < 0.0:
+        b = x
+    else:
+        return x, a, b, True
+    xn = x - g / dg if dg != 0.0 else 0.5 * (a + b)
+    if abs(xn - x) <= conv and a <= xn <= b:
+        return xn, a, b, True
+    if not (a < xn < b):
+        xn = 0.5 * (a + b)
+    return xn, a, b, b - a <= 1e-15
+
+
+@jit(nrt=False, inline=True)
 def locate_interp(kind, y, ynew, hh, lo, hi, K, side, par, trig, f0, df0, f1, df1):
     """The event in ``[lo, hi]`` on the step's own interpolant, without a field evaluation.
 
@@ -817,24 +839,10 @@ def locate_interp(kind, y, ynew, hh, lo, hi, K, side, par, trig, f0, df0, f1, df
         if not (a < x < b):
             x = 0.5 * (a + b)
     for _ in range(BISECT_ITERS):
-        g = poly7(g0, g1, g2, g3, g4, g5, g6, g7, x)
-        if g > 0.0:
-            a = x
-        elif g < 0.0:
-            b = x
-        else:
+        x, a, b, done = newton_bracketed(x, poly7(g0, g1, g2, g3, g4, g5, g6, g7, x),
+                                         poly6(g1, d2, d3, d4, d5, d6, d7, x), a, b, 1e-9)
+        if done:
             break
-        dg = poly6(g1, d2, d3, d4, d5, d6, d7, x)
-        xn = x - g / dg if dg != 0.0 else 0.5 * (a + b)
-        if abs(xn - x) <= 1e-9 and a <= xn <= b:
-            x = xn
-            break
-        if not (a < xn < b):
-            xn = 0.5 * (a + b)
-        if b - a <= 1e-15:
-            x = xn
-            break
-        x = xn
     th = poly7(tc[0], tc[1], tc[2], tc[3], tc[4], tc[5], tc[6], tc[7], x)
     v = poly7(vc[0], vc[1], vc[2], vc[3], vc[4], vc[5], vc[6], vc[7], x)
     err = interp_error(cint, dfc, x)
@@ -909,24 +917,9 @@ def locate_step(EMBED4, TANGENT, kind, y, hh, lo, hi, K, side, par, ytmp, yev, c
             x = 0.5 * (a + b)
         for _ in range(BISECT_ITERS):
             g, dg = dense_event_slope(kind, y[comp], hh, q0, q1, q2, q3, side, par, x)
-            if g > 0.0:
-                a = x
-            elif g < 0.0:
-                b = x
-            else:
+            x, a, b, done = newton_bracketed(x, g, dg, a, b, 1e-15)
+            if done:
                 break
-            xn = x - g / dg if dg != 0.0 else 0.5 * (a + b)
-            # converged (Newton's step within rounding: it may land on a bracket's end), or
-            # else safeguarded
-            if abs(xn - x) <= 1e-15 and a <= xn <= b:
-                x = xn
-                break
-            if not (a < xn < b):
-                xn = 0.5 * (a + b)
-            if b - a <= 1e-15:
-                x = xn
-                break
-            x = xn
         tau = x * hh
     lo_b = lo
     hi_b = hi
