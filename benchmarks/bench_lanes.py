@@ -303,7 +303,7 @@ def main(argv=None):
                       for (name, L), p in parts.items() if L == 8)
           + " (the rest: the lanes' bookkeeping and the cycle counter's own reads).\n\n"
           + f"The study's hb=1 basin at {cfg['grid_big']}x{cfg['grid_big']} (500 periods, early "
-          f"stop, attractors identified; issue 17's target: 1000x1000 in under 60 s), one run "
+          f"stop, attractors identified; the goal: 1000x1000 in under 60 s), one run "
           f"each: {big[1]:.1f} s with one lane, {big[8]:.1f} s with eight.\n\n"
           + H.env_line(b.env) + "\n")
     plt = H.pyplot()
