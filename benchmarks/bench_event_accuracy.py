@@ -136,6 +136,7 @@ def plot(records, ns, n_def, periods):
     ax.axhline(TOL, color="0.3", ls="--", lw=0.8)
     ax.axvline(n_def, color="0.5", ls=":", lw=0.8)
     ax.set_xticks(ns, [str(n) for n in ns])
+    ax.set_xticks([], minor=True)  # the log axis's own minor labels overlapped the N labels
     ax.set_xlabel("steps per forcing period N")
     ax.set_ylabel(f"largest impact-time error over {periods} periods")
     ax.set_title(f"Impact times against N (vs rockjit N={N_CONV}); dashed: {TOL:g}; "
