@@ -202,7 +202,8 @@ def yardstick(rows, cases):
     out = ["", "Full-length basin against the plain RK4 reference (`reference_rk4.py`), "
            "throughput in cell-periods per second, each version against the reference's own "
            "timing in its worker:", "",
-           "| version | rockjit full length | RK4 reference | rockjit / RK4 |", "|---|---|---|---|"]
+           "| version | rockjit full length | RK4 reference | rockjit / RK4 |",
+           "|---|---|---|---|"]
     for v in ("base", "this"):
         a = cells * p_full / full[f"{v}_s"]
         b = cells * p_rk4 / rk4[f"{v}_s"]

@@ -308,8 +308,9 @@ def run_chunk_counted(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=
 
 #: The lanes' counters per block (:func:`rockjit._engine.lanes.run_lanes`): fast steps (and
 #: steps held at rest), scalar steps, vector steps; cycles in vector steps, in scalar steps, in
-#: all; within the scalar steps, cycles in rest phases, in the steps after events, in locating events, in impacts, in detection, in
-#: first steps taken again, at grid points (:func:`rockjit._engine.lanes.scalar_step`).
+#: all; within the scalar steps, cycles in rest phases, in the steps after events, in locating
+#: events, in impacts, in detection, in first steps taken again, at grid points
+#: (:func:`rockjit._engine.lanes.scalar_step`).
 N_LANE_COUNTS = 13
 
 #: Cells per thread in lockstep at most (:data:`rockjit._engine.lanes.W`, the vector's width).

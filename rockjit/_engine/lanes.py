@@ -453,12 +453,12 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
     every lane in flight whose step has no event, stays in the polynomials' range; a lane at
     rest whose uplift (computed once when it came to rest) lies beyond the grid point is held
     there, as the single-lane code would hold it; every other lane's step (an event, the end of
-    a rest phase) is taken again by :func:`scalar_step`, the single-lane code. A lane's arithmetic is the single-lane kernel's either way, so its results are bit for
-    bit those of :func:`rockjit._engine.kernel._grid` (the running error estimate ``max_err`` is not
-    kept on the fast path: no grid output reads it). ``counts``: the fast steps (with the steps
-    held at rest) and the scalar steps,
-    the vector steps taken, and with ``prof`` the cycles (``readcyclecounter``) spent in the
-    vector steps, in the scalar steps, and in all, then the parts of the scalar steps
+    a rest phase) is taken again by :func:`scalar_step`, the single-lane code. A lane's
+    arithmetic is the single-lane kernel's either way, so its results are bit for bit those of
+    :func:`rockjit._engine.kernel._grid` (the running error estimate ``max_err`` is not kept on
+    the fast path: no grid output reads it). ``counts``: the fast steps (with the steps held at
+    rest) and the scalar steps, the vector steps taken, and with ``prof`` the cycles
+    (``readcyclecounter``) spent in the vector steps, in the scalar steps, and in all, then the parts of the scalar steps
     (:func:`scalar_step`); without, the cycle counter is not read (its reads cost ~10 % of a
     basin's time).
     """
