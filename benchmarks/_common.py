@@ -399,6 +399,18 @@ def _flat_grids(rj):
     raise ImportError(f"{rj.__name__} has neither grids.grids nor analysis")
 
 
+def plan_in(rj, fn: str, kw: dict):
+    """The validated plan of a ``basin`` or ``sweep`` case in the package ``rj``'s own API (its
+    packed kernel inputs ``y0s, pars, ipar, cpar`` are laid out alike in every version)."""
+    kw = dict(kw)
+    if api_of(rj) == "flat":
+        f = getattr(_flat_grids(rj), f"plan_{fn}")
+        known = inspect.signature(f).parameters
+        return f(**{k: v for k, v in kw.items() if k in known})
+    entry, args, settings = _objects_call(rj, fn, kw)
+    return entry.plan(*args, **settings)
+
+
 def call_in(rj, fn: str, kw: dict):
     """A zero-argument callable running ``fn`` of the rockjit package ``rj`` in its own API.
 
@@ -426,6 +438,12 @@ def call_in(rj, fn: str, kw: dict):
         known = inspect.signature(f).parameters
         kw = {k: v for k, v in kw.items() if k in known}
         return lambda: f(**kw)
+    entry, args, settings = _objects_call(rj, fn, kw)
+    return lambda: entry(*args, **settings)
+
+
+def _objects_call(rj, fn, kw):
+    """``(entry point, args, keywords)`` of a case in the settings-objects API."""
     obj = {name: {k: kw.pop(k) for k in keys if k in kw} for name, keys in _FLAT.items()}
     state = None
     if "z0" in kw:
@@ -455,8 +473,7 @@ def call_in(rj, fn: str, kw: dict):
     if kw:
         raise ValueError(f"call_in: keywords {sorted(kw)} have no place in a {fn} of "
                          f"rockjit's settings objects")
-    f = getattr(rj, fn)
-    return lambda: f(*args, **settings)
+    return getattr(rj, fn), args, settings
 
 
 # --------------------------------------------------------------------------- comparing runs

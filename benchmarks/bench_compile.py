@@ -257,7 +257,7 @@ def _child(spec):
         from rockjit.cli.main import main as cli
         argv = [a if a != "OUT" else spec["out"] for a in spec["argv"]]
         t1 = time.perf_counter()
-        out["rc"] = int(cli.main(argv) or 0)
+        out["rc"] = int(cli(argv) or 0)
         out["first_s"] = time.perf_counter() - t1
     ru = resource.getrusage(resource.RUSAGE_SELF)
     out["cpu_s"] = ru.ru_utime + ru.ru_stime

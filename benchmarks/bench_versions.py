@@ -11,6 +11,12 @@ medians is taken side by side on one noisy machine:
   nanoseconds per step; ``run+lyapunov``: the same with the exponents;
 - ``basin``: the study's 100x100 hb=1 Housner basin (alpha=0.66, omega=1.3, (r0, s0) = (0, 1),
   early stopping, no exponents; attractor identification off where the version has it);
+- ``basin-full``: the same basin at full length (``early_stop=False``, 500 periods);
+- ``rk4-basin``: the same basin computed by the plain RK4 reference of
+  ``benchmarks/reference_rk4.py`` (this checkout's, in both workers: its two timings are one
+  program measured twice) at full length over 100 periods (500 would take a minute a call),
+  the yardstick of the full-length basin: the report compares their throughputs in
+  cell-periods per second, each version's own in the same run;
 - ``sweep``: hb=1 Housner over alpha in [0.5, 1.0] every 0.005 with exponents.
 
 Each case also reports whether both versions returned the same numbers, bit for bit (the final
@@ -55,11 +61,18 @@ CASES = {
     "run+lyapunov": ("simulate", dict(REFERENCE_RUN, periods=500, lyapunov=True)),
     "basin": ("basin", dict(hb=1.0, alpha=0.66, omega=1.3, law="housner", grid=100, r0=0.0,
                             s0=1.0, attractors=False)),
+    "basin-full": ("basin", dict(hb=1.0, alpha=0.66, omega=1.3, law="housner", grid=100,
+                                 r0=0.0, s0=1.0, attractors=False, early_stop=False)),
+    "rk4-basin": ("rk4basin", dict(hb=1.0, alpha=0.66, omega=1.3, law="housner", grid=100,
+                                   r0=0.0, s0=1.0, periods=100)),
     "sweep": ("sweep", dict(hb=1.0, omega=1.3, law="housner", alpha_range=(0.5, 1.0),
                             alpha_step=0.005, lyapunov=True, attractors=False)),
 }
 QUICK = {"run": dict(periods=50), "run+lyapunov": dict(periods=50), "basin": dict(grid=20,
-         periods=50), "sweep": dict(alpha_step=0.05, periods=50)}
+         periods=50), "basin-full": dict(grid=12, periods=50),
+         "rk4-basin": dict(grid=12, periods=20), "sweep": dict(alpha_step=0.05, periods=50)}
+#: The cases a plain run measures (``--cases`` names others): the two long ones are asked for.
+DEFAULT_CASES = ("run", "run+lyapunov", "basin", "sweep")
 
 #: The worker: reads one JSON request per line, answers one JSON line (seconds, a digest, and
 #: which API it called); it imports the rockjit of its version and this folder's _common.
@@ -68,6 +81,16 @@ _WORKER = textwrap.dedent("""
     import numpy as np
     import rockjit
     import _common as H
+
+    def rk4basin(kw):
+        """The plain RK4 reference basin of this checkout (benchmarks/reference_rk4.py) on the
+        packed inputs of the version's own basin plan, at full length."""
+        import reference_rk4  # compiled once per worker
+        kw = dict(kw, early_stop=False)
+        plan = H.plan_in(rockjit, "basin", kw)
+        class Labels:
+            label = reference_rk4.basin_rk4(plan.y0s, plan.pars, plan.ipar, plan.cpar)
+        return lambda: Labels
 
     def digest(res):
         h = hashlib.sha256()
@@ -81,7 +104,7 @@ _WORKER = textwrap.dedent("""
 
     for line in sys.stdin:
         fn_name, kw = json.loads(line)
-        call = H.call_in(rockjit, fn_name, kw)
+        call = rk4basin(kw) if fn_name == "rk4basin" else H.call_in(rockjit, fn_name, kw)
         c0, t0 = time.process_time(), time.perf_counter()
         res = call()
         wall, cpu = time.perf_counter() - t0, time.process_time() - c0
@@ -118,9 +141,9 @@ def options(p):
     p.add_argument("--repeats", type=int, default=None, help="rounds (default 15; quick 3)")
     p.add_argument("--processes", type=int, default=None,
                    help="fresh worker pairs the rounds are shared out over (default 3; quick 1)")
-    p.add_argument("--cases", default=",".join(CASES),
-                   help=f"comma-separated subset of {', '.join(CASES)} (default: all), e.g. to "
-                        f"bisect one case's change quickly")
+    p.add_argument("--cases", default=",".join(DEFAULT_CASES),
+                   help=f"comma-separated subset of {', '.join(CASES)} (default: "
+                        f"{', '.join(DEFAULT_CASES)}), e.g. to bisect one case's change quickly")
 
 
 def measure(bench, base_src, cases, repeats, processes=1):
@@ -178,6 +201,33 @@ def _api_words(names):
     return " and ".join(words.get(n, n) for n in names)
 
 
+def yardstick(rows, cases):
+    """Lines comparing the full-length basin with the plain RK4 reference, when both ran: each
+    version's throughput (cell-periods per second) over the reference's in the same run, and
+    the full-length basin's speed-up of this over base."""
+    by = {r["case"]: r for r in rows}
+    if "basin-full" not in by or "rk4-basin" not in by:
+        return []
+    full, rk4 = by["basin-full"], by["rk4-basin"]
+    cells = cases["basin-full"][1]["grid"] ** 2
+    assert cases["rk4-basin"][1]["grid"] ** 2 == cells
+    p_full = cases["basin-full"][1].get("periods", 500)
+    p_rk4 = cases["rk4-basin"][1]["periods"]
+    out = ["", "Full-length basin against the plain RK4 reference (`reference_rk4.py`), "
+           "throughput in cell-periods per second, each version against the reference's own "
+           "timing in its worker:", "",
+           "| version | rockjit full length | RK4 reference | rockjit / RK4 |",
+           "|---|---|---|---|"]
+    for v in ("base", "this"):
+        a = cells * p_full / full[f"{v}_s"]
+        b = cells * p_rk4 / rk4[f"{v}_s"]
+        out.append(f"| {v} | {a:.4g} | {b:.4g} | {a / b:.2f} |")
+    out += ["", f"Full-length basin, this over base: {1.0 / full['ratio']:.2f}x the cells per "
+                f"second (pairs of processes: {1.0 / full['pair_max']:.2f}-"
+                f"{1.0 / full['pair_min']:.2f}x)."]
+    return out
+
+
 def main(argv=None):
     bench = H.Bench(__doc__, argv, options=options)
     a = bench.args
@@ -226,6 +276,7 @@ def main(argv=None):
                      f"{r['ratio']:.3f} | {r['pair_min']:.2f}-{r['pair_max']:.2f} | "
                      f"{r['cpu_ratio']:.3f} | {ns[0]} | {ns[1]} | "
                      f"{'yes' if r['identical'] else 'no'} |")
+    lines += yardstick(rows, cases)
     markdown = "\n".join(lines) + "\n"
     plt = H.pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.2))

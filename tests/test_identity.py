@@ -2,8 +2,10 @@
 fates, orbit branches and single runs, recomputed through today's API, against the SHA-256 of
 every array and the exact value of every scalar recorded in ``tests/data/identity/``.
 
-The record was made with an earlier API (its calls are kept in ``identity.json``, by their old
-names and keywords); :func:`translate` turns each into today's call. A change that moves any
+The record keeps each call by the name and keywords it was first recorded with (in
+``identity.json``); :func:`translate` turns each into today's call, and
+``tests/data/identity/make_identity.py`` re-records the results when a change is meant to move
+them. A change that moves any
 result by one bit fails here, naming the case and the first array that differs (with the cells
 where the behaviour labels differ, from ``labels.npz``).
 """
@@ -231,23 +233,6 @@ def _is_result(path):
     return not any(f".{c}." in path + "." for c in CONTEXT)
 
 
-#: The recorded grid results' ``lambda_max`` (the finite-window estimate) is today's
-#: ``lambda_window``; today's ``lambda_max`` (exact where a cell is periodic) was not recorded.
-RENAMED = (".lambda_max", ".lambda_window")
-
-
-def _renamed(want_arrays, arrays):
-    """The record's paths in today's names, and today's arrays less the unrecorded ones."""
-    old, new = RENAMED
-    moved = {p[:-len(old)] for p in want_arrays if p.endswith(old)
-             and p[:-len(old)] + new in arrays}
-    want_arrays = {(k[:-len(old)] + new if k.endswith(old) and k[:-len(old)] in moved
-                    else k): v for k, v in want_arrays.items()}
-    arrays = {k: v for k, v in arrays.items()
-              if not (k.endswith(old) and k[:-len(old)] in moved)}
-    return want_arrays, arrays
-
-
 def _compare(name, res, *, arrays_only=False, skip=()):
     want = CASES[name]
     arrays, scalars = {}, {}
@@ -255,7 +240,6 @@ def _compare(name, res, *, arrays_only=False, skip=()):
     arrays = {k: v for k, v in arrays.items() if not k.startswith(skip) and _is_result(k)}
     want_arrays = {k: v for k, v in want["arrays"].items()
                    if not k.startswith(skip) and _is_result(k)}
-    want_arrays, arrays = _renamed(want_arrays, arrays)
     assert sorted(arrays) == sorted(want_arrays), (
         f"{name}: arrays held differ: missing {sorted(set(want_arrays) - set(arrays))[:5]}, "
         f"new {sorted(set(arrays) - set(want_arrays))[:5]}")
@@ -293,20 +277,24 @@ def test_plane_is_bit_identical():
     _compare("plane_hb1", _result("plane_hb1"))
 
 
-def test_plane_of_two_states_is_bit_identical_state_by_state():
-    # recorded as one plane of two initial states at two forcing phases; today a plane's
-    # states share one phase, so each state is its own plane: the cells are the same runs
-    want = CASES["plane_hb2_mao_two_states"]
+#: Recorded as one plane of two initial states at two forcing phases; today a plane's states
+#: share one phase, so each state is its own plane (the cells are the same runs).
+TWO_STATES = "plane_hb2_mao_two_states"
+
+
+def two_state_planes():
     block = Block(hb=2, law="mao")
-    got = []
-    for (th, dth, r, s) in ((-0.2254, -0.1597, -0.7778, 0.6284), (0.1, 0.0, 0.0, 1.0)):
-        pl = rockjit.plane(block, (0.1, 0.5), (1.2, 2.0), grid=(8, 6), state=(th, dth),
-                           forcing=Harmonic(r0=r, s0=s))
-        got.append(pl)
-    for field in ("label", "period", "lambda_max", "t_end"):
-        today = "lambda_window" if field == "lambda_max" else field  # RENAMED
-        joined = np.concatenate([getattr(p, today) for p in got])
-        assert _sha(joined) == want["arrays"][f".{field}"]["sha256"], field
+    return [rockjit.plane(block, (0.1, 0.5), (1.2, 2.0), grid=(8, 6), state=(th, dth),
+                          forcing=Harmonic(r0=r, s0=s))
+            for (th, dth, r, s) in ((-0.2254, -0.1597, -0.7778, 0.6284), (0.1, 0.0, 0.0, 1.0))]
+
+
+def test_plane_of_two_states_is_bit_identical_state_by_state():
+    want = CASES[TWO_STATES]
+    got = two_state_planes()
+    for field in ("label", "period", "lambda_window", "t_end"):
+        joined = np.concatenate([getattr(p, field) for p in got])
+        assert _sha(joined) == want["arrays"][f"[{json.dumps(field)}]"]["sha256"], field
 
 
 @pytest.mark.slow

@@ -24,6 +24,7 @@ import rockjit
 from rockjit import Block, Harmonic, Integration, Scipy
 from rockjit._engine import integrate as ig
 from rockjit._engine.kernel import pack
+from rockjit.model import accel
 
 DOP = Scipy("DOP853", rtol=1e-12, atol=1e-12)
 
@@ -542,3 +543,191 @@ def test_turning_point_is_the_derivatives_root(want_max):
                     hi = mid
             assert abs(x - 0.5 * (lo + hi)) <= 1e-12
     assert checked > 200  # about a fifth of random cubics are bracketed
+
+
+# ---- the event interpolant ------------------------------------------------------------------
+
+def _exact(spec, t0, y0, t1, side, hb, aw2, omega, phi, xi, event=False):
+    """A tight DOP853 solution of the equation of motion (docs/theory/model.md) on one corner from ``(t0, y0)`` to ``t1``: the state
+    there, or with ``event`` the first ``theta = 0`` (its time and state)."""
+    from scipy.integrate import solve_ivp
+
+    def f(t, y):
+        return [y[1], spec.theta_ddot(t, y[0], y[1], side, hb, aw2, omega, phi, xi)]
+
+    ev = None
+    if event:
+        def ev(t, y):
+            return y[0]
+        ev.terminal = True
+    sol = solve_ivp(f, (t0, t1), y0, method="DOP853", rtol=2.5e-14, atol=1e-16, events=ev)
+    if event:
+        return sol.t_events[0][0], sol.y_events[0][0]
+    return sol.y[:, -1]
+
+
+class _Step:
+    """One compiled Dormand–Prince step of length ``T / n`` from ``(t0, y0)`` on corner ``side``
+    (closed-form forcing), with what the event interpolant reads: the stages, the sines and
+    cosines of theta at the ends, the forcing and its derivative at the ends."""
+
+    def __init__(self, hb, alpha, omega, phi, t0, y0, n, side):
+        block = Block(hb=hb)
+        self.block = block
+        self.par = np.zeros(ig.N_PARW)
+        self.par[:ig.N_PAR] = pack(block, Harmonic(alpha=alpha, omega=omega), phi,
+                                   Integration(), n)
+        self.par[ig.P_STHC] = math.sin(block.thc)
+        self.par[ig.P_CTHC] = math.cos(block.thc)
+        self.h = h = self.par[ig.P_H]
+        self.side, self.t0, self.phi = side, t0, phi
+        self.aw2, self.omega = alpha * omega**2, omega
+        sp, cp = math.sin(omega * t0 + phi), math.cos(omega * t0 + phi)
+        self.sp, self.cp = sp, cp
+        self.y = np.array(y0, dtype=float)
+        self.K = np.zeros((ig.N_STAGES + 1, 2))
+        self.jac = np.zeros(ig.N_STAGES + 1)
+        self.trig = np.zeros(4)
+        self.fr = np.zeros(ig.N_STAGES + 1)
+        self.tab = np.zeros((ig.N_TAB, ig.N_STAGES + 1))
+        self.ynew = np.zeros(2)
+        ig.rhs(None, sp, self.y, side, self.par, self.K, self.jac, self.trig)
+        ig.step_table(omega, h, self.tab)
+        ig.rk_step(None, None, False, sp, cp, self.y, self.K, side, self.par, np.zeros(2),
+                   self.ynew, self.tab, self.fr, self.jac, self.trig)
+        aw3 = self.aw2 * omega
+        self.fd = (self.fr[0], aw3 * cp, self.fr[ig.N_STAGES],
+                   aw3 * math.cos(omega * (t0 + h) + phi))
+
+    def with_end(self, y1):
+        """The same step with its end state replaced (``K[-1]`` and the end's sines too)."""
+        other = _Step.__new__(_Step)
+        other.__dict__.update(self.__dict__)
+        other.ynew = np.array(y1, dtype=float)
+        other.K = self.K.copy()
+        other.trig = self.trig.copy()
+        other.K[ig.N_STAGES, 0] = y1[1]
+        other.K[ig.N_STAGES, 1] = accel(y1[0], y1[1], self.fr[ig.N_STAGES], self.side,
+                                        self.block.thc, self.block.xi)
+        other.trig[2], other.trig[3] = math.sin(y1[0]), math.cos(y1[0])
+        return other
+
+    def at(self, x):
+        """theta, theta' and the error estimate of the step's interpolant at ``x``."""
+        return ig.interp_at(self.y, self.ynew, self.h, self.K, self.side, self.par, self.trig,
+                            *self.fd, x)
+
+    def locate(self, interp=True):
+        """The impact in the step: ``(ok, tau, theta'(tau))`` on the interpolant, or by genuine
+        steps (``ok`` None)."""
+        if interp:
+            ok, x, _, v = ig.locate_interp(ig.EV_IMPACT, self.y, self.ynew, self.h, 0.0, self.h,
+                                           self.K, self.side, self.par, self.trig, *self.fd)
+            return ok, x * self.h, v
+        yev = np.zeros(2)
+        tau = ig.locate_step(None, None, ig.EV_IMPACT, self.y, self.h, 0.0, self.h,
+                             self.K.copy(), self.side, self.par, np.zeros(2), yev,
+                             np.zeros(ig.N_IOUT, dtype=np.int64), self.tab.copy(),
+                             self.fr.copy(), self.jac.copy(), self.trig.copy(), self.sp,
+                             self.cp, -1.0)
+        return None, tau, yev[1]
+
+
+#: A slender block thrown up on its corner: no impact within one period (as in the test of the
+#: empirical order above).
+SMOOTH = dict(hb=2.0, alpha=0.02, omega=5.0, phi=0.3, y0=(0.2, 0.5), side=1)
+
+
+def _smooth_errors(spec, n, exact_end, x):
+    kw = SMOOTH
+    st = _Step(kw["hb"], kw["alpha"], kw["omega"], kw["phi"], 0.0, kw["y0"], n, kw["side"])
+    ex = lambda t: _exact(spec, 0.0, kw["y0"], t, kw["side"], kw["hb"], st.aw2, kw["omega"],
+                          kw["phi"], st.block.xi)
+    if exact_end:
+        st = st.with_end(ex(st.h))
+    th, v, est = st.at(x)
+    ref = ex(x * st.h)
+    return abs(th - ref[0]), abs(v - ref[1]), est
+
+
+def _slope(ns, errs):
+    return -np.polyfit(np.log(ns), np.log(errs), 1)[0]
+
+
+@pytest.mark.parametrize("x", [0.3, 0.62])
+def test_interpolant_is_of_degree_seven_through_exact_ends(spec, x):
+    # with the exact state at the step's end, what is left is the interpolation error of the
+    # two Hermite polynomials of degree 7: of order h^8
+    ns = np.array([8, 12, 16, 24])
+    e = np.array([_smooth_errors(spec, n, True, x)[:2] for n in ns])
+    assert e[-1].max() > 1e-14  # above the reference's own error
+    assert _slope(ns, e[:, 0]) >= 7.4, e[:, 0]
+    assert _slope(ns, e[:, 1]) >= 7.4, e[:, 1]
+
+
+def test_interpolant_carries_the_steps_own_error(spec):
+    # with the step's own end state: the end's local error, of order h^6, weighted by the
+    # basis function of the end value, so of order h^6 within the step as well
+    ns = np.array([16, 24, 32, 48])
+    e = np.array([_smooth_errors(spec, n, False, 0.5)[:2] for n in ns])
+    assert 5.4 <= _slope(ns, e[:, 0]) <= 6.6, e[:, 0]
+    assert 5.4 <= _slope(ns, e[:, 1]) <= 6.6, e[:, 1]
+
+
+@pytest.mark.parametrize("n", [32, 64, 128])
+def test_interpolant_error_estimate_tracks_its_error(spec, n):
+    # the estimate (the end value's defect weighted, plus the septic less the quintic) is of the
+    # size of the interpolant's true error in theta: neither far below (it would trust a bad
+    # interpolant) nor far above (it would send every event to genuine steps)
+    ratios = []
+    for x in (0.25, 0.5, 0.75):
+        th_err, _, est = _smooth_errors(spec, n, False, x)
+        ratios.append(est / th_err)
+    assert 0.5 <= min(ratios) and max(ratios) <= 4.0, ratios
+
+
+#: States a little before an impact on the event test's asymmetric orbit's block.
+EVENT_BLOCK = dict(hb=1.0, alpha=0.8, omega=1.3, phi=0.4)
+
+
+@pytest.mark.parametrize("n, tol", [(64, 1e-10), (160, 1e-12)])
+@pytest.mark.parametrize("frac, dth0, t0", [(0.6, -0.45, 0.3), (0.25, -0.12, 2.1),
+                                            (0.9, 0.7, 4.0)])
+def test_event_on_the_interpolant_against_dop853(spec, n, tol, frac, dth0, t0):
+    # from an exact state, one step with an impact (about ``frac`` of the way): the time and
+    # speed of the impact on the interpolant against a tight DOP853 event from the same state
+    # (the local error only: the step's own, ~1e-11 at N = 64 and ~1e-13 at N = 160), and the
+    # time's error within the interpolant's own estimate (theta's, over the crossing speed)
+    kw = EVENT_BLOCK
+    block = Block(hb=kw["hb"])
+    T = Harmonic(alpha=kw["alpha"], omega=kw["omega"]).period
+    th0 = -dth0 * frac * T / n
+    side = 1 if th0 > 0 else -1
+    aw2 = kw["alpha"] * kw["omega"] ** 2
+    t_ev, y_ev = _exact(spec, t0, (th0, dth0), t0 + T / n, side, kw["hb"], aw2, kw["omega"],
+                        kw["phi"], block.xi, event=True)
+    st = _Step(kw["hb"], kw["alpha"], kw["omega"], kw["phi"], t0, (th0, dth0), n, side)
+    assert side * st.ynew[0] < 0.0  # the impact lies in the step
+    ok, tau, v = st.locate()
+    assert ok == 1
+    assert abs(t0 + tau - t_ev) <= tol
+    assert abs(v - y_ev[1]) <= tol
+    assert abs(t0 + tau - t_ev) <= 2.0 * st.at(tau / st.h)[2] / abs(v) + 1e-15
+    # the genuine steps (a step of the event's own length) agree to the same level
+    _, tau_g, v_g = st.locate(interp=False)
+    assert abs(tau_g - tau) <= tol and abs(v_g - v) <= tol
+
+
+def test_coarse_steps_take_genuine_steps_where_the_estimate_says_so():
+    # the interpolant is trusted from N = 64 on on the event test's orbits; at N = 16 the
+    # estimate sends most events to genuine steps, which keep the event times of the coarse
+    # grid as they were (tests above: the dips through 0 at N = 16 to 1e-9)
+    run = (Block(1.0, "housner"), Harmonic(alpha=0.8, omega=1.3))  # the study's state
+
+    def resteps(**integration):
+        return rockjit.simulate(*run, integration=Integration(periods=20, **integration))
+
+    assert resteps(n_steps=64).extra["locate_resteps"] == 0
+    assert resteps().extra["locate_resteps"] == 0
+    coarse = resteps(n_steps=16)
+    assert coarse.extra["locate_resteps"] > coarse.n_impacts // 2

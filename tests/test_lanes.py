@@ -23,6 +23,7 @@ from rockjit._engine import integrate as ig
 from rockjit._engine import kernel as kn
 from rockjit._engine import lanes as ln
 from rockjit.grids import plan as gp
+from rockjit.result import REST
 
 #: The study's four basins (docs/theory/study.md).
 BASINS = (
@@ -91,6 +92,34 @@ def test_sweep_and_plane_per_cell_parameters():
                             integration=Integration(periods=30, window=15), lyapunov=False)
     assert len(np.unique(pl.pars[:, ig.P_H])) > 1
     assert_same(chunk(pl, 1), chunk(pl, 8))
+
+
+def test_rest_phases_held_without_scalar_steps():
+    # hb=1 Housner just above the uplift threshold (alpha omega^2 = 1.03 cot(thc)): every cell
+    # that survives spends most of each period at rest; the lanes hold a resting lane to the
+    # grid point while its uplift lies beyond it (one uplift instant per rest phase), and hand
+    # it to the single-lane code only for the step that lifts it. The outputs stay one lane's.
+    plan = basin_plan(1.0, 0.61, 1.3, "housner", grid=10, periods=30, window=15,
+                      early_stop=False)
+    ref = chunk(plan, 1)
+    out, counts = kn.run_chunk_counted(plan.tangent, plan.y0s, plan.pars, plan.ipar,
+                                       plan.cpar, plan.n_pts, plan.n_imp_pts, None, 8)
+    assert_same(ref, out)
+    assert (ref["res"][:, kn.R_LABEL] != REST).any()  # not every cell rests for good
+    steps = counts[:, 0].sum() + counts[:, 1].sum()
+    assert counts[:, 1].sum() < 0.1 * steps  # the scalar steps: events and uplifts only
+
+
+def test_lanes_keep_their_tables_only_for_the_same_forcing():
+    # a lane keeps its forcing table for its next cell when alpha omega^2, omega, phi, h and N
+    # are the same; cells alternating between two amplitudes must each get their own
+    base = basin_plan(1.0, 0.66, 1.3, "housner", grid=8, periods=30, window=15,
+                      early_stop=False)
+    other = basin_plan(1.0, 0.8, 1.3, "housner", grid=8, periods=30, window=15,
+                       early_stop=False)
+    plan = dataclasses.replace(base, y0s=base.y0s.copy(), pars=base.pars.copy())
+    plan.pars[1::2] = other.pars[1::2]
+    assert_same(chunk(plan, 1), chunk(plan, 8))
 
 
 def test_continue_past_overturning():

@@ -226,6 +226,8 @@ def single_result(p, code, out):
         n_locate_unconverged=int(iout[ig.O_UNCONVERGED]),
         t_overturn=float(fout[ig.F_TOVER]),
     )
+    # events located by genuine steps because the step's interpolant was not trusted
+    res.extra["locate_resteps"] = int(iout[ig.O_RESTEP])
     if lyapunov:
         # the tangent matrix at the end: the flow's Jacobian since the last renormalisation;
         # with qr_every = 0 that is the whole run's, and zero once a perturbation died (a rest
@@ -367,18 +369,20 @@ def run_chunk_counted(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=
     return out, counts
 
 
-#: The lanes' counters per block (:func:`rockjit._engine.lanes.run_lanes`): fast steps, scalar steps,
-#: vector steps; cycles in vector steps, in scalar steps, in all; within the scalar steps, cycles
-#: in rest phases, in the steps after events, in locating events, in impacts, in detection, in
-#: first steps taken again, at grid points (:func:`rockjit._engine.lanes.scalar_step`).
+#: The lanes' counters per block (:func:`rockjit._engine.lanes.run_lanes`): fast steps (and
+#: steps held at rest), scalar steps, vector steps; cycles in vector steps, in scalar steps, in
+#: all; within the scalar steps, cycles in rest phases, in the steps after events, in locating
+#: events, in impacts, in detection, in first steps taken again, at grid points
+#: (:func:`rockjit._engine.lanes.scalar_step`).
 N_LANE_COUNTS = 13
 
 #: Cells per thread in lockstep at most (:data:`rockjit._engine.lanes.W`, the vector's width).
 LANES_MAX = 8
 #: Cells per thread in lockstep by default, for grids without tangent vectors (basins, erosion,
 #: fates; the grids with exponents run one cell at a time). Measured (benchmarks/bench_lanes.py,
-#: the study's basin, 2 threads): 8 lanes 1.18x the cells per second of one full length, 1.40x
-#: early-stopped; 2 lanes lose, 4 about even. The same outputs bit for bit whatever the count.
+#: the study's basin, 2 threads): 8 lanes 1.86x the cells per second of one full length, 2.08x
+#: early-stopped; 2 lanes lose, 4 about even full length. The same outputs bit for bit whatever
+#: the count.
 #: The lanes' kernel replaces the single-lane one in the ``grid`` variant (a cold compile ~20 s).
 DEFAULT_LANES = 8
 

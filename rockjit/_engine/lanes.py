@@ -25,7 +25,7 @@ from . import integrate as ig
 from . import cell
 from .._jit import cycles, fma, jit
 from ..model import (NEAR_RANGE, SINCOS_RANGE, accel_near, corner, initial_side, rotate,
-                    sincos_poly)
+                    sincos_poly, uplift_time)
 
 __all__ = ["W", "bank", "block_step_lanes", "lane_tables", "run_lanes", "scalar_step"]
 
@@ -206,11 +206,14 @@ def block_step_lanes(n, j, lin, lout, ftl):
 (S_STATUS, S_SIDE, S_NIMP, S_STEP, S_JPER, S_KPER, S_JQR, S_JREC, S_NCOL, S_NCOLWIN,
  S_CELL) = range(11)
 N_ST = 11
-F_TT, F_MAXERR, F_TLIFT = range(3)
-N_FS = 3
+F_TT, F_MAXERR, F_TLIFT, F_TUP = range(4)
+# F_TUP: at rest, the instant the forcing lifts the block (rockjit.model.uplift_time)
+# the forcing and grid the lane's tables were made for: alpha omega^2, omega, phi, h, N
+F_KEY = 4
+N_FS = F_KEY + 5
 
 
-@jit(nrt=False)
+@jit(nrt=False, inline=True)
 def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, prof, counts):
     """One grid step of a lane on the scalar path: :func:`rockjit._engine.integrate.grid_step`, the
     single-lane loop's own step (closed-form forcing, no trajectory), with the lane's loop
@@ -268,7 +271,7 @@ def _bank(periods, n_per, cap):
                 np.zeros((W, n_st, 2)), np.zeros((W, 4, 2)), np.zeros((W, 4)),
                 np.zeros((W, ig.N_TAB, n_st)), np.zeros((W, ig.N_TAB, n_st)),
                 np.zeros((W, n_st)), np.zeros((W, n_st)), np.zeros((W, 4)),
-                np.zeros((W, n_per, n_st)))
+                np.zeros((W, n_per, ig.N_FTAB)))
 
 
 @jit(nrt=False, inline=True)
@@ -294,9 +297,12 @@ def _zero(a):
 @jit(nrt=False)
 def _load(l, i, y0s, pars, ipar, b):
     """Start cell ``i`` in lane ``l`` (:func:`rockjit._engine.integrate._run` and the start of its
-    loop, on fresh arrays). Returns whether it runs (False: it ended before its first step)."""
-    _zero(b.strobe[l])
-    _zero(b.half[l])
+    loop, on fresh arrays). Returns whether it runs (False: it ended before its first step).
+
+    The stroboscopic samples (``strobe``, ``half``) and impact counts (``per_imp``) are not
+    cleared: a run writes each row before anything reads it (the period test and the
+    classifier read the periods completed so far), and clearing them, ~36 kB a cell at 500
+    periods, cost an early-stopped cell of the study's basin (~12 periods) several percent."""
     _zero(b.impacts[l])
     _zero(b.traj[l])
     _zero(b.lam_run[l])
@@ -304,13 +310,10 @@ def _load(l, i, y0s, pars, ipar, b):
     _zero(b.K[l])
     _zero(b.states[l])
     _zero(b.lam[l])
-    _zero(b.tab_h[l])
     _zero(b.tab[l])
     _zero(b.fr[l])
     _zero(b.jac[l])
     _zero(b.trig[l])
-    _zero(b.ftab[l])
-    _zero(b.per_imp[l])
     _zero(b.iout[l])
     par = b.par[l]
     for m in range(ig.N_PARW):
@@ -323,9 +326,27 @@ def _load(l, i, y0s, pars, ipar, b):
     w = lane_work(b, l)
     y0 = y0s[i]
     side0 = initial_side(y0[0], y0[1])
-    status = ig.start(None, None, y0, side0, par, ipar, out, w)
     st = b.st[l]
     fs = b.fs[l]
+    # the lane's tables serve the next cell too when its forcing and grid are the same (every
+    # cell of a basin): they are made by the same code from the same numbers
+    same = (fs[F_KEY] == par[ig.P_AW2] and fs[F_KEY + 1] == par[ig.P_OMEGA]
+            and fs[F_KEY + 2] == par[ig.P_PHI] and fs[F_KEY + 3] == par[ig.P_H]
+            and fs[F_KEY + 4] == ipar[ig.I_N])
+    if not same:
+        _zero(b.tab_h[l])
+        _zero(b.ftab[l])
+        ig.tables(None, par, ipar, w)
+        lane_tables(w.tab_h, b.lin, l)
+        for jj in range(ipar[ig.I_N]):
+            for s in range(ig.N_STAGES + 1):
+                b.ftl[(jj * (ig.N_STAGES + 1) + s) * W + l] = w.ftab[jj, s]
+        fs[F_KEY] = par[ig.P_AW2]
+        fs[F_KEY + 1] = par[ig.P_OMEGA]
+        fs[F_KEY + 2] = par[ig.P_PHI]
+        fs[F_KEY + 3] = par[ig.P_H]
+        fs[F_KEY + 4] = ipar[ig.I_N]
+    status = ig.start_state(None, None, y0, side0, par, ipar, out, w)
     for m in range(N_ST):
         st[m] = 0
     st[S_STATUS] = status
@@ -336,15 +357,26 @@ def _load(l, i, y0s, pars, ipar, b):
     fs[F_TT] = 0.0
     fs[F_MAXERR] = 0.0
     fs[F_TLIFT] = -math.inf
-    lane_tables(w.tab_h, b.lin, l)
-    for jj in range(ipar[ig.I_N]):
-        for s in range(ig.N_STAGES + 1):
-            b.ftl[(jj * (ig.N_STAGES + 1) + s) * W + l] = w.ftab[jj, s]
+    fs[F_TUP] = _uplift(st, fs, par)
     b.lin[I_STHC * W + l] = par[ig.P_STHC]
     b.lin[I_CTHC * W + l] = par[ig.P_CTHC]
     b.lin[I_XI * W + l] = par[ig.P_XI]
     _refresh(l, b)
     return status == ig.RUNNING and ipar[ig.I_N] * ipar[ig.I_PERIODS] > 0
+
+
+#: A lane at rest skips its scalar steps while the uplift lies this many steps' lengths
+#: beyond the grid point (margin for the rounding of uplift_time at another instant): the
+#: single-lane code holds it at rest there (REST_HOLD), and so do the lanes, bit for bit.
+REST_MARGIN = 1e-9
+
+
+@jit(nrt=False, inline=True)
+def _uplift(st, fs, par):
+    """At rest (``side`` 0): the next uplift after the lane's time; else -inf."""
+    if st[S_SIDE] != 0 or st[S_STATUS] != ig.RUNNING:
+        return -math.inf
+    return uplift_time(fs[F_TT], par[ig.P_AW2], par[ig.P_COT], par[ig.P_OMEGA], par[ig.P_PHI])
 
 
 @jit(nrt=False, inline=True)
@@ -418,13 +450,15 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
     :func:`rockjit._engine.kernel._grid`'s.
 
     Each grid step: :func:`block_step_lanes` for all lanes at once, which accepts the step of
-    every lane in flight whose step has no event, stays in the polynomials' range; every other
-    lane's step (an event, a rest phase) is taken again by :func:`scalar_step`, the single-lane
-    code. A lane's arithmetic is the single-lane kernel's either way, so its results are bit for
-    bit those of :func:`rockjit._engine.kernel._grid` (the running error estimate ``max_err`` is not
-    kept on the fast path: no grid output reads it). ``counts``: the fast and the scalar steps,
-    the vector steps taken, and with ``prof`` the cycles (``readcyclecounter``) spent in the
-    vector steps, in the scalar steps, and in all, then the parts of the scalar steps
+    every lane in flight whose step has no event, stays in the polynomials' range; a lane at
+    rest whose uplift (computed once when it came to rest) lies beyond the grid point is held
+    there, as the single-lane code would hold it; every other lane's step (an event, the end of
+    a rest phase) is taken again by :func:`scalar_step`, the single-lane code. A lane's
+    arithmetic is the single-lane kernel's either way, so its results are bit for bit those of
+    :func:`rockjit._engine.kernel._grid` (the running error estimate ``max_err`` is not kept on
+    the fast path: no grid output reads it). ``counts``: the fast steps (with the steps held at
+    rest) and the scalar steps, the vector steps taken, and with ``prof`` the cycles
+    (``readcyclecounter``) spent in the vector steps, in the scalar steps, and in all, then the parts of the scalar steps
     (:func:`scalar_step`); without, the cycle counter is not read (its reads cost ~10 % of a
     basin's time).
     """
@@ -469,11 +503,18 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
             st = b.st[l]
             if st[S_CELL] < 0:
                 continue
-            if lout[O_FAST * W + l] != 0.0:
+            fast = lout[O_FAST * W + l] != 0.0
+            hl = b.par[l, ig.P_H]
+            # at rest with the uplift beyond the grid point: held there, as the scalar step
+            # would (rockjit._engine.integrate.leave_rest), without taking it
+            held = (st[S_SIDE] == 0
+                    and b.fs[l, F_TUP] - (st[S_STEP] + 1) * hl > REST_MARGIN * hl)
+            if fast or held:
                 counts[0] += 1
-                iout = b.iout[l]
-                iout[ig.O_RHS] += ig.N_STAGES
-                iout[ig.O_SUBSTEPS] += 1
+                if fast:
+                    iout = b.iout[l]
+                    iout[ig.O_RHS] += ig.N_STAGES
+                    iout[ig.O_SUBSTEPS] += 1
                 step = st[S_STEP] + 1
                 st[S_STEP] = step
                 t = step * b.par[l, ig.P_H]
@@ -504,6 +545,7 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
                 scalar_step(None, st, b.fs[l], b.par[l], ipar, lane_outputs(b, l),
                             lane_work(b, l), pre, prof, counts)
                 _refresh(l, b)
+                b.fs[l, F_TUP] = _uplift(st, b.fs[l], b.par[l])
                 counts[4] += (cycles() - c0) if prof else 0
             if st[S_STATUS] != ig.RUNNING or st[S_STEP] >= total:
                 _sync(l, b)
