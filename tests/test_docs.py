@@ -141,8 +141,11 @@ def _listed(name, patterns):
 
 OUTPUTS = _sections((DOCS / "guide" / "outputs.md").read_text())
 #: npz archives whose arrays another section lists ("with the arrays of `sweep.npz`")
-SHARED_ARRAYS = {"sweep.npz": "sweep", "erosion.npz": "erosion"}
+SHARED_ARRAYS = {"sweep.npz": "sweep", "erosion.npz": "erosion", "orbits.npz": "orbits",
+                 "chart.npz": "chart"}
 
+#: stands for two small record files (two-column CSV, written by the test)
+RECORDS = "<records>"
 BASIN = ["--hb", "1", "--alpha", "0.66", "--omega", "1.3", "--grid", "6", "--periods", "20"]
 TINY = ["--periods", "20", "--quiet"]
 
@@ -174,10 +177,40 @@ RUNS = [
     ("paper", "paper", ["paper", "--grid", "4", "--periods", "20", "--n-steps", "64",
                         "--alpha-step", "0.1", "--zoom-step", "0.05", "--as-published",
                         "--quiet"]),
+    ("chart", "chart", ["chart", "--hb", "1", "--alpha-range", "0.2", "1.2", "--omega-range",
+                        "0.8", "3", "--grid", "8", "6", "--max-period", "1", "--seed-omegas",
+                        "1.2"] + TINY),
+    ("chart-both", "chart", ["chart", "--hb", "1", "--law", "both", "--alpha-range", "0.2",
+                             "1.2", "--omega-range", "0.8", "3", "--grid", "8", "6",
+                             "--max-period", "1", "--seed-omegas", "1.2"] + TINY),
+    ("spectrum", "spectrum", ["spectrum", "--hb", "4", "--ratio-range", "1", "5",
+                              "--amplitude-range", "1.5", "9", "--grid", "2", "2", "--tol",
+                              "1e-3", "--quiet"]),
+    ("spectrum-both", "spectrum", ["spectrum", "--hb", "4", "--law", "both", "--ratio-range",
+                                   "1", "5", "--amplitude-range", "1.5", "9", "--grid", "2",
+                                   "2", "--tol", "1e-3", "--quiet"]),
+    ("fragility-both", "fragility", ["fragility", "--hb", "3", "--law", "both", "--size", "0.5",
+                                     "2", "--records", RECORDS, "--intensities", "0.9", "4",
+                                     "--free-time", "20", "--quiet"]),
 ]
 
 def _marks(run_id):
     return []
+
+
+def _records(directory):
+    """Two short synthetic accelerograms (time in s, acceleration in g) as CSV files."""
+    files = []
+    for seed in (1, 2):
+        rng = np.random.default_rng(seed)
+        t = np.arange(401) * 0.01
+        a = sum(rng.normal(0, 0.1) * np.sin(2 * np.pi * f * t + rng.uniform(0, 6))
+                for f in (0.6, 1.4, 3.1)) * np.sin(np.pi * t / t[-1]) ** 2
+        path = directory / f"record{seed}.csv"
+        path.write_text("time (s),acceleration (g)\n" +
+                        "".join(f"{x:.2f},{y:.8f}\n" for x, y in zip(t, a)))
+        files.append(str(path))
+    return files
 
 
 @pytest.mark.parametrize("section, argv", [pytest.param(s, a, id=i, marks=_marks(i))
@@ -185,13 +218,21 @@ def _marks(run_id):
 def test_outputs_page_lists_what_a_command_writes(section, argv, tmp_path):
     from rockjit.cli.main import main
     out = tmp_path / "out"
+    if RECORDS in argv:
+        i = argv.index(RECORDS)
+        argv = argv[:i] + _records(tmp_path) + argv[i + 1:]
     assert main(argv + ["--out", str(out)]) == 0
     own = OUTPUTS[section]
     patterns = _patterns(own)
     common = _patterns(OUTPUTS["common"])
     written = sorted(p.name for p in out.iterdir())
     summary = json.loads((out / "summary.json").read_text())
-    assert sorted(summary["files"]) == written
+    # the manifest: every file written, each with what it holds in words
+    assert all(set(f) == {"name", "holds"} for f in summary["files"]), summary["files"]
+    assert sorted(f["name"] for f in summary["files"]) == written
+    undescribed = [f["name"] for f in summary["files"]
+                   if not (isinstance(f["holds"], str) and f["holds"].strip())]
+    assert not undescribed, f"summary.json's files: nothing said of {undescribed}"
     missing = [f for f in written if not _listed(f, patterns + common)]
     assert not missing, f"docs/guide/outputs.md, section {section}: add the files {missing}"
     for f in written:
