@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import doctest
 import importlib
+import importlib.util
 import inspect
 import json
 import re
@@ -34,7 +35,13 @@ PUBLIC_MODULES = [
     "rockjit.basins.fate", "rockjit.basins.measures", "rockjit.storage.files",
     "rockjit.testing.stress", "rockjit.orbits.shooting", "rockjit.orbits.arclength",
     "rockjit.orbits.types", "rockjit.basins.identity", "rockjit.basins.cycles",
+    "rockjit.orbits.curves", "rockjit.orbits.plane_chart", "rockjit.ground.pulses",
+    "rockjit.ground.records", "rockjit.ground.fema", "rockjit.ground.settings",
+    "rockjit.ground.response", "rockjit.ground.spectrum", "rockjit.ground.fitting",
+    "rockjit.ground.fragility",
 ]
+if importlib.util.find_spec("bokeh") is not None:  # the explorer's example starts its server
+    PUBLIC_MODULES.append("rockjit.explorer")
 
 
 # ------------------------------------------------------------------------------- doctests
@@ -70,10 +77,18 @@ def test_docstring_example(test):
 
 def _public_objects():
     """``(qualified name, object)`` of everything the API reference documents."""
+    from rockjit import ground, orbits
     from rockjit.basins import erosion, fate, measures
+    from rockjit.single import Prepared
     from rockjit.storage import files
     from rockjit.testing import stress
+    spectrum = sys.modules["rockjit.ground.spectrum"]  # (rockjit.ground.spectrum: the function)
     out = [(f"rockjit.{n}", getattr(rockjit, n)) for n in rockjit.__all__]
+    out += [(f"rockjit.ground.{n}", getattr(ground, n)) for n in ground.__all__]
+    out += [("rockjit.ground.spectrum.compare", spectrum.compare),
+            ("rockjit.single.Prepared", Prepared),
+            ("rockjit.orbits.ChartResult", orbits.ChartResult),
+            ("rockjit.orbits.BifurcationCurve", orbits.BifurcationCurve)]
     out += [(f"rockjit.basins.measures.{n}", getattr(measures, n)) for n in measures.__all__]
     out += [("rockjit.basins.erosion.ErosionResult", erosion.ErosionResult),
             ("rockjit.basins.fate.FateResult", fate.FateResult),
