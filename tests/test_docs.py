@@ -306,6 +306,24 @@ def test_command_line_reference_lists_every_command_and_option():
                     assert f"`{opt}" in section or f", {opt}" in section, (name, opt)
 
 
+def test_no_internal_references_in_what_the_site_renders():
+    """The command-line reference and the package's docstrings say what the code does: no work
+    item, specification or style-guide number (the benchmark results alone are cleaned when
+    the site is built, below). The compiled engine's modules are not rendered on the site."""
+    sc = _ext("_scrub")
+    internal = re.compile(rf"{sc._ITEM}|{sc._SPEC}|STYLE\.md")
+    cli = _ext("rockjit_cli").render()
+    assert not internal.search(cli), internal.search(cli).group(0)
+    found = []
+    for path in sorted((ROOT / "rockjit").rglob("*.py")):
+        if "_engine" in path.relative_to(ROOT).parts:
+            continue
+        for n, line in enumerate(path.read_text().splitlines(), 1):
+            if internal.search(line):
+                found.append(f"{path.relative_to(ROOT)}:{n}: {line.strip()}")
+    assert not found, "\n".join(found)
+
+
 def test_scrub_keeps_the_figures():
     """The results as the site shows them: no internal reference left, every table row that
     had none unchanged."""
