@@ -1,6 +1,6 @@
 """The project's one numba policy: every compiled function is decorated with :func:`jit`.
 
-``FASTMATH`` is the single fastmath setting (STYLE.md 7). It keeps IEEE NaN/inf semantics (no
+``FASTMATH`` is the single fastmath setting, for every kernel. It keeps IEEE NaN/inf semantics (no
 ``nnan``/``ninf``) so event tests and non-finite guards behave, and it leaves out ``contract`` and
 ``reassoc``: with them LLVM fuses or reorders the same arithmetic differently in two compilations
 (tangent vectors on or off, say), and the state's trajectory then differs in the last bit. The

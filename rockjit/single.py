@@ -323,8 +323,18 @@ class Prepared:
     integration and little else (the plan's checks, the packing and the kernel's look-up are
     not made again).
 
-    Made by ``rockjit.simulate.prepare(...)`` (the parameters of :func:`simulate`);
-    :func:`simulate` keeps one per block, excitation and settings it is called with again.
+    Made by ``rockjit.simulate.prepare(...)`` (the parameters of :func:`rockjit.simulate`);
+    :func:`rockjit.simulate` keeps one per block, excitation and settings it is called with
+    again.
+    Calling it with ``state`` (a new ``(theta0, theta0')``) and ``alpha`` (a new amplitude)
+    returns the :class:`rockjit.Result` of that run; the forcing phase stays the prepared
+    run's (give it in the excitation, ``phase`` or ``r0, s0``, to fix it yourself).
+
+    Parameters
+    ----------
+    plan : RunPlan
+        A validated single run of the compiled path (``rockjit.simulate.plan(...)``);
+        ``method`` must be ``"rockjit"``.
 
     Examples
     --------
@@ -370,8 +380,9 @@ def _prepare(*args, **kwargs):
     return Prepared(simulate.plan(*args, **kwargs))
 
 
-_prepare.__doc__ = """A :class:`Prepared` run: the parameters of :func:`simulate`, validated once;
-call it with a new ``state`` or ``alpha``."""
+_prepare.__doc__ = """A :class:`Prepared` run: the parameters of :func:`simulate`, validated once
+and packed for the compiled kernel; call it with a new ``state`` or ``alpha`` to run again
+without the checks, the packing and the kernel's look-up."""
 
 #: Prepared runs :func:`simulate` reuses, by its arguments but the state (a few at most).
 _PREPARED = {}

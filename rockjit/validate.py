@@ -2,7 +2,7 @@
 
 Each function takes the parameter's user-facing ``name`` and its value, and either returns the
 value in canonical form or raises ``ValueError`` naming the parameter, the allowed range and the
-value got (STYLE.md 12): ``ValueError: periods must be in [1, 1e9] (got 0)``. No value a user can
+value got: ``ValueError: periods must be in [1, 1e9] (got 0)``. No value a user can
 type reaches numpy, numba or scipy unchecked.
 
 :func:`memory` refuses a computation whose arrays would not fit, before anything is allocated:

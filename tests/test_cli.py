@@ -350,7 +350,7 @@ def test_npz_and_csv_round_trip(tmp_path):
 
 
 # ---------------------------------------------------------------------------------------------
-# issue 10: what a user is told
+# what a user is told: quiet runs, runs stopped early, stale files
 # ---------------------------------------------------------------------------------------------
 
 def test_quiet_means_quiet_even_for_a_degenerate_grid(tmp_path, capsys):
@@ -380,7 +380,7 @@ def test_a_second_command_into_the_same_folder_warns_of_stale_files(tmp_path, ca
 
 
 # ---------------------------------------------------------------------------------------------
-# beyond the study: attractors, erosion, fates (issues 12 and 14)
+# beyond the study: attractors, erosion, fates
 # ---------------------------------------------------------------------------------------------
 
 def test_basin_writes_attractors_and_their_measures(tmp_path):

@@ -1,6 +1,6 @@
 """Seeded fuzz test of the command line: every bad input is refused cleanly, before any work.
 
-The specification of issue 10 §1 for ``rockjit.cli.main``. For every invalid argument vector:
+What ``rockjit.cli.main`` promises for every invalid argument vector:
 exit status 2; exactly one line on stderr, starting with ``rockjit: error:`` and naming the
 offending option or parameter; nothing on stdout, no traceback, no warning; nothing written (the
 command runs with the current directory set to an empty temporary directory and ``--out`` inside
@@ -9,10 +9,13 @@ it; afterwards that directory holds exactly what it held before: no ``--out``, n
 
 The cases (``CASES``, printable with ``pytest --collect-only -q``):
 
-- ``issue10 ...``: every item of issue 10 §1, literally, and the numerics items of §3 whose
-  refusal the issue asks for;
+- ``refusals: ...``: hand-written command lines that once got past the checks or ended in a
+  traceback (overflowing frequencies and periods, grids too large for memory, unwritable
+  ``--out``, a plain file where the chunk store goes, ...), and the numerical settings that
+  must be refused (an explicit N below the damping's stability limit, a zero Zeno cut-off, an
+  impact bound too large to allocate), literally;
 - generated: every subcommand, every option that takes a value, given values outside the range
-  its documentation states (SPEC.md, the docstrings, ``--help``) and malformed values (``nan``,
+  its documentation states (docs/theory, the docstrings, ``--help``) and malformed values (``nan``,
   ``inf``, ``1e308``, ``5e-324``, ``abc``, ``""``, ``1,5``, ``0x10``, ...), numbers that are not
   ASCII decimal (``1_0``, Arabic-Indic or fullwidth digits, spaces), required options left out,
   the wrong number of values; the scipy tolerances whatever the method; ``--scheduler``
@@ -22,7 +25,7 @@ The cases (``CASES``, printable with ``pytest --collect-only -q``):
   is really invalid.
 - ``numbers: ...``: non-ASCII numbers in single and multi-valued options, literally.
 
-Options the command line did not have but the specification implies carry ``[guessed --NAME]``
+Options the command line did not have but its documented model implies carry ``[guessed --NAME]``
 in their ids: ``--max-impacts`` must exist; ``--xi`` cases are skipped while the parser does not
 have it; ``--rest-speed`` is tried only on ``trajectory``, the one command that has it.
 
@@ -98,7 +101,7 @@ SEED = int(os.environ.get("ROCKJIT_FUZZ_SEED", "20240610"))
 ALLOC_LIMIT = 64 * 2**20
 MAX_THREADS = numba.config.NUMBA_NUM_THREADS
 MEMORY_MESSAGE = r"would need .+at most .+fits"
-#: argparse's words when it takes a negative number for an option (issue 10 §1)
+#: argparse's words when it takes a negative number for an option
 TAKEN_FOR_AN_OPTION = r"expected (one|at least one|\d+) argument"
 
 
@@ -293,14 +296,14 @@ def _real_opt(cmd, opt, bad, extra=None):
 def _int_opt(cmd, opt, bad):
     cases = _values(cmd, opt, bad + NOT_INT + _malformed(cmd, opt) + _not_ascii(cmd, opt))
     for c in cases:
-        if c.set[opt] == [HUGE_INT]:  # an integer: too large, not "not an integer" (issue 10)
+        if c.set[opt] == [HUGE_INT]:  # an integer: too large, not "not an integer"
             c.forbid = (r"must be an integer",)
     return cases
 
 
 def _block_cases(cmd, alpha=True, omega=True, laws_ok=("housner", "mao", "constant")):
     c = _real_opt(cmd, "--hb", ["0", "-1", "-1e308"])
-    # below 1/sqrt(2) the Housner law has e_H < 0 (SPEC.md §2)
+    # below 1/sqrt(2) the Housner law has e_H < 0 (docs/theory/impacts.md)
     c += _values(cmd, "--hb", ["0.5", "5e-324"], {"--law": ["housner"]})
     c += _values(cmd, "--law", [v for v in ("abc", "", "HOUSNER", "0", "both")
                                 if v not in laws_ok])
@@ -312,7 +315,7 @@ def _block_cases(cmd, alpha=True, omega=True, laws_ok=("housner", "mao", "consta
     if alpha:
         c += _real_opt(cmd, "--alpha", ["-1", "-1e-3", "-1e308"])
     if omega:
-        # 1e308: alpha omega^2 overflows; 5e-324: the period overflows (issue 10 §1)
+        # 1e308: alpha omega^2 overflows; 5e-324: the period overflows
         c += _real_opt(cmd, "--omega", ["0", "-1.3", "-1e-3", "-1e308", "1e308", "5e-324"])
     return c
 
@@ -333,7 +336,7 @@ def _state_cases(cmd, theta=True):
                      r"\b[rs]0\b")]]
     for group in forcing:
         for case in group:
-            if cmd not in ("trajectory", "fate"):  # only these take --forcing (issue 10 §1)
+            if cmd not in ("trajectory", "fate"):  # only these take --forcing
                 case.forbid = (r"embedded",)
         c += group
     c += _values(cmd, "--r0", NONFINITE + _malformed(cmd, "--r0"), {"--s0": ["1"]})
@@ -351,7 +354,7 @@ def _run_cases(cmd):
 
 
 def _chunks_case(cmd):
-    # issue 10 §1: a plain file where the chunk store goes ended in NotADirectoryError
+    # a plain file where the chunk store goes once ended in NotADirectoryError
     return [Case(f"{cmd} <out>.chunks is a plain file", cmd, {}, r"chunks", setup="chunks-file"),
             Case(f"{cmd} <out>.chunks is a dangling link", cmd, {}, r"chunks.*--out",
                  setup="chunks-dangling"),
@@ -484,7 +487,7 @@ def _paper():
     c = _run_cases(cmd)
     c += _int_opt(cmd, "--grid", ["0", "-3", HUGE_INT])
     c += _real_opt(cmd, "--alpha-step", ["0", "-0.1", "-1e308", "5e-324"])
-    # the zoom lies inside the Housner hb=1 range [0.5, 1] (SPEC.md §7), start <= end
+    # the zoom lies inside the Housner hb=1 range [0.5, 1] (docs/theory/study.md), start <= end
     c += _pairs(cmd, "--zoom", [
         ["0.9"], ["0.9", "0.95", "0.97"], ["0.2", "0.3"], ["0.9", "1.1"], ["-0.9", "0.95"],
         ["nan", "0.9"], ["0.9", "inf"], ["-inf", "0.9"], ["abc", "0.9"], ["0.9", ""],
@@ -501,15 +504,16 @@ def _stable_n(omega, xi, stability=3.31):
     return math.ceil(2.0 * math.pi / omega * 0.75 * xi / stability)
 
 
-def _issue10():
-    """Issue 10 §1 (and the refusals §3 asks for), literally."""
+def _refusals():
+    """Hand-written command lines that must be refused, literally: ones that once got past
+    the checks or ended in a traceback, and the numerical settings that must be refused."""
     traj = {"--hb": ["1"], "--alpha": ["0.6"], "--omega": ["1.3"]}
     sweep = {"--hb": ["1"], "--omega": ["1.3"], "--alpha-range": ["0.5", "0.6"]}
     basin = {"--hb": ["1"], "--alpha": ["0.66"], "--omega": ["1.3"]}
     plane = {"--hb": ["1"], "--alpha-range": ["0.5", "0.6"]}
 
     def case(text, cmd, opts, names, **kw):
-        return Case(f"issue10: {text}", cmd, opts, names, base=False, **kw)
+        return Case(f"refusals: {text}", cmd, opts, names, base=False, **kw)
 
     out = {"--out": ["{out}"]}
     return [
@@ -554,7 +558,7 @@ def _issue10():
              {**traj, "--theta0": ["2"], **out}, NAMES["--theta0"]),
         case("trajectory --method scipy:FOO", "trajectory",
              {**traj, "--method": ["scipy:FOO"], **out}, NAMES["--method"]),
-        # §3 stiff damping: an explicit N below the stability limit in h*3/4*xi is refused,
+        # stiff damping: an explicit N below the stability limit in h*3/4*xi is refused,
         # naming the N needed, at least T * 3/4 xi / 3.31 (Dormand-Prince's stability interval
         # on the negative real axis is about [-3.31, 0]): 220 for xi = 200, 548 for xi = 500
         case("trajectory --xi 200 --n-steps 64 [guessed --xi]", "trajectory",
@@ -563,12 +567,12 @@ def _issue10():
         case("sweep --xi 500 --n-steps 64 [guessed --xi]", "sweep",
              {**sweep, "--alpha-step": ["0.05"], "--xi": ["500"], "--n-steps": ["64"], **out},
              NAMES["--n-steps"], guessed="--xi", n_at_least=_stable_n(1.3, 500)),
-        # §3: rest_speed = 0 piles impacts at one instant; refused unless the accumulation
-        # point of SPEC §3 is implemented (then drop this case)
+        # rest_speed = 0 piles impacts at one instant; refused unless the accumulation
+        # point of the impacts (docs/theory/impacts.md) is computed (then drop this case)
         case("trajectory --rest-speed 0 [guessed --rest-speed]", "trajectory",
              {**traj, "--rest-speed": ["0"], **out}, NAMES["--rest-speed"],
              guessed="--rest-speed"),
-        # §3: expose --max-impacts; a bound whose impact table cannot fit is refused
+        # --max-impacts exists; a bound whose impact table cannot fit is refused
         case("trajectory --max-impacts 99999999999999999999 [guessed --max-impacts]",
              "trajectory", {**traj, "--max-impacts": [HUGE_INT], **out},
              NAMES["--max-impacts"], guessed="--max-impacts", guessed_required=True),
@@ -576,7 +580,7 @@ def _issue10():
 
 
 def _grid_extras(cmd):
-    """Options every grid command has beyond the study's (issues 10, 12, 14)."""
+    """Options every grid command has beyond the study's (uncertain cells)."""
     return _real_opt(cmd, "--uncertainty", ["0", "-1e-6", "0.9", "1e308", "5e-324"])
 
 
@@ -724,7 +728,7 @@ def _misc():
         Case("(no command)", "", {}, r"COMMAND|command", base=False),
         Case("frobnicate --out x", "frobnicate", {"--out": ["{out}"]}, r"frobnicate",
              base=False),
-        # rockjit compile takes only --quiet (issue 15): everything else is refused
+        # rockjit compile takes only --quiet: everything else is refused
         Case("compile --all", "compile", {"--all": True}, r"--all", extra_ok=True, base=False),
         Case("compile --out x", "compile", {"--out": ["{out}"]}, r"--out", extra_ok=True,
              base=False),
@@ -765,7 +769,7 @@ def _numbers():
     ]
 
 
-CASES = (_issue10() + _trajectory() + _sweep() + _basin() + _plane() + _cor() + _paper()
+CASES = (_refusals() + _trajectory() + _sweep() + _basin() + _plane() + _cor() + _paper()
          + _erosion() + _fate() + _orbits() + _chart() + _grid_extras("sweep")
          + _grid_extras("basin")
          + _grid_extras("plane") + _real_opt("paper", "--erosion-step", ["0", "-0.01", "5e-324"])
@@ -878,7 +882,7 @@ def reached():
     """Replace every entry point of real work by a sentinel; the list records what was reached."""
     calls = []
     # import every module the CLI may import lazily first: one imported while the patches are
-    # in place would keep a sentinel under its own name for the rest of the session
+    # in place would keep a sentinel under its own name for the rest of the test run
     for name in ("grids.plan", "ground.batch", "ground.spectrum", "ground.fragility",
                  "ground.reference", "basins.identity", "basins.erosion", "basins.fate",
                  "orbits.arclength", "orbits.plane_chart", "cli.outputs", "plotting.figures",
@@ -1057,7 +1061,7 @@ def verdict(case, rc, exc, stdout, stderr, caught, peak, reached):
 
 
 # ---------------------------------------------------------------------------------------------
-# Negative numbers in e-notation are numbers (issue 10 §1)
+# Negative numbers in e-notation are numbers
 # ---------------------------------------------------------------------------------------------
 
 #: (command line up to the value, the value's words, argparse dest, the number expected)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import doctest
 import importlib
+import importlib.util
 import inspect
 import json
 import re
@@ -34,7 +35,13 @@ PUBLIC_MODULES = [
     "rockjit.basins.fate", "rockjit.basins.measures", "rockjit.storage.files",
     "rockjit.testing.stress", "rockjit.orbits.shooting", "rockjit.orbits.arclength",
     "rockjit.orbits.types", "rockjit.basins.identity", "rockjit.basins.cycles",
+    "rockjit.orbits.curves", "rockjit.orbits.plane_chart", "rockjit.ground.pulses",
+    "rockjit.ground.records", "rockjit.ground.fema", "rockjit.ground.settings",
+    "rockjit.ground.response", "rockjit.ground.spectrum", "rockjit.ground.fitting",
+    "rockjit.ground.fragility",
 ]
+if importlib.util.find_spec("bokeh") is not None:  # the explorer's example starts its server
+    PUBLIC_MODULES.append("rockjit.explorer")
 
 
 # ------------------------------------------------------------------------------- doctests
@@ -70,10 +77,18 @@ def test_docstring_example(test):
 
 def _public_objects():
     """``(qualified name, object)`` of everything the API reference documents."""
+    from rockjit import ground, orbits
     from rockjit.basins import erosion, fate, measures
+    from rockjit.single import Prepared
     from rockjit.storage import files
     from rockjit.testing import stress
+    spectrum = sys.modules["rockjit.ground.spectrum"]  # (rockjit.ground.spectrum: the function)
     out = [(f"rockjit.{n}", getattr(rockjit, n)) for n in rockjit.__all__]
+    out += [(f"rockjit.ground.{n}", getattr(ground, n)) for n in ground.__all__]
+    out += [("rockjit.ground.spectrum.compare", spectrum.compare),
+            ("rockjit.single.Prepared", Prepared),
+            ("rockjit.orbits.ChartResult", orbits.ChartResult),
+            ("rockjit.orbits.BifurcationCurve", orbits.BifurcationCurve)]
     out += [(f"rockjit.basins.measures.{n}", getattr(measures, n)) for n in measures.__all__]
     out += [("rockjit.basins.erosion.ErosionResult", erosion.ErosionResult),
             ("rockjit.basins.fate.FateResult", fate.FateResult),
@@ -141,8 +156,11 @@ def _listed(name, patterns):
 
 OUTPUTS = _sections((DOCS / "guide" / "outputs.md").read_text())
 #: npz archives whose arrays another section lists ("with the arrays of `sweep.npz`")
-SHARED_ARRAYS = {"sweep.npz": "sweep", "erosion.npz": "erosion"}
+SHARED_ARRAYS = {"sweep.npz": "sweep", "erosion.npz": "erosion", "orbits.npz": "orbits",
+                 "chart.npz": "chart"}
 
+#: stands for two small record files (two-column CSV, written by the test)
+RECORDS = "<records>"
 BASIN = ["--hb", "1", "--alpha", "0.66", "--omega", "1.3", "--grid", "6", "--periods", "20"]
 TINY = ["--periods", "20", "--quiet"]
 
@@ -174,10 +192,40 @@ RUNS = [
     ("paper", "paper", ["paper", "--grid", "4", "--periods", "20", "--n-steps", "64",
                         "--alpha-step", "0.1", "--zoom-step", "0.05", "--as-published",
                         "--quiet"]),
+    ("chart", "chart", ["chart", "--hb", "1", "--alpha-range", "0.2", "1.2", "--omega-range",
+                        "0.8", "3", "--grid", "8", "6", "--max-period", "1", "--seed-omegas",
+                        "1.2"] + TINY),
+    ("chart-both", "chart", ["chart", "--hb", "1", "--law", "both", "--alpha-range", "0.2",
+                             "1.2", "--omega-range", "0.8", "3", "--grid", "8", "6",
+                             "--max-period", "1", "--seed-omegas", "1.2"] + TINY),
+    ("spectrum", "spectrum", ["spectrum", "--hb", "4", "--ratio-range", "1", "5",
+                              "--amplitude-range", "1.5", "9", "--grid", "2", "2", "--tol",
+                              "1e-3", "--quiet"]),
+    ("spectrum-both", "spectrum", ["spectrum", "--hb", "4", "--law", "both", "--ratio-range",
+                                   "1", "5", "--amplitude-range", "1.5", "9", "--grid", "2",
+                                   "2", "--tol", "1e-3", "--quiet"]),
+    ("fragility-both", "fragility", ["fragility", "--hb", "3", "--law", "both", "--size", "0.5",
+                                     "2", "--records", RECORDS, "--intensities", "0.9", "4",
+                                     "--free-time", "20", "--quiet"]),
 ]
 
 def _marks(run_id):
     return []
+
+
+def _records(directory):
+    """Two short synthetic accelerograms (time in s, acceleration in g) as CSV files."""
+    files = []
+    for seed in (1, 2):
+        rng = np.random.default_rng(seed)
+        t = np.arange(401) * 0.01
+        a = sum(rng.normal(0, 0.1) * np.sin(2 * np.pi * f * t + rng.uniform(0, 6))
+                for f in (0.6, 1.4, 3.1)) * np.sin(np.pi * t / t[-1]) ** 2
+        path = directory / f"record{seed}.csv"
+        path.write_text("time (s),acceleration (g)\n" +
+                        "".join(f"{x:.2f},{y:.8f}\n" for x, y in zip(t, a)))
+        files.append(str(path))
+    return files
 
 
 @pytest.mark.parametrize("section, argv", [pytest.param(s, a, id=i, marks=_marks(i))
@@ -185,13 +233,21 @@ def _marks(run_id):
 def test_outputs_page_lists_what_a_command_writes(section, argv, tmp_path):
     from rockjit.cli.main import main
     out = tmp_path / "out"
+    if RECORDS in argv:
+        i = argv.index(RECORDS)
+        argv = argv[:i] + _records(tmp_path) + argv[i + 1:]
     assert main(argv + ["--out", str(out)]) == 0
     own = OUTPUTS[section]
     patterns = _patterns(own)
     common = _patterns(OUTPUTS["common"])
     written = sorted(p.name for p in out.iterdir())
     summary = json.loads((out / "summary.json").read_text())
-    assert sorted(summary["files"]) == written
+    # the manifest: every file written, each with what it holds in words
+    assert all(set(f) == {"name", "holds"} for f in summary["files"]), summary["files"]
+    assert sorted(f["name"] for f in summary["files"]) == written
+    undescribed = [f["name"] for f in summary["files"]
+                   if not (isinstance(f["holds"], str) and f["holds"].strip())]
+    assert not undescribed, f"summary.json's files: nothing said of {undescribed}"
     missing = [f for f in written if not _listed(f, patterns + common)]
     assert not missing, f"docs/guide/outputs.md, section {section}: add the files {missing}"
     for f in written:
@@ -248,6 +304,24 @@ def test_command_line_reference_lists_every_command_and_option():
             for opt in action.option_strings:
                 if opt not in ("-h", "--help"):
                     assert f"`{opt}" in section or f", {opt}" in section, (name, opt)
+
+
+def test_no_internal_references_in_what_the_site_renders():
+    """The command-line reference and the package's docstrings say what the code does: no work
+    item, specification or style-guide number (the benchmark results alone are cleaned when
+    the site is built, below). The compiled engine's modules are not rendered on the site."""
+    sc = _ext("_scrub")
+    internal = re.compile(rf"{sc._ITEM}|{sc._SPEC}|STYLE\.md")
+    cli = _ext("rockjit_cli").render()
+    assert not internal.search(cli), internal.search(cli).group(0)
+    found = []
+    for path in sorted((ROOT / "rockjit").rglob("*.py")):
+        if "_engine" in path.relative_to(ROOT).parts:
+            continue
+        for n, line in enumerate(path.read_text().splitlines(), 1):
+            if internal.search(line):
+                found.append(f"{path.relative_to(ROOT)}:{n}: {line.strip()}")
+    assert not found, "\n".join(found)
 
 
 def test_scrub_keeps_the_figures():

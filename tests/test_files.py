@@ -1,6 +1,6 @@
 """Files rockjit writes: the user's umask, outputs published as one unit, chunk stores that
 refuse a second run, survive damage and report progress readably, and a numba cache check that
-deletes only numba's files of this package (issue 10, section 2 and the progress item of 4).
+deletes only numba's files of this package.
 
 The references are independent of the code under test: the mode a plain ``open``/``mkdir``
 gets under the same umask, byte snapshots of directories taken before an operation, outputs

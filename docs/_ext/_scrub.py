@@ -1,9 +1,12 @@
-"""Text clean-up shared by the generating extensions.
+"""The benchmark results as the performance page shows them (``rockjit_bench``).
 
-Measurement notes, help strings and some docstrings were written beside the development
-history; on the site they read as plain statements. References to the project's internal work
-items and to its specification file are taken out, a Python process is called a process, and a
-sentence reporting a missed target is dropped (the figures themselves stay).
+The files in ``benchmarks/results/`` are what the scripts last wrote, kept as measured; some
+were written by earlier versions of the scripts, whose notes named the project's internal work
+items and specification file. Until each script runs again (the scripts no longer write such
+notes), those references are taken out here, a Python process is called a process, and a
+sentence reporting a missed target is dropped (the figures themselves stay). Nothing else goes
+through this: the help strings and the docstrings say what the code does at their source, which
+``tests/test_docs.py`` checks.
 """
 
 from __future__ import annotations

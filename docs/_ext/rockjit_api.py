@@ -4,10 +4,6 @@
 writes ``docs/_generated/orbits-api.md`` from its public names when the site is built: the
 package's ``__all__`` when it has one, else its ``orbits`` module's. Classes and functions go
 into an autosummary table (with generated pages), constants into ``autodata`` entries.
-
-It also passes every docstring autodoc renders through ``_scrub.scrub``, so that notes written
-beside the development history (references to its work items and specification file) stay out
-of the site.
 """
 
 from __future__ import annotations
@@ -16,7 +12,6 @@ import importlib
 import inspect
 from pathlib import Path
 
-from _scrub import scrub
 from rockjit_cli import GENERATED, write_if_changed
 
 
@@ -47,12 +42,6 @@ def _generate(app, config=None):
     write_if_changed(Path(app.srcdir) / GENERATED / "orbits-api.md", render())
 
 
-def _scrub_docstring(app, what, name, obj, options, lines):
-    """Docstrings as the site shows them: internal references taken out (``_scrub``)."""
-    lines[:] = scrub("\n".join(lines)).split("\n")
-
-
 def setup(app):
     app.connect("config-inited", _generate)
-    app.connect("autodoc-process-docstring", _scrub_docstring)
     return {"version": "1.0", "parallel_read_safe": True, "parallel_write_safe": True}

@@ -15,8 +15,6 @@ import argparse
 import os
 from pathlib import Path
 
-from _scrub import scrub
-
 GENERATED = "_generated"
 WIDTH = "92"  # columns for argparse's usage lines
 
@@ -120,7 +118,7 @@ def render(parser=None):
         table = _options_table(p)
         if table:
             lines += [table]
-    return scrub("\n".join(lines).rstrip()) + "\n"
+    return "\n".join(lines).rstrip() + "\n"
 
 
 def write_if_changed(path, text):

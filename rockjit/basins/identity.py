@@ -394,10 +394,20 @@ def agreement(label_a, label_b):
     """Percentage of cells where two label arrays (the two laws' behaviour maps of one grid)
     agree.
 
+    Parameters
+    ----------
+    label_a, label_b : array_like of int
+        Two behaviour maps of the same shape (codes into :data:`rockjit.BEHAVIOURS`).
+
+    Returns
+    -------
+    numpy.float64
+        The percent of cells with the same code; NaN for empty maps.
+
     Examples
     --------
     >>> from rockjit.basins.identity import agreement
-    >>> agreement([[0, 2], [2, 5]], [[0, 2], [3, 5]])
+    >>> print(agreement([[0, 2], [2, 5]], [[0, 2], [3, 5]]))
     75.0
     """
     a = np.asarray(label_a)

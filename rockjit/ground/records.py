@@ -347,7 +347,38 @@ _FLOAT = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?"
 def read_at2(path, *, size=None, p=None, name=None) -> Record:
     """A PEER NGA ``.AT2`` record: four header lines (the third states the units, which must
     be ``g``; the fourth ``NPTS`` and ``DT``, in either of the database's two layouts), then
-    the accelerations."""
+    the accelerations.
+
+    Parameters
+    ----------
+    path : str or path
+        The file.
+    size : float, optional
+        The block's half-diagonal ``R`` in metres (see :class:`rockjit.Record`).
+    p : float, optional
+        The block's frequency parameter in rad/s, instead of ``size``.
+    name : str, optional
+        The record's name; default the file's name without its suffix.
+
+    Returns
+    -------
+    Record
+        The record; a bad file is refused with one ``ValueError`` line naming it and the
+        problem.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> from rockjit.ground import read_at2
+    >>> header = ("PEER NGA STRONG MOTION DATABASE RECORD\\nAn example, component 000\\n"
+    ...           "ACCELERATION TIME SERIES IN UNITS OF G\\nNPTS=    5, DT=   .0100 SEC\\n")
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     path = pathlib.Path(d) / "example.AT2"
+    ...     _ = path.write_text(header + "  0.0  0.1  -0.2  0.05  0.0\\n")
+    ...     rec = read_at2(path, size=1.0)
+    >>> rec, rec.pga
+    (Record('example', n=5, dt=0.01, size=1), 0.2)
+    """
     src = str(path)
     lines = _read_text(path).splitlines()
     if len(lines) < 4:
@@ -453,7 +484,44 @@ def read_table(path, *, size=None, p=None, name=None) -> Record:
     separated by commas, semicolons, tabs or spaces; ``#`` starts a comment; one header line
     of column names is allowed, and a unit written in it (``acc (g)``, ``a [m/s^2]``) must be
     ``g`` for the acceleration and seconds for the time. A third column named ``unit(s)`` must
-    say ``g`` on every row."""
+    say ``g`` on every row.
+
+    Parameters
+    ----------
+    path : str or path
+        The file.
+    size : float, optional
+        The block's half-diagonal ``R`` in metres (see :class:`rockjit.Record`).
+    p : float, optional
+        The block's frequency parameter in rad/s, instead of ``size``.
+    name : str, optional
+        The record's name; default the file's name without its suffix.
+
+    Returns
+    -------
+    Record
+        The record; a bad file is refused with one ``ValueError`` line naming it and the
+        problem.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> from rockjit.ground import read_table
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     path = pathlib.Path(d) / "motion.csv"
+    ...     _ = path.write_text("time (s), acc (g)\\n0.00, 0.0\\n0.01, 0.1\\n0.02, -0.2\\n"
+    ...                         "0.03, 0.05\\n")
+    ...     rec = read_table(path, size=1.0)
+    >>> rec, rec.pga
+    (Record('motion', n=4, dt=0.01, size=1), 0.2)
+    >>> with tempfile.TemporaryDirectory() as d:       # doctest: +ELLIPSIS
+    ...     path = pathlib.Path(d) / "cms2.csv"
+    ...     _ = path.write_text("t (s), a (cm/s^2)\\n0, 0\\n0.01, 98.1\\n")
+    ...     read_table(path)
+    Traceback (most recent call last):
+    ...
+    ValueError: record ...cms2.csv: the acceleration column is in 'cm/s^2', not g (header 'a (cm/s^2)'); divide by 9.81 m/s^2 first
+    """
     src = str(path)
     text = _read_text(path)
     rows = []
@@ -499,7 +567,36 @@ def read_table(path, *, size=None, p=None, name=None) -> Record:
 
 def read_record(path, *, size=None, p=None, name=None) -> Record:
     """A record from a file: ``.AT2`` (PEER NGA) by its suffix, anything else as a two-column
-    table (:func:`read_table`)."""
+    table (:func:`read_table`).
+
+    Parameters
+    ----------
+    path : str or path
+        The file.
+    size : float, optional
+        The block's half-diagonal ``R`` in metres (see :class:`rockjit.Record`).
+    p : float, optional
+        The block's frequency parameter in rad/s, instead of ``size``.
+    name : str, optional
+        The record's name; default the file's name without its suffix.
+
+    Returns
+    -------
+    Record
+        The record; a bad file is refused with one ``ValueError`` line naming it and the
+        problem.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> from rockjit.ground import read_record
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     path = pathlib.Path(d) / "motion.txt"
+    ...     _ = path.write_text("0.00 0.0\\n0.02 0.15\\n0.04 -0.1\\n")
+    ...     rec = read_record(path, size=2.0, name="a text file")
+    >>> rec.name, rec.n, rec.dt
+    ('a text file', 3, 0.02)
+    """
     if Path(path).suffix.lower() == ".at2":
         return read_at2(path, size=size, p=p, name=name)
     return read_table(path, size=size, p=p, name=name)

@@ -65,7 +65,7 @@ class TransientResult:
     method : str
         ``"scipy:<solve_ivp method>"`` (the compiled path comes later).
     status : str
-        One of :data:`STATUSES`.
+        One of :data:`rockjit.ground.response.STATUSES`.
     t : float
         Model time reached.
     state : ndarray, shape (2,)
@@ -84,6 +84,17 @@ class TransientResult:
         Right-hand-side evaluations.
     n_rest : int
         Rest phases entered after an impact (Zeno cut-offs).
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> from rockjit import Block, Pulse
+    >>> res = rockjit.simulate(Block(hb=4), Pulse("sine", ratio=2.0, amplitude=1.5),
+    ...                        method="scipy")
+    >>> res.status, res.mode, res.n_impacts
+    ('overturned', 'with impact', 1)
+    >>> rockjit.ground.OUTCOMES[res.outcome]
+    'overturn after impact'
     """
 
     block: object
@@ -103,10 +114,12 @@ class TransientResult:
 
     @property
     def message(self) -> str:
+        """What ``status`` means, in words (:data:`rockjit.ground.response.STATUSES`)."""
         return STATUSES[self.status]
 
     @property
     def n_impacts(self) -> int:
+        """The number of impacts."""
         return int(self.impacts.shape[0])
 
     @property
@@ -121,6 +134,7 @@ class TransientResult:
 
     @property
     def overturned(self) -> bool:
+        """Whether the block overturned."""
         return self.status == "overturned"
 
     @property

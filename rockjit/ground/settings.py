@@ -95,5 +95,5 @@ class Transient:
         return self.duration if self.duration is not None else end + self.free_time
 
     def impact_bound(self):
-        """``max_impacts``, or :data:`DEFAULT_MAX_IMPACTS`."""
+        """``max_impacts``, or ``DEFAULT_MAX_IMPACTS`` (100,000)."""
         return DEFAULT_MAX_IMPACTS if self.max_impacts is None else self.max_impacts

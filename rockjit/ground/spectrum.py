@@ -79,10 +79,48 @@ class SpectrumResult:
     """A pulse's overturning spectrum for one block.
 
     ``outcome[i, j]`` belongs to ``ratio[i]``, ``amplitude[j]`` (codes of
-    :data:`rockjit.ground.response.OUTCOMES`); ``max_rotation``, ``t_overturn``,
+    :data:`rockjit.ground.OUTCOMES`); ``max_rotation``, ``t_overturn``,
     ``n_impacts`` likewise. ``min_overturn[i]`` is the located minimum overturning amplitude at
     ``ratio[i]`` (``nan``: no grid amplitude overturns the block), ``min_mode[i]`` its mode's
     outcome code; ``min_no_impact[i]`` the located boundary of overturning without impact.
+
+    Attributes
+    ----------
+    block : Block
+        The block.
+    pulse : Pulse
+        The pulse's kind (its ratio and amplitude are the grid's).
+    ratio : ndarray, shape (nr,)
+        The frequency ratios ``omega_p / p``.
+    amplitude : ndarray, shape (nk,)
+        The amplitude ratios ``a_p / (g tan alpha_s)``.
+    outcome : ndarray of int8, shape (nr, nk)
+        Each cell's outcome code (:data:`rockjit.ground.OUTCOMES`).
+    max_rotation, t_overturn : ndarray, shape (nr, nk)
+        Each cell's ``max |theta| / alpha_s`` and overturning time (``nan``: it did not).
+    n_impacts : ndarray of int, shape (nr, nk)
+        Each cell's impacts.
+    min_overturn, min_no_impact : ndarray, shape (nr,)
+        The located boundaries at each ratio (``nan`` where the grid has none).
+    min_mode : ndarray of int8, shape (nr,)
+        The outcome code at ``min_overturn``: the mode of overturning.
+    settings : dict
+        The bisections' tolerance and the integration's settings.
+    method : str
+        The path that ran, e.g. ``"scipy:DOP853"``.
+    n_runs : int
+        Runs made, the bisections' included.
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> from rockjit import Block, Pulse
+    >>> sp = rockjit.spectrum(Block(hb=4, xi=0.0), Pulse("cosine"), [2.0], [4.0, 6.0],
+    ...                       tol=1e-4)
+    >>> sp.outcome.tolist()            # at amplitude 4: after an impact; at 6: without one
+    [[1, 2]]
+    >>> sp.min_overturn_list()[0]["mode"], round(float(sp.min_overturn[0]), 3)
+    ('with impact', 1.407)
     """
 
     block: Block
@@ -292,7 +330,32 @@ def spectrum(block, pulse, ratios, amplitudes, *, integration=None, method=None,
 def compare(a: SpectrumResult, b: SpectrumResult):
     """Where two spectra on the same grid (two restitution laws) differ: the cells whose
     outcome differs, and the ratio of their minimum overturning amplitudes at each ratio
-    (``b`` over ``a``). JSON-ready."""
+    (``b`` over ``a``). JSON-ready.
+
+    Parameters
+    ----------
+    a, b : SpectrumResult
+        Two spectra on the same ratios and amplitudes, of blocks with different laws.
+
+    Returns
+    -------
+    dict
+        ``cells_differ`` and ``percent_differ``, the cells whose outcome differs;
+        ``min_overturn_ratio``, ``[{"ratio", "<law b>_over_<law a>"}, ...]`` (``None`` where
+        either has no minimum overturning amplitude); ``differ_at``, each differing cell's
+        ratio, amplitude and both outcomes.
+
+    Examples
+    --------
+    >>> import sys, rockjit
+    >>> from rockjit import Block, Pulse
+    >>> compare = sys.modules["rockjit.ground.spectrum"].compare
+    >>> a, b = (rockjit.spectrum(Block(hb=4, xi=0.0, law=law), Pulse("cosine"), [2.0],
+    ...                          [4.0, 6.0], tol=1e-4) for law in ("housner", "mao"))
+    >>> c = compare(a, b)
+    >>> c["cells_differ"], round(float(c["min_overturn_ratio"][0]["mao_over_housner"]), 3)
+    (0, 0.994)
+    """
     if a.outcome.shape != b.outcome.shape or not np.allclose(a.ratio, b.ratio):
         raise ValueError("the two spectra are not on the same grid")
     diff = a.outcome != b.outcome

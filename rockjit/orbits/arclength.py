@@ -641,8 +641,8 @@ class OrbitsPlan:
 
 
 def run(plan: OrbitsPlan, execution=None):
-    """Execute an :class:`OrbitsPlan`: the sweep, then the branches from its periodic
-    attractors (:func:`continue_branches`).
+    """Execute an ``OrbitsPlan`` (``orbits_of_sweep.plan(...)``): the sweep, then the branches
+    from its periodic attractors (:func:`rockjit.orbits.continue_branches`).
 
     Parameters
     ----------

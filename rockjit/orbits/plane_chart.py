@@ -133,6 +133,7 @@ class ChartResult:
 
     @property
     def law(self):
+        """The block's restitution law."""
         return self.block.law
 
     def label(self):
@@ -188,7 +189,8 @@ def _types(types):
 
 
 def run(plan: ChartPlan, execution=None) -> ChartResult:
-    """Execute a :class:`ChartPlan`: the chart, the seed lines, the curves.
+    """Execute a ``ChartPlan`` (``rockjit.chart.plan(...)``): the chart, the seed lines, the
+    curves.
 
     Parameters
     ----------
@@ -307,9 +309,10 @@ def chart(block, alpha_range, omega_range, *, grid=CHART_GRID, seed_omegas=None,
         The chart, ``start < end`` (``omega > 0``).
     grid : pair of int
         The chart's points ``(NA, NW)`` along ``alpha`` and ``omega``, default
-        :data:`CHART_GRID`.
+        :data:`~rockjit.orbits.plane_chart.CHART_GRID`.
     seed_omegas : sequence of float, optional
-        The seed lines, inside ``omega_range``; default :data:`SEED_LINES` evenly spaced.
+        The seed lines, inside ``omega_range``; default
+        :data:`~rockjit.orbits.plane_chart.SEED_LINES` evenly spaced.
     max_period : int
         Longest period whose bifurcations seed curves, in ``[1, 16]``; default 2.
     types : sequence of str

@@ -1,4 +1,4 @@
-"""Writing files safely: atomic writers and a command's output directory (STYLE.md 11).
+"""Writing files safely: atomic writers and a command's output directory.
 
 Every writer here writes a hidden temporary file next to its target
 (``.<name>.<random>.tmp``, same directory so the rename stays on one file system), flushes and
@@ -842,8 +842,8 @@ class OutputDir:
         self._add(name)
 
     def figure(self, name, fig, *, dpi=None):
-        """Stage a matplotlib figure (:func:`save_figure`) in :attr:`figure_format` at
-        :attr:`dpi` (or ``dpi``), then clear it to free its memory; returns the name written
+        """Stage a matplotlib figure (``save_figure``) in the format ``figure_format`` at
+        ``self.dpi`` (or ``dpi``), then clear it to free its memory; returns the name written
         (its suffix the format's)."""
         if self.figure_format:
             name = f"{Path(name).stem}.{self.figure_format}"

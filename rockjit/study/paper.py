@@ -1,4 +1,5 @@
-"""The study rockjit reproduces (SPEC.md §7): every constant of it, and its pipeline, ``paper``.
+"""The study rockjit reproduces (docs/theory/study.md): every constant of it, and its pipeline,
+``paper``.
 
 The constants are the study's parameters: the slenderness ratios with their forcing frequencies
 and amplitude ranges, the sweeps' step, the zoom, the initial states of the single runs, the
