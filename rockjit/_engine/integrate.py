@@ -1,7 +1,7 @@
 """The compiled hybrid integrator: fixed-step Dormand–Prince 5(4) with located impacts.
 
 One period of the forcing is cut into ``N`` equal steps ``h = T/N``, so the stroboscopic samples
-``t = kT`` and ``kT + T/2`` fall on the grid. Per step (SPEC.md §4, STYLE.md 5):
+``t = kT`` and ``kT + T/2`` fall on the grid. Per step (docs/theory/integrator.md):
 
 1. take a Dormand–Prince step on the current corner (the field of a corner extends smoothly past
    ``theta = 0``, so the step can overshoot the impact);
@@ -33,15 +33,14 @@ them inlined; a cold compile of a variant, 2-6 % longer).
 The state lives in one array ``y``: ``theta, theta'``, then ``r, s`` when the oscillator
 embedding is integrated, then the 2×2 tangent matrix (column-major) when Lyapunov exponents are
 asked for. Which of these exist is decided at compile time by :func:`build`; a run that does not
-ask for tangent vectors compiles without them (STYLE.md 3). The compile-time switches
+ask for tangent vectors compiles without them. The compile-time switches
 ``EMBED4``, ``TANGENT`` (and ``block_step``'s ``SLOPE``) are ``True`` or ``None``, never
 ``False``, and are tested as ``is not None``: numba prunes a branch before typing it only when
 it compares an argument with ``None`` (``numba.core.analysis.dead_branch_prune``), so a run
 without tangent vectors or embedding never types, lowers or optimises their code (a cold first
-run 11.7 -> 10.2 s, issue 15). ``False`` would read as on. Recording a trajectory is the one
+run 11.7 -> 10.2 s). ``False`` would read as on. Recording a trajectory is the one
 run-time switch (one test per grid step, in :func:`grid_point`): measured side by side it costs
-nothing distinguishable per step, and it halves the variants to compile (issue 15,
-benchmarks/README.md, "Cold start").
+nothing distinguishable per step, and it halves the variants to compile (benchmarks/bench_compile.py).
 
 Kernels never raise; they return the status codes below, which :mod:`rockjit.single` turns into
 messages.
@@ -133,7 +132,7 @@ N_PARW = N_PAR + 2
 I_N, I_PERIODS, I_MAXIMP, I_STRIDE, I_WINDOW, I_SETTLE, I_QR, I_PMAX, I_CONTINUE = range(9)
 N_IPAR = 9
 # I_CONTINUE: 1 to integrate on past the overturning threshold (the study's own runs did; the
-# first crossing is recorded in F_TOVER), 0 to stop there (the physical rule, SPEC.md §3).
+# first crossing is recorded in F_TOVER), 0 to stop there (the physical rule, docs/theory/impacts.md).
 # I_QR: grid steps between renormalisations of the tangent vectors (0: never).
 # I_SETTLE: repetitions of a period that count as settled (0: never stop early); I_PMAX: the
 # longest period looked for.
@@ -175,17 +174,17 @@ def build(embed4: bool = False, tangent: bool = False):
     Parameters
     ----------
     embed4 : bool
-        Integrate the forcing oscillator ``(r, s)`` with the block (SPEC.md §1) instead of using
+        Integrate the forcing oscillator ``(r, s)`` with the block (docs/theory/model.md) instead of using
         the closed form ``r = sin(omega t + phi)``.
     tangent : bool
-        Carry the 2×2 tangent matrix for Lyapunov exponents (SPEC.md §5).
+        Carry the 2×2 tangent matrix for Lyapunov exponents (docs/theory/exponents.md).
 
     Returns
     -------
     run : numba dispatcher
         ``run(y0, side0, par, ipar, out)`` with ``out`` an :data:`Outputs`; returns the status
         code (see :func:`_loop`). Recording is not a switch here: ``out.traj`` with more than
-        one row records the dense trajectory (see :func:`_run`; issue 15).
+        one row records the dense trajectory (see :func:`_run`).
     """
     return _build(True if embed4 else None, True if tangent else None)
 
@@ -563,7 +562,7 @@ def turning_point(q0, q1, q2, q3, sgn, want_max):
     component), otherwise from <= 0 to > 0 (a minimum). When the step's ends bracket the
     change, a safeguarded Newton iteration on the derivative (a cubic) finds it in a few
     iterations; otherwise, or if Newton stalls, bisection (60 halvings, each a branch the
-    processor cannot predict, were a third of an event step's time: issue 17).
+    processor cannot predict, were a third of an event step's time).
     """
     lo = 0.0
     hi = 1.0
@@ -1080,7 +1079,7 @@ def _run(EMBED4, TANGENT, y0, side0, par_in, ipar, out):
              np.zeros((ipar[I_N], N_FTAB)))
     # Recording is a run-time switch (a trajectory array of more than one row), not a
     # compile-time one: one compiled loop serves runs with and without it and the grids; its
-    # test costs nothing measurable per step (issue 15).
+    # test costs nothing measurable per step.
     record = out.traj.shape[0] > 1
     return _loop(EMBED4, TANGENT, record, y0, side0, par, ipar, out, w)
 
@@ -1196,7 +1195,7 @@ def accept(EMBED4, TANGENT, side, hh, max_err, w):
 
     It takes the compile-time switches, not the state's sizes: compiled on its own with sizes
     unknown, LLVM vectorised its copies behind run-time overlap checks before inlining it, and
-    a run with exponents took 9 % longer a step (found bisecting issue 11's promise)."""
+    a run with exponents took 9 % longer a step (found by bisecting the commits)."""
     NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
     NY = NS + (4 if TANGENT is not None else 0)  # plus the tangent matrix, column-major
     K = w.K
@@ -1221,8 +1220,8 @@ def accept(EMBED4, TANGENT, side, hh, max_err, w):
 
 @jit(nrt=False, inline=True)
 def impact(EMBED4, TANGENT, t, r, t_lift, side, n_imp, in_window, par, out, w):
-    """The jump at an impact (SPEC.md §2), the saltation of the tangent vectors (§5), the
-    impact's record, and the Zeno cut-off (§3). ``r``: the closed-form forcing
+    """The jump at an impact (docs/theory/impacts.md), the saltation of the tangent vectors
+    (docs/theory/exponents.md), the impact's record, and the Zeno cut-off. ``r``: the closed-form forcing
     ``sin(omega t + phi)`` at ``t`` (ignored with the embedding).
 
     Returns ``(side, n_imp, rests, hold)``: the new corner (0 if the block came to rest), the
@@ -1375,7 +1374,7 @@ def tock(PROF, counts, k, c0):
 def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k_per, j_qr,
               j_rec, n_col, n_col_win, t_lift, max_err, par, ipar, out, w, counts):
     """One grid step, from ``t`` (the grid point ``step h``, or the block still at rest) to the
-    next grid point (SPEC.md §4): a step of the current corner, or of rest; an event in it is
+    next grid point (docs/theory/integrator.md): a step of the current corner, or of rest; an event in it is
     located, the state taken there (impact: :func:`impact`; uplift; overturning ends the run),
     and the step finished from the event to the grid point; then :func:`grid_point`.
 
@@ -1505,7 +1504,7 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
                 # A rest phase ends every perturbation: a nearby state reaches rest too (its
                 # Zeno cascade ends a little earlier or later), and the block leaves rest
                 # when the forcing alone says. The flow's Jacobian across it is zero, and
-                # the exponents of a stretch holding one are -inf (SPEC.md §5). (Banking the
+                # the exponents of a stretch holding one are -inf (docs/theory/exponents.md). (Banking the
                 # vectors' growth instead counted the cascade's saltation entries, ~1/theta'
                 # at the last impacts, as growth: exponents that depended on rest_speed.)
                 reset_tangent(EMBED4, y)
@@ -1545,7 +1544,7 @@ def _loop(EMBED4, TANGENT, record, y0, side0, par, ipar, out, w):
     t = 0.0
     max_err = 0.0
     # the counters start as int64, not as the literal 0: numba would type (and compile) every
-    # piece they are passed to once more for the literal (issue 15)
+    # piece they are passed to once more for the literal
     n_imp = np.int64(0)
     step = np.int64(0)
     j_per = np.int64(0)  # grid steps into the current period

@@ -8,7 +8,7 @@ outputs (:func:`outputs`), estimates their memory before anything is allocated
 (:func:`run_bytes`, :func:`grid_bytes`), and reads them back into the result types of
 :mod:`rockjit.result` (:func:`run_single`, :func:`run_grid`).
 
-Grids (three tiers, STYLE.md 1): :func:`_cell`, a serial compiled worker, runs one cell and
+Grids (three tiers): :func:`_cell`, a serial compiled worker, runs one cell and
 classifies it (:mod:`rockjit._engine.classify`); :func:`_grid`, ``parallel=True``, runs a chunk of cells
 with ``prange``, each iteration with private scratch writing only its own row of the outputs,
 so results do not depend on the number of threads; :func:`run_chunk` is the unit of work of

@@ -1,4 +1,4 @@
-"""Several grid cells per thread in lockstep (issue 17): the free-flight step of ``L`` lanes.
+"""Several grid cells per thread in lockstep: the free-flight step of ``L`` lanes.
 
 rockjit's step is a fixed-step Dormand–Prince step: every cell of a grid steps on the same time
 grid, and an event inside a step is handled within that step. ``L`` cells advanced together
