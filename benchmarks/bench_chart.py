@@ -32,7 +32,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import _common as H  # noqa: E402
 
 import rockjit  # noqa: E402
-from rockjit import Block, Classification, Harmonic  # noqa: E402
+from rockjit import Block, ChartCurves, Classification, Harmonic  # noqa: E402
 
 TARGET_S = 60.0
 ALPHA, OMEGA = (0.2, 1.2), (0.8, 3.0)
@@ -47,13 +47,14 @@ BOUNDARIES = ("symmetry_breaking", "period_doubling", "overturn")
 
 def timing_runs(cfg):
     block = Block(hb=1)
-    rockjit.chart(block, ALPHA, OMEGA, grid=(12, 12), max_period=1)  # warm the caches
+    rockjit.chart(block, ALPHA, OMEGA, grid=(12, 12), curves=ChartCurves(max_period=1))  # warm
     runs = []
     for i in range(cfg["repeats"]):
         load = H.loadavg()[0]
         t0 = time.perf_counter()
         c0 = time.process_time()
-        res = rockjit.chart(block, ALPHA, OMEGA, grid=cfg["grid"], max_period=cfg["max_period"])
+        res = rockjit.chart(block, ALPHA, OMEGA, grid=cfg["grid"],
+                            curves=ChartCurves(max_period=cfg["max_period"]))
         wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         runs.append(dict(run=i, total_s=wall, cpu_s=cpu, load1=load, **res.timing,
                          curves=len(res.curves),
@@ -75,7 +76,7 @@ def timing_markdown(runs, cfg, quick, env):
     return "".join([
         f"### The h/b = 1 Housner chart with its bifurcation curves{q}\n",
         f"`rockjit.chart(Block(hb=1), {ALPHA}, {OMEGA}, grid={cfg['grid']}, "
-        f"max_period={cfg['max_period']})`: {na * nw} cells from the study's z0 (no exponents, "
+        f"curves=ChartCurves(max_period={cfg['max_period']}))`: {na * nw} cells from the study's z0 (no exponents, "
         f"the chart's default), five seed lines, {last['curves']} curves "
         f"({', '.join(last['kinds'])}; {last['curve_points']} points, "
         f"{last['calls']} runs of the orbits' shooting). Warm; median of {len(runs)}.\n\n",
@@ -115,7 +116,7 @@ def laws_rows(cfg):
     rows = []
     for hb in (1, 2):
         res = {law: rockjit.chart(Block(hb=hb, law=law), ALPHA, OMEGA, grid=cfg["laws_grid"],
-                                  max_period=1)
+                                  curves=ChartCurves(max_period=1))
                for law in ("housner", "mao")}
         for w in cfg["omegas"]:
             for kind in BOUNDARIES:

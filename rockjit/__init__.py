@@ -19,7 +19,7 @@ _HOMES = {
     "Harmonic": "rockjit.excitation",
     "Pulse": "rockjit.ground", "Record": "rockjit.ground", "Transient": "rockjit.ground",
     "fragility": "rockjit.ground", "spectrum": "rockjit.ground",
-    "chart": "rockjit.orbits.plane_chart",
+    "chart": "rockjit.orbits.plane_chart", "ChartCurves": "rockjit.orbits.plane_chart",
     "alpha_grid": "rockjit.grids", "basin": "rockjit.grids", "plane": "rockjit.grids",
     "sweep": "rockjit.grids",
     "Block": "rockjit.model", "delta_e_percent": "rockjit.model", "e_housner": "rockjit.model",

@@ -10,9 +10,9 @@ import pytest
 
 import rockjit
 from rockjit import Block, Harmonic
-from rockjit.orbits import (Bifurcation, ContinuationSettings, CurveSettings, OrbitRefused,
-                            Shooting, continue_branches, continue_curve, periodic_orbit,
-                            relocate)
+from rockjit.orbits import (Bifurcation, ChartCurves, ContinuationSettings, CurveSettings,
+                            OrbitRefused, Shooting, continue_branches, continue_curve,
+                            periodic_orbit, relocate)
 
 ALPHA, OMEGA = (0.2, 1.2), (0.8, 3.0)
 STUDY_OMEGA = {1: 1.3, 2: 1.6}
@@ -183,15 +183,17 @@ def test_refusals():
     with pytest.raises(ValueError, match="contain no seed"):
         rockjit.chart(Block(hb=1), (0.2, 0.25), (0.8, 0.9), grid=(3, 3))
     with pytest.raises(ValueError, match="seed_omegas must lie in omega_range"):
-        rockjit.chart.plan(Block(hb=1), ALPHA, OMEGA, seed_omegas=[0.5])
+        rockjit.chart.plan(Block(hb=1), ALPHA, OMEGA, curves=ChartCurves(seed_omegas=[0.5]))
     with pytest.raises(ValueError, match="types"):
-        rockjit.chart.plan(Block(hb=1), ALPHA, OMEGA, types=("neimark_sacker",))
+        ChartCurves(types=("neimark_sacker",))
     with pytest.raises(ValueError, match="max_period"):
-        rockjit.chart.plan(Block(hb=1), ALPHA, OMEGA, max_period=0)
+        ChartCurves(max_period=0)
+    with pytest.raises(ValueError, match="curves must be"):
+        rockjit.chart.plan(Block(hb=1), ALPHA, OMEGA, curves=CurveSettings())
     with pytest.raises(ValueError, match="start < end"):
         rockjit.chart.plan(Block(hb=1), (0.5, 0.5), OMEGA)
-    with pytest.raises(ValueError, match="settings must be"):
-        rockjit.chart.plan(Block(hb=1), ALPHA, OMEGA, settings=ContinuationSettings())
+    with pytest.raises(ValueError, match="follow must be"):
+        ChartCurves(follow=ContinuationSettings())
     with pytest.raises(ValueError, match="max_multiplier"):
         CurveSettings(max_multiplier=1.0)
     # a curve asked for outside the chart

@@ -403,11 +403,11 @@ def _orbits_plan(args):
 
 def _chart_plan(args):
     """``rockjit chart``: one :func:`rockjit.chart` plan per law (``--law both``: two)."""
-    from ..orbits.plane_chart import chart
+    from ..orbits.plane_chart import ChartCurves, chart
     from ..validate import memory
+    curves = ChartCurves(seed_omegas=args.seed_omegas, max_period=args.max_period)
     plans = {law: chart.plan(_block(args, law), tuple(args.alpha_range),
-                             tuple(args.omega_range), grid=tuple(args.grid),
-                             seed_omegas=args.seed_omegas, max_period=args.max_period,
+                             tuple(args.omega_range), grid=tuple(args.grid), curves=curves,
                              integration=_integration(args), lyapunov=args.lyapunov,
                              execution=_execution(args))
              for law in _laws(args)}

@@ -65,14 +65,14 @@ and nonlinear eigenvalue problems", in *Applications of Bifurcation Theory*, Aca
 from .arclength import continuation, continue_branches, orbits_of_sweep
 from .curves import (CODIM2_TYPES, CURVE_ENDS, CURVE_TYPES, BifurcationCurve, Codim2Point,
                      CurveSettings, continue_curve, relocate)
-from .plane_chart import ChartResult, chart
+from .plane_chart import ChartCurves, ChartResult, chart
 from .shooting import N_ORBIT, periodic_orbit
 from .types import (BIFURCATION_TYPES, REASONS, Bifurcation, Branch, Continuation,
                     ContinuationSettings, OrbitRefused, PeriodicOrbit, Shooting)
 
 __all__ = ["BIFURCATION_TYPES", "CODIM2_TYPES", "CURVE_ENDS", "CURVE_TYPES", "N_ORBIT",
            "REASONS", "Bifurcation", "BifurcationCurve", "Branch", "ChartResult",
-           "Codim2Point", "Continuation", "ContinuationSettings", "CurveSettings",
+           "ChartCurves", "Codim2Point", "Continuation", "ContinuationSettings", "CurveSettings",
            "OrbitRefused", "PeriodicOrbit", "Shooting", "chart", "continuation",
            "continue_branches", "continue_curve", "orbits_of_sweep", "periodic_orbit",
            "relocate"]

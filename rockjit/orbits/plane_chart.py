@@ -45,12 +45,72 @@ from .curves import CURVE_TYPES, CurveSettings, continue_curve
 from .shooting import N_ORBIT, check_block, check_n_steps, check_shooting
 from .types import ContinuationSettings, OrbitRefused, Shooting
 
-__all__ = ["CHART_GRID", "SEED_LINES", "ChartPlan", "ChartResult", "chart", "run"]
+__all__ = ["CHART_GRID", "SEED_LINES", "ChartCurves", "ChartPlan", "ChartResult", "chart", "run"]
 
 #: The chart's default grid ``(NA, NW)``.
 CHART_GRID = (200, 200)
 #: The default number of seed lines.
 SEED_LINES = 5
+
+
+@dataclass(frozen=True)
+class ChartCurves:
+    """Which bifurcation curves a chart draws, where they are seeded, how they are followed.
+
+    Parameters
+    ----------
+    seed_omegas : sequence of float, optional
+        The seed lines, inside the chart's ``omega_range``; default :data:`SEED_LINES` lines
+        evenly spaced.
+    max_period : int
+        Longest period whose bifurcations seed curves, in ``[1, 16]``; default 2.
+    types : sequence of str
+        The curve types followed (:data:`rockjit.orbits.CURVE_TYPES`), default all.
+    sweep_step : float
+        The seed sweeps' amplitude step, ``> 0``; default 0.005.
+    n_steps : int
+        Steps per period of the orbits' runs, default :data:`rockjit.orbits.N_ORBIT`.
+    shooting : Shooting, optional
+        The orbits' solver, as in :func:`rockjit.orbits.continue_branches`.
+    follow : CurveSettings, optional
+        How each curve is followed (steps, points, runs, tolerances).
+
+    Examples
+    --------
+    >>> from rockjit.orbits import ChartCurves
+    >>> ChartCurves(max_period=1, types="fold").types
+    ('fold',)
+    >>> ChartCurves(max_period=0)
+    Traceback (most recent call last):
+    ...
+    ValueError: max_period must be in [1, 16] (got 0)
+    """
+
+    seed_omegas: tuple | None = None
+    max_period: int = 2
+    types: tuple = CURVE_TYPES
+    sweep_step: float = 0.005
+    n_steps: int = N_ORBIT
+    shooting: Shooting | None = None
+    follow: CurveSettings = field(default_factory=CurveSettings)
+
+    def __post_init__(self):
+        if self.seed_omegas is not None:
+            ws = np.atleast_1d(real_array("seed_omegas", self.seed_omegas, "omega values"))
+            if ws.ndim != 1 or ws.size == 0:
+                raise ValueError(f"seed_omegas must be one or more omega values (got shape "
+                                 f"{ws.shape})")
+            object.__setattr__(self, "seed_omegas", tuple(float(w) for w in ws))
+        object.__setattr__(self, "max_period", integer("max_period", self.max_period, 1, 16))
+        object.__setattr__(self, "types", _types(self.types))
+        object.__setattr__(self, "sweep_step", real("sweep_step", self.sweep_step, 0.0, None,
+                                                     lo_open=True))
+        object.__setattr__(self, "n_steps", check_n_steps(self.n_steps, 10**6))
+        if self.shooting is not None:
+            object.__setattr__(self, "shooting", check_shooting(self.shooting))
+        if not isinstance(self.follow, CurveSettings):
+            raise ValueError(f"follow must be a rockjit.orbits.CurveSettings (got "
+                             f"{type(self.follow).__name__})")
 
 
 @dataclass(frozen=True)
@@ -110,8 +170,9 @@ class ChartResult:
     Examples
     --------
     >>> from rockjit import Block, chart
-    >>> res = chart(Block(hb=1), (0.7, 0.95), (1.25, 1.35), grid=(6, 5), seed_omegas=[1.3],
-    ...             types=("period_doubling",), max_period=1)
+    >>> from rockjit.orbits import ChartCurves
+    >>> res = chart(Block(hb=1), (0.7, 0.95), (1.25, 1.35), grid=(6, 5),
+    ...             curves=ChartCurves(seed_omegas=[1.3], types="period_doubling", max_period=1))
     >>> res.label().shape, [s["type"] for s in res.seeds], res.refused
     ((6, 5), ['period_doubling'], [])
     >>> summary, arrays = res.to_summary()
@@ -164,16 +225,11 @@ def _seed_lines(omega_range, seed_omegas):
     w0, w1 = omega_range
     if seed_omegas is None:
         return tuple(w0 + (w1 - w0) * (k + 0.5) / SEED_LINES for k in range(SEED_LINES))
-    ws = real_array("seed_omegas", seed_omegas, "omega values")
-    ws = np.atleast_1d(ws)
-    if ws.ndim != 1 or ws.size == 0:
-        raise ValueError(f"seed_omegas must be one or more omega values (got shape "
-                         f"{ws.shape})")
-    for w in ws:
+    for w in seed_omegas:
         if not w0 <= w <= w1:
             raise ValueError(f"seed_omegas must lie in omega_range [{w0:g}, {w1:g}] "
                              f"(got {w:g}): a seed outside the chart starts no curve on it")
-    return tuple(float(w) for w in ws)
+    return seed_omegas
 
 
 def _types(types):
@@ -213,8 +269,9 @@ def run(plan: ChartPlan, execution=None) -> ChartResult:
     --------
     >>> from rockjit import Block, Execution
     >>> from rockjit.orbits import chart, plane_chart
+    >>> from rockjit.orbits import ChartCurves
     >>> plan = chart.plan(Block(hb=1), (0.75, 0.8), (1.28, 1.32), grid=(3, 3),
-    ...                   seed_omegas=[1.3], max_period=1)
+    ...                   curves=ChartCurves(seed_omegas=[1.3], max_period=1))
     >>> res = plane_chart.run(plan, Execution(progress=False))
     >>> [(c.type, c.ends) for c in res.curves]
     [('symmetry_breaking', ('range', 'range'))]
@@ -291,10 +348,9 @@ def run(plan: ChartPlan, execution=None) -> ChartResult:
 
 
 @entry_point(run)
-def chart(block, alpha_range, omega_range, *, grid=CHART_GRID, seed_omegas=None,
-          max_period=2, types=CURVE_TYPES, state=None, forcing=None, integration=None,
-          classification=None, lyapunov=False, sweep_step=0.005, n_steps=N_ORBIT,
-          shooting=None, settings=None, execution=None) -> ChartResult:
+def chart(block, alpha_range, omega_range, *, grid=CHART_GRID, curves=None, state=None,
+          integration=None, classification=None, lyapunov=False,
+          execution=None) -> ChartResult:
     """The forcing plane with exact boundaries: the chart of behaviours over ``(alpha,
     omega)`` and the fold, symmetry-breaking, period-doubling and grazing curves across it.
 
@@ -310,31 +366,17 @@ def chart(block, alpha_range, omega_range, *, grid=CHART_GRID, seed_omegas=None,
     grid : pair of int
         The chart's points ``(NA, NW)`` along ``alpha`` and ``omega``, default
         :data:`~rockjit.orbits.plane_chart.CHART_GRID`.
-    seed_omegas : sequence of float, optional
-        The seed lines, inside ``omega_range``; default
-        :data:`~rockjit.orbits.plane_chart.SEED_LINES` evenly spaced.
-    max_period : int
-        Longest period whose bifurcations seed curves, in ``[1, 16]``; default 2.
-    types : sequence of str
-        The curve types followed (:data:`rockjit.orbits.CURVE_TYPES`), default all.
+    curves : ChartCurves, optional
+        Which curves, seeded on which ``omega`` lines, followed how; default
+        ``ChartCurves()``: every type up to period 2 from five lines.
     state : pair of float, optional
-        The initial ``(theta0, theta0')`` of the chart and the seed sweeps; default the
-        study's ``z0``.
-    forcing : Harmonic, optional
-        The forcing phase only (``Harmonic(phase=...)``), as in :func:`rockjit.plane`.
+        The initial ``(theta0, theta0')`` of the chart and the seed sweeps, at the study's
+        forcing phase; default the study's ``z0``.
     integration, classification : optional
         The chart's and the seed sweeps' runs and classification (:func:`rockjit.plane`).
     lyapunov : bool
         Compute the chart's ``lambda_max`` (it tells chaotic from aperiodic cells; three
         times the chart's cost). Default ``False``.
-    sweep_step : float
-        The seed sweeps' amplitude step, ``> 0``; default 0.005.
-    n_steps : int
-        Steps per period of the orbits' runs, default :data:`rockjit.orbits.N_ORBIT`.
-    shooting : Shooting, optional
-        As in :func:`rockjit.orbits.continue_branches`.
-    settings : CurveSettings, optional
-        How the curves are followed.
     execution : Execution, optional
         The chart's threads, chunks, Dask client, chunk store, progress.
 
@@ -351,12 +393,13 @@ def chart(block, alpha_range, omega_range, *, grid=CHART_GRID, seed_omegas=None,
     Examples
     --------
     >>> from rockjit import Block
-    >>> from rockjit.orbits import chart
-    >>> res = chart(Block(hb=1), (0.7, 0.95), (1.25, 1.35), grid=(6, 5), seed_omegas=[1.3],
-    ...             types=("symmetry_breaking", "period_doubling"), max_period=1)
+    >>> from rockjit.orbits import ChartCurves, chart
+    >>> curves = ChartCurves(seed_omegas=[1.3], max_period=1,
+    ...                      types=("symmetry_breaking", "period_doubling"))
+    >>> res = chart(Block(hb=1), (0.7, 0.95), (1.25, 1.35), grid=(6, 5), curves=curves)
     >>> [(c.type, c.period, [round(a, 6) for a in c.alpha_at(1.3)]) for c in res.curves]
     [('symmetry_breaking', 1, [0.779798]), ('period_doubling', 1, [0.911511])]
-    >>> chart.plan(Block(hb=1), (0.2, 1.2), (0.8, 3.0), seed_omegas=[3.5])
+    >>> chart.plan(Block(hb=1), (0.2, 1.2), (0.8, 3.0), curves=ChartCurves(seed_omegas=[3.5]))
     Traceback (most recent call last):
     ...
     ValueError: seed_omegas must lie in omega_range [0.8, 3] (got 3.5): a seed outside the \
@@ -368,26 +411,22 @@ chart starts no curve on it
     if a1 <= a0 or w1 <= w0:
         raise ValueError(f"alpha_range and omega_range must have start < end (got ({a0:g}, "
                          f"{a1:g}), ({w0:g}, {w1:g}))")
+    curves = ChartCurves() if curves is None else curves
+    if not isinstance(curves, ChartCurves):
+        raise ValueError(f"curves must be a rockjit.orbits.ChartCurves (got "
+                         f"{type(curves).__name__})")
     plane_plan = plane_grid.plane.plan(block, (a0, a1), (w0, w1), grid=grid, state=state,
-                                       forcing=forcing, integration=integration,
+                                       integration=integration,
                                        classification=classification,
                                        lyapunov=boolean("lyapunov", lyapunov),
                                        execution=execution)
-    seed_omegas = _seed_lines((w0, w1), seed_omegas)
-    max_period = integer("max_period", max_period, 1, 16)
-    types = _types(types)
-    sweep_step = real("sweep_step", sweep_step, 0.0, None, lo_open=True)
-    gp.alpha_count((a0, a1), sweep_step)
-    n_steps = check_n_steps(n_steps, 10**6)
-    shooting = None if shooting is None else check_shooting(shooting)
-    settings = CurveSettings() if settings is None else settings
-    if not isinstance(settings, CurveSettings):
-        raise ValueError(f"settings must be a rockjit.orbits.CurveSettings (got "
-                         f"{type(settings).__name__})")
+    seed_omegas = _seed_lines((w0, w1), curves.seed_omegas)
+    gp.alpha_count((a0, a1), curves.sweep_step)
     integration, _, _ = gp.objects(block, integration, classification, execution)
     return ChartPlan(plane_plan=plane_plan, block=block, alpha_range=(a0, a1),
-                     omega_range=(w0, w1), seed_omegas=seed_omegas, max_period=max_period,
-                     types=types, sweep_step=sweep_step, state=state,
-                     forcing=gp.harmonic(forcing, "-alpha", "-omega", why="a chart"),
-                     integration=integration, n_steps=n_steps, shooting=shooting,
-                     settings=settings)
+                     omega_range=(w0, w1), seed_omegas=seed_omegas,
+                     max_period=curves.max_period, types=curves.types,
+                     sweep_step=curves.sweep_step, state=state,
+                     forcing=gp.harmonic(None, "-alpha", "-omega", why="a chart"),
+                     integration=integration, n_steps=curves.n_steps,
+                     shooting=curves.shooting, settings=curves.follow)

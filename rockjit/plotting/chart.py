@@ -158,8 +158,10 @@ def fig_chart(results, title=None):
     --------
     >>> from rockjit import Block, chart
     >>> from rockjit.plotting.chart import fig_chart
-    >>> res = chart(Block(hb=1), (0.7, 0.95), (1.25, 1.35), grid=(6, 5), seed_omegas=[1.3],
-    ...             types=("symmetry_breaking",), max_period=1)
+    >>> from rockjit.orbits import ChartCurves
+    >>> res = chart(Block(hb=1), (0.7, 0.95), (1.25, 1.35), grid=(6, 5),
+    ...             curves=ChartCurves(seed_omegas=[1.3], types="symmetry_breaking",
+    ...                                max_period=1))
     >>> fig = fig_chart(res)
     >>> [t.get_text() for t in fig.axes[0].texts]
     ['SB\u2081']

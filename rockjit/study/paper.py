@@ -751,13 +751,13 @@ def _finite(a, fn):
 #: 200 x 200 chart and the period-2 curves), over the plane around both slendernesses' study
 #: frequencies.
 CHART = dict(alpha_range=(0.2, 1.2), omega_range=(0.8, 3.0), grid=(40, 40),
-             seed_omegas=(1.3, 2.4), max_period=1, sweep_step=0.01)
+             curves=dict(seed_omegas=(1.3, 2.4), max_period=1, sweep_step=0.01))
 
 
 def _fig9_charts(out, integration, within, say):
     """Figure 9: per slenderness, both laws' charts with their curves, side by side and
     overlaid; returns the curves (type, period, law, points) per slenderness."""
-    from ..orbits.plane_chart import chart
+    from ..orbits.plane_chart import ChartCurves, chart
     from ..plotting.chart import fig_chart
     from ..cli.outputs import chart as write_chart
     found, names = {}, []
@@ -766,7 +766,8 @@ def _fig9_charts(out, integration, within, say):
         for law in ("housner", "mao"):
             say(f"paper: chart {law} hb={hb:g}")
             try:
-                res[law] = chart(Block(hb=float(hb), law=law), **CHART, integration=integration,
+                kw = dict(CHART, curves=ChartCurves(**CHART["curves"]))
+                res[law] = chart(Block(hb=float(hb), law=law), **kw, integration=integration,
                                  execution=within(f"chart_hb{hb}_{law}"))
             except ValueError as exc:  # no seed on the lines (a quick paper's short runs)
                 found[f"hb{hb}_{law}_refused"] = str(exc)
