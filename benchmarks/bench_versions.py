@@ -83,8 +83,8 @@ _WORKER = textwrap.dedent("""
     import _common as H
 
     def rk4basin(kw):
-        """The plain RK4 reference basin of this checkout (benchmarks/reference_rk4.py) on the
-        packed inputs of the version's own basin plan, at full length."""
+        # the plain RK4 reference basin of this checkout (benchmarks/reference_rk4.py) on the
+        # packed inputs of the version's own basin plan, at full length
         import reference_rk4  # compiled once per worker
         kw = dict(kw, early_stop=False)
         plan = H.plan_in(rockjit, "basin", kw)

@@ -174,6 +174,13 @@ LAWS = ("housner", "mao", "constant")
 #: numbers must be numbers of the right kind and in a sane range. Columns with no rule are
 #: free text.
 VALUES = {
+    "bench_explore.py": (
+        dict(measurement=text, median_s=nan_or(positive), min_s=nan_or(positive),
+             max_s=nan_or(positive), n=count(0), target_s=empty_or(positive)),
+        [("a stage has times exactly when it ran",
+          lambda r: (r["median_s"] == "nan") == (r["n"] == "0") == ("not run" in r["measurement"])),
+         ("the median lies between the extremes", lambda r: r["n"] == "0"
+          or num(r, "min_s") <= num(r, "median_s") <= num(r, "max_s"))]),
     "bench_chart.py": (
         dict(run=count(0), chart_s=positive, seeds_s=positive, curves_s=positive,
              total_s=positive, cpu_s=positive, cells=count(1), curves=count(1),

@@ -90,11 +90,11 @@ CASES = [
     (dict(r0=NAN, s0=1.0), "r0"),
     (dict(phase=NAN), "phase"),
     (dict(phase=0.3, r0=0.0, s0=1.0), "phase"),
-    (dict(state=(0.1, 0.2, 0.3)), "state"),            # was z0 of 3 numbers
-    (dict(state=(0.1, 0.2, 0.0, 1.0)), "state"),       # the old z0 (theta, theta', r, s)
+    (dict(state=(0.1, 0.2, 0.3)), "state"),
+    (dict(state=(0.1, 0.2, 0.0, 1.0)), "state"),  # four numbers: theta, theta', r, s
     (dict(state=(NAN, 0.2)), "theta0|state"),
     (dict(state=(NAN, 0.0)), "theta0"),
-    (dict(state=(0.0, NAN)), "theta0'"),               # was dtheta0
+    (dict(state=(0.0, NAN)), "dtheta0"),
     (dict(state=(math.inf, 0.0)), "theta0"),
 ]
 
