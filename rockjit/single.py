@@ -171,22 +171,30 @@ def check_theta0(theta0, integration, name="theta0"):
     return theta0
 
 
+def state_pair(state, integration):
+    """``(theta0, theta0')`` from a run's ``state``, checked: two finite numbers, the angle
+    inside ``|theta0| < theta_over``."""
+    if type(state) is tuple and len(state) == 2 and type(state[0]) is float \
+            and type(state[1]) is float:  # the common case, without an array (a run's cost)
+        th, dth = state
+    else:
+        z = real_array("state", state, "two numbers (theta0, theta0')")
+        if z.shape != (2,):
+            raise ValueError(f"state must be two numbers (theta0, theta0') (got {state!r})")
+        th, dth = float(z[0]), float(z[1])
+    th = check_theta0(th, integration, "state[0] (theta0)")
+    dth = real("state[1] (dtheta0)", dth, -1e6, 1e6)
+    return th, dth
+
+
 def initial_state(state, forcing, integration):
     """``(theta0, theta0', phi, r0, s0)`` from a run's ``state`` (``(theta0, theta0')``, or
     ``None``: the study's) and its excitation's phase (not given: the study's forcing point
     for the study's state, ``(0, 1)`` otherwise)."""
     if state is None:
         th, dth = Z0_STUDY[:2]
-        default = STUDY_PHASE
-    else:
-        z = real_array("state", state, "two numbers (theta0, theta0')")
-        if z.shape != (2,):
-            raise ValueError(f"state must be two numbers (theta0, theta0') (got {state!r})")
-        th, dth = float(z[0]), float(z[1])
-        default = (0.0, 1.0)
-    th = check_theta0(th, integration, "state[0] (theta0)")
-    dth = real("state[1] (dtheta0)", dth, -1e6, 1e6)
-    return (th, dth) + forcing.start(default)
+        return (th, dth) + forcing.start(STUDY_PHASE)
+    return state_pair(state, integration) + forcing.start((0.0, 1.0))
 
 
 @dataclass(frozen=True)
@@ -367,11 +375,11 @@ class Prepared:
             par = par.copy()
             kernel.vary(par[None, :], alpha=np.array([forcing.alpha]))
             p = replace(p, forcing=forcing)
-        if state is not None:
-            th, dth, _, r0, s0 = initial_state(state, p.forcing, p.integration)
-            p = replace(p, y0=(th, dth, r0, s0))
-        out = kernel.single_outputs(p)
         y0 = np.array(p.y0)
+        if state is not None:
+            # a new block state; the forcing's, (r0, s0), stays the plan's (its phase)
+            y0[0], y0[1] = state_pair(state, p.integration)
+        out = kernel.single_outputs(p)
         code = self._kernel(y0, initial_side(y0[0], y0[1]), par, self._ipar, out)
         return kernel.single_result(p, code, out)
 
@@ -392,7 +400,9 @@ _plan_and_run = simulate
 
 def _simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
               record_stride=None, method="rockjit"):
-    key = (block, forcing, integration, lyapunov, record_stride, method)
+    # a run from the study's state starts at the study's forcing phase, one from a given state
+    # at phase 0 (unless the excitation gives one): the two never share a prepared run
+    key = (block, forcing, integration, lyapunov, record_stride, method, state is None)
     try:
         prepared = _PREPARED.get(key)
     except TypeError:  # an argument that cannot be hashed: no reuse (and no error here)
