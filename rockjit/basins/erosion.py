@@ -192,7 +192,8 @@ def run(plan: ErosionPlan, execution=None):
     cont_tol = plan.cont_tol
     g_plan = plan.grid_plan
     out = runner.run_grid(g_plan.y0s, g_plan.pars, g_plan.ipar, g_plan.cpar, tangent=False,
-                          n_pts=g_plan.n_pts, n_imp_pts=0, label="erosion",
+                          n_pts=g_plan.n_pts, n_imp_pts=0,
+                          label=gp.progress_label("erosion", g_plan.block, g_plan.forcing),
                           execution=execution)
     r = kernel.grid_results(out)
     na, g = plan.alpha.size, plan.grid
