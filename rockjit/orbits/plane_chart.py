@@ -208,7 +208,7 @@ class ChartResult:
         Returns
         -------
         xarray.Dataset
-            :meth:`rockjit.PlaneResult.to_xarray` of :attr:`plane` with ``overturn_onset``
+            :meth:`rockjit.PlaneResult.to_xarray` of ``plane`` with ``overturn_onset``
             over ``omega`` and the attributes ``chart_phase`` (the curves' section phase) and
             ``n_curves``; the curves themselves are in :meth:`to_summary`.
 
