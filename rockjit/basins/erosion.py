@@ -156,8 +156,9 @@ class ErosionResult:
         >>> ds.branch_behaviour.values.tolist()
         ['symmetric', 'symmetric', 'asymmetric']
         """
+        from ..result import BEHAVIOURS
         from ..storage.labelled import erosion_dataset
-        return erosion_dataset(self)
+        return erosion_dataset(self, BEHAVIOURS)
 
 def _link(prev, cur, tol, floor):
     """``{id_cur: id_prev}``: each current attractor, largest basin first, to the nearest

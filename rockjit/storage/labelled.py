@@ -219,14 +219,14 @@ def chart_dataset(res):
     return ds
 
 
-def erosion_dataset(res):
-    """:meth:`rockjit.basins.erosion.ErosionResult.to_xarray`."""
+def erosion_dataset(res, names):
+    """:meth:`rockjit.basins.erosion.ErosionResult.to_xarray` (``names``: the behaviour names
+    its label codes index)."""
     xr = xarray()
-    from ..result import BEHAVIOURS
     dims3 = ("alpha", "theta0", "dtheta0")
     data = {name: (("alpha",), np.asarray(getattr(res, name)), _meta(name))
             for name in ("GIM", "IF", "basin_entropy", "boundary_basin_entropy", "overturn")}
-    data["label"] = (dims3, np.asarray(res.label), _flags(BEHAVIOURS, _meta("label")))
+    data["label"] = (dims3, np.asarray(res.label), _flags(names, _meta("label")))
     branches = res.branches
     data["attractor"] = (dims3, np.asarray(res.attractor), dict(
         _meta("attractor"), long_name="outcome: the branch reached (-1 overturn, "
