@@ -174,6 +174,7 @@ def test_chart_is_its_plane_with_the_overturn_onset(plane):
     assert _same(ds.label.values, plane.label)
     assert _same(ds.overturn_onset.values, onset) and ds.overturn_onset.dims == ("omega",)
     assert ds.attrs["kind"] == "chart" and ds.attrs["chart_phase"] == 0.25
+    assert ds.attrs["alpha_range"].tolist() == [0.5, 0.8] and ds.attrs["n_curves"] == 0
     _plain_attrs(ds.attrs)
 
 

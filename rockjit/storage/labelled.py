@@ -211,9 +211,10 @@ def plane_dataset(res, kind="plane", **more):
 
 def chart_dataset(res):
     """:meth:`rockjit.orbits.ChartResult.to_xarray`: its plane's dataset, the overturn onset
-    per ``omega``, and the curves' section phase."""
+    per ``omega``, the curves' section phase and the chart's ranges."""
     ds = plane_dataset(res.plane, kind="chart", chart_phase=res.phase,
-                       n_curves=len(res.curves))
+                       n_curves=len(res.curves), alpha_range=res.alpha_range,
+                       omega_range=res.omega_range)
     ds["overturn_onset"] = (("omega",), np.asarray(res.overturn_onset),
                             _meta("overturn_onset"))
     return ds
