@@ -360,6 +360,40 @@ class SweepResult(GridResult):
             out.update(t_overturn=self.t_overturn, motion=self.motion)
         return out
 
+    def to_xarray(self):
+        """The sweep as a labelled ``xarray.Dataset`` (needs ``pip install rockjit[xarray]``).
+
+        Returns
+        -------
+        xarray.Dataset
+            Coordinate ``alpha`` (with ``units`` and ``long_name``); variables ``label``
+            (the behaviour names as CF ``flag_values``/``flag_meanings``), ``period``,
+            ``lambda_max``, ``t_end``, ``strobe`` (``alpha, strobe_sample, strobe_var``),
+            ``impact_section`` (``alpha, impact, impact_var``) and, where computed,
+            ``lambda_window``, ``attractor``, ``uncertain``, ``t_overturn``, ``motion``;
+            attributes: the block, the excitation and the settings as numbers and strings
+            (booleans as 0/1), so that ``ds.to_netcdf(path)`` writes it.
+
+        Raises
+        ------
+        ImportError
+            Without xarray.
+
+        Examples
+        --------
+        >>> import rockjit
+        >>> from rockjit import Block, Harmonic, Integration
+        >>> sw = rockjit.sweep(Block(hb=1), Harmonic(omega=1.3), [0.6, 0.8],
+        ...                    integration=Integration(periods=100))
+        >>> ds = sw.to_xarray()
+        >>> bool(ds.label.sel(alpha=0.8) == sw.label[1]), ds.attrs["law"]
+        (True, 'housner')
+        >>> ds.label.attrs["flag_meanings"].split()[:3]
+        ['overturn', 'rest', 'symmetric']
+        """
+        from .storage.labelled import sweep_dataset
+        return sweep_dataset(self)
+
 
 @dataclass(kw_only=True)
 class BasinResult(GridResult):
@@ -414,6 +448,41 @@ class BasinResult(GridResult):
         if self.attractor is not None:
             out.update(self.measures())
         return out
+
+    def to_xarray(self):
+        """The basin as a labelled ``xarray.Dataset`` (needs ``pip install rockjit[xarray]``).
+
+        Returns
+        -------
+        xarray.Dataset
+            Coordinates ``theta0``, ``dtheta0`` (with ``units`` and ``long_name``);
+            variables ``label`` (the behaviour names as CF ``flag_values``/
+            ``flag_meanings``), ``period``, ``t_end`` and, where computed, ``attractor``
+            (each attractor named in its flags), ``uncertain``, ``lambda_max``,
+            ``lambda_window``; attributes: the block, the excitation (``alpha``, ``omega``,
+            the phase) and the settings as numbers and strings (booleans as 0/1), so that
+            ``ds.to_netcdf(path)`` writes it.
+
+        Raises
+        ------
+        ImportError
+            Without xarray.
+
+        Examples
+        --------
+        >>> import rockjit
+        >>> from rockjit import Block, Harmonic, Integration
+        >>> b = rockjit.basin(Block(hb=1), Harmonic(alpha=0.66, omega=1.3), grid=10,
+        ...                   integration=Integration(periods=100))
+        >>> ds = b.to_xarray()
+        >>> ds.label.dims, ds.attrs["alpha"], ds.attrs["law"]
+        (('theta0', 'dtheta0'), 0.66, 'housner')
+        >>> cell = ds.label.sel(theta0=0.1, dtheta0=0.1, method="nearest")
+        >>> bool(cell == b.label[5, 5]), str(b.names[cell.item()])
+        (True, 'symmetric')
+        """
+        from .storage.labelled import basin_dataset
+        return basin_dataset(self)
 
     def measures(self, box=5, eps_cells=(1, 2, 3, 4, 6, 8)):
         """Measures of the attractor map (rockjit.basins.measures): basin entropy ``Sb`` and
@@ -485,3 +554,36 @@ class PlaneResult(GridResult):
     period: np.ndarray
     lambda_max: np.ndarray
     t_end: np.ndarray
+
+    def to_xarray(self):
+        """The plane as a labelled ``xarray.Dataset`` (needs ``pip install rockjit[xarray]``).
+
+        Returns
+        -------
+        xarray.Dataset
+            Dimensions ``state, alpha, omega``: coordinates ``alpha``, ``omega`` (with
+            ``units`` and ``long_name``) and, along ``state``, the initial states ``z0`` as
+            ``theta0, dtheta0, r0, s0``; variables ``label`` (the behaviour names as CF
+            ``flag_values``/``flag_meanings``), ``period``, ``lambda_max``, ``t_end`` and,
+            where computed, ``lambda_window``, ``attractor``, ``uncertain``; attributes: the
+            block and the settings as numbers and strings, so that ``ds.to_netcdf(path)``
+            writes it.
+
+        Raises
+        ------
+        ImportError
+            Without xarray.
+
+        Examples
+        --------
+        >>> import rockjit
+        >>> from rockjit import Block
+        >>> pl = rockjit.plane(Block(hb=1), (0.5, 0.6), (1.2, 1.3), grid=(2, 2))
+        >>> ds = pl.to_xarray()
+        >>> ds.label.dims
+        ('state', 'alpha', 'omega')
+        >>> str(pl.names[ds.label.sel(state=0, alpha=0.6, omega=1.3).item()])
+        'symmetric'
+        """
+        from .storage.labelled import plane_dataset
+        return plane_dataset(self)

@@ -265,9 +265,12 @@ class Execution(_Replace):
         Directory for finished chunks: a rerun with the same inputs computes only what is
         missing.
     progress : bool or callable
-        Show progress on stderr; or a callable ``progress(done, total)``, called with the
-        cells finished so far once the chunks already stored are counted and after each
-        chunk, instead of the lines on stderr. An exception it raises stops the grid between
+        Show progress on stderr, described by what it counts (the grid, the block's
+        slenderness and law, the fixed forcing: ``basin hb=1 housner alpha=0.66 omega=1.3``):
+        a tqdm bar on a terminal; elsewhere (a log file, a pipe) plain lines, at most one
+        every 5 s plus the last, so that a log stays readable. Or a callable
+        ``progress(done, total)``, called with the cells finished so far once the chunks
+        already stored are counted and after each chunk, instead of the output on stderr. An exception it raises stops the grid between
         two chunks and propagates (the chunks finished so far stay in the store, if any): an
         interactive caller cancels a computation this way.
     message : callable, optional

@@ -7,6 +7,7 @@ gets under the same umask, byte snapshots of directories taken before an operati
 computed directly without chunks, and the cache folder numba's own locator names.
 """
 
+import io
 import json
 import os
 import signal
@@ -807,19 +808,52 @@ def test_progress_in_a_log_file_is_plain_throttled_lines(tmp_path, monkeypatch, 
                         f"~{fake_now * left / done:.1f} s left")
 
 
-def test_progress_on_a_terminal_rewrites_one_line(monkeypatch):
-    import io
+class _Tty(io.StringIO):
+    def isatty(self):
+        return True
 
-    class Tty(io.StringIO):
-        def isatty(self):
-            return True
 
-    tty = Tty()
+def test_progress_on_a_terminal_is_a_tqdm_bar_on_one_line(monkeypatch):
+    tty = _Tty()
     monkeypatch.setattr(sys, "stderr", tty)
     grid_runner.run_chunks(_runner, (np.arange(N, dtype=float),), N, CHUNK, _outputs(),
-                      progress=True)
+                           progress=True, label="basin hb=1 mao")
     text = tty.getvalue()
-    assert text.count("\r") == len(BOUNDS) and text.count("\n") == 1 and text.endswith("\n")
+    # tqdm redraws after a \r (as often as its own throttle allows) and ends the line once
+    assert text.startswith("\r") and text.count("\n") == 1 and text.endswith("\n")
+    draws = text.rstrip("\n").split("\r")[1:]
+    assert draws and all(d.startswith("basin hb=1 mao: ") for d in draws)
+    assert f"{N}/{N} cells" in draws[-1] and "100%" in draws[-1]
+
+
+def test_progress_in_a_log_file_stays_a_few_lines_over_many_chunks(monkeypatch, capsys):
+    now = _fake_clock(monkeypatch)
+    n, chunk = 1000, 5  # 200 chunks of 0.1 s each: 20 s
+
+    def runner(xs):
+        now[0] += 0.1
+        return {"y": 2.0 * xs}
+
+    grid_runner.run_chunks(runner, (np.arange(n, dtype=float),), n, chunk,
+                           {"y": np.zeros(n)}, progress=True, label="sweep hb=2 housner")
+    err = capsys.readouterr().err
+    assert "\r" not in err
+    lines = err.splitlines()
+    assert 2 <= len(lines) <= 5, lines  # one line per 5 s and the last, not one per chunk
+    assert all(line.startswith("sweep hb=2 housner: ") for line in lines)
+    assert lines[-1].startswith(f"sweep hb=2 housner: {n}/{n} cells")
+
+
+@pytest.mark.parametrize("law", ["housner", "mao"])
+def test_a_grids_progress_names_the_grid_the_law_and_the_forcing(law, capsys):
+    import rockjit
+    rockjit.basin(rockjit.Block(hb=1, law=law), rockjit.Harmonic(alpha=0.66, omega=1.3),
+                  grid=4, integration=rockjit.Integration(periods=10),
+                  execution=rockjit.Execution(progress=True))
+    lines = capsys.readouterr().err.splitlines()
+    assert lines and all(line.startswith(f"basin hb=1 {law} alpha=0.66 omega=1.3: ")
+                         for line in lines), lines
+    assert lines[-1].startswith(f"basin hb=1 {law} alpha=0.66 omega=1.3: 16/16 cells")
 
 
 def test_progress_callable_hears_each_chunk_and_can_stop_the_run(capsys):

@@ -125,6 +125,41 @@ class ErosionResult:
                     settings=self.settings)
 
 
+    def to_xarray(self):
+        """The profile as a labelled ``xarray.Dataset`` (needs ``pip install
+        rockjit[xarray]``).
+
+        Returns
+        -------
+        xarray.Dataset
+            Coordinates ``alpha``, ``theta0``, ``dtheta0`` (with ``units`` and ``long_name``)
+            and ``branch`` (the branch ids); variables ``GIM``, ``IF``, ``basin_entropy``,
+            ``boundary_basin_entropy``, ``overturn`` (over ``alpha``), ``label`` and
+            ``attractor`` (``alpha, theta0, dtheta0``, their codes named in CF
+            ``flag_values``/``flag_meanings``), ``fraction`` (``branch, alpha``: :meth:`fractions`),
+            ``branch_behaviour`` and ``branch_period``; attributes: the block, the excitation
+            and the settings as numbers and strings, so that ``ds.to_netcdf(path)`` writes it.
+
+        Raises
+        ------
+        ImportError
+            Without xarray.
+
+        Examples
+        --------
+        >>> import rockjit
+        >>> from rockjit import Block, Harmonic
+        >>> prof = rockjit.erosion(Block(hb=1), Harmonic(omega=1.3), [0.6, 0.7], grid=10)
+        >>> ds = prof.to_xarray()
+        >>> ds.GIM.sel(alpha=0.7).item(), ds.attractor.dims
+        (0.49, ('alpha', 'theta0', 'dtheta0'))
+        >>> ds.branch_behaviour.values.tolist()
+        ['symmetric', 'symmetric', 'asymmetric']
+        """
+        from ..result import BEHAVIOURS
+        from ..storage.labelled import erosion_dataset
+        return erosion_dataset(self, BEHAVIOURS)
+
 def _link(prev, cur, tol, floor):
     """``{id_cur: id_prev}``: each current attractor, largest basin first, to the nearest
     previous one not yet taken of the same behaviour and period whose
@@ -158,7 +193,8 @@ def run(plan: ErosionPlan, execution=None):
     cont_tol = plan.cont_tol
     g_plan = plan.grid_plan
     out = runner.run_grid(g_plan.y0s, g_plan.pars, g_plan.ipar, g_plan.cpar, tangent=False,
-                          n_pts=g_plan.n_pts, n_imp_pts=0, label="erosion",
+                          n_pts=g_plan.n_pts, n_imp_pts=0,
+                          label=gp.progress_label("erosion", g_plan.block, g_plan.forcing),
                           execution=execution)
     r = kernel.grid_results(out)
     na, g = plan.alpha.size, plan.grid

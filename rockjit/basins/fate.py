@@ -217,7 +217,8 @@ def _members_on_a_grid(p, starts, execution):
     cpar = kernel.classification_vector(cl)
     y0s = np.column_stack([starts, np.full(n, p.y0[2]), np.full(n, p.y0[3])])
     out = runner.run_grid(y0s, np.tile(par, (n, 1)), ipar, cpar, tangent=False, n_pts=cl.pmax,
-                          n_imp_pts=0, label="fate", execution=execution)
+                          n_imp_pts=0, label=gp.progress_label("fate", p.block, p.forcing),
+                          execution=execution)
     r = kernel.grid_results(out)
     return r["label"], r["period"], out["pts"], out["n_got"], r["t_end"]
 

@@ -33,7 +33,7 @@ from ..validate import integer, memory, pair, real
 from . import runner
 
 __all__ = ["GRID_N", "MAX_CELLS", "GridPlan", "alpha_count", "alpha_grid", "common",
-           "exponents", "grid_memory", "run", "uncertain_cells"]
+           "exponents", "grid_memory", "progress_label", "run", "uncertain_cells"]
 
 #: Steps per period of sweeps, basins and planes: they need labels and lambda_max, not 1e-10
 #: event times. On the study's four basins and its 501-amplitude sweep, N = 64 gives the labels
@@ -197,14 +197,44 @@ def n_points(name, value, default):
     return default if value is None else integer(name, value, 1, 10**6)
 
 
+#: The excitation's fields each kind of grid holds fixed (the others it sweeps).
+FIXED = {"sweep": ("omega",), "basin": ("alpha", "omega"), "plane": (),
+         "erosion": ("omega",), "fate": ("alpha", "omega")}
+
+
+def progress_label(kind, block, forcing=None):
+    """What a grid's progress counts, as its description: the kind of grid, the block's
+    slenderness and law, and the forcing's fixed fields (:data:`FIXED`).
+
+    >>> from rockjit import Block, Harmonic
+    >>> progress_label("basin", Block(hb=1), Harmonic(alpha=0.66, omega=1.3))
+    'basin hb=1 housner alpha=0.66 omega=1.3'
+    >>> progress_label("sweep", Block(hb=2, e=0.8), Harmonic(omega=1.6))
+    'sweep hb=2 constant e=0.8 omega=1.6'
+    """
+    words = [kind, f"hb={block.hb:g}", block.law]
+    if block.e is not None:
+        words.append(f"e={block.e:g}")
+    for name in FIXED.get(kind, ()):
+        value = getattr(forcing, name, None)
+        if value is not None:
+            words.append(f"{name}={value:g}")
+    return " ".join(words)
+
+
 def run(plan: GridPlan, execution=None):
     """Execute a :class:`GridPlan`; returns its :class:`SweepResult`, :class:`BasinResult` or
     :class:`PlaneResult` (``execution``: a :class:`rockjit.Execution`, default in-process with
     all threads)."""
+    return _run(plan, execution, progress_label(plan.kind, plan.block, plan.forcing))
+
+
+def _run(plan, execution, label):
+    """:func:`run`, its progress described by ``label``."""
     p = plan
     execution = Execution() if execution is None else execution
     out = runner.run_grid(p.y0s, p.pars, p.ipar, p.cpar, tangent=p.tangent, n_pts=p.n_pts,
-                          n_imp_pts=p.n_imp_pts, label=p.kind, execution=execution)
+                          n_imp_pts=p.n_imp_pts, label=label, execution=execution)
     r = kernel.grid_results(out)
     label = r["label"].reshape(p.shape)
     period = r["period"].reshape(p.shape)
@@ -254,7 +284,8 @@ def uncertain_cells(plan, result, eps, *, seed=0, execution=None):
         # the moved grid is another computation: its chunks keep a store of their own
         from pathlib import Path
         execution = execution.replace(store=Path(execution.store) / "uncertainty")
-    moved = run(replace(plan, y0s=y0s, uncertainty=None), execution)
+    moved = _run(replace(plan, y0s=y0s, uncertainty=None), execution,
+                 progress_label(plan.kind, plan.block, plan.forcing) + " (moved by eps)")
     differ = (np.asarray(result.label) != moved.label) | (np.asarray(result.period) !=
                                                           moved.period)
     if result.attractor is not None and moved.attractor is not None and plan.kind == "basin":

@@ -155,8 +155,20 @@ def _client(execution):
 
 
 class _Progress:
-    """Progress on stderr: one line rewritten with ``\\r`` on a terminal; otherwise plain lines,
-    at most one every :attr:`EVERY` seconds plus the last, so that a log file stays readable."""
+    """Progress on stderr (``stream``): a :mod:`tqdm` bar on a terminal; plain lines otherwise.
+
+    On a terminal the bar redraws itself in place: its description is ``label`` (what is
+    counted: the grid, the block's law and the fixed forcing, e.g. ``"basin hb=1 housner
+    alpha=0.66 omega=1.3"``), then the percentage, ``done/total cells``, the time elapsed and
+    left, and the rate. Cells loaded from a chunk store count as done from the start and not
+    in the rate.
+
+    When ``stream`` is not a terminal (a log file, a pipe, a notebook's captured stderr), tqdm
+    is not used: it redraws by writing ``\r`` before each refresh even to a file (also with
+    ``mininterval=5``), so a log would hold one ever-growing line of bars. There, plain lines
+    are written instead, ``"<label>: done/total cells, 12.0 s elapsed, ~30.0 s left"``, at
+    most one every :attr:`EVERY` seconds plus the last, so that the log stays readable.
+    """
 
     EVERY = 5.0
 
@@ -169,16 +181,19 @@ class _Progress:
             self.tty = False
         self.t0 = self.last = time.perf_counter()
         self.done = self.start = done
-        self.shown = False
         self.pending = False
+        self.bar = None
+        if enabled and self.tty:
+            from tqdm import tqdm
+            self.bar = tqdm(total=total, initial=done, desc=label, file=self.stream,
+                            unit="cells", smoothing=0, dynamic_ncols=True, leave=True,
+                            bar_format="{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} "
+                                       "cells [{elapsed}<{remaining}, {rate_fmt}]")
 
-    def _line(self, width):
+    def _line(self):
         el = time.perf_counter() - self.t0
         fresh = self.done - self.start
         eta = el / fresh * (self.total - self.done) if fresh else float("nan")
-        if width:
-            return (f"{self.label}: {self.done}/{self.total} cells, {el:6.1f} s elapsed, "
-                    f"~{eta:5.1f} s left ")
         return (f"{self.label}: {self.done}/{self.total} cells, {el:.1f} s elapsed, "
                 f"~{eta:.1f} s left")
 
@@ -186,27 +201,25 @@ class _Progress:
         self.done += n
         if not self.enabled:
             return
-        if self.tty:
-            self.stream.write("\r" + self._line(True))
+        if self.bar is not None:
+            self.bar.update(n)
         elif time.perf_counter() - self.last >= self.EVERY or self.done >= self.total:
-            self.stream.write(self._line(False) + "\n")
+            self.stream.write(self._line() + "\n")
+            self.stream.flush()
             self.last = time.perf_counter()
             self.pending = False
         else:
             self.pending = True
-            return
-        self.shown = True
-        self.stream.flush()
 
     def close(self):
         if not self.enabled:
             return
-        if self.tty and self.shown:
-            self.stream.write("\n")
+        if self.bar is not None:
+            self.bar.close()
         elif self.pending:
-            self.stream.write(self._line(False) + "\n")
+            self.stream.write(self._line() + "\n")
             self.pending = False
-        self.stream.flush()
+            self.stream.flush()
 
 
 class _Callback:
@@ -251,9 +264,12 @@ def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, pr
         run (if :meth:`ChunkStore.close` gave it back) and released when this function
         returns or raises.
     progress : bool or callable
-        Report progress on stderr (a rewritten line on a terminal, else throttled lines); or
-        call ``progress(done, total)`` with the cells finished, once before the first chunk
+        Report progress on stderr (a tqdm bar on a terminal, else plain lines at most every
+        5 s and the last, described by ``label``); or call ``progress(done, total)`` with the cells finished, once before the first chunk
         and after each; an exception it raises stops the run between two chunks.
+    label : str
+        What the progress counts, its description: the grid, the law and the fixed forcing
+        (:func:`rockjit.grids.plan.progress_label`).
     message : callable, optional
         ``message(text)`` for the wait for Dask workers (default: the store's, else a line on
         stderr).

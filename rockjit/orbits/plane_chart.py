@@ -201,6 +201,36 @@ class ChartResult:
         """``(n_alpha, n_omega)``: the behaviour codes of the chart."""
         return np.asarray(self.plane.label)[0]
 
+    def to_xarray(self):
+        """The chart's plane as a labelled ``xarray.Dataset``, with the overturn onset (needs
+        ``pip install rockjit[xarray]``).
+
+        Returns
+        -------
+        xarray.Dataset
+            :meth:`rockjit.PlaneResult.to_xarray` of ``plane`` with ``overturn_onset``
+            over ``omega`` and the attributes ``chart_phase`` (the curves' section phase) and
+            ``n_curves``; the curves themselves are in :meth:`to_summary`.
+
+        Raises
+        ------
+        ImportError
+            Without xarray.
+
+        Examples
+        --------
+        >>> from rockjit import Block, chart
+        >>> from rockjit.orbits import ChartCurves
+        >>> res = chart(Block(hb=1), (0.7, 0.95), (1.25, 1.35), grid=(6, 5),
+        ...             curves=ChartCurves(seed_omegas=[1.3], types="period_doubling",
+        ...                                max_period=1))
+        >>> ds = res.to_xarray()
+        >>> ds.overturn_onset.dims, ds.attrs["kind"], ds.attrs["n_curves"] == len(res.curves)
+        (('omega',), 'chart', True)
+        """
+        from ..storage.labelled import chart_dataset
+        return chart_dataset(self)
+
     def to_summary(self, suffix=""):
         """``(summary, arrays)``: the chart's fractions, the curves (``"curves"``: type,
         period, law, points and the rest of :meth:`BifurcationCurve.to_dict`), the seeds and
