@@ -60,8 +60,8 @@ class ChartCurves:
     Parameters
     ----------
     seed_omegas : sequence of float, optional
-        The seed lines, inside the chart's ``omega_range``; default :data:`SEED_LINES` lines
-        evenly spaced.
+        The seed lines, inside the chart's ``omega_range``; default
+        :data:`~rockjit.orbits.plane_chart.SEED_LINES` lines evenly spaced.
     max_period : int
         Longest period whose bifurcations seed curves, in ``[1, 16]``; default 2.
     types : sequence of str
