@@ -59,21 +59,31 @@ def _numeric_list(v):
     return v is None or isinstance(v, (bool, int, float, complex, str, np.generic))
 
 
-def walk(obj, path, arrays, scalars):
-    """Every array (by SHA-256) and value ``obj`` holds, by path."""
+#: Integer arrays :func:`walk` also keeps whole (in ``small``) when their path ends with one of
+#: these names: ``labels.npz`` holds them, so that a failing comparison says where.
+SMALL_INT = {"label", "period", "attractor", "motion", "outcome", "impacts", "stable",
+             "symmetric_points", "uncertain"}
+
+
+def walk(obj, path, arrays, scalars, small=None):
+    """Every array (by SHA-256) and value ``obj`` holds, by path (and the small integer
+    arrays whole, into ``small`` if given)."""
     if isinstance(obj, np.ndarray):
         arrays[path] = dict(dtype=obj.dtype.str, shape=list(obj.shape), sha256=_sha(obj))
+        if small is not None and obj.dtype.kind in "iub" \
+                and path.rsplit(".", 1)[-1] in SMALL_INT:
+            small[path] = obj
     elif dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         for f in dataclasses.fields(obj):
             if f.name in SKIP or (f.name in CONTEXT and path == ""):
                 continue
-            walk(getattr(obj, f.name), f"{path}.{f.name}", arrays, scalars)
+            walk(getattr(obj, f.name), f"{path}.{f.name}", arrays, scalars, small)
     elif isinstance(obj, dict):
         for k, v in obj.items():
-            walk(v, f"{path}[{json.dumps(str(k))}]", arrays, scalars)
+            walk(v, f"{path}[{json.dumps(str(k))}]", arrays, scalars, small)
     elif isinstance(obj, (list, tuple)) and not _numeric_list(obj):
         for i, v in enumerate(obj):
-            walk(v, f"{path}[{i}]", arrays, scalars)
+            walk(v, f"{path}[{i}]", arrays, scalars, small)
     else:
         scalars[path] = _scalar(obj)
 

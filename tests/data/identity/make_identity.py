@@ -29,8 +29,6 @@ wall times go to stdout only, so that two runs write identical files.
 from __future__ import annotations
 
 import argparse
-import dataclasses
-import hashlib
 import json
 import sys
 import time
@@ -45,75 +43,17 @@ sys.path.insert(0, str(ROOT))  # this tree's rockjit, not an installed one
 import rockjit  # noqa: E402
 
 assert Path(rockjit.__file__).resolve().parent == ROOT / "rockjit", rockjit.__file__
+sys.path.insert(0, str(HERE.parent.parent))  # tests/: the cases' translation and the walk
 
-#: Fields that are not results: timings (not reproducible) and the inputs echoed back.
-SKIP = {"wall_s"}
-CONTEXT = {"settings", "block", "forcing", "integration"}
-
-#: Integer arrays kept in full in labels.npz when their path ends with one of these names.
-SMALL_INT = {"label", "period", "attractor", "motion", "outcome", "impacts", "stable",
-             "symmetric_points", "uncertain"}
-
-
-def sha(a):
-    return hashlib.sha256(np.ascontiguousarray(a).tobytes()).hexdigest()
-
-
-def scalar(v):
-    """A JSON value that compares exactly."""
-    if v is None or isinstance(v, (bool, np.bool_)):
-        return None if v is None else bool(v)
-    if isinstance(v, (int, np.integer)):
-        return int(v)
-    if isinstance(v, (float, np.floating)):
-        return float(v).hex()
-    if isinstance(v, (complex, np.complexfloating)):
-        return [float(v.real).hex(), float(v.imag).hex()]
-    if isinstance(v, str):
-        return v
-    if isinstance(v, (list, tuple)):
-        return [scalar(x) for x in v]
-    raise TypeError(f"not a scalar: {type(v).__name__}")
-
-
-def _numeric_list(v):
-    if isinstance(v, (list, tuple)):
-        return all(_numeric_list(x) for x in v)
-    return v is None or isinstance(v, (bool, int, float, complex, str, np.generic))
-
-
-def walk(obj, path, arrays, scalars, small):
-    """Every array and value ``obj`` holds, by path."""
-    if isinstance(obj, np.ndarray):
-        arrays[path] = dict(dtype=obj.dtype.str, shape=list(obj.shape), sha256=sha(obj))
-        leaf = path.rsplit(".", 1)[-1]
-        if obj.dtype.kind in "iub" and leaf in SMALL_INT:
-            small[path] = obj
-    elif dataclasses.is_dataclass(obj) and not isinstance(obj, type):
-        for f in dataclasses.fields(obj):
-            if f.name in SKIP or (f.name in CONTEXT and path == ""):
-                continue
-            walk(getattr(obj, f.name), f"{path}.{f.name}", arrays, scalars, small)
-    elif isinstance(obj, dict):
-        for k, v in obj.items():
-            walk(v, f"{path}[{json.dumps(str(k))}]", arrays, scalars, small)
-    elif isinstance(obj, (list, tuple)) and not _numeric_list(obj):
-        for i, v in enumerate(obj):
-            walk(v, f"{path}[{i}]", arrays, scalars, small)
-    else:
-        scalars[path] = scalar(obj)
-
+import test_identity as ti  # noqa: E402
 
 def _two_state_plane():
     """The plane of two states, one plane per state, joined (as the test compares it)."""
-    import test_identity as ti
     return {f: np.concatenate([getattr(p, f) for p in ti.two_state_planes()])
             for f in ("label", "period", "lambda_window", "t_end")}
 
 
 def main(argv=None):
-    sys.path.insert(0, str(HERE.parent.parent))  # tests/, for test_identity
-    import test_identity as ti
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--only", nargs="*", help="case names (and the cases they use)")
@@ -132,7 +72,7 @@ def main(argv=None):
         t0 = time.perf_counter()
         res = _two_state_plane() if name == ti.TWO_STATES else ti._result(name)
         arrays, scalars, sm = {}, {}, {}
-        walk(res, "", arrays, scalars, sm)
+        ti.walk(res, "", arrays, scalars, sm)
         case["arrays"], case["scalars"] = arrays, scalars
         small.update({f"{name}::{p}": a for p, a in sm.items()})
         print(f"{name:34s} {time.perf_counter() - t0:7.3f} s  {len(arrays):4d} arrays  "
