@@ -335,3 +335,17 @@ def test_scrub_keeps_the_figures():
         assert not internal.search(shown), md.name
         rows = [r for r in text.splitlines() if r.startswith("|") and not internal.search(r)]
         assert set(rows) <= set(shown.splitlines()), md.name
+
+
+def test_no_control_characters_in_the_texts():
+    # a backslash sequence written through a string that interprets it ("\a" in "\approx")
+    # leaves a control character the page shows as nothing
+    bad = []
+    for folder in ("docs", "rockjit", "benchmarks", "tests", "notebooks"):
+        for path in (ROOT / folder).rglob("*"):
+            if "_build" in path.parts or path.suffix not in (".md", ".py", ".rst", ".ipynb"):
+                continue
+            text = path.read_text(encoding="utf-8")
+            bad += [f"{path.relative_to(ROOT)}: {hex(ord(c))}" for c in set(text)
+                    if ord(c) < 32 and c not in "\n\t\r"]
+    assert not bad, bad
