@@ -402,7 +402,8 @@ def _simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
         return prepared(state)
     p = simulate.plan(block, forcing, state, integration=integration, lyapunov=lyapunov,
                       record_stride=record_stride, method=method)
-    if p.method == "rockjit" and type(lyapunov) is bool:
+    if p.method == "rockjit" and type(lyapunov) is bool and not getattr(forcing, "transient",
+                                                                         False):
         if len(_PREPARED) >= _PREPARED_MAX:
             _PREPARED.clear()
         _PREPARED[key] = Prepared(p)

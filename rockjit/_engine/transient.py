@@ -54,7 +54,7 @@ A61, A62, A63, A64, A65 = (float(_A[5, 0]), float(_A[5, 1]), float(_A[5, 2]), fl
                            float(_A[5, 4]))
 B1, B3, B4, B5, B6 = float(_B[0]), float(_B[2]), float(_B[3]), float(_B[4]), float(_B[5])
 
-# ---- codes ----------------------------------------------------------------------------------------
+# ---- codes --------------------------------------------------------------------------------------
 K_SINE, K_COSINE, K_RICKER, K_RECORD = 0, 1, 2, 3
 #: columns of a cell's forcing row ``xpar``
 X_KIND, X_AMP, X_OMEGA, X_END, X_DELAY, X_DT, X_OFF, X_N, X_STEPS = range(9)
@@ -76,7 +76,7 @@ _EPS = float(np.finfo(float).eps)
 ROOT_ITERS = 60
 
 
-# ---- the forcing ----------------------------------------------------------------------------------
+# ---- the forcing --------------------------------------------------------------------------------
 
 @jit(nrt=False, inline=True)
 def forcing(t, x, rec):
@@ -160,17 +160,19 @@ def locate(kind, target, t, th, v, a0, lo, hi, glo, cap, side, sthc, cthc, xi, x
     ``kind`` 0, ``side * theta - target`` (slope ``side * theta'``); ``kind`` 1,
     ``side * theta'`` (slope ``side * theta''``). ``glo`` is its value at ``lo``, and its value
     at ``hi`` has the other sign. Newton's iteration, bisection where it would leave the
-    bracket. Returns ``(tau, theta, theta', theta'')`` at the root."""
+    bracket. Returns ``(tau, theta, theta', theta'', steps taken)`` at the root."""
     tol = 4.0 * _EPS * max(1.0, abs(t) + hi)
     z = lo + 0.5 * (hi - lo)
+    steps = 1
     for _ in range(ROOT_ITERS):
+        steps += 1
         th1, v1, a1 = dp_step(t, th, v, a0, z, cap, side, sthc, cthc, xi, x, rec)
         if kind == 0:
             g, dg = side * th1 - target, side * v1
         else:
             g, dg = side * v1, side * a1
         if g == 0.0:
-            return z, th1, v1, a1
+            return z, th1, v1, a1, steps
         if (g > 0.0) == (glo > 0.0):
             lo, glo = z, g
         else:
@@ -183,10 +185,10 @@ def locate(kind, target, t, th, v, a0, lo, hi, glo, cap, side, sthc, cthc, xi, x
             break
         z = zn
     th1, v1, a1 = dp_step(t, th, v, a0, z, cap, side, sthc, cthc, xi, x, rec)
-    return z, th1, v1, a1
+    return z, th1, v1, a1, steps
 
 
-# ---- when the block leaves rest ---------------------------------------------------------------
+# ---- when the block leaves rest -----------------------------------------------------------------
 
 @jit(nrt=False)
 def _ulp(x):
@@ -323,7 +325,7 @@ def next_uplift(t, x, rec, win, nwin, thc, xi, thr):
         tq = t1
 
 
-# ---- one cell -------------------------------------------------------------------------------------
+# ---- one cell -----------------------------------------------------------------------------------
 
 @jit(nrt=False, inline=True)
 def _settled(th, v, side, thc, th_top, e_top):
@@ -366,9 +368,10 @@ def grid_next(t, end, h_exc, nsub, dt, h_free, t_lim):
 F_MAXROT, F_TOVER, F_T, F_TUP, F_TH, F_DTH, F_MAXTH = range(7)
 N_F = 7
 #: its integer outputs ``out_i``: outcome, impacts, status, rest phases entered after an impact,
-#: trajectory points (recorded up to the buffer's length)
-I_OUTCOME, I_IMPACTS, I_STATUS, I_REST, I_TRAJ = range(5)
-N_I = 5
+#: trajectory points (recorded up to the buffer's length), steps taken (each six evaluations
+#: of the right-hand side), the events' included
+I_OUTCOME, I_IMPACTS, I_STATUS, I_REST, I_TRAJ, I_STEPS = range(6)
+N_I = 6
 
 
 @jit(nrt=False, inline=True)
@@ -415,6 +418,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp,
     a = acc(th, v, t, side, sthc, cthc, xi, x, rec) if side != 0 else 0.0
     n_imp = 0
     n_rest = 0
+    n_step = 0
     n_tr = _keep(traj, 0, t, th, v)
     max_th = abs(th0)
     t_over = math.nan
@@ -451,6 +455,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp,
         tn = grid_next(t, end, h_exc, nsub, dt, h_free, t_lim)
         hh = tn - t
         th1, v1, a1 = dp_step(t, th, v, a, hh, tn, side, sthc, cthc, xi, x, rec)
+        n_step += 1
         if not (math.isfinite(th1) and math.isfinite(v1) and math.isfinite(a1)):
             status = ST_NONFINITE
             break
@@ -458,8 +463,9 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp,
         th_c = 0.0
         crest = side * v > 0.0 and side * v1 < 0.0
         if crest:  # a maximum of side * theta inside the step
-            tau, th_c, vc, ac = locate(1, 0.0, t, th, v, a, 0.0, hh, side * v, tn, side, sthc,
-                                       cthc, xi, x, rec)
+            tau, th_c, vc, ac, ns = locate(1, 0.0, t, th, v, a, 0.0, hh, side * v, tn, side,
+                                           sthc, cthc, xi, x, rec)
+            n_step += ns
             max_th = max(max_th, abs(th_c))
             if decide and t + tau >= end and _settled(th_c, 0.0, side, thc, th_top, e_top):
                 t = t + tau
@@ -470,8 +476,9 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp,
             lo = tau
         impact_at = -1.0
         if side * th1 >= thover:  # overturning
-            tau, th2, v2, a2 = locate(0, thover, t, th, v, a, 0.0, hh, side * th - thover,
-                                      tn, side, sthc, cthc, xi, x, rec)
+            tau, th2, v2, a2, ns = locate(0, thover, t, th, v, a, 0.0, hh,
+                                          side * th - thover, tn, side, sthc, cthc, xi, x, rec)
+            n_step += ns
             t = t_over = t + tau
             th, v = th2, v2
             n_tr = _keep(traj, n_tr, t, th, v)
@@ -482,8 +489,9 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp,
             impact_at = hh
         elif not crest and side * v < 0.0 and side * v1 > 0.0:
             # a minimum of side * theta: below 0, the block went through an impact and back
-            tau, th2, v2, a2 = locate(1, 0.0, t, th, v, a, 0.0, hh, side * v, tn, side, sthc,
-                                      cthc, xi, x, rec)
+            tau, th2, v2, a2, ns = locate(1, 0.0, t, th, v, a, 0.0, hh, side * v, tn, side,
+                                          sthc, cthc, xi, x, rec)
+            n_step += ns
             if side * th2 < 0.0:
                 impact_at = tau
         if impact_at < 0.0:
@@ -496,8 +504,9 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp,
             continue
         # ---- impact --------------------------------------------------------------------------
         g_lo = side * th if lo == 0.0 else side * th_c
-        tau, th2, v2, a2 = locate(0, 0.0, t, th, v, a, lo, impact_at, g_lo, tn, side, sthc, cthc,
-                                  xi, x, rec)
+        tau, th2, v2, a2, ns = locate(0, 0.0, t, th, v, a, lo, impact_at, g_lo, tn, side,
+                                      sthc, cthc, xi, x, rec)
+        n_step += ns
         t = t + tau
         n_tr = _keep(traj, n_tr, t, 0.0, v2)
         dth_p = jump(v2, e)
@@ -538,6 +547,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp,
     out_i[I_STATUS] = status
     out_i[I_REST] = n_rest
     out_i[I_TRAJ] = n_tr
+    out_i[I_STEPS] = n_step
 
 
 @jit(parallel=True)
