@@ -351,6 +351,9 @@ class Prepared:
     __slots__ = ("plan", "_kernel", "_par", "_ipar")
 
     def __init__(self, plan):
+        if not isinstance(plan, RunPlan):
+            raise ValueError("a run under a pulse or a record cannot be prepared: call "
+                             "rockjit.simulate for each run")
         if plan.method != "rockjit":
             raise ValueError("only runs of the compiled path can be prepared "
                              "(method='rockjit')")
