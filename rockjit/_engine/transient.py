@@ -158,8 +158,8 @@ def dp_step(t, th, v, a0, hh, cap, side, sthc, cthc, xi, x, rec):
 def locate(kind, target, t, th, v, a0, lo, hi, glo, cap, side, sthc, cthc, xi, x, rec):
     """The root in ``(lo, hi)`` of an event function along genuine steps from ``(t, th, v)``:
     ``kind`` 0, ``side * theta - target`` (slope ``side * theta'``); ``kind`` 1,
-    ``side * theta'`` (slope ``side * theta''``). ``glo`` is its value at ``lo``, and its value
-    at ``hi`` has the other sign. Newton's iteration, bisection where it would leave the
+    ``side * theta'`` (slope ``side * theta''``). ``glo`` has its sign just after ``lo``, and
+    its value at ``hi`` has the other sign. Newton's iteration, bisection where it would leave the
     bracket. Returns ``(tau, theta, theta', theta'', steps taken)`` at the root."""
     tol = 4.0 * _EPS * max(1.0, abs(t) + hi)
     z = lo + 0.5 * (hi - lo)
@@ -461,9 +461,10 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp,
             break
         lo = 0.0
         th_c = 0.0
-        crest = side * v > 0.0 and side * v1 < 0.0
+        # rising at the start (or about to: the instant of an uplift) and falling at the end
+        crest = (side * v > 0.0 or (v == 0.0 and side * a > 0.0)) and side * v1 < 0.0
         if crest:  # a maximum of side * theta inside the step
-            tau, th_c, vc, ac, ns = locate(1, 0.0, t, th, v, a, 0.0, hh, side * v, tn, side,
+            tau, th_c, vc, ac, ns = locate(1, 0.0, t, th, v, a, 0.0, hh, 1.0, tn, side,
                                            sthc, cthc, xi, x, rec)
             n_step += ns
             max_th = max(max_th, abs(th_c))
