@@ -5,7 +5,7 @@ integration: adaptive steps, events located on its dense output, the same model 
 a dozen pulses (one-sine, one-cosine, Ricker; both restitution laws; overturning after an
 impact, without one, and safe runs) and a FEMA P695 record (or, without the ``records`` extra,
 a synthetic one) agree in outcome, impacts, ``t_overturn`` to 1e-8 and ``max_rotation`` to
-1e-9. A block below the uplift threshold never moves. The results do not depend on the number
+1e-9, also just above the uplift threshold. A block below the threshold never moves. The results do not depend on the number
 of threads. A spectrum on the compiled kernel has the scipy kernel's outcome map. Single runs
 on the compiled path keep the impacts and the trajectory the scipy path keeps.
 """
@@ -120,6 +120,20 @@ def test_below_the_uplift_threshold_nothing_moves(kind):
     assert np.all(got["max_rotation"] == 0.0)
     assert np.all(got["status"] == B.STATUS_CODES.index("rest"))
     assert np.all(got["t_end"] == 0.0)  # never lifted: at rest for good from the start
+
+
+def test_just_above_the_uplift_threshold():
+    """The block rises by 1e-8 to 1e-4 of alpha_s and falls back, within a step or two: the
+    crest right after the uplift and the Zeno cascade that ends in rest."""
+    cells = [(Block(hb=4), Pulse(kind, ratio=2.0, amplitude=1.0, hb=4.0), amp)
+             for kind in ("sine", "cosine", "ricker") for amp in (1.000001, 1.0001, 1.01)]
+    batch = _batch(cells)
+    got = compiled_kernel(*batch, SETTINGS, "rockjit")
+    ref = B.scipy_kernel(*batch, SETTINGS, Scipy("DOP853", rtol=1e-12, atol=1e-16))
+    assert np.all(ref["max_rotation"] > 0.0) and np.all(ref["max_rotation"] < 1e-3)
+    assert np.all(ref["outcome"] == SAFE) and ref["n_impacts"].min() >= 1
+    _agree(got, ref)
+    np.testing.assert_allclose(got["max_rotation"], ref["max_rotation"], rtol=1e-6)
 
 
 def test_the_results_do_not_depend_on_the_threads():
