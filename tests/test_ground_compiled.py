@@ -5,9 +5,10 @@ integration: adaptive steps, events located on its dense output, the same model 
 a dozen pulses (one-sine, one-cosine, Ricker; both restitution laws; overturning after an
 impact, without one, and safe runs) and a FEMA P695 record (or, without the ``records`` extra,
 a synthetic one) agree in outcome, impacts, ``t_overturn`` to 1e-8 and ``max_rotation`` to
-1e-9, also just above the uplift threshold. A block below the threshold never moves. The results do not depend on the number
-of threads. A spectrum on the compiled kernel has the scipy kernel's outcome map. Single runs
-on the compiled path keep the impacts and the trajectory the scipy path keeps.
+1e-9, also just above the uplift threshold. A block below the threshold never moves. The
+results do not depend on the number of threads. A spectrum on the compiled kernel has the
+scipy kernel's outcome map. Single runs on the compiled path keep the impacts and the
+trajectory the scipy path keeps.
 """
 
 from __future__ import annotations
