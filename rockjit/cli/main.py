@@ -503,10 +503,9 @@ def _transient_method(args):
     from ..ground.methods import check_method
     from ..single import Scipy
     method = check_method(args.method)
-    if method == "rockjit":
-        return method
-    name = "DOP853" if args.method == "scipy" else method.method  # explicit: non-stiff
-    return Scipy(name, rtol=args.rtol, atol=args.atol)
+    name = "DOP853" if method == "rockjit" or args.method == "scipy" else method.method
+    scipy = Scipy(name, rtol=args.rtol, atol=args.atol)  # the tolerances checked either way
+    return method if method == "rockjit" else scipy
 
 
 def _transient(args):
