@@ -22,6 +22,10 @@ scipy reference path (:mod:`rockjit.ground.reference`, the specification):
   event's state has the step's own order of accuracy;
 - **impact**: :func:`rockjit.model.jump` on the other corner, or rest below ``rest_speed``.
 
+The forcing may jump where the excitation ends (the one-cosine pulse ends on ``a_p``): the last
+step of the excitation sees its value there (its stages never pass the grid instant that ends
+it), and free rocking starts from the still base, its first stage included.
+
 Every equation comes from :mod:`rockjit.model` (:func:`~rockjit.model.corner`,
 :func:`~rockjit.model.accel_pq`, :func:`~rockjit.model.sincos`, :func:`~rockjit.model.jump`,
 :func:`~rockjit.model.accel`); this module writes none.
