@@ -281,7 +281,7 @@ def spectrum(block, pulse, ratios, amplitudes, *, integration=None, method=None,
         Free rocking time, Zeno cut-off, overturning threshold; every run stops once its
         outcome is decided (``stop_when_decided``) and keeps no trajectory.
     method : {"rockjit"} or Scipy, optional
-        ``"rockjit"``, the compiled path (the default: :mod:`rockjit.ground.compiled`), or a
+        ``"rockjit"``, the compiled path (the default: ``rockjit.ground.compiled``), or a
         :class:`rockjit.Scipy` for the scipy reference path (the checks use DOP853 at
         ``rtol = 1e-10, atol = 1e-12``).
     tol : float
