@@ -359,6 +359,9 @@ class Prepared:
     __slots__ = ("plan", "_kernel", "_par", "_ipar")
 
     def __init__(self, plan):
+        if not isinstance(plan, RunPlan):
+            raise ValueError("a run under a pulse or a record cannot be prepared: call "
+                             "rockjit.simulate for each run")
         if plan.method != "rockjit":
             raise ValueError("only runs of the compiled path can be prepared "
                              "(method='rockjit')")
@@ -412,7 +415,8 @@ def _simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
         return prepared(state)
     p = simulate.plan(block, forcing, state, integration=integration, lyapunov=lyapunov,
                       record_stride=record_stride, method=method)
-    if p.method == "rockjit" and type(lyapunov) is bool:
+    if p.method == "rockjit" and type(lyapunov) is bool and not getattr(forcing, "transient",
+                                                                         False):
         if len(_PREPARED) >= _PREPARED_MAX:
             _PREPARED.clear()
         _PREPARED[key] = Prepared(p)

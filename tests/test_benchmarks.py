@@ -62,6 +62,10 @@ SCRIPTS = {
     "bench_distributed.py": (
         ["run", "chunks", "wall median s", "ratio to in-process", "overhead per chunk s",
          "identical to in-process"], ["distributed.png"]),
+    "bench_ground.py": (
+        ["computation", "runs", "compiled_median_s", "compiled_runs_per_s", "target_s",
+         "scipy_sampled_runs", "scipy_s_per_run", "scipy_extrapolated_s", "speedup",
+         "outcomes_equal", "max_rotation_max_diff", "t_overturn_max_diff"], ["ground.png"]),
     "bench_attractors.py": (["hb", "alpha", "omega", "law", "grid", "without_s", "with_s",
                              "overhead", "measures_s", "n_attractors", "labels_equal"],
                             ["attractors.png"]),
@@ -245,6 +249,17 @@ VALUES = {
          "ratio to in-process": positive, "overhead per chunk s": empty_or(finite),
          "identical to in-process": one_of("yes")},
         []),
+    "bench_ground.py": (
+        dict(computation=text, runs=count(1), compiled_median_s=positive,
+             compiled_runs_per_s=positive, target_s=empty_or(positive),
+             scipy_sampled_runs=count(1), scipy_s_per_run=positive,
+             scipy_extrapolated_s=positive, speedup=positive,
+             outcomes_equal=_rule("k/k: every sampled outcome the same",
+                                  lambda c: len(set(c.split("/"))) == 1 and c[0] != "0"),
+             max_rotation_max_diff=between(0, 1e-6), t_overturn_max_diff=between(0, 1e-6)),
+        [("the extrapolation is per run times runs", lambda r: abs(
+            num(r, "scipy_extrapolated_s") - num(r, "scipy_s_per_run") * num(r, "runs"))
+          <= 1e-9 * num(r, "scipy_extrapolated_s"))]),
     "bench_attractors.py": (
         dict(hb=positive, alpha=nonneg, omega=positive, law=one_of(*LAWS), grid=count(1),
              without_s=positive, with_s=positive,

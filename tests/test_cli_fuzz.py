@@ -661,11 +661,16 @@ def _fate():
 def _transient_cases(cmd):
     """Options of the commands on pulses and records (spectrum, fragility)."""
     c = _real_opt(cmd, "--free-time", ["-1", "-1e-3", "1e10", "1e308"])
-    c += _values(cmd, "--method", ["abc", "", "rockjit", "scipy:FOO", "SCIPY", "scipy:rk45"])
-    c += _real_opt(cmd, "--rtol", ["0", "-1", "-1e-6", "-1e308", "1", "2"])
-    c += _real_opt(cmd, "--atol", ["0", "-1", "-1e-6", "-1e308"])
+    c += _values(cmd, "--method", ["abc", "", "rockjit:RK45", "scipy:FOO", "SCIPY",
+                                   "scipy:rk45"])
+    # refused whatever the method: the compiled one ignores them, but takes them
+    for method in ("rockjit", "scipy"):
+        c += _real_opt(cmd, "--rtol", ["0", "-1", "-1e-6", "-1e308", "1", "2"],
+                       {"--method": [method]})
+        c += _real_opt(cmd, "--atol", ["0", "-1", "-1e-6", "-1e308"], {"--method": [method]})
     c += _real_opt(cmd, "--xi", ["-1", "-1e-3", "1e5", "1e308"])
-    # no --threads: the scipy path runs its cells one after another
+    # no --threads option: the compiled path takes numba's threads (Execution(threads=...) in
+    # the API)
     c.append(Case(f"{cmd} --threads 2", cmd, {"--threads": ["2"]}, r"--threads",
                   extra_ok=True))
     return c

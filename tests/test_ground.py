@@ -9,8 +9,8 @@ closed-form instant; free rocking after a pulse conserves ``E = 1/2 theta'^2 +
 outcome is decided changes neither the outcome nor ``max |theta|``; the two overturning modes;
 the located boundary of overturning without impact converges to the slender linearised block's
 closed forms (rockjit.ground.closed_forms) at second order in ``alpha_s``; the bisection's
-bracket; the batch kernel's interface (a stand-in compiled kernel is used when registered);
-and the refusals: the compiled path, periods, exponents.
+bracket; the batch kernel's interface (a kernel registered under "rockjit" takes the batches);
+and the refusals: periods, exponents.
 """
 
 from __future__ import annotations
@@ -272,8 +272,8 @@ def test_compare_two_laws():
 
 
 def test_a_registered_compiled_kernel_takes_the_batches(monkeypatch):
-    """The second stage registers its kernel under "rockjit": spectra then run on it. A
-    stand-in that counts its cells and delegates to the scipy kernel gives the same spectrum."""
+    """The kernel registered under "rockjit" runs the spectra's batches: a stand-in that counts
+    its cells and delegates to the scipy kernel gives the scipy kernel's spectrum."""
     seen = []
 
     def stand_in(blocks, sources, block_of, source_of, gain, settings, method):
@@ -282,12 +282,9 @@ def test_a_registered_compiled_kernel_takes_the_batches(monkeypatch):
                               transient_scipy())
 
     args = (Block(hb=3), Pulse("cosine"), [1.0, 2.0], [1.5, 4.0])
-    with pytest.raises(ValueError, match="compiled path for pulses and records is not "
-                                         "available yet"):
-        rockjit.spectrum(*args, method="rockjit")
     monkeypatch.setitem(B.KERNELS, "rockjit", stand_in)
     got = rockjit.spectrum(*args, method="rockjit", tol=1e-3)
-    ref = rockjit.spectrum(*args, tol=1e-3)
+    ref = rockjit.spectrum(*args, tol=1e-3, method=transient_scipy())
     assert seen and sum(seen) == got.n_runs
     assert np.array_equal(got.outcome, ref.outcome)
     np.testing.assert_array_equal(got.min_overturn, ref.min_overturn)
@@ -310,9 +307,7 @@ def test_batch_outputs_on_a_dask_cluster_are_the_same():
 
 def test_refusals():
     block, p = Block(hb=2), Pulse("sine", ratio=1.0, amplitude=2.0)
-    with pytest.raises(ValueError, match="compiled path for pulses and records is not "
-                                         "available yet"):
-        rockjit.simulate(block, p)  # the default method is the compiled path
+    assert rockjit.simulate(block, p).method == "rockjit"  # the default: the compiled path
     with pytest.raises(ValueError, match="no period"):
         rockjit.simulate(block, p, integration=Integration(periods=5), method="scipy")
     with pytest.raises(ValueError, match="lyapunov"):

@@ -4,7 +4,8 @@ Checked: ``rockjit spectrum`` writes spectrum.npz, spectrum.png and summary.json
 ``"min_overturn": [{"ratio", "amplitude", "mode"}, ...]`` at the top level for one law and inside
 each law's object with ``--law both`` (beside where the laws differ), the same numbers as the
 API; ``rockjit fragility`` on record files writes its arrays, both figures and the fitted curves
-per law and size; the compiled path is refused for now with exit status 2 and one line.
+per law and size; ``--method scipy`` gives the compiled path's outcomes; an unknown method is
+refused with exit status 2 and one line.
 """
 
 from __future__ import annotations
@@ -91,9 +92,18 @@ def test_fragility_on_record_files(tmp_path, capsys):
         assert (out / png).stat().st_size > 1000
 
 
-def test_the_compiled_path_is_refused_for_now(tmp_path, capsys):
-    rc, err = _run(["spectrum", "--hb", "2", "--ratio-range", "1", "2", "--amplitude-range",
-                    "1", "2", "--method", "rockjit", "--out", str(tmp_path / "x")], capsys)
-    assert rc == 2 and err.count("\n") == 1
-    assert "compiled path for pulses and records is not available yet" in err
+def test_the_scipy_path_on_request_and_a_bad_method(tmp_path, capsys):
+    args = ["spectrum", "--hb", "4", "--ratio-range", "1", "4", "--amplitude-range", "1.5",
+            "8", "--grid", "3", "3", "--tol", "1e-3", "--quiet"]
+    outs = {}
+    for method in ("rockjit", "scipy"):
+        rc, err = _run(args + ["--method", method, "--out", str(tmp_path / method)], capsys)
+        assert rc == 0, err
+        s = json.loads((tmp_path / method / "summary.json").read_text())
+        assert s["method"] == {"rockjit": "rockjit", "scipy": "scipy:DOP853"}[method]
+        with np.load(tmp_path / method / "spectrum.npz") as z:
+            outs[method] = z["outcome"]
+    assert np.array_equal(outs["rockjit"], outs["scipy"]) and len(np.unique(outs["scipy"])) > 1
+    rc, err = _run(args + ["--method", "compiled", "--out", str(tmp_path / "x")], capsys)
+    assert rc == 2 and err.count("\n") == 1 and "method must be" in err
     assert not (tmp_path / "x").exists()

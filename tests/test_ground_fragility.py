@@ -189,7 +189,7 @@ def test_fragility_refusals():
         rockjit.fragility(b, [Record(np.zeros(5), 0.01)], [1.0], [1.0])
     with pytest.raises(ValueError, match="rockjit.Record"):
         rockjit.fragility(b, [np.zeros(5)], [1.0], [1.0])
-    with pytest.raises(ValueError, match="not available yet"):
-        rockjit.fragility(b, recs, [1.0], [1.0], method="rockjit")
+    with pytest.raises(ValueError, match="method must be"):
+        rockjit.fragility(b, recs, [1.0], [1.0], method="compiled")
     with pytest.raises(ValueError, match="sizes must be distinct"):
         rockjit.fragility(b, recs, [1.0, 1.0], [1.0])

@@ -498,13 +498,14 @@ def _explore_plan(args):
 
 
 def _transient_method(args):
-    """The scipy path of ``--method --rtol --atol`` for pulses and records (the compiled path
-    is refused until it supports them)."""
+    """The method of ``--method --rtol --atol`` for pulses and records: ``"rockjit"`` (the
+    compiled path), or the scipy path at the tolerances given."""
     from ..ground.methods import check_method
     from ..single import Scipy
     method = check_method(args.method)
-    name = "DOP853" if args.method == "scipy" else method.method  # explicit: non-stiff
-    return Scipy(name, rtol=args.rtol, atol=args.atol)
+    name = "DOP853" if method == "rockjit" or args.method == "scipy" else method.method
+    scipy = Scipy(name, rtol=args.rtol, atol=args.atol)  # the tolerances checked either way
+    return method if method == "rockjit" else scipy
 
 
 def _transient(args):
@@ -697,11 +698,13 @@ def _add_transient(p):
     p.add_argument("--free-time", type=float, default=100.0,
                    help="model time units of free rocking after the excitation (default 100; "
                         "each run stops earlier once its outcome is decided)")
-    p.add_argument("--method", default="scipy",
-                   help="scipy or scipy:<solve_ivp method> (default scipy: DOP853); the "
-                        "compiled path for pulses and records is not available yet")
-    p.add_argument("--rtol", type=float, default=1e-10, help="scipy tolerance (default 1e-10)")
-    p.add_argument("--atol", type=float, default=1e-12, help="scipy tolerance (default 1e-12)")
+    p.add_argument("--method", default="rockjit",
+                   help="rockjit (the compiled path, default), scipy (DOP853) or "
+                        "scipy:<solve_ivp method>")
+    p.add_argument("--rtol", type=float, default=1e-10,
+                   help="scipy path tolerance (default 1e-10)")
+    p.add_argument("--atol", type=float, default=1e-12,
+                   help="scipy path tolerance (default 1e-12)")
 
 
 def _add_alphas(p, step):

@@ -10,8 +10,9 @@ One concept per module:
 - :mod:`~rockjit.ground.settings`: :class:`Transient`, how a transient run is integrated;
 - :mod:`~rockjit.ground.response`: :class:`TransientResult` and the outcome codes;
 - :mod:`~rockjit.ground.reference`: one run on the scipy reference path;
+- :mod:`~rockjit.ground.compiled`: the compiled path: a batch's cells in parallel, or one run;
 - :mod:`~rockjit.ground.plan`: a single run's plan (what :func:`rockjit.simulate` builds);
-- :mod:`~rockjit.ground.methods`: the scipy path's default method, the compiled path's refusal;
+- :mod:`~rockjit.ground.methods`: the compiled path or which scipy path;
 - :mod:`~rockjit.ground.batch`: a batch of cells and the kernels that compute their outcomes;
 - :mod:`~rockjit.ground.spectrum`: overturning spectra of pulses;
 - :mod:`~rockjit.ground.fitting`: lognormal fragility fits by maximum likelihood;

@@ -22,22 +22,23 @@ returning one array per name of :data:`OUTPUTS`, each of the chunk's length:
 - ``n_impacts`` (int64): the impacts before it stopped;
 - ``status`` (int8): the index of the run's status in :data:`STATUS_CODES`.
 
-Today's kernel, :func:`scipy_kernel`, runs the cells one after another on the scipy reference
-path. The compiled kernel registers itself in :data:`KERNELS` under ``"rockjit"``; until it
-does, :func:`kernel_for` refuses ``method="rockjit"`` for pulses and records. :func:`run_batch`
+Two kernels: :func:`scipy_kernel` runs the cells one after another on the scipy reference path;
+the compiled kernel (:func:`rockjit.ground.compiled.compiled_kernel`, the default) runs a
+chunk's cells in parallel threads; :func:`kernel_for` registers it in :data:`KERNELS` under
+``"rockjit"`` when first asked for it. :func:`run_batch`
 cuts a batch into chunks and runs them through a kernel, in this process or on a Dask cluster
 (``Execution.client`` or ``Execution.scheduler``), with progress.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
 import uuid
 from dataclasses import dataclass
 
 import numpy as np
 
-from .plan import COMPILED_NOT_YET
 from .response import STATUSES
 
 __all__ = ["Batch", "KERNELS", "OUTPUTS", "STATUS_CODES", "grid_method", "kernel_for",
@@ -106,42 +107,64 @@ def scipy_kernel(blocks, sources, block_of, source_of, gain, settings, method):
     return out
 
 
-#: The kernels by method: ``"scipy"`` (any :class:`rockjit.Scipy`) today; the compiled path
-#: adds ``"rockjit"``.
+#: The kernels by method: ``"scipy"`` (any :class:`rockjit.Scipy`) and, once
+#: :func:`kernel_for` has been asked for it, ``"rockjit"``.
 KERNELS = {"scipy": scipy_kernel}
 
 
 def kernel_for(method):
     """The kernel of ``method`` (``"rockjit"`` or a :class:`rockjit.Scipy`)."""
     name = "rockjit" if method == "rockjit" else "scipy"
-    if name not in KERNELS:
-        raise ValueError(COMPILED_NOT_YET)
+    if name == "rockjit" and name not in KERNELS:
+        from .compiled import compiled_kernel  # numba only when asked for
+        KERNELS[name] = compiled_kernel
     return KERNELS[name]
 
 
 def grid_method(method):
-    """The method of a grid: ``"rockjit"`` when a compiled kernel is registered (refused
-    otherwise, :data:`rockjit.ground.plan.COMPILED_NOT_YET`), else the :class:`rockjit.Scipy`
-    of ``method`` (default DOP853 at ``rtol = 1e-10, atol = 1e-12``)."""
-    from .methods import check_method, transient_scipy
-    if method is None:
-        return transient_scipy()
-    if method == "rockjit":
-        kernel_for(method)
-        return method
+    """The method of a grid: ``"rockjit"`` (the compiled kernel, the default), else the
+    :class:`rockjit.Scipy` of ``method`` (:func:`rockjit.ground.methods.transient_scipy` is
+    the one the checks use: DOP853 at ``rtol = 1e-10, atol = 1e-12``)."""
+    from .methods import check_method
+    if method is None or method == "rockjit":
+        kernel_for("rockjit")
+        return "rockjit"
     return check_method(method)
 
 
-def default_chunk(n):
+#: The fewest cells of a chunk of the compiled kernel in this process: each call starts the
+#: kernel's threads, which costs up to about ten milliseconds on a loaded machine, as much as
+#: a hundred pulse runs.
+MIN_COMPILED_CHUNK = 2048
+
+
+def default_chunk(n, compiled=False):
     """Cells per chunk: about a twentieth of the batch (the unit of progress and of Dask
-    tasks), at least one."""
-    return max(1, math.ceil(n / 20))
+    tasks), at least one; with ``compiled`` (the compiled kernel in this process) at least
+    :data:`MIN_COMPILED_CHUNK`."""
+    return max(MIN_COMPILED_CHUNK if compiled else 1, math.ceil(n / 20))
+
+
+@contextlib.contextmanager
+def _threads(threads):
+    """numba's threads set to ``threads`` (``Execution.threads``) for the block, if given."""
+    if threads is None:
+        yield
+        return
+    import numba
+    old = numba.get_num_threads()
+    numba.set_num_threads(threads)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(old)
 
 
 def run_batch(batch, settings, method, execution=None, label="cells"):
     """Every cell of ``batch`` through the kernel of ``method``, chunk by chunk, as
-    ``execution`` (a :class:`rockjit.Execution`) says: in this process or on a Dask cluster,
-    with progress. Returns the outputs by name (:data:`OUTPUTS`)."""
+    ``execution`` (a :class:`rockjit.Execution`) says: in this process (the compiled kernel on
+    ``threads`` numba threads) or on a Dask cluster, with progress. Returns the outputs by
+    name (:data:`OUTPUTS`)."""
     from ..grids.runner import _client, run_chunks
     from ..settings import Execution
     ex = Execution() if execution is None else execution
@@ -150,10 +173,11 @@ def run_batch(batch, settings, method, execution=None, label="cells"):
     outputs = empty_outputs(n)
     if n == 0:
         return outputs
-    chunk = default_chunk(n) if ex.chunk is None else ex.chunk
     # task keys unique to this call: a bisection runs many batches on one cluster
     prefix = f"rockjit-{label.replace(' ', '-')}-{uuid.uuid4().hex[:12]}"
-    with _client(ex) as client:
+    with _client(ex) as client, _threads(ex.threads if client is None else None):
+        local = client is None and method == "rockjit"
+        chunk = default_chunk(n, local) if ex.chunk is None else ex.chunk
         run_chunks(kernel, (batch.blocks, batch.sources, batch.block_of, batch.source_of,
                             batch.gain, settings, method), n, chunk, outputs, client=client,
                    progress=ex.progress, label=label, task_prefix=prefix)

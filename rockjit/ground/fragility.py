@@ -16,7 +16,7 @@ directly comparable: Housner's scale effect makes the larger block the safer one
 (docs/theory/ground-motions.md).
 
 All runs (laws x sizes x records x intensities) form one batch
-(:mod:`rockjit.ground.batch`): the scipy path today, the compiled kernel later, in this process
+(:mod:`rockjit.ground.batch`): the compiled kernel by default, in this process
 or on a Dask cluster.
 """
 
@@ -298,8 +298,9 @@ def fragility(block, records, sizes, intensities, *, measure="pga", laws=None,
     integration : Transient, optional
         Free rocking time after each record, Zeno cut-off, overturning threshold; every run
         stops once its outcome is decided.
-    method : Scipy, optional
-        Default DOP853 at ``rtol = 1e-10, atol = 1e-12``; ``"rockjit"`` is not available yet.
+    method : {"rockjit"} or Scipy, optional
+        ``"rockjit"``, the compiled path (the default), or a :class:`rockjit.Scipy` for the
+        scipy reference path (the checks use DOP853 at ``rtol = 1e-10, atol = 1e-12``).
     execution : Execution, optional
         Where the batch runs (this process, or a Dask cluster) and progress.
 

@@ -1,5 +1,4 @@
-"""The integration methods of the transient runs: which scipy path, and the compiled one's
-refusal until it exists.
+"""The integration methods of the transient runs: the compiled path or which scipy path.
 
 Kept apart from :mod:`rockjit.ground.plan`, which :mod:`rockjit.single` imports: the method
 objects live in :mod:`rockjit.single`, and this module is the one place of the ground-motion
@@ -7,8 +6,6 @@ package that imports it.
 """
 
 from __future__ import annotations
-
-from .plan import COMPILED_NOT_YET
 
 __all__ = ["check_method", "transient_scipy"]
 
@@ -22,10 +19,7 @@ def transient_scipy():
 
 
 def check_method(method):
-    """The :class:`rockjit.Scipy` of ``method`` (``"scipy"``, ``"scipy:<M>"`` or a Scipy);
-    ``"rockjit"`` is refused for now (:data:`rockjit.ground.plan.COMPILED_NOT_YET`)."""
+    """``"rockjit"`` (the compiled path), or the :class:`rockjit.Scipy` of ``method``
+    (``"scipy"``, ``"scipy:<M>"`` or a Scipy)."""
     from ..single import _method
-    m = _method(method)
-    if m == "rockjit":
-        raise ValueError(COMPILED_NOT_YET)
-    return m
+    return _method(method)

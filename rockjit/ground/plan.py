@@ -3,8 +3,8 @@
 :func:`rockjit.simulate` hands a pulse or a record here (:func:`plan_transient`): the block
 starts at rest unless a state is given, the integration settings are a
 :class:`rockjit.Transient` (a transient excitation has no period to count), and the run goes
-to the scipy reference path (:mod:`rockjit.ground.reference`). The compiled path for pulses
-and records comes later; asking for it is refused with a message that says so.
+to the compiled path (:mod:`rockjit.ground.compiled`, ``method="rockjit"``, the default) or
+the scipy reference path (:mod:`rockjit.ground.reference`).
 """
 
 from __future__ import annotations
@@ -15,11 +15,7 @@ from ..model import Block
 from ..validate import real, real_array
 from .settings import Transient
 
-__all__ = ["COMPILED_NOT_YET", "TransientPlan", "grid_settings", "plan_transient",
-           "run_transient"]
-
-COMPILED_NOT_YET = ("the compiled path for pulses and records is not available yet: use "
-                    "method='scipy' or a rockjit.Scipy(...)")
+__all__ = ["TransientPlan", "grid_settings", "plan_transient", "run_transient"]
 
 
 @dataclass(frozen=True)
@@ -30,7 +26,7 @@ class TransientPlan:
     excitation: object   # bound Pulse or Record
     state: tuple         # (theta0, theta0')
     settings: Transient
-    method: object       # a Scipy
+    method: object       # "rockjit" or a Scipy
 
 
 def grid_settings(integration):
@@ -73,7 +69,7 @@ def initial_state(state, settings):
 
 def plan_transient(block, forcing, state, integration, lyapunov, record_stride, method):
     """The plan of :func:`rockjit.simulate` for a pulse or a record; ``method`` is
-    ``"rockjit"`` (refused for now) or a :class:`rockjit.Scipy`."""
+    ``"rockjit"`` (the compiled path) or a :class:`rockjit.Scipy`."""
     from ..settings import Integration
     if integration is None:
         integration = Transient()
@@ -89,8 +85,6 @@ def plan_transient(block, forcing, state, integration, lyapunov, record_stride, 
     if record_stride is not None:
         raise ValueError("record_stride counts the steps of a forcing period; a run under a "
                          "pulse or a record keeps the solver's points (Transient(record=...))")
-    if method == "rockjit":
-        raise ValueError(COMPILED_NOT_YET)
     excitation = bind(forcing, block)
     return TransientPlan(block=block, excitation=excitation,
                          state=initial_state(state, integration), settings=integration,
@@ -98,6 +92,10 @@ def plan_transient(block, forcing, state, integration, lyapunov, record_stride, 
 
 
 def run_transient(p: TransientPlan):
-    """Run a :class:`TransientPlan` on the scipy reference path."""
+    """Run a :class:`TransientPlan`: on the compiled path (:mod:`rockjit.ground.compiled`) or
+    the scipy reference path (:mod:`rockjit.ground.reference`)."""
+    if p.method == "rockjit":
+        from .compiled import run_compiled
+        return run_compiled(p.block, p.excitation, p.state, p.settings)
     from .reference import run_scipy
     return run_scipy(p.block, p.excitation, p.state, p.settings, p.method)

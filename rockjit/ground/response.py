@@ -63,7 +63,7 @@ class TransientResult:
         The excitation, bound to the block (the pulse's ``hb``, the record's size).
     settings : Transient
     method : str
-        ``"scipy:<solve_ivp method>"`` (the compiled path comes later).
+        ``"rockjit"`` (the compiled path) or ``"scipy:<solve_ivp method>"``.
     status : str
         One of :data:`rockjit.ground.response.STATUSES`.
     t : float
@@ -79,9 +79,11 @@ class TransientResult:
     t_overturn : float
         When ``|theta|`` reached ``theta_over`` (``nan``: it did not).
     trajectory : ndarray, shape (p, 3) or None
-        ``(t, theta, theta')`` at the solver's points, the events and the ends of rest.
+        ``(t, theta, theta')`` at the solver's points (the compiled path: its grid's), the
+        events and the ends of rest.
     n_rhs : int
-        Right-hand-side evaluations.
+        Right-hand-side evaluations (the compiled path: six per step, the events' steps
+        included).
     n_rest : int
         Rest phases entered after an impact (Zeno cut-offs).
 

@@ -17,8 +17,8 @@ Overturning is not monotonic in the amplitude (the safe island between the two m
 bisection finds *a* boundary inside its bracket: the lowest the grid can see. An overturning
 sliver narrower than the grid's spacing below the first overturning grid amplitude is missed.
 
-The cells and every bisection step are batches (:mod:`rockjit.ground.batch`): the scipy path
-runs them today; the compiled kernel will take its place for the same batches.
+The cells and every bisection step are batches (:mod:`rockjit.ground.batch`): the compiled
+kernel runs them by default, the scipy reference path on request.
 """
 
 from __future__ import annotations
@@ -280,9 +280,10 @@ def spectrum(block, pulse, ratios, amplitudes, *, integration=None, method=None,
     integration : Transient, optional
         Free rocking time, Zeno cut-off, overturning threshold; every run stops once its
         outcome is decided (``stop_when_decided``) and keeps no trajectory.
-    method : Scipy, optional
-        The scipy path's method and tolerances; default DOP853 at ``rtol = 1e-10,
-        atol = 1e-12``. ``"rockjit"`` (the compiled path) is not available yet.
+    method : {"rockjit"} or Scipy, optional
+        ``"rockjit"``, the compiled path (the default: ``rockjit.ground.compiled``), or a
+        :class:`rockjit.Scipy` for the scipy reference path (the checks use DOP853 at
+        ``rtol = 1e-10, atol = 1e-12``).
     tol : float
         Relative width, in ``[1e-12, 0.1]``, to which the bisections locate each boundary;
         default ``1e-6``.

@@ -1,0 +1,180 @@
+"""The compiled kernel of the transient batches: pulses and records on the compiled path.
+
+:func:`compiled_kernel` packs a chunk of a :class:`rockjit.ground.batch.Batch` into arrays
+(one row per block, one per cell's forcing, every record's samples in one flat array) and runs
+its cells in parallel in :func:`rockjit._engine.transient.run_cells`; it is
+``KERNELS["rockjit"]`` of :mod:`rockjit.ground.batch`, registered when a batch first asks for
+it. :func:`run_compiled` is a single run (:func:`rockjit.simulate`) on the same code. The
+cells follow the scipy reference path (:mod:`rockjit.ground.reference`) phase by phase; at the
+step lengths below they agree with scipy's DOP853 at ``rtol = 1e-13`` to about 1e-11 in
+``max |theta| / alpha_s`` and 4e-11 in the overturning time of a pulse run
+(tests/test_ground_compiled.py, benchmarks/bench_ground.py).
+
+Step lengths, in model time (``1/sqrt(g/R)``, about 0.32 s for a 1 m block): a pulse is cut
+into equal steps of at most :data:`H_PULSE` and at least :data:`MIN_PULSE_STEPS` of them; a
+record's sample step into the fewest equal steps of at most :data:`H_RECORD`, so that its
+samples (the kinks of the linear interpolation) are step boundaries; free rocking after the
+excitation takes steps of :data:`H_FREE`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from .._engine import transient as T
+from ..model import initial_side
+from .pulses import KINDS, Pulse
+from .response import STATUSES, TransientResult, alpha_s
+
+__all__ = ["H_FREE", "H_PULSE", "H_RECORD", "MIN_PULSE_STEPS", "compiled_kernel",
+           "run_compiled"]
+
+#: The longest step during a pulse.
+H_PULSE = 0.01
+#: The fewest steps per pulse (a short pulse still has its shape resolved).
+MIN_PULSE_STEPS = 256
+#: The longest step during a record.
+H_RECORD = 0.005
+#: The step of free rocking after the excitation.
+H_FREE = 0.01
+#: The largest ``h 3/4 xi`` of a step: a heavily damped block (``xi`` up to 1e4) gets shorter
+#: steps, inside the explicit tableau's region of stability (``rockjit.single.STABLE_DAMPING``
+#: is 3).
+DAMPED_STEP = 2.0
+
+#: The statuses in the order of the kernel's codes (:data:`rockjit.ground.batch.STATUS_CODES`).
+STATUS_CODES = tuple(STATUSES)
+assert STATUS_CODES[T.ST_DECIDED] == "decided" and STATUS_CODES[T.ST_REST] == "rest"
+
+
+def _block_row(block, theta_over):
+    th_top = min(alpha_s(block.hb), theta_over)
+    return (block.thc, block.xi, block.restitution, block.cot, th_top,
+            0.75 * math.sin(block.thc + th_top), alpha_s(block.hb))
+
+
+def _sources(sources, shrink):
+    """``(rows, samples)``: each source's forcing row at unit gain and the records' samples;
+    the step lengths multiplied by ``shrink``."""
+    rows = np.zeros((len(sources), T.N_X))
+    chunks = []
+    off = 0
+    for k, src in enumerate(sources):
+        row = rows[k]
+        row[T.X_END] = src.end
+        if isinstance(src, Pulse):
+            row[T.X_KIND] = KINDS.index(src.kind)
+            row[T.X_OMEGA] = src.omega_p
+            row[T.X_DELAY] = src.delay
+            row[T.X_STEPS] = max(MIN_PULSE_STEPS, math.ceil(src.end / (shrink * H_PULSE)))
+        else:
+            dt = src.dt_model
+            row[T.X_KIND] = T.K_RECORD
+            row[T.X_DT] = dt
+            row[T.X_OFF] = off
+            row[T.X_N] = src.n
+            row[T.X_STEPS] = max(1, math.ceil(dt / (shrink * H_RECORD)))
+            chunks.append(np.asarray(src.accel, dtype=float))
+            off += src.n
+    samples = np.concatenate(chunks) if chunks else np.zeros(1)
+    return rows, samples
+
+
+def _shrink(blocks):
+    """The factor on the step lengths for the most damped of ``blocks`` (:data:`DAMPED_STEP`)."""
+    xi = max(b.xi for b in blocks)
+    if xi <= 0.0:
+        return 1.0
+    return min(1.0, DAMPED_STEP / (0.75 * xi * max(H_PULSE, H_RECORD, H_FREE)))
+
+
+def compiled_kernel(blocks, sources, block_of, source_of, gain, settings, method):
+    """The compiled path on a chunk of cells (the kernel interface of
+    :mod:`rockjit.ground.batch`): every cell from rest, in parallel."""
+    n = len(gain)
+    out = {"outcome": np.zeros(n, np.int8), "max_rotation": np.full(n, np.nan),
+           "t_overturn": np.full(n, np.nan), "t_end": np.full(n, np.nan),
+           "n_impacts": np.zeros(n, np.int64), "status": np.zeros(n, np.int8)}
+    if n == 0:
+        return out
+    bpar = np.array([_block_row(b, settings.theta_over) for b in blocks], dtype=float)
+    shrink = _shrink(blocks)
+    rows, samples = _sources(sources, shrink)
+    source_of = np.asarray(source_of, dtype=np.int64)
+    gain = np.asarray(gain, dtype=float)
+    xpar = rows[source_of]
+    xpar[:, T.X_AMP] = _amplitudes(sources, source_of, gain)
+    t_lim = np.array([settings.limit(float(src.end)) for src in sources])[source_of]
+    spar = np.array([settings.theta_over, settings.rest_speed, shrink * H_FREE])
+    out_f = np.empty((n, T.N_F))
+    out_i = np.empty((n, T.N_I), dtype=np.int64)
+    T.run_cells(xpar, samples, bpar, np.asarray(block_of, dtype=np.int64), spar, t_lim,
+                int(settings.impact_bound()), bool(settings.stop_when_decided),
+                numba.get_num_threads(), out_f, out_i)
+    out["max_rotation"][:] = out_f[:, T.F_MAXROT]
+    out["t_overturn"][:] = out_f[:, T.F_TOVER]
+    out["t_end"][:] = out_f[:, T.F_T]
+    out["outcome"][:] = out_i[:, T.I_OUTCOME]
+    out["n_impacts"][:] = out_i[:, T.I_IMPACTS]
+    out["status"][:] = out_i[:, T.I_STATUS]
+    return out
+
+
+def _amplitudes(sources, source_of, gain):
+    """Every cell's amplitude in ``g`` as the reference path forms it: ``src.scaled(gain)``'s
+    ``accel`` for a pulse (``amplitude * gain / hb``), its ``scale`` for a record."""
+    is_pulse = np.array([isinstance(s, Pulse) for s in sources])
+    base = np.array([s.amplitude if isinstance(s, Pulse) else s.scale for s in sources])
+    hb = np.array([s.hb if isinstance(s, Pulse) else 1.0 for s in sources])
+    p = is_pulse[source_of]
+    a = base[source_of] * gain
+    return np.where(p, a / hb[source_of], a)
+
+
+def run_compiled(block, excitation, state, settings) -> TransientResult:
+    """One run of ``block`` under the bound transient ``excitation`` from ``state``
+    (``(theta0, theta0')``) with the :class:`rockjit.Transient` ``settings``, on the compiled
+    path: the trajectory at the grid's points and the events (``settings.record``), every
+    impact."""
+    shrink = _shrink((block,))
+    rows, samples = _sources((excitation,), shrink)
+    rows[0, T.X_AMP] = excitation.accel if isinstance(excitation, Pulse) else excitation.scale
+    bpar = np.array(_block_row(block, settings.theta_over), dtype=float)
+    spar = np.array([settings.theta_over, settings.rest_speed, shrink * H_FREE])
+    end = float(excitation.end)
+    t_lim = float(settings.limit(end))
+    max_imp = int(settings.impact_bound())
+    th0, v0 = float(state[0]), float(state[1])
+    side0 = int(initial_side(th0, v0))
+    # buffers: the grid's points and a few per impact; a run that needs more runs again with
+    # exactly what it needed (the run is deterministic)
+    n_imp = min(max_imp, 1024)
+    n_traj = 0
+    if settings.record:
+        steps = rows[0, T.X_STEPS] * (excitation.n - 1 if rows[0, T.X_KIND] == T.K_RECORD
+                                      else 1)
+        n_traj = int(steps + (t_lim - min(end, t_lim)) / (shrink * H_FREE)) + 2 * n_imp + 16
+    out_f = np.empty(T.N_F)
+    out_i = np.zeros(T.N_I, dtype=np.int64)
+    for _ in range(2):
+        imp = np.empty((n_imp, 3))
+        traj = np.empty((n_traj, 3))
+        T.run_cell(rows[0], samples, bpar, spar, t_lim, max_imp,
+                   bool(settings.stop_when_decided), th0, v0, side0, np.empty((3, 3)), imp, traj,
+                   out_f, out_i)
+        got_imp, got_traj = int(out_i[T.I_IMPACTS]), int(out_i[T.I_TRAJ])
+        if got_imp <= n_imp and (not settings.record or got_traj <= n_traj):
+            break
+        n_imp, n_traj = got_imp, (got_traj if settings.record else 0)
+    return TransientResult(
+        block=block, excitation=excitation, settings=settings, method="rockjit",
+        status=STATUS_CODES[int(out_i[T.I_STATUS])], t=float(out_f[T.F_T]),
+        state=np.array([out_f[T.F_TH], out_f[T.F_DTH]]), t_uplift=float(out_f[T.F_TUP]),
+        max_theta=float(out_f[T.F_MAXTH]), impacts=imp[:got_imp].copy(),
+        t_overturn=float(out_f[T.F_TOVER]),
+        trajectory=traj[:got_traj].copy() if settings.record else None,
+        n_rhs=6 * int(out_i[T.I_STEPS]), n_rest=int(out_i[T.I_REST]))
+
