@@ -83,6 +83,7 @@ SCRIPTS = {
                         "speedup_vs_1", "scalar_steps", "time_vector", "time_scalar", "bound"],
                        ["lanes.png"]),
     "bench_explore.py": (["measurement", "median_s", "min_s", "max_s", "n", "target_s"], []),
+    "bench_mutants.py": (["mutant", "area", "file", "breaks", "tests", "outcome", "seconds"], []),
     "bench_stress.py": (
         ["id", "category", "hb", "alpha", "omega", "law", "e", "n_steps", "periods", "forcing",
          "status", "t", "n_impacts", "n_rhs", "work_bound", "wall_s", "failed_checks"],
@@ -185,6 +186,12 @@ VALUES = {
           lambda r: (r["median_s"] == "nan") == (r["n"] == "0") == ("not run" in r["measurement"])),
          ("the median lies between the extremes", lambda r: r["n"] == "0"
           or num(r, "min_s") <= num(r, "median_s") <= num(r, "max_s"))]),
+    "bench_mutants.py": (
+        dict(mutant=text, area=text, file=_rule("a file of the package", lambda c:
+                                              c.startswith("rockjit/") and c.endswith(".py")),
+             breaks=text, tests=_rule("pytest node ids", lambda c: c.startswith("tests/")),
+             outcome=one_of("caught", "caught (timeout)", "caught (error)"), seconds=positive),
+        []),
     "bench_chart.py": (
         dict(run=count(0), chart_s=positive, seeds_s=positive, curves_s=positive,
              total_s=positive, cpu_s=positive, cells=count(1), curves=count(1),

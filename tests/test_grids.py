@@ -89,6 +89,21 @@ def test_multiperiodic_period_and_chaos():
     assert BEHAVIOURS[sw.label[0]] == "chaotic" and sw.lambda_max[0] > 0
 
 
+def test_a_period_two_orbit_just_past_its_doubling():
+    """Just past the period doubling at alpha = 0.9115 the two points of the period-2 orbit lie
+    only 8 % of the orbit's size apart (alpha = 0.912; measured): the period test, at its
+    tolerance of 1e-6 of that size, must still tell them apart, as the slow classifier does."""
+    block, forcing, integration = Block(1), Harmonic(omega=1.3), Integration(periods=500)
+    res = rockjit.simulate(block, forcing.replace(alpha=0.912), integration=integration,
+                           lyapunov=True)
+    x = res.strobe[400:, :2]
+    assert 0.05 < np.abs(x[-1] - x[-2]).max() / np.abs(x).max() < 0.1  # the case it is
+    assert slow_classify(res, 400) == ("multiperiodic", 2)
+    assert rockjit.classify_result(res) == ("multiperiodic", 2)
+    sw = rockjit.sweep(block, forcing, [0.912], integration=integration)
+    assert BEHAVIOURS[sw.label[0]] == "multiperiodic" and sw.period[0] == 2
+
+
 def test_transient_chaos_is_resolved():
     """At the study's alpha = 0.969 the block wanders chaotically for ~23 periods and overturns.
     Errors grow by ~1e13 over that stretch, so the overturning time is a severe accuracy probe:

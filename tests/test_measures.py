@@ -183,7 +183,15 @@ def test_random_map_fraction_is_flat_and_exponent_zero():
 
 def test_uncertain_fraction_scalar_and_validation():
     ids = np.zeros((10, 10), dtype=int)
-    assert isinstance(uncertain_fraction(ids, 2), float)
+    f = uncertain_fraction(ids, 2)
+    assert isinstance(f, float) and f == 0.0  # one outcome: nothing is uncertain
+    # a straight boundary between columns 4 and 5, counted by hand over the interior rows and
+    # columns 2..7 (margin 2): at eps = 1 the two columns beside it are uncertain, at eps = 2
+    # the four nearest
+    ids[:, 5:] = 7
+    assert uncertain_fraction(ids, 2) == 4 / 6
+    assert uncertain_fraction(ids.T, 2) == 4 / 6
+    np.testing.assert_array_equal(uncertain_fraction(ids, (1, 2)), [2 / 6, 4 / 6])
     with pytest.raises(ValueError, match="eps_cells"):
         uncertain_fraction(ids, 0)
     with pytest.raises(ValueError, match="eps_cells"):
