@@ -30,7 +30,7 @@ from ..grids import runner
 from ..settings import Integration
 from ..validate import real
 from . import measures as M
-from .identity import attractor_distance, floquet, identify
+from .identity import FloquetRuns, attractor_distance, identify
 
 __all__ = ["LINK_TOL", "ErosionResult", "erosion"]
 
@@ -201,8 +201,10 @@ def run(plan: ErosionPlan, execution=None):
     n = g * g
     label, period = r["label"], r["period"]
     th, dth = g_plan.axes["theta0"], g_plan.axes["dtheta0"]
-    integration = Integration(theta_over=g_plan.settings["theta_over"],
-                              rest_speed=g_plan.settings["rest_speed"])
+    runs = FloquetRuns(g_plan.block,
+                       Integration(theta_over=g_plan.settings["theta_over"],
+                                   rest_speed=g_plan.settings["rest_speed"]),
+                       g_plan.settings["n_steps"])
     # the size below which orbits count as small: a tenth of the sampled region's half-width
     floor = 0.1 * max(th[-1] - th[0], dth[-1] - dth[0]) / 2 or 0.1
     gim, if_, sb, sbb, over = (np.zeros(na) for _ in range(5))
@@ -216,9 +218,7 @@ def run(plan: ErosionPlan, execution=None):
         if plan.floquet:
             for a in found:
                 if a.period:
-                    a.multipliers, a.lam = floquet(g_plan.block, forcing, g_plan.phi,
-                                                   integration, g_plan.settings["n_steps"],
-                                                   a.points[0], a.period)
+                    a.multipliers, a.lam = runs(forcing, g_plan.phi, a.points[0], a.period)
         links = _link(prev, found, cont_tol, floor)
         branch_of = {}
         for a in found:

@@ -312,23 +312,42 @@ def _continues(a, b, label, period, pts, n_got, tol):
     return keep
 
 
+class FloquetRuns:
+    """Floquet multipliers of the cycles of one block (:func:`floquet`), many at a time: one
+    prepared run (``rockjit.simulate.prepare``) per forcing frequency, phase and period, called
+    again with each cycle's amplitude and point, so that a grid's cycles cost their integration
+    and not a run's set-up each."""
+
+    def __init__(self, block, integration, n_steps):
+        self.block, self.integration, self.n_steps = block, integration, n_steps
+        self._runs = {}
+
+    def __call__(self, forcing, phi, point, period):
+        from ..single import simulate
+        state = (float(point[0]), float(point[1]))
+        key = (forcing.omega, float(phi), int(period))
+        run = self._runs.get(key)
+        if run is None:
+            integration = self.integration.replace(periods=int(period), n_steps=self.n_steps,
+                                                   qr_every=0, window=None, max_impacts=None)
+            run = simulate.prepare(self.block, forcing.replace(phase=phi, r0=None, s0=None),
+                                   state, integration=integration, lyapunov=True)
+            self._runs[key] = run
+        r = run(state=state, alpha=forcing.alpha)
+        mu = np.linalg.eigvals(r.extra["tangent"])
+        mu = mu[np.argsort(-np.abs(mu))]
+        with np.errstate(divide="ignore"):
+            lam = np.log(np.abs(mu)) / (period * forcing.period)
+        return mu, lam
+
+
 def floquet(block, forcing, phi, integration, n_steps, point, period):
     """Floquet multipliers of the cycle through ``point`` (``theta, theta'`` at a strobe
     instant of phase ``phi``): the eigenvalues of the tangent over ``period`` periods, saltation
     at every impact (zero when the cycle passes through rest). ``integration`` gives the
     overturning threshold and the Zeno cut-off. Returns ``(mu, lam)`` with
     ``lam = ln|mu| / (period T)``, sorted decreasing."""
-    from ..single import simulate
-    r = simulate(block, forcing.replace(phase=phi, r0=None, s0=None),
-                 (float(point[0]), float(point[1])),
-                 integration=integration.replace(periods=int(period), n_steps=n_steps,
-                                                 qr_every=0, window=None, max_impacts=None),
-                 lyapunov=True)
-    mu = np.linalg.eigvals(r.extra["tangent"])
-    mu = mu[np.argsort(-np.abs(mu))]
-    with np.errstate(divide="ignore"):
-        lam = np.log(np.abs(mu)) / (period * forcing.period)
-    return mu, lam
+    return FloquetRuns(block, integration, n_steps)(forcing, phi, point, period)
 
 
 def attractor_distance(x, y, floor=1e-12):

@@ -22,7 +22,8 @@ import numba
 import numpy as np
 
 from .._engine import kernel
-from ..basins.identity import cycles_differ, floquet, identify, identify_along, match_attractors
+from ..basins.identity import (FloquetRuns, cycles_differ, identify, identify_along,
+                               match_attractors)
 from ..excitation import ALPHA_MAX, Harmonic
 from ..model import Block
 from ..result import BasinResult, PlaneResult, SweepResult
@@ -308,21 +309,24 @@ def _cell_forcing(p, cell):
     return kernel.forcing_of(p.pars[cell])
 
 
-def _floquet_of(p, integration, alpha, omega, phi, point, period, exact):
-    """:func:`rockjit.basins.identity.floquet` of one cycle, kept in ``exact`` under its exact
-    inputs: a cycle met again with bit-identical inputs reuses the multipliers, any other is
-    computed anew."""
+def _floquet_of(runs, alpha, omega, phi, point, period, exact):
+    """The multipliers of one cycle (``runs``: a :class:`~rockjit.basins.identity.FloquetRuns`
+    of the plan's block), kept in ``exact`` under its exact inputs: a cycle met again with
+    bit-identical inputs reuses them, any other is computed anew."""
     point = np.asarray(point, dtype=float)
     key = (float(alpha), float(omega), float(phi), point.tobytes(), int(period))
     if key not in exact:
-        exact[key] = floquet(p.block, Harmonic(alpha=alpha, omega=omega), phi, integration,
-                             p.settings["n_steps"], point, int(period))
+        exact[key] = runs(Harmonic(alpha=alpha, omega=omega), phi, point, int(period))
     mu, lam = exact[key]
     return mu.copy(), lam.copy()
 
 
-def _runs_integration(p):
-    return Integration(theta_over=p.settings["theta_over"], rest_speed=p.settings["rest_speed"])
+def _floquet_runs(p):
+    """The Floquet runs of a plan's cycles: its block, its overturning threshold and Zeno
+    cut-off, its steps per period."""
+    integration = Integration(theta_over=p.settings["theta_over"],
+                              rest_speed=p.settings["rest_speed"])
+    return FloquetRuns(p.block, integration, p.settings["n_steps"])
 
 
 def exponents(p, r, pts, n_got, exact=None):
@@ -347,12 +351,12 @@ def exponents(p, r, pts, n_got, exact=None):
     label, period = r["label"], r["period"]
     periodic = np.isin(label, (SYMMETRIC, ASYMMETRIC, MULTIPERIODIC)) & (period > 0) & \
         (n_got >= period)
-    integration = _runs_integration(p)
+    runs = _floquet_runs(p)
     for cell in np.flatnonzero(periodic):
         per = int(period[cell])
         alpha, omega, phi = _cell_forcing(p, cell)
-        _, lam_c = _floquet_of(p, integration, alpha, omega, phi, pts[cell, n_got[cell] - per],
-                               per, exact)
+        _, lam_c = _floquet_of(runs, alpha, omega, phi, pts[cell, n_got[cell] - per], per,
+                               exact)
         lam[cell] = lam_c[0]
     return lam
 
@@ -364,7 +368,7 @@ def _identify(p, r, pts, n_got, exact=None):
     exact = {} if exact is None else exact
     label, period = r["label"], r["period"]
     lam = np.column_stack([r["lam1"], r["lam2"]]) if p.tangent else None
-    integration = _runs_integration(p)
+    runs = _floquet_runs(p)
     if p.kind == "basin":
         ids, found = identify(label, period, pts, n_got, lam)
         forcing = {a.id: (p.forcing.alpha, p.forcing.omega, p.phi) for a in found}
@@ -389,6 +393,6 @@ def _identify(p, r, pts, n_got, exact=None):
     for a in found:
         if a.period:
             alpha, omega, phi = forcing[a.id]
-            a.multipliers, a.lam = _floquet_of(p, integration, alpha, omega, phi, a.points[0],
-                                               a.period, exact)
+            a.multipliers, a.lam = _floquet_of(runs, alpha, omega, phi, a.points[0], a.period,
+                                               exact)
     return ids.reshape(p.shape), found
