@@ -180,18 +180,30 @@ def measure(cfg):
 # --------------------------------------------------------------------------- the report
 
 def plot(table):
+    """Each computation's wall time, compiled (measured) and on the scipy path (extrapolated),
+    on a log axis, with the goal where the computation has one."""
     plt = H.pyplot()
-    fig, ax = plt.subplots(figsize=(7.5, 3.2))
+    fig, ax = plt.subplots(figsize=(7.5, 3.0))
     names = [r[0].split(":")[0] for r in table]
-    y = np.arange(len(table))
-    ax.barh(y + 0.2, [r[2] for r in table], height=0.4, color="#4c72b0",
-            label="compiled (median, measured)")
-    ax.barh(y - 0.2, [r[7] for r in table], height=0.4, color="#dd8452",
-            label="scipy path (extrapolated from a sample)")
+    y = np.arange(len(table))[::-1]
+    for yi, r in zip(y, table):
+        ax.plot([r[2], r[7]], [yi, yi], color="0.75", lw=1.5, zorder=1)
+        ax.annotate(f"{r[8]:.0f}x", (r[7], yi), xytext=(8, 0), textcoords="offset points",
+                    ha="left", va="center", fontsize=8)
+    ax.scatter([r[2] for r in table], y, s=40, color="#4c72b0", zorder=2,
+               label="compiled (median of the warm runs)")
+    ax.scatter([r[7] for r in table], y, s=40, color="#dd8452", zorder=2,
+               label="scipy path (extrapolated from a sample)")
+    goals = [(yi, r[4]) for yi, r in zip(y, table) if r[4] != ""]
+    ax.scatter([g for _, g in goals], [yi for yi, _ in goals], marker="|", s=300,
+               color="k", zorder=2, label="goal")
     ax.set_yticks(y, names)
+    ax.set_ylim(-0.6, len(table) - 0.4)
     ax.set_xscale("log")
+    ax.set_xlim(0.5, 1.5e4)
     ax.set_xlabel("wall time [s]")
-    ax.legend(fontsize=8, loc="lower right")
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.28), ncol=3,
+              frameon=False)
     ax.set_title("Ground-motion grids: compiled path against the scipy path", fontsize=9)
     fig.tight_layout()
     return fig
