@@ -221,8 +221,14 @@ def _same_basin(a, b, what):
                                       err_msg=f"{what}: {name}")
 
 
-def _within(seconds, fn, *args):
-    """``fn(*args)`` in a thread; fails (instead of hanging the suite) if it takes longer."""
+#: How long a call may run before it counts as waiting forever (the fault these tests guard
+#: against): a bound far above any normal run, so that it never decides a correct run's fate.
+HANG = 300
+
+
+def _returns(fn, *args):
+    """``fn(*args)`` in a thread, returned or raised; a call that never returns (a wait for
+    workers without end) fails the test instead of hanging the suite."""
     box = {}
 
     def run():
@@ -233,8 +239,9 @@ def _within(seconds, fn, *args):
 
     th = threading.Thread(target=run, daemon=True)
     th.start()
-    th.join(seconds)
-    assert not th.is_alive(), f"still running after {seconds} s"
+    th.join(HANG)
+    if th.is_alive():
+        pytest.fail(f"{getattr(fn, '__name__', fn)} never returned: it waits forever")
     if "error" in box:
         raise box["error"]
     return box["value"]
@@ -291,12 +298,10 @@ def no_workers():
 def test_a_scheduler_without_workers_is_an_error_after_the_timeout(no_workers, capsys):
     msgs = []
     with distributed.Client(no_workers) as c:
-        t0 = time.monotonic()
         with pytest.raises(grid_runner.NoWorkers, match="had no worker in 1 s"):
-            _within(60, lambda: grid_runner.run_chunks(
+            _returns(lambda: grid_runner.run_chunks(
                 kernel.run_chunk, (), 4, 2, {}, client=c, message=msgs.append,
                 worker_timeout=1))
-        assert time.monotonic() - t0 < 30
         assert len(msgs) == 1 and msgs[0].startswith("waiting for a worker on the Dask "
                                                      "scheduler at ")
 
@@ -305,7 +310,7 @@ def test_a_scheduler_without_workers_is_an_error_after_the_timeout(no_workers, c
                 return _basin_at(0.66, client=c)
 
         with pytest.raises(grid_runner.NoWorkers, match="in 0.5 s"):
-            _within(60, basin_in_half_a_second)
+            _returns(basin_in_half_a_second)
 
 
 def test_the_command_line_gives_up_on_a_scheduler_without_workers(no_workers, tmp_path,
@@ -314,7 +319,7 @@ def test_the_command_line_gives_up_on_a_scheduler_without_workers(no_workers, tm
     argv = ["basin", "--hb", "1", "--alpha", "0.66", "--omega", "1.3", "--grid", "4",
             "--periods", "20", "--scheduler", no_workers.scheduler_address,
             "--scheduler-timeout", "1", "--out", str(out)]
-    assert _within(120, main, argv) == 2
+    assert _returns(main, argv) == 2
     err = capsys.readouterr().err.splitlines()
     assert any(line.startswith("rockjit: waiting for a worker") for line in err), err
     assert err[-1].startswith(f"rockjit: error: --scheduler {no_workers.scheduler_address}: ")
@@ -335,26 +340,22 @@ def test_losing_every_worker_mid_run_is_an_error_after_the_timeout():
             x = np.arange(40.0)
             out = {"y": np.zeros(40)}
             msgs = []
-            box = {}
+            started = threading.Event()
 
             def run():
-                try:
-                    grid_runner.run_chunks(_slow_chunk, (x,), 40, 2, out, client=c,
-                                           message=msgs.append, worker_timeout=1)
-                except BaseException as exc:  # noqa: BLE001 - checked below
-                    box["error"] = exc
+                return grid_runner.run_chunks(_slow_chunk, (x,), 40, 2, out, client=c,
+                                              message=msgs.append, worker_timeout=1,
+                                              progress=lambda done, total: done and
+                                              started.set())
 
-            th = threading.Thread(target=run, daemon=True)
-            th.start()
-            deadline = time.monotonic() + 60
-            while not out["y"].any() and time.monotonic() < deadline:
-                time.sleep(0.05)
-            assert out["y"].any(), "no chunk finished"
-            cluster.scale(0)
-            th.join(120)
-            assert not th.is_alive()
-            assert isinstance(box.get("error"), grid_runner.NoWorkers), box
-            assert "lost its workers" in str(box["error"])
+            def lose_the_workers():
+                started.wait()  # one chunk is back: the run is under way
+                cluster.scale(0)
+
+            threading.Thread(target=lose_the_workers, daemon=True).start()
+            with pytest.raises(grid_runner.NoWorkers, match="lost its workers"):
+                _returns(run)
+            assert out["y"].any()  # the chunks before the loss were placed
             assert any(m.startswith("waiting for a worker") for m in msgs)
     finally:
         cluster.close()
