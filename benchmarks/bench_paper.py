@@ -167,7 +167,7 @@ def plot(runs, sm, quick):
         for p in PARTS:
             ax.barh(y, parts[p], left=left, color=colours[p],
                     label=PART_NAMES[p] if y == 0 else None)
-            if parts[p] > 0.04 * outside:
+            if parts[p] > 0.06 * max(b[2] for b in bars):  # room for its label
                 ax.text(left + parts[p] / 2, y, f"{parts[p]:.1f}", ha="center", va="center",
                         fontsize=7, color="w")
             left += parts[p]
@@ -182,7 +182,7 @@ def plot(runs, sm, quick):
     ax.set_title("rockjit paper end to end" + (" (quick)" if quick else
                                               " (grid 100, 500 periods, alpha step 0.001)"),
                  fontsize=9)
-    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncols=3,
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncols=2,
               frameon=False)
     return fig
 

@@ -379,7 +379,7 @@ def correctness(ref_rows, basin):
 def plot_wp(s):
     """The work–precision figure of one scene."""
     plt = H.pyplot()
-    fig, ax = plt.subplots(figsize=(6.6, 4.8), layout="constrained")
+    fig, ax = plt.subplots(figsize=(8.4, 4.8), layout="constrained")
     methods = list(dict.fromkeys(r["method"] for r in s["rows"]))
     marks = "osD^vP*Xh"
     for i, m in enumerate(methods):
@@ -403,7 +403,7 @@ def plot_wp(s):
     ax.set_ylabel("final-state error max|d(theta, theta')|")
     ax.set_title(s["title"] + " (shaded: the goal's 1e-4..1e-10)", fontsize=8)
     ax.grid(True, which="both", alpha=0.25)
-    ax.legend(fontsize=6.5, loc="best")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # off the curves
     return fig
 
 
