@@ -336,7 +336,7 @@ def test_json_conventions(tmp_path):
     assert back == {"i": 3, "f": 0.5, "b": True, "t": [1, 2],
                     "a": [[1.0, "nan"], ["inf", "-inf"]], "n": None, "m": "-inf"}
     assert math.isinf(float(back["m"])) and math.isnan(float(back["a"][0][1]))
-    with pytest.raises(TypeError):
+    with pytest.raises(TypeError, match="cannot write object to JSON"):
         rio.write_json(tmp_path / "bad.json", {"x": object()})
     assert not (tmp_path / "bad.json").exists() and _no_temp_files(tmp_path)
 

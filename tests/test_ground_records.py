@@ -78,8 +78,6 @@ def test_at2_csv_and_arrays_give_the_same_record_and_run(tmp_path):
         assert r.max_rotation == pytest.approx(runs[0].max_rotation, rel=1e-9)
     # the same record from the same numbers runs identically
     assert runs[0].impacts.tolist() == runs[1].impacts.tolist()
-    assert runs[4].impacts.tolist() == runs[5].impacts.tolist() or \
-        np.allclose(runs[4].impacts, runs[5].impacts, rtol=1e-9)
 
 
 def test_piecewise_linear_in_model_time():
@@ -279,5 +277,5 @@ def test_a_pickled_record_is_the_same_read_only_record():
     assert (q.name, q.dt, q.size, q.scale) == (r.name, r.dt, r.size, r.scale)
     np.testing.assert_array_equal(q.accel, r.accel)
     assert not q.accel.flags.writeable
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="read-only"):
         q.accel[0] = 1.0
