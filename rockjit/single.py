@@ -381,7 +381,7 @@ class Prepared:
             raise ValueError("only runs of the compiled path can be prepared "
                              "(method='rockjit')")
         self.plan = plan
-        self._kernel, self._par, self._ipar, _ = kernel.prepare_single(plan)
+        self._kernel, self._par, self._ipar = kernel.prepare_single(plan)
 
     def __call__(self, state=None, *, alpha=None):
         """Run from ``state`` (``(theta0, theta0')``; default the plan's) at amplitude
@@ -434,7 +434,8 @@ def _simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
                                                                          False):
         if len(_PREPARED) >= _PREPARED_MAX:
             _PREPARED.clear()
-        _PREPARED[key] = Prepared(p)
+        prepared = _PREPARED[key] = Prepared(p)
+        return prepared()  # the plan's own state: run(p), packed once
     return run(p)
 
 

@@ -175,15 +175,16 @@ def grid_bytes(n_cells, periods, n_steps, n_pts, n_imp_pts, tangent, chunk, thre
 
 def run_single(p):
     """One compiled run of a :class:`rockjit.single.RunPlan` (validated); a Result."""
-    run, par, ipar, out = prepare_single(p)
+    run, par, ipar = prepare_single(p)
+    out = single_outputs(p)
     y0 = np.asarray(p.y0, dtype=float)
     code = run(y0, initial_side(y0[0], y0[1]), par, ipar, out)
     return single_result(p, code, out)
 
 
 def prepare_single(p):
-    """What a compiled run of the plan ``p`` needs besides its initial state:
-    ``(kernel, par, ipar, out)``, the outputs freshly allocated."""
+    """What a compiled run of the plan ``p`` needs besides its initial state and its outputs
+    (:func:`single_outputs`): ``(kernel, par, ipar)``."""
     block, forcing, n_steps, periods = p.block, p.forcing, p.n_steps, p.periods
     record_stride = p.record_stride
     run = ig.build(embed4=forcing.embedded, tangent=p.lyapunov)
@@ -192,7 +193,7 @@ def prepare_single(p):
                     qr_every=p.integration.qr_every,
                     stop_at_overturn=p.integration.stop_at_overturn,
                     h=forcing.period / n_steps, xi=block.xi)
-    return run, par, ipar, single_outputs(p)
+    return run, par, ipar
 
 
 def single_outputs(p):

@@ -565,11 +565,11 @@ def run_cells(xpar, rec, bpar, block_of, spar, t_lim, max_impacts, decide, strid
     cells (a spectrum's long pulses, say) cost alike and are spread over the threads."""
     n = xpar.shape[0]
     per = (n + stride - 1) // stride
+    none = np.empty((0, 3))  # no windows given: read only, shared
     for k in prange(per * stride):
         i = (k % per) * stride + k // per
         if i >= n:
             continue
-        win = np.empty((3, 3))
-        none = np.empty((0, 3))
+        win = np.empty((3, 3))  # each cell's own scratch
         run_cell(xpar[i], rec, bpar[block_of[i]], spar, t_lim[i], max_impacts, decide, 0.0,
                  0.0, 0, win, none, none, out_f[i], out_i[i])

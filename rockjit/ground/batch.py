@@ -39,17 +39,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .response import STATUSES
+from .response import OUTPUTS, STATUS_CODES, empty_outputs
 
 __all__ = ["Batch", "KERNELS", "OUTPUTS", "STATUS_CODES", "grid_method", "kernel_for",
            "run_batch", "scipy_kernel"]
-
-#: A kernel's outputs: name -> dtype.
-OUTPUTS = {"outcome": np.int8, "max_rotation": np.float64, "t_overturn": np.float64,
-           "t_end": np.float64, "n_impacts": np.int64, "status": np.int8}
-#: The statuses a kernel reports, in the order of their codes.
-STATUS_CODES = tuple(STATUSES)
-
 
 @dataclass(frozen=True, eq=False)
 class Batch:
@@ -80,12 +73,6 @@ class Batch:
         """``(block, excitation)`` of cell ``i``."""
         return (self.blocks[self.block_of[i]],
                 self.sources[self.source_of[i]].scaled(float(self.gain[i])))
-
-
-def empty_outputs(n):
-    """The output arrays of ``n`` cells, filled as a kernel fills them for no run."""
-    return {k: (np.full(n, np.nan) if np.dtype(t).kind == "f" else np.zeros(n, dtype=t))
-            for k, t in OUTPUTS.items()}
 
 
 def scipy_kernel(blocks, sources, block_of, source_of, gain, settings, method):

@@ -27,7 +27,7 @@ import numpy as np
 from .._engine import transient as T
 from ..model import initial_side
 from .pulses import KINDS, Pulse
-from .response import STATUSES, TransientResult, alpha_s
+from .response import STATUS_CODES, TransientResult, alpha_s, empty_outputs
 
 __all__ = ["H_FREE", "H_PULSE", "H_RECORD", "MIN_PULSE_STEPS", "compiled_kernel",
            "run_compiled"]
@@ -45,8 +45,6 @@ H_FREE = 0.01
 #: is 3).
 DAMPED_STEP = 2.0
 
-#: The statuses in the order of the kernel's codes (:data:`rockjit.ground.batch.STATUS_CODES`).
-STATUS_CODES = tuple(STATUSES)
 assert STATUS_CODES[T.ST_DECIDED] == "decided" and STATUS_CODES[T.ST_REST] == "rest"
 
 
@@ -95,9 +93,7 @@ def compiled_kernel(blocks, sources, block_of, source_of, gain, settings, method
     """The compiled path on a chunk of cells (the kernel interface of
     :mod:`rockjit.ground.batch`): every cell from rest, in parallel."""
     n = len(gain)
-    out = {"outcome": np.zeros(n, np.int8), "max_rotation": np.full(n, np.nan),
-           "t_overturn": np.full(n, np.nan), "t_end": np.full(n, np.nan),
-           "n_impacts": np.zeros(n, np.int64), "status": np.zeros(n, np.int8)}
+    out = empty_outputs(n)
     if n == 0:
         return out
     bpar = np.array([_block_row(b, settings.theta_over) for b in blocks], dtype=float)

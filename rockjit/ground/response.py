@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["MODE_NAMES", "OUTCOMES", "SAFE", "OVERTURN_IMPACT", "OVERTURN_NO_IMPACT",
-           "STATUSES", "TransientResult", "UNRESOLVED", "alpha_s", "outcome_of"]
+           "OUTPUTS", "STATUSES", "STATUS_CODES", "TransientResult", "UNRESOLVED", "alpha_s",
+           "empty_outputs", "outcome_of"]
 
 #: Outcome codes of a transient run, in order.
 OUTCOMES = ("safe", "overturn after impact", "overturn without impact", "unresolved")
@@ -35,6 +36,18 @@ STATUSES = {
     "max_impacts": "stopped at the impact bound max_impacts",
     "nonfinite": "a non-finite number appeared; this is a bug, please report the inputs",
 }
+
+#: The statuses a kernel reports, in the order of their codes.
+STATUS_CODES = tuple(STATUSES)
+#: A kernel's outputs for a chunk of cells (:mod:`rockjit.ground.batch`): name -> dtype.
+OUTPUTS = {"outcome": np.int8, "max_rotation": np.float64, "t_overturn": np.float64,
+           "t_end": np.float64, "n_impacts": np.int64, "status": np.int8}
+
+
+def empty_outputs(n):
+    """The output arrays of ``n`` cells, filled as a kernel fills them for no run."""
+    return {k: (np.full(n, np.nan) if np.dtype(t).kind == "f" else np.zeros(n, dtype=t))
+            for k, t in OUTPUTS.items()}
 
 
 def alpha_s(hb):
