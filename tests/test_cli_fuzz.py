@@ -88,6 +88,7 @@ GUARDED = (
     "rockjit.storage.files:write_csv",
     "rockjit.storage.files:write_text",
     "rockjit.storage.files:save_figure",
+    "rockjit.explorer.server:Explorer",     # `explore`: its server is up (after the checks)
 )
 #: Patched as well where they exist (names of a refactor in progress); absent ones are ignored.
 GUARDED_IF_PRESENT = (
@@ -137,13 +138,15 @@ NAMES = {
     "--tol": r"\btol\b", "--free-time": r"free[-_]time", "--size": r"\bsizes?\b",
     "--records": r"\brecords?\b", "--measure": r"\bmeasure\b",
     "--intensities": r"\bintensit(y|ies)\b",
+    "--style": r"--style\b", "--format": r"--format\b", "--port": r"\bport\b",
+    "--address": r"\baddress\b|cannot listen on",
 }
 
 NARGS = {"--alpha-range": 2, "--omega-range": 2, "--theta-range": 2, "--dtheta-range": 2,
          "--zoom": 2, "--hb-values": "+", "--spread": 2, "--seed-omegas": "+",
          "--ratio-range": 2, "--amplitude-range": 2, "--size": "+", "--records": "+",
          "--intensities": "+"}
-FLAGS = {"--quiet", "--lyapunov", "--no-lyapunov", "--full-length"}
+FLAGS = {"--quiet", "--lyapunov", "--no-lyapunov", "--full-length", "--no-browser"}
 
 NONFINITE = ["nan", "inf", "-inf"]
 #: strings no number parser takes; each option gets two of them, rotating from option to option
@@ -728,6 +731,32 @@ def _fragility():
     return c
 
 
+def _explore():
+    """``rockjit explore``: the port and the address are refused before the server starts
+    (no browser: ``--no-browser`` on every case)."""
+    cmd, quiet = "explore", {"--no-browser": True}
+    c = _values(cmd, "--port", ["-1", "65536", HUGE_INT] + NOT_INT + _malformed(cmd, "--port")
+                + _not_ascii(cmd, "--port"), quiet)
+    # not a host address, or not one of this machine's (the OS's choice of port)
+    c += _values(cmd, "--address", ["", " ", "a b", "999.1.1.1", "8.8.8.8"], quiet)
+    return c
+
+
+def _commands_with(opt):
+    """The commands of the parser that take ``opt``."""
+    import argparse
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    return sorted(name for name, p in sub.choices.items()
+                  if any(opt in a.option_strings for a in p._actions))
+
+
+def _figure_options():
+    """``--style`` and ``--format``: a choice, on every command that draws."""
+    return [c for cmd in _commands_with("--style")
+            for c in _values(cmd, "--style", ["", "PAPER", "bogus"])
+            + _values(cmd, "--format", ["", "jpg", "PNG"])]
+
+
 def _misc():
     return [
         Case("(no command)", "", {}, r"COMMAND|command", base=False),
@@ -779,9 +808,12 @@ CASES = (_refusals() + _trajectory() + _sweep() + _basin() + _plane() + _cor() +
          + _grid_extras("basin")
          + _grid_extras("plane") + _real_opt("paper", "--erosion-step", ["0", "-0.01", "5e-324"])
          + _int_opt("paper", "--erosion-grid", ["0", "-1", HUGE_INT])
-         + [c for cmd in ("sweep", "basin", "plane", "erosion", "orbits", "paper")
+         + [c for cmd in ("sweep", "basin", "plane", "erosion", "orbits", "paper", "chart",
+                          "spectrum", "fragility")
             for c in _scheduler_cases(cmd)]
-         + _numbers() + _spectrum() + _fragility() + _misc())
+         + [c for cmd in ("chart", "erosion", "orbits", "fate")
+            for c in _real_opt(cmd, "--xi", ["-1", "-1e-3", "1e5"])]
+         + _numbers() + _spectrum() + _fragility() + _explore() + _figure_options() + _misc())
 
 
 # ---------------------------------------------------------------------------------------------

@@ -21,11 +21,15 @@ def _need_bokeh():
 
 
 def free_port(address="127.0.0.1"):
-    """A port free on ``address`` now (the OS's choice)."""
+    """A port free on ``address`` now (the OS's choice); ``ValueError`` when nothing can
+    listen on ``address`` (not a host address, or not one of this machine's)."""
     family = socket.AF_INET6 if ":" in address else socket.AF_INET
-    with socket.socket(family, socket.SOCK_STREAM) as s:
-        s.bind((address, 0))
-        return s.getsockname()[1]
+    try:
+        with socket.socket(family, socket.SOCK_STREAM) as s:
+            s.bind((address, 0))
+            return s.getsockname()[1]
+    except OSError as exc:  # socket.gaierror included
+        raise ValueError(f"cannot listen on {address} ({exc.strerror or exc})") from None
 
 
 def _host(address):
