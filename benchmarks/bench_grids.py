@@ -56,9 +56,10 @@ BASINS = (
 SWEEP = (Block(hb=1.0, law="housner"), Harmonic(omega=1.3))
 NS = (64, 128, 256)
 N_REF = 256
-#: Goals: the basin's and the sweep's wall time (early stop, all threads), and the agreement
-#: of early stopping with full length required on every basin
-TARGET_BASIN_S = 2.0
+#: Goals: the basin's and the sweep's wall time (early stop, all threads; the basin's was 2 s
+#: when the grids were first written, 0.15 s since events are located on the interpolant), and
+#: the agreement of early stopping with full length required on every basin
+TARGET_BASIN_S = 0.15
 TARGET_SWEEP_S = 3.0
 TARGET_AGREEMENT = 99.9
 SECTION = H.RESULTS / "grids_section.md"

@@ -26,9 +26,12 @@ The forcing may jump where the excitation ends (the one-cosine pulse ends on ``a
 step of the excitation sees its value there (its stages never pass the grid instant that ends
 it), and free rocking starts from the still base, its first stage included.
 
-Every equation comes from :mod:`rockjit.model` (:func:`~rockjit.model.corner`,
+Every equation of the block comes from :mod:`rockjit.model` (:func:`~rockjit.model.corner`,
 :func:`~rockjit.model.accel_pq`, :func:`~rockjit.model.sincos`, :func:`~rockjit.model.jump`,
-:func:`~rockjit.model.accel`); this module writes none.
+:func:`~rockjit.model.accel`); this module writes none. The excitations are the one thing it
+writes again: :func:`forcing` and the uplift windows are the compiled twins of
+``Pulse.scalar``/``Pulse.windows`` and ``Record.scalar``/``Record.windows``, held to them by
+the tests that compare every cell with the scipy path, which evaluates those.
 
 The forcing of a cell is described by a row of ``xpar`` (columns ``X_*``): the kind (0, 1, 2:
 the pulses of :data:`rockjit.ground.pulses.KINDS`; 3: a record), its amplitude in ``g``, the
