@@ -351,9 +351,11 @@ def _speed_child(spec):
 
 # =========================================================================== the parent
 
-def _run_child(spec, root, cache_dir, workdir, timeout):
-    """One fresh process; returns the child's JSON plus the wall time seen from outside."""
+def _run_child(spec, root, cache_dir, workdir, timeout, extra_env=None):
+    """One fresh process (with ``extra_env`` set in its environment); returns the child's JSON
+    plus the wall time seen from outside."""
     env = H.child_env(NUMBA_CACHE_DIR=str(cache_dir), PYTHONDONTWRITEBYTECODE="1")
+    env.update(extra_env or {})
     env["PYTHONPATH"] = str(root) + os.pathsep + str(H.HERE)
     env.pop("NUMBA_DISABLE_JIT", None)
     cmd = [sys.executable, str(Path(__file__).resolve()), "--child", json.dumps(spec)]
@@ -405,7 +407,7 @@ def _measure_pair(item, root_name, root, rep, args, tmp):
     try:
         for mode in ("cold", "warm"):
             s = dict(spec, out=str(work / f"out-{mode}"))
-            d = _run_child(s, root, cache, work, args.timeout)
+            d = _run_child(s, root, cache, work, args.timeout, args.root_env.get(root_name))
             d.update(root=root_name, item=name, group=group, mode=mode, rep=rep)
             rows.append(d)
             print(f"  {root_name:>10} {mode:4} {name:36} wall {d['wall_s']:7.2f} s  "
@@ -561,6 +563,10 @@ def markdown(b, args, rows, summary, spd, quick):
           "of the whole process; CPU = its user + system time. The stage columns split the "
           "cold process's compile CPU time (exclusive seconds: numba's event API and wrappers "
           "of its code library).\n"]
+    if args.root_env:
+        md.append("Roots run with an environment of their own (levers that are switches): "
+                  + "; ".join(f"{rn}: " + " ".join(f"`{k}={v}`" for k, v in e.items())
+                              for rn, e in args.root_env.items()) + ".\n")
     by = {(s["root"], s["item"], s["mode"]): s for s in summary}
     items = list(dict.fromkeys(s["item"] for s in summary))
     for group, title in (("kernel", "Kernel variants (first call of `kernel.compile_variant`, "
@@ -655,12 +661,18 @@ def goals(summary, inst):
     cold ``rockjit paper`` under 45 s."""
     by = {(s["root"], s["item"], s["mode"]): s["wall_s"] for s in summary}
     lines = []
-    for root in dict.fromkeys(s["root"] for s in summary):
+    roots = list(dict.fromkeys(s["root"] for s in summary))
+    warm0 = by.get((roots[0], "rockjit trajectory", "warm")) if roots else None
+    for root in roots:
         cold, warm = by.get((root, "rockjit trajectory", "cold")), by.get(
             (root, "rockjit trajectory", "warm"))
         if cold and warm:
             ok = "reached" if cold <= 4 * warm else \
                 f"out of reach: the cold run compiles for ~{cold - warm:.0f} s"
+            if warm0 and warm > 1.25 * warm0:
+                # a slower kernel shrinks the ratio without shortening the wait
+                ok = (f"no gain: the ratio falls because the warm run takes "
+                      f"{warm / warm0:.1f}x {roots[0]}'s")
             lines.append(f"| {root} | cold `rockjit trajectory` / warm | {cold:.1f} s / "
                          f"{warm:.2f} s = {cold / warm:.1f}x | <= 4x | {ok} |")
         paper = by.get((root, "rockjit paper", "cold"))
@@ -731,6 +743,10 @@ def options(p):
     p.add_argument("--root", action="append", default=[], metavar="NAME=DIR",
                    help="a folder holding a rockjit package to measure (repeatable; default "
                         "this checkout)")
+    p.add_argument("--env", action="append", default=[], metavar="NAME:VAR=VALUE",
+                   help="an environment variable for the cold and warm processes of root NAME "
+                        "(repeatable): a lever that is a switch, e.g. --root opt1=. --env "
+                        "opt1:NUMBA_OPT=1 (the speed part ignores it)")
     p.add_argument("--parts", default="kernels,commands,install,speed",
                    help="comma-separated: kernels, commands, install, speed (default all; "
                         "--quick: one small function only)")
@@ -773,6 +789,14 @@ def main(argv=None):
         if not (d / "rockjit" / "__init__.py").is_file():
             raise SystemExit(f"--root {r}: no rockjit package in {d}")
         roots[name] = d
+    args.root_env = {}
+    for e in args.env:
+        name, _, kv = e.partition(":")
+        var, eq, value = kv.partition("=")
+        if name not in roots or not var or not eq:
+            raise SystemExit(f"--env {e}: NAME:VAR=VALUE with NAME one of the roots "
+                             f"({', '.join(roots)})")
+        args.root_env.setdefault(name, {})[var] = value
     b.env["load_start"] = H.load_text()
     with tempfile.TemporaryDirectory(prefix="bench-compile-") as tmp:
         rows = measure(args, roots, tmp, quick) if quick or args.parts & {"kernels",

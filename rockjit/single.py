@@ -371,7 +371,7 @@ class Prepared:
     0.7
     """
 
-    __slots__ = ("plan", "_kernel", "_par", "_ipar")
+    __slots__ = ("plan", "_kernel", "_par", "_ipar", "_entry")
 
     def __init__(self, plan):
         if not isinstance(plan, RunPlan):
@@ -382,6 +382,7 @@ class Prepared:
                              "(method='rockjit')")
         self.plan = plan
         self._kernel, self._par, self._ipar = kernel.prepare_single(plan)
+        self._entry = None
 
     def __call__(self, state=None, *, alpha=None):
         """Run from ``state`` (``(theta0, theta0')``; default the plan's) at amplitude
@@ -398,7 +399,15 @@ class Prepared:
             # a new block state; the forcing's, (r0, s0), stays the plan's (its phase)
             y0[0], y0[1] = state_pair(state, p.integration)
         out = kernel.single_outputs(p)
-        code = self._kernel(y0, initial_side(y0[0], y0[1]), par, self._ipar, out)
+        args = (y0, initial_side(y0[0], y0[1]), par, self._ipar, out)
+        if self._entry is None:
+            code = self._kernel(*args)
+            # the arguments' types never change: later calls go straight to the compiled
+            # code, without numba's dispatch (a microsecond a call)
+            self._entry = self._kernel.get_overload(tuple(map(self._kernel.typeof_pyval,
+                                                              args)))
+        else:
+            code = self._entry(*args)
         return kernel.single_result(p, code, out)
 
 

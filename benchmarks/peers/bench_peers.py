@@ -82,13 +82,20 @@ fmt = H.fmt
 md_table = H.md_table
 
 
+def rj_call(kw, periods, n_steps=None, method="rockjit"):
+    """A call of rockjit's run of ``kw`` (``hb``, ``alpha``, ``omega``): Housner restitution,
+    from the study's initial state, over ``periods``, at ``n_steps`` or through ``method``.
+    The block, excitation and settings are made once, as each peer's problem is: the call is
+    what a user repeats."""
+    block = Block(hb=kw["hb"], law="housner")
+    forcing = Harmonic(alpha=kw["alpha"], omega=kw["omega"])
+    integration = Integration(periods=periods, n_steps=n_steps)
+    return lambda: rockjit.simulate(block, forcing, integration=integration, method=method)
+
+
 def rj_run(kw, periods, n_steps=None, method="rockjit"):
-    """rockjit's run of ``kw`` (``hb``, ``alpha``, ``omega``): Housner restitution, from the
-    study's initial state, over ``periods``, at ``n_steps`` or through ``method``."""
-    return rockjit.simulate(Block(hb=kw["hb"], law="housner"),
-                            Harmonic(alpha=kw["alpha"], omega=kw["omega"]),
-                            integration=Integration(periods=periods, n_steps=n_steps),
-                            method=method)
+    """rockjit's run (:func:`rj_call`), once."""
+    return rj_call(kw, periods, n_steps, method)()
 
 
 def interleaved(cases, repeats, counts=None):
@@ -176,7 +183,7 @@ def scene_runs(peers, name, scene, quick, repeats):
 
     for n in ns:
         key = ("rockjit", "", f"N={n}")
-        cases[key] = keep(key, lambda n=n: rj_run(kw, periods, n))
+        cases[key] = keep(key, rj_call(kw, periods, n))
         meta[key] = dict(method="rockjit", setting=f"N={n}", n=n, rtol=None)
     for pname, mod in peers.items():
         for m in PEER_METHODS[pname]:
@@ -193,8 +200,8 @@ def scene_runs(peers, name, scene, quick, repeats):
                                  rtol=rtol)
     for rtol in rtols:
         key = ("scipy", "DOP853", f"rtol={rtol:.0e}")
-        cases[key] = keep(key, lambda rtol=rtol: rj_run(
-            kw, periods, method=Scipy("DOP853", rtol=rtol, atol=ATOL_RATIO * rtol)))
+        cases[key] = keep(key, rj_call(kw, periods, method=Scipy("DOP853", rtol=rtol,
+                                                                   atol=ATOL_RATIO * rtol)))
         meta[key] = dict(method="scipy DOP853", setting=f"rtol={rtol:.0e}", n=None, rtol=rtol)
     # one untimed call of each case; slow ones (> 50 ms) run in fewer rounds
     probe = {k: timed(fn)[0] for k, fn in cases.items()}
@@ -226,8 +233,10 @@ def scene_runs(peers, name, scene, quick, repeats):
 
 def call_floor(peers, n=41):
     """The fixed cost of one call: a one-period run of the chaotic scene's block at the
-    loosest settings, median of ``n``; for rockjit also its two halves, validating the inputs
-    (``rockjit.simulate.plan``) and running the plan (``rockjit.single.run``)."""
+    loosest settings, median of ``n``; for rockjit also its parts: validating the inputs
+    (``rockjit.simulate.plan``), running a plan from scratch (``rockjit.single.run``: packing,
+    the kernel's look-up, the run) and calling a prepared run (``rockjit.simulate.prepare``,
+    which ``rockjit.simulate`` calls underneath when a block and its settings come again)."""
     sim = importlib.import_module("rockjit.single")
     sc = C.SCENES["chaotic"]
     kw = dict(hb=sc["hb"], alpha=sc["alpha"], omega=sc["omega"])
@@ -240,7 +249,8 @@ def call_floor(peers, n=41):
     cases = {"rockjit simulate": lambda: rockjit.simulate(block, forcing, integration=one),
              "rockjit plan (validation)": lambda: rockjit.simulate.plan(block, forcing,
                                                                         integration=one),
-             "rockjit run(plan)": lambda: sim.run(plan)}
+             "rockjit run(plan)": lambda: sim.run(plan),
+             "rockjit prepared run": rockjit.simulate.prepare(block, forcing, integration=one)}
     for name, mod in peers.items():
         m = PEER_METHODS[name][0]
         cases[f"{name} {m}"] = (lambda mod=mod, m=m:
@@ -457,7 +467,7 @@ def options(ap):
 def main(argv=None):
     b = H.Bench(__doc__, argv, options=options)
     args, quick = b.args, b.quick
-    repeats = args.repeats or (3 if quick else 9)
+    repeats = args.repeats or (3 if quick else 21)
     sub = args.basin_sub or (10 if quick else 30)
     sub_slow = args.basin_sub_slow or (6 if quick else 15)
     cap = args.full_basin_cap if args.full_basin_cap is not None else (0.0 if quick else 600.0)

@@ -206,48 +206,45 @@ def single_outputs(p):
 def single_result(p, code, out):
     """The :class:`rockjit.Result` of plan ``p`` from the kernel's status ``code`` and outputs
     ``out`` (views of ``out``'s arrays: give each run its own outputs)."""
-    block, forcing, n_steps, periods = p.block, p.forcing, p.n_steps, p.periods
-    lyapunov, record_stride, window = p.lyapunov, p.record_stride, p.window
-    qr_every = p.integration.qr_every
-    iout, fout = out.iout, out.fout
-    status = ig.STATUS_NAMES[int(code)]
-    n_imp = int(iout[ig.O_IMPACTS])
-    ns = int(iout[ig.O_NSTROBE])
+    forcing = p.forcing
+    # the scalar outputs as Python numbers, read once (indexing the arrays one number at a
+    # time was a third of a short run's overhead)
+    iout, fout = out.iout.tolist(), out.fout.tolist()
+    n_imp, ns = iout[ig.O_IMPACTS], iout[ig.O_NSTROBE]
     res = Result(
-        block=block, forcing=forcing, integration=p.integration, method="rockjit",
-        status=status, t=float(fout[ig.F_T]),
-        state=fout[ig.F_TH:ig.F_S + 1].copy(), period=forcing.period, n_steps=n_steps,
-        periods=periods, strobe=out.strobe[:ns], strobe_half=out.half[:int(iout[ig.O_NHALF])],
+        block=p.block, forcing=forcing, integration=p.integration, method="rockjit",
+        status=ig.STATUS_NAMES[int(code)], t=fout[ig.F_T],
+        state=out.fout[ig.F_TH:ig.F_S + 1].copy(), period=forcing.period, n_steps=p.n_steps,
+        periods=p.periods, strobe=out.strobe[:ns], strobe_half=out.half[:iout[ig.O_NHALF]],
         impacts=_impacts_in_order(out.impacts, n_imp), n_impacts=n_imp,
-        n_grid_steps=int(iout[ig.O_STEPS]), n_rhs=int(iout[ig.O_RHS]),
-        max_error_estimate=float(fout[ig.F_MAXERR]),
-        trajectory=out.traj[:int(iout[ig.O_NTRAJ])] if record_stride else None,
-        n_rest=int(iout[ig.O_NREST]), n_rest_window=int(iout[ig.O_NREST_WIN]),
-        n_impacts_window=int(iout[ig.O_NIMP_WIN]),
-        n_locate_unconverged=int(iout[ig.O_UNCONVERGED]),
-        t_overturn=float(fout[ig.F_TOVER]),
+        n_grid_steps=iout[ig.O_STEPS], n_rhs=iout[ig.O_RHS],
+        max_error_estimate=fout[ig.F_MAXERR],
+        trajectory=out.traj[:iout[ig.O_NTRAJ]] if p.record_stride else None,
+        n_rest=iout[ig.O_NREST], n_rest_window=iout[ig.O_NREST_WIN],
+        n_impacts_window=iout[ig.O_NIMP_WIN], n_locate_unconverged=iout[ig.O_UNCONVERGED],
+        t_overturn=fout[ig.F_TOVER],
     )
     # events located by genuine steps because the step's interpolant was not trusted
-    res.extra["locate_resteps"] = int(iout[ig.O_RESTEP])
-    if lyapunov:
+    res.extra["locate_resteps"] = iout[ig.O_RESTEP]
+    if p.lyapunov:
         # the tangent matrix at the end: the flow's Jacobian since the last renormalisation;
         # with qr_every = 0 that is the whole run's, and zero once a perturbation died (a rest
         # phase, an impact with e = 0)
-        tangent = fout[ig.F_V:ig.F_V + 4].reshape(2, 2, order="F").copy()
-        res.extra["collapses"] = int(iout[ig.O_NCOL])
-        if qr_every == 0 and iout[ig.O_NCOL] > 0:
+        tangent = out.fout[ig.F_V:ig.F_V + 4].reshape(2, 2, order="F").copy()
+        res.extra["collapses"] = iout[ig.O_NCOL]
+        if p.integration.qr_every == 0 and iout[ig.O_NCOL] > 0:
             tangent[:] = 0.0
         res.extra["tangent"] = tangent
-        res.window = (window * forcing.period, res.t)
+        res.window = (p.window * forcing.period, res.t)
         lam_run = out.lam_run[:ns]
         running = np.where(lam_run[:, 2:3] > 0, -math.inf, lam_run[:, :2])
-        if status == "rest":
+        if res.status == "rest":
             # at rest for good every perturbation dies out in finite time
             res.lyapunov = np.array([-math.inf, -math.inf])
         else:
             # Gram-Schmidt's first column carries the largest growth only asymptotically; over
             # a finite window a (near-)degenerate pair may come out in either order
-            res.lyapunov = np.sort(fout[ig.F_LAM1:ig.F_LAM2 + 1])[::-1].copy()
+            res.lyapunov = np.sort(out.fout[ig.F_LAM1:ig.F_LAM2 + 1])[::-1].copy()
         res.lyapunov_running = -np.sort(-running, axis=1)
     return res
 
