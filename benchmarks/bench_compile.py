@@ -50,6 +50,10 @@ how the levers against compile time are compared (benchmarks/README.md).
     python benchmarks/bench_compile.py          # full (~15 min)
     python benchmarks/bench_compile.py --quick    # smoke (seconds): one small function
     python benchmarks/bench_compile.py --root base=. --root new=/tmp/patched --parts speed
+    python benchmarks/bench_compile.py --parts commands --commands trajectory --repeats 3 \
+        --root default=. --root opt1=. --env opt1:NUMBA_OPT=1 --root opt0=. \
+        --env opt0:NUMBA_OPT=0 --root novec=. --env novec:NUMBA_LOOP_VECTORIZE=0 \
+        --env novec:NUMBA_SLP_VECTORIZE=0 --name compile_levers   # the switches as levers
 
 Writes compile.{md,csv,json,png} through the shared harness (benchmarks/_common.py).
 """
@@ -771,6 +775,9 @@ def options(p):
     p.add_argument("--threads", type=int, default=None,
                    help="numba threads of the basin and sweep speed cases (default all)")
     p.add_argument("--timeout", type=float, default=1800.0, help="seconds per process")
+    p.add_argument("--name", default="compile",
+                   help="the report's name: NAME.{md,csv,json,png} (default compile; the levers "
+                        "page is compile_levers)")
 
 
 def main(argv=None):
@@ -807,10 +814,10 @@ def main(argv=None):
     summary = summarise(rows)
     md = markdown(b, args, rows, summary, spd, quick) + goals(summary, inst)
     settings = {k: sorted(v) if isinstance(v, set) else v for k, v in vars(args).items()}
-    b.report("compile", markdown=md, csv=(CSV_COLUMNS, csv_rows(summary, spd)),
+    b.report(args.name, markdown=md, csv=(CSV_COLUMNS, csv_rows(summary, spd)),
              data=dict(environment=b.env, settings=settings, roots=roots, summary=summary,
                        runs=rows, speed=spd, install_s=inst),
-             figures=[("compile.png", plot(summary), 120)])
+             figures=[(f"{args.name}.png", plot(summary), 120)])
     return 0
 
 

@@ -5,6 +5,8 @@ Measured here, each as a table:
 - nanoseconds per grid step and per right-hand side, on the study's reference run (hb=1,
   alpha=0.6, omega=1.3, Housner, 500 periods) at N = 64 ... 1024, and the fixed cost of one
   ``simulate`` call; where the time goes (microbenchmarks of the step's pieces);
+- the fixed cost of a call by path (a prepared run, ``simulate``, a plan then its run) against
+  the compiled run alone, on the chaotic scene of the peers' benchmark;
 - trajectories per second: single runs, basin cells (early stop on and off), sweep alphas;
 - basin time against grid size n = 25 ... 400 (the study's basin hb=1, alpha=0.66, omega=1.3,
   defaults: N = GRID_N, 500 periods, early stop), against periods, against threads (1 and 2);
@@ -13,8 +15,9 @@ Measured here, each as a table:
 - peak memory of a 400 x 400 basin (ru_maxrss of a fresh process, and tracemalloc's peak of the
   NumPy allocations made around the kernel).
 
-The microbenchmarks of a step's pieces are the one place where a benchmark reaches into
-rockjit's private integrator code: :func:`step_internals` (see its docstring for the names).
+The microbenchmarks of a step's pieces and the compiled run alone are the places where a
+benchmark reaches into rockjit's private code: :func:`step_internals` and :func:`kernel_alone`
+(see their docstrings for the names).
 
     python benchmarks/bench_throughput.py           # full (~10 min)
     python benchmarks/bench_throughput.py --quick   # smoke (~40 s; no compile probes)
@@ -50,10 +53,11 @@ FULL_LENGTH = Classification(early_stop=False)
 FULL = dict(periods=500, reps=11, ns=(64, 128, 256, 1024), micro_steps=2_000_000,
             g_es=100, g_full=20, sweep_step=0.005, full_reps=1, sizes=(25, 50, 100, 200, 400),
             g_p=24, plist=(50, 100, 200, 500, 1000), thread_reps=(5, 3), g_l=50, lyap_reps=7,
-            g_m=400)
+            g_m=400, call_reps=3001)
 QUICK = dict(periods=50, reps=3, ns=(64, 256), micro_steps=200_000,
              g_es=30, g_full=8, sweep_step=0.02, full_reps=2, sizes=(10, 20, 40),
-             g_p=12, plist=(20, 50), thread_reps=(2, 2), g_l=20, lyap_reps=3, g_m=40)
+             g_p=12, plist=(20, 50), thread_reps=(2, 2), g_l=20, lyap_reps=3, g_m=40,
+             call_reps=301)
 
 
 def cpu_mhz():
@@ -70,6 +74,23 @@ def cpu_mhz():
 # --------------------------------------------------------------------------- PRIVATE API
 # The one function of the benchmarks that uses rockjit's private integrator code. When the
 # integrator's internals change, this is what to update (and nothing else in benchmarks/).
+
+def kernel_alone(prepared):
+    """A call of the compiled run under a prepared run (``rockjit.single.Prepared``) from the
+    plan's own state, on outputs made once: the integration and nothing else, the floor a call
+    of any path pays. Uses the private ``Prepared._entry`` (the compiled code, set by its first
+    call), ``Prepared._par`` and ``_ipar``, ``rockjit.single.initial_side`` and
+    ``rockjit._engine.kernel.single_outputs``."""
+    from rockjit import single
+    from rockjit._engine import kernel
+
+    prepared()
+    y0 = np.array(prepared.plan.y0)
+    args = (y0, single.initial_side(y0[0], y0[1]), prepared._par, prepared._ipar,
+            kernel.single_outputs(prepared.plan))
+    entry = prepared._entry
+    return lambda: (entry(*args), args[-1])[1]
+
 
 def step_internals():
     """Microbenchmark callables built on rockjit's private integrator code.
@@ -181,6 +202,49 @@ def ns_per_step(cfg, mhz):
                 call_overhead_max_impacts_100_s=call_small_s,
                 raw={str(k): v for k, v in t.wall.items()},
                 single_run_s=t.median(rockjit.DEFAULT_N))
+
+
+#: The fixed cost of a call, on the chaotic scene of bench_work_precision.py and the peers'
+#: benchmark (hb=1, alpha=0.955, omega=1.3, from the study's state): at the loosest settings,
+#: and as that scene runs at 1e-6.
+CALL_SCENES = {"1 period, N=8": (1, 8), "5 periods, N=64": (5, 64)}
+
+
+def calls(cfg):
+    """The cost of one call by path, side by side, and its overhead: the median less the
+    compiled run's own (:func:`kernel_alone`). Every path runs the same integration (checked)."""
+    rows = []
+    for label, (periods, n) in CALL_SCENES.items():
+        def objects(periods=periods, n=n):
+            return (Block(hb=1.0, law="housner"), Harmonic(alpha=0.955, omega=1.3),
+                    Integration(periods=periods, n_steps=n))
+        block, forcing, integration = objects()
+        prepared = simulate.prepare(block, forcing, integration=integration)
+        theta0, dtheta0 = (float(x) for x in prepared.plan.y0[:2])
+        cases = {
+            "the compiled run alone": kernel_alone(prepared),
+            "prepared run": prepared,
+            "prepared run, new state": lambda: prepared(state=(theta0, dtheta0)),
+            "prepared run, new amplitude": lambda: prepared(alpha=0.955),
+            "simulate (its prepared run reused)": lambda: simulate(block, forcing,
+                                                                   integration=integration),
+            "simulate, objects made per call": lambda: simulate(*objects()[:2],
+                                                                integration=objects()[2]),
+            "plan, then run (nothing reused)": lambda: rockjit.single.run(
+                simulate.plan(block, forcing, integration=integration)),
+        }
+        for fn in cases.values():
+            fn()
+        t = H.side_by_side(cases, cfg["call_reps"])
+        final = t.result["the compiled run alone"].fout[1:5]  # theta, theta', r, s
+        for path, r in t.result.items():
+            if path != "the compiled run alone" and not np.array_equal(r.state, final):
+                raise RuntimeError(f"{path} ran another integration ({label})")
+        base = t.median("the compiled run alone")
+        for path in cases:
+            rows.append([label, path, 1e6 * t.median(path), 1e6 * (t.median(path) - base)])
+    print("calls", rows)
+    return rows
 
 
 def where_time_goes(cfg):
@@ -421,6 +485,15 @@ def markdown(rec, cfg, quick, env):
                          + [["6 x sincos chained (a step's sines, were none overlapped)",
                              6 * micro["sincos, chained"],
                              6 * micro["sincos, chained"] * mhz / 1e3]]))
+    md.append(f"\n**The fixed cost of a call**: the chaotic scene (hb=1, alpha=0.955, "
+              f"omega=1.3, Housner, from the study's state), each path medians of "
+              f"{cfg['call_reps']} interleaved calls; overhead = the median less the compiled "
+              "run's own (called straight, on outputs made once). Every path runs the same "
+              "integration (its final state checked). A prepared run "
+              "(`rockjit.simulate.prepare`) skips the checks, the packing and numba's "
+              "dispatch; what it still pays is the result: its arrays made, the scalars read "
+              "back, the `Result` built.\n\n")
+    md.append(H.md_table(["scene", "path", "µs per call", "overhead (µs)"], rec["calls"]))
     md.append("\n**Trajectories per second** (one basin cell or sweep value is one trajectory; "
               "default threads):\n\n")
     md.append(H.md_table(["what", "setting", "trajectories", "wall (s)", "trajectories / s"],
@@ -480,6 +553,9 @@ def markdown(rec, cfg, quick, env):
 def csv_rows(rec):
     rows = [["ns_per_step", f"N={r[0]}", r[4]] for r in rec["ns_per_step"]["rows"]]
     rows += [["micro_ns", k, v] for k, v in rec["ns_per_step"]["micro_ns"].items()]
+    rows += [["call_us", f"{r[0]}|{r[1]}", r[2]] for r in rec["calls"]]
+    rows += [["call_overhead_us", f"{r[0]}|{r[1]}", r[3]] for r in rec["calls"]
+             if r[1] != "the compiled run alone"]
     rows += [["trajectories_per_s", r[0], r[4]] for r in rec["trajectories"]]
     rows += [["basin_size_wall_s", f"n={r[0]}", r[3]] for r in rec["basin_size"]]
     for r in rec["basin_periods"]["rows"]:
@@ -538,6 +614,7 @@ def main(argv=None):
     rec = dict(quick=b.quick, environment=b.env)
     rec["ns_per_step"] = ns_per_step(cfg, b.env["cpu_mhz"])
     rec["ns_per_step"]["micro_ns"] = where_time_goes(cfg)
+    rec["calls"] = calls(cfg)
     rec["trajectories"] = trajectories(cfg, rec["ns_per_step"].pop("single_run_s"))
     rec["basin_size"] = basin_sizes(cfg)
     rec["basin_periods"] = dict(grid=cfg["g_p"], rows=basin_periods(cfg))

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -384,16 +384,22 @@ class Prepared:
         self._kernel, self._par, self._ipar = kernel.prepare_single(plan)
         self._entry = None
 
+    def __getstate__(self):
+        # the compiled code's entry cannot be pickled: a copy finds it again at its first call
+        return self.plan, self._kernel, self._par, self._ipar
+
+    def __setstate__(self, state):
+        self.plan, self._kernel, self._par, self._ipar = state
+        self._entry = None
+
     def __call__(self, state=None, *, alpha=None):
         """Run from ``state`` (``(theta0, theta0')``; default the plan's) at amplitude
         ``alpha`` (default the plan's): a :class:`Result`."""
         p = self.plan
-        par = self._par
+        par, forcing = self._par, None
         if alpha is not None:
             forcing = p.forcing.replace(alpha=alpha)
-            par = par.copy()
-            kernel.vary(par[None, :], alpha=np.array([forcing.alpha]))
-            p = replace(p, forcing=forcing)
+            par = kernel.vary(par.copy()[None, :], alpha=forcing.alpha)[0]
         y0 = np.array(p.y0)
         if state is not None:
             # a new block state; the forcing's, (r0, s0), stays the plan's (its phase)
@@ -408,7 +414,7 @@ class Prepared:
                                                               args)))
         else:
             code = self._entry(*args)
-        return kernel.single_result(p, code, out)
+        return kernel.single_result(p, code, out, forcing)
 
 
 def _prepare(*args, **kwargs):

@@ -8,6 +8,7 @@ with the block stays on ``(sin(omega t + phi), cos(omega t + phi))``.
 """
 
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -66,6 +67,38 @@ def test_a_new_amplitude_is_the_fresh_run_at_that_amplitude():
         got = run(state=(0.05, 0.0), alpha=alpha)
         assert got.forcing.alpha == alpha
         same(got, fresh(Harmonic(alpha=alpha, omega=1.3, phase=0.4), (0.05, 0.0)))
+
+
+def test_every_output_of_a_new_amplitude_is_the_fresh_run_s():
+    # exponents and a recorded trajectory: every array and number of the result, against a
+    # fresh plan at that amplitude
+    forcing = Harmonic(alpha=0.6, omega=1.3, phase=0.4)
+    kw = dict(integration=RUNS, lyapunov=True, record_stride=4)
+    run = rockjit.simulate.prepare(BLOCK, forcing, (0.05, 0.0), **kw)
+    for alpha in (0.8, 0.955):
+        got = run(state=(0.05, 0.0), alpha=alpha)
+        want = single.run(rockjit.simulate.plan(BLOCK, forcing.replace(alpha=alpha),
+                                                (0.05, 0.0), **kw))
+        assert got.forcing == want.forcing and got.window == want.window
+        for name in ("status", "t", "n_impacts", "n_grid_steps", "n_rhs", "n_rest",
+                     "n_rest_window", "n_impacts_window", "max_error_estimate"):
+            assert getattr(got, name) == getattr(want, name), name
+        for name in ("state", "strobe", "strobe_half", "impacts", "trajectory", "lyapunov",
+                     "lyapunov_running"):
+            assert np.array_equal(getattr(got, name), getattr(want, name)), name
+        assert got.extra.keys() == want.extra.keys()
+        assert np.array_equal(got.extra["tangent"], want.extra["tangent"])
+        assert got.n_impacts > 0 and np.isfinite(got.lyapunov[0])
+
+
+def test_a_prepared_run_travels_by_pickle_after_its_first_call():
+    # worker processes (Dask) receive prepared runs by pickle, called or not
+    run = rockjit.simulate.prepare(BLOCK, Harmonic(alpha=0.8, omega=1.3), integration=RUNS)
+    first = run(state=(0.05, 0.0))
+    run(state=(0.05, 0.0))
+    copy = pickle.loads(pickle.dumps(run))
+    same(copy(state=(0.05, 0.0)), first)
+    same(copy(state=(0.05, 0.0)), first)
 
 
 def test_simulate_reuses_a_run_only_at_the_same_phase():

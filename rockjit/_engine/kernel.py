@@ -203,10 +203,11 @@ def single_outputs(p):
     return outputs(p.periods, p.max_impacts, n_traj, p.lyapunov)
 
 
-def single_result(p, code, out):
-    """The :class:`rockjit.Result` of plan ``p`` from the kernel's status ``code`` and outputs
-    ``out`` (views of ``out``'s arrays: give each run its own outputs)."""
-    forcing = p.forcing
+def single_result(p, code, out, forcing=None):
+    """The :class:`rockjit.Result` of plan ``p`` (run under ``forcing`` when given: the plan's
+    at another amplitude) from the kernel's status ``code`` and outputs ``out`` (views of
+    ``out``'s arrays: give each run its own outputs)."""
+    forcing = p.forcing if forcing is None else forcing
     # the scalar outputs as Python numbers, read once (indexing the arrays one number at a
     # time was a third of a short run's overhead)
     iout, fout = out.iout.tolist(), out.fout.tolist()
