@@ -241,16 +241,21 @@ class Timings:
         return median(self.cpu[key])
 
 
-def side_by_side(cases: dict, repeats: int, *, counts: dict | None = None) -> Timings:
+def side_by_side(cases: dict, repeats: int, *, counts: dict | None = None,
+                 warmups: dict | None = None) -> Timings:
     """Time every case round-robin, so that all are measured side by side in one process.
 
     ``cases`` maps a key to a zero-argument callable. There are ``repeats`` rounds; each calls
     every case once, in an order rotated (and reversed every other round) from round to round so
     that no case always runs first or always after the same one. ``counts`` lets an expensive
-    case run in only ``counts[key]`` of the rounds, spread evenly over them.
+    case run in only ``counts[key]`` of the rounds, spread evenly over them. ``warmups[key]``
+    untimed calls of a case come right before each of its timed calls: a call of microseconds
+    is then timed as in a loop of such calls, not with the caches another case (a library of
+    megabytes) just emptied.
     """
     keys = list(cases)
     counts = counts or {}
+    warmups = warmups or {}
     rounds = {k: {int(i * repeats / counts[k]) for i in range(counts[k])} if k in counts
               else set(range(repeats)) for k in keys}
     t = Timings(wall={k: [] for k in keys}, cpu={k: [] for k in keys})
@@ -261,6 +266,8 @@ def side_by_side(cases: dict, repeats: int, *, counts: dict | None = None) -> Ti
             order = order[::-1]
         for k in order:
             if rep in rounds[k]:
+                for _ in range(warmups.get(k, 0)):
+                    cases[k]()
                 wall, cpu, t.result[k] = timed_cpu(cases[k])
                 t.wall[k].append(wall)
                 t.cpu[k].append(cpu)

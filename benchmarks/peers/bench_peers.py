@@ -15,7 +15,9 @@ best scipy method of ``bench_work_precision.py`` (DOP853) through rockjit's scip
    parameters, same error: the final (theta, theta') against rockjit at N = 8192; a run with
    another status or impact count is flagged, not counted): rockjit at N = 16..1024, each peer
    method at rtol = 1e-3..1e-12 (atol = 1e-3 rtol), scipy DOP853 likewise. Warm wall times are
-   medians of interleaved repeats (every case of a scene in each round, the order rotated);
+   medians of interleaved repeats (every case of a scene in each round, the order rotated; a
+   case under 10 ms after two untimed calls of its own, so that it is not timed with the caches
+   the case before emptied);
    compile times (first call in this process minus the warm median) are reported apart.
 3. **Basin at equal label accuracy**: for each peer the loosest rtol in a ladder whose labels
    agree with rockjit's in >= 99.5 % of the subgrid's cells, and its time; the time for the
@@ -98,9 +100,19 @@ def rj_run(kw, periods, n_steps=None, method="rockjit"):
     return rj_call(kw, periods, n_steps, method)()
 
 
-def interleaved(cases, repeats, counts=None):
-    """``{key: [seconds]}``: the harness's :func:`_common.side_by_side` wall times."""
-    return H.side_by_side(cases, repeats, counts=counts).wall
+#: A case faster than this is timed after untimed calls of its own (:data:`WARMUPS`): a
+#: run of microseconds right after another library's (JAX, SUNDIALS) would be timed with the
+#: caches that library emptied, two to three times its time in a loop of such runs (measured
+#: for rockjit's and nbkode's); every method, rockjit's and the peers', is treated alike.
+FAST_CASE_S = 0.01
+WARMUPS = 2
+
+
+def interleaved(cases, repeats, counts=None, probe=None):
+    """``{key: [seconds]}``: the harness's :func:`_common.side_by_side` wall times, the cases
+    faster than :data:`FAST_CASE_S` in ``probe`` (seconds by key) timed after warm-up calls."""
+    warm = {k: WARMUPS for k, t in (probe or {}).items() if t < FAST_CASE_S}
+    return H.side_by_side(cases, repeats, counts=counts, warmups=warm).wall
 
 
 def peer_versions():
@@ -206,7 +218,7 @@ def scene_runs(peers, name, scene, quick, repeats):
     # one untimed call of each case; slow ones (> 50 ms) run in fewer rounds
     probe = {k: timed(fn)[0] for k, fn in cases.items()}
     slow = {k: max(2, repeats // 3) for k, t in probe.items() if t > 0.05}
-    times = interleaved(cases, repeats, counts=slow)
+    times = interleaved(cases, repeats, counts=slow, probe=probe)
     rows = []
     for key in cases:
         r = results[key]
@@ -255,9 +267,8 @@ def call_floor(peers, n=41):
         m = PEER_METHODS[name][0]
         cases[f"{name} {m}"] = (lambda mod=mod, m=m:
                                 mod.run(p, z[0], z[1], 1, 1e-3, 1e-6, method=m))
-    for fn in cases.values():
-        fn()
-    times = interleaved(cases, n)
+    probe = {k: timed(fn)[0] for k, fn in cases.items()}
+    times = interleaved(cases, n, probe=probe)
     return {k: statistics.median(v) for k, v in times.items()}
 
 
@@ -452,7 +463,7 @@ def options(ap):
     ap.add_argument("--peers", nargs="*", default=list(PEER_METHODS),
                     help="peers to run (default all)")
     ap.add_argument("--repeats", type=int, default=None,
-                    help="interleaved rounds of the work–precision timings (default 9; 3 quick)")
+                    help="interleaved rounds of the work–precision timings (default 21; 3 quick)")
     ap.add_argument("--basin-sub", type=int, default=None,
                     help="side of the basin subgrid every peer runs (default 30; 10 quick; "
                          "100 = the whole lattice)")
@@ -568,8 +579,8 @@ def main(argv=None):
     md.append(f"\nrockjit: first call in this process {fmt(t_first_rj)} s (its kernels load "
               "from numba's cache).\n")
     md.append("\nFixed cost of a call (one period of the chaotic scene's block at the loosest "
-              "settings, median of 41 interleaved calls): " + "; ".join(
-                  f"{k} {fmt(1e6 * v)} µs" for k, v in floor_calls.items()) + ".\n")
+              f"settings, median of 41 interleaved calls, each after {WARMUPS} untimed ones): "
+              + "; ".join(f"{k} {fmt(1e6 * v)} µs" for k, v in floor_calls.items()) + ".\n")
     md.append("\nEvery run (error, median wall s; flags in brackets):\n")
     for s in scenes.values():
         md.append(f"\n*{s['title']}* (reference: rockjit N = {N_REF}, {s['ref']['n_impacts']} "
@@ -621,7 +632,10 @@ def main(argv=None):
               "threads, CVODE a pool of as many processes for the basin, JAX its own CPU "
               "threads. Work–precision: medians of "
               f"{repeats} interleaved rounds (cases slower than 50 ms in a third of them, at "
-              "least 2). The machine is shared: 1/5/15-min load average "
+              f"least 2; cases faster than {FAST_CASE_S * 1e3:.0f} ms timed after {WARMUPS} "
+              "untimed calls of their own, as in a loop of them: right after a run of another "
+              "library they take two to three times as long, whichever the method). The "
+              "machine is shared: 1/5/15-min load average "
               f"{' / '.join(f'{x:.2f}' for x in load0)} at the start, "
               f"{' / '.join(f'{x:.2f}' for x in load1)} at the end; {total / 60:.1f} min in "
               "all.\n")
