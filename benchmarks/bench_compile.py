@@ -737,7 +737,8 @@ def plot(summary):
     ax.set_xlabel("wall time (s): cold (light, min-max) and warm (dark)")
     bx.set_xlabel("cold: compile CPU time by stage (s)")
     if its:
-        bx.legend(fontsize=7, loc="lower right")
+        # beside the bars, never over them
+        bx.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     fig.suptitle("rockjit cold start: numba compilation per kernel variant and command")
     fig.tight_layout()
     return fig
