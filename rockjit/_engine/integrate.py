@@ -167,6 +167,12 @@ NEWTON_ITERS = 8
 DELTA_EULER = 1e-8  # see locate_step
 LOCATE_TOL = DELTA_EULER  # see locate_interp
 
+# Constants handed to the step's inlined pieces go as int64 and bool values (np.int64(0),
+# np.bool_(True), OFF_GRID), not as Python literals: numba types a literal argument by its value
+# and compiles the piece once more for each value (a cold start's time), while LLVM folds the
+# constant once the piece is inlined either way.
+OFF_GRID = np.bool_(False)  # rk_step's ``tabulated`` for a step off the grid (from an event)
+
 
 def build(embed4: bool = False, tangent: bool = False):
     """Compile (once, then from numba's cache) the integrator for one set of switches.
@@ -869,7 +875,7 @@ def locate(EMBED4, TANGENT, kind, y, ynew, hh, lo, hi, K, side, par, ytmp, yev, 
             tau = x * hh
             if TANGENT is not None:
                 step_table(par[P_OMEGA], tau, tab)
-                rk_step(EMBED4, TANGENT, False, sp, cp, y, K, side, par, ytmp, yev, tab, fr,
+                rk_step(EMBED4, TANGENT, OFF_GRID, sp, cp, y, K, side, par, ytmp, yev, tab, fr,
                         jac, trig)
                 counts[O_RHS] += N_STAGES
             yev[0] = th
@@ -925,7 +931,7 @@ def locate_step(EMBED4, TANGENT, kind, y, hh, lo, hi, K, side, par, ytmp, yev, c
     NY = yev.shape[0]
     for it in range(NEWTON_ITERS):
         step_table(par[P_OMEGA], tau, tab)
-        rk_step(EMBED4, TANGENT, False, sp, cp, y, K, side, par, ytmp, yev, tab, fr, jac, trig)
+        rk_step(EMBED4, TANGENT, OFF_GRID, sp, cp, y, K, side, par, ytmp, yev, tab, fr, jac, trig)
         counts[O_RHS] += N_STAGES
         g, dg = event_value(kind, yev, side, par)
         if g == 0.0:
@@ -961,9 +967,9 @@ def detect(y, ynew, hh, K, side, par):
             return EV_UPLIFT, 0.0, hh
         sg = 1.0 if y[2] >= 0.0 else -1.0
         if sg * K[0, 2] > 0.0 and sg * K[N_STAGES, 2] < 0.0:
-            q0, q1, q2, q3 = dense_coeffs(K, 2)
-            x = turning_point(q0, q1, q2, q3, sg, True)
-            if dense_event(EV_UPLIFT, y[2], hh, q0, q1, q2, q3, side, par, x) < 0.0:
+            q0, q1, q2, q3 = dense_coeffs(K, np.int64(2))
+            x = turning_point(q0, q1, q2, q3, sg, np.bool_(True))
+            if dense_event(np.int64(EV_UPLIFT), y[2], hh, q0, q1, q2, q3, side, par, x) < 0.0:
                 return EV_UPLIFT, 0.0, x * hh
         return EV_NONE, 0.0, 0.0
     g0 = side * y[0]
@@ -976,16 +982,16 @@ def detect(y, ynew, hh, K, side, par):
         if g0 > 0.0:
             return EV_IMPACT, 0.0, hh
         # started on theta = 0 (just after an impact or an uplift): bracket from the apex
-        q0, q1, q2, q3 = dense_coeffs(K, 0)
-        x = turning_point(q0, q1, q2, q3, float(side), True)
-        if dense_event(EV_IMPACT, y[0], hh, q0, q1, q2, q3, side, par, x) > 0.0:
+        q0, q1, q2, q3 = dense_coeffs(K, np.int64(0))
+        x = turning_point(q0, q1, q2, q3, float(side), np.bool_(True))
+        if dense_event(np.int64(EV_IMPACT), y[0], hh, q0, q1, q2, q3, side, par, x) > 0.0:
             return EV_IMPACT, x * hh, hh
         return EV_IMPACT, 0.0, 0.0  # a flight too small to resolve: lo == hi marks it
     if g0 > 0.0 and d0 < 0.0 and d1 > 0.0:
         # grazing: theta may dip through 0 and come back within the step
-        q0, q1, q2, q3 = dense_coeffs(K, 0)
-        x = turning_point(q0, q1, q2, q3, float(side), False)
-        if dense_event(EV_IMPACT, y[0], hh, q0, q1, q2, q3, side, par, x) < 0.0:
+        q0, q1, q2, q3 = dense_coeffs(K, np.int64(0))
+        x = turning_point(q0, q1, q2, q3, float(side), np.bool_(False))
+        if dense_event(np.int64(EV_IMPACT), y[0], hh, q0, q1, q2, q3, side, par, x) < 0.0:
             return EV_IMPACT, 0.0, x * hh
     return EV_NONE, 0.0, 0.0
 
@@ -1410,7 +1416,7 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
         if side == 0:
             c0 = tick(PROF)
             action, t, side = leave_rest(EMBED4, t, t_grid, hold, y, side, par, w, out.iout)
-            tock(PROF, counts, 6, c0)
+            tock(PROF, counts, np.int64(6), c0)
             if action == REST_END:
                 status = REST
                 break
@@ -1428,7 +1434,7 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
                 c0 = tick(PROF)
                 rk_step(EMBED4, TANGENT, EMBED4 is None, 0.0, 0.0, y, K, side, par, w.ytmp, w.ynew,
                         w.tab_h, w.fr if EMBED4 is not None else ftab[j], w.jac, w.trig)
-                tock(PROF, counts, 11, c0)
+                tock(PROF, counts, np.int64(11), c0)
             pre = False
             # the forcing's phase at the start, its value and derivative at the ends (locate)
             sp = ftab[j, FT_SIN]
@@ -1440,9 +1446,9 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
             c0 = tick(PROF)
             hh = t_grid - t
             step_table(par[P_OMEGA], hh, w.tab)
-            rk_step(EMBED4, TANGENT, False, sp, cp, y, K, side, par, w.ytmp, w.ynew, w.tab,
+            rk_step(EMBED4, TANGENT, OFF_GRID, sp, cp, y, K, side, par, w.ytmp, w.ynew, w.tab,
                     w.fr, w.jac, w.trig)
-            tock(PROF, counts, 7, c0)
+            tock(PROF, counts, np.int64(7), c0)
             f0 = w.fr[0]
             df0 = par[P_AW2] * par[P_OMEGA] * cp
             f1 = w.fr[N_STAGES]
@@ -1450,7 +1456,7 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
         out.iout[O_SUBSTEPS] += 1
         c0 = tick(PROF)
         kind, lo, hi = detect(y, w.ynew, hh, K, side, par)
-        tock(PROF, counts, 10, c0)
+        tock(PROF, counts, np.int64(10), c0)
         if hold and kind == EV_UPLIFT:
             kind = EV_NONE
         if kind == EV_NONE:
@@ -1468,7 +1474,7 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
             for m in range(NY):
                 w.yev[m] = y[m]
             w.yev[1] = 0.0
-        tock(PROF, counts, 8, c0)
+        tock(PROF, counts, np.int64(8), c0)
         t = t + tau
         fresh = False
         for m in range(NY):
@@ -1497,7 +1503,7 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
         c0 = tick(PROF)
         side, n_imp, rests, held = impact(EMBED4, TANGENT, t, sp, t_lift, side, n_imp,
                                           in_window, par, out, w)
-        tock(PROF, counts, 9, c0)
+        tock(PROF, counts, np.int64(9), c0)
         if rests:
             hold = hold or held
             if TANGENT is not None:
@@ -1523,7 +1529,7 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
             status, j_per, k_per, j_qr, j_rec, collapsed = grid_point(
                 EMBED4, TANGENT, record, t, step, side, n_imp, n_col, in_window, ipar, par,
                 out, w, j_per, k_per, j_qr, j_rec)
-            tock(PROF, counts, 12, c0)
+            tock(PROF, counts, np.int64(12), c0)
             if collapsed:
                 n_col += 1
                 if in_window:
