@@ -22,7 +22,7 @@ from numba.extending import intrinsic
 FASTMATH = frozenset({"nsz"})
 
 
-def jit(func=None, *, parallel=False, nrt=True, inline=False):
+def jit(func=None, *, parallel=False, nrt=True, inline=False, ir_inline=False):
     """``numba.njit`` with the project policy: cached, the one fastmath set.
 
     ``nrt=False`` compiles without numba's reference-counting runtime: for the helpers of the
@@ -40,9 +40,17 @@ def jit(func=None, *, parallel=False, nrt=True, inline=False):
     at every call site: the step's pieces made a cold compile 1.5x longer
     (benchmarks/bench_compile.py). The flag is set on every function, off where not asked for:
     numba would otherwise let a callee inherit it from its caller.
+
+    ``ir_inline=True`` inlines the function in numba's own IR (``inline="always"``) instead:
+    no compiled function of its own. For a layer with one or two callers above the whole loop
+    (``integrate._run``): every compiled function is linked with all it calls and optimised and
+    turned into machine code again, so each layer above the loop pays the loop's LLVM time once
+    more (benchmarks/results/compile_code_levers.md).
     """
     opts = dict(cache=True, fastmath=set(FASTMATH), parallel=parallel, error_model="numpy",
                 forceinline=bool(inline))
+    if ir_inline:
+        opts["inline"] = "always"
     if not nrt:
         opts["_nrt"] = False
     deco = numba.njit(**opts)

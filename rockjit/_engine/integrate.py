@@ -1064,7 +1064,7 @@ def reset_tangent(EMBED4, y):
     y[NS + 3] = 1.0
 
 
-@jit
+@jit(ir_inline=True)
 def _run(EMBED4, TANGENT, y0, side0, par_in, ipar, out):
     """One run from ``y0`` on corner ``side0``: the parameters ``par_in`` (``N_PAR``) and
     settings ``ipar`` in, :data:`Outputs` ``out`` filled; returns the status code.
