@@ -78,18 +78,22 @@ def cpu_mhz():
 def kernel_alone(prepared):
     """A call of the compiled run under a prepared run (``rockjit.single.Prepared``) from the
     plan's own state, on outputs made once: the integration and nothing else, the floor a call
-    of any path pays. Uses the private ``Prepared._entry`` (the compiled code, set by its first
-    call), ``Prepared._par`` and ``_ipar``, ``rockjit.single.initial_side`` and
-    ``rockjit._engine.kernel.single_outputs``."""
+    of any path pays; the call returns the final state. Uses the private ``Prepared._entry``
+    (the compiled code, set by its first call), ``Prepared._par`` and ``_ipar``,
+    ``rockjit.single.initial_side``, ``rockjit._engine.kernel.single_outputs`` and the output
+    layout ``rockjit._engine.integrate.F_TH``, ``F_S``."""
     from rockjit import single
     from rockjit._engine import kernel
 
+    from rockjit._engine import integrate
+
     prepared()
     y0 = np.array(prepared.plan.y0)
-    args = (y0, single.initial_side(y0[0], y0[1]), prepared._par, prepared._ipar,
-            kernel.single_outputs(prepared.plan))
+    out = kernel.single_outputs(prepared.plan)
+    args = (y0, single.initial_side(y0[0], y0[1]), prepared._par, prepared._ipar, out)
     entry = prepared._entry
-    return lambda: (entry(*args), args[-1])[1]
+    final = slice(integrate.F_TH, integrate.F_S + 1)  # theta, theta', r, s at the end
+    return lambda: (entry(*args), out.fout[final])[1]
 
 
 def step_internals():
@@ -228,15 +232,15 @@ def calls(cfg):
             "prepared run, new amplitude": lambda: prepared(alpha=0.955),
             "simulate (its prepared run reused)": lambda: simulate(block, forcing,
                                                                    integration=integration),
-            "simulate, objects made per call": lambda: simulate(*objects()[:2],
-                                                                integration=objects()[2]),
+            "simulate, objects made per call": lambda: (
+                lambda b, f, i: simulate(b, f, integration=i))(*objects()),
             "plan, then run (nothing reused)": lambda: rockjit.single.run(
                 simulate.plan(block, forcing, integration=integration)),
         }
         for fn in cases.values():
             fn()
         t = H.side_by_side(cases, cfg["call_reps"])
-        final = t.result["the compiled run alone"].fout[1:5]  # theta, theta', r, s
+        final = t.result["the compiled run alone"]
         for path, r in t.result.items():
             if path != "the compiled run alone" and not np.array_equal(r.state, final):
                 raise RuntimeError(f"{path} ran another integration ({label})")

@@ -408,8 +408,9 @@ class Prepared:
         args = (y0, initial_side(y0[0], y0[1]), par, self._ipar, out)
         if self._entry is None:
             code = self._kernel(*args)
-            # the arguments' types never change: later calls go straight to the compiled
-            # code, without numba's dispatch (a microsecond a call)
+            # the arguments' types never change (the plan's y0 and outputs, the packed
+            # parameters, an int side): later calls go straight to the compiled code, without
+            # numba's dispatch (a microsecond a call), which also skips its check of the types
             self._entry = self._kernel.get_overload(tuple(map(self._kernel.typeof_pyval,
                                                               args)))
         else:

@@ -267,6 +267,8 @@ def call_floor(peers, n=41):
         m = PEER_METHODS[name][0]
         cases[f"{name} {m}"] = (lambda mod=mod, m=m:
                                 mod.run(p, z[0], z[1], 1, 1e-3, 1e-6, method=m))
+    for fn in cases.values():   # a first call compiles (nbkode) or traces (JAX): apart
+        fn()
     probe = {k: timed(fn)[0] for k, fn in cases.items()}
     times = interleaved(cases, n, probe=probe)
     return {k: statistics.median(v) for k, v in times.items()}
