@@ -54,3 +54,18 @@ def test_it_stays_short_and_points_inside_the_repository():
     for target in re.findall(r"\]\(([^)#]+)\)", README):
         if not target.startswith("http"):
             assert (ROOT / target).exists(), target
+
+
+def test_one_version_everywhere():
+    # pyproject reads the version from rockjit/__init__.py; the citation metadata and the
+    # installed package's metadata say the same
+    import importlib.metadata
+    import tomllib
+
+    import rockjit
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    assert "version" not in project["project"] and "version" in project["project"]["dynamic"]
+    assert project["tool"]["setuptools"]["dynamic"]["version"] == {"attr": "rockjit.__version__"}
+    cff = re.search(r"^version:\s*(\S+)\s*$", (ROOT / "CITATION.cff").read_text(), re.M)
+    assert cff and cff.group(1).strip("\"'") == rockjit.__version__
+    assert importlib.metadata.version("rockjit") == rockjit.__version__
