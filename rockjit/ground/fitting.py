@@ -1,19 +1,28 @@
-"""Lognormal fragility curves fitted by maximum likelihood.
+"""Lognormal fragility curves fitted by maximum likelihood, with profile-likelihood intervals.
 
 ``P(overturn | IM = x) = Phi(ln(x / theta_m) / beta)`` (docs/theory/ground-motions.md,
 "Incremental dynamic analysis and fragility curves"). :func:`fit_lognormal` fits the median
 ``theta_m`` and the dispersion ``beta`` to counts of overturned runs at fixed intensities by
 maximising the binomial likelihood (Shinozuka et al. 2000; Baker 2015), which uses every run,
-a survival above a level that overturned included. Standard errors come from the observed
-information matrix: the Hessian of the negative log-likelihood at its maximum, in
-``(ln theta_m, beta)``, inverted; the median's by the delta method,
-``se(theta_m) = theta_m se(ln theta_m)``.
+a survival above a level that overturned included. In ``(a, s) = (ln theta_m / beta,
+1 / beta)`` the model is a probit regression, ``z = s ln x - a``, whose log-likelihood is
+concave: Newton's method finds its maximum, and the observed information (its Hessian,
+analytic) gives standard errors in ``(ln theta_m, beta)`` by the change of variables; the
+median's by the delta method, ``se(theta_m) = theta_m se(ln theta_m)``. Confidence intervals
+of ``theta_m`` and ``beta`` are profile-likelihood intervals: the values whose profile
+log-likelihood lies within ``chi2_1(level) / 2`` of the maximum.
 
-Data the likelihood has no interior maximum for are reported as such rather than fitted:
-no overturning at all (``"all_survive"``: the median lies above the largest intensity), only
-overturning (``"all_overturn"``: below the smallest), or a clean cut between the levels
-(``"separated"``: ``beta -> 0`` and any median between the two levels; the geometric mean is
-given). :func:`fit_capacities` is the closed form from one collapse capacity per record.
+A fit is reported only where the data identify it. Otherwise the status says why and no
+median or dispersion is given: no overturning at all (``"all_survive"``: the median lies above
+the largest intensity), only overturning (``"all_overturn"``: below the smallest), or
+``"unidentified"`` with a ``reason``: a single intensity level (the likelihood is flat along a
+line of ``(theta_m, beta)``); complete separation (every level below a cut survives and every
+level above overturns: the likelihood grows as ``beta -> 0``, with any median in the gap);
+quasi-complete separation (the same, with one level mixed); an overturning fraction that does
+not rise with the intensity; or a nearly flat likelihood (a probability that does not change
+with the intensity fits about as well: the interval of ``beta`` has no upper end).
+:func:`fit_capacities` is the closed form from one collapse capacity per record, with exact
+intervals (Student's t and chi-square).
 """
 
 from __future__ import annotations
@@ -22,12 +31,14 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import log_ndtr, ndtr
+from scipy.special import log_ndtr, ndtr, ndtri
 
-__all__ = ["LognormalFit", "fit_capacities", "fit_lognormal"]
+__all__ = ["CONFIDENCE", "LognormalFit", "fit_capacities", "fit_lognormal"]
 
-#: Smallest dispersion the fit reports as a finite maximum; below it the data are a clean cut.
-BETA_MIN = 1e-3
+#: Confidence level of the intervals (and of the test that a fit is identified).
+CONFIDENCE = 0.95
+_NAN2 = (math.nan, math.nan)
+_HALF_LN_2PI = 0.5 * math.log(2.0 * math.pi)
 
 
 @dataclass(frozen=True)
@@ -37,11 +48,12 @@ class LognormalFit:
     Attributes
     ----------
     median, beta : float
-        ``theta_m`` and ``beta`` (``nan`` where the data have no maximum; see ``status``).
+        ``theta_m`` and ``beta``; ``nan`` unless ``status`` is ``"ok"``.
     se_median, se_beta, se_log_median : float
-        Standard errors from the observed information (``nan`` without an interior maximum).
+        Standard errors from the observed information (``nan`` unless ``"ok"``).
     status : str
-        ``"ok"``, ``"all_survive"``, ``"all_overturn"``, ``"separated"`` or ``"no_data"``.
+        ``"ok"``, ``"unidentified"`` (see ``reason``), ``"all_survive"``, ``"all_overturn"``
+        or ``"no_data"``.
     bound : float
         Where ``status`` bounds the median instead: the largest intensity (all survive), the
         smallest (all overturn); ``nan`` otherwise.
@@ -49,7 +61,17 @@ class LognormalFit:
         The runs counted and those that overturned (for :func:`fit_capacities`: the records,
         and those whose capacity was used).
     log_likelihood : float
-        The binomial log-likelihood at the fit (``nan`` for :func:`fit_capacities`).
+        The binomial log-likelihood at the fit, or its supremum where the fit is unidentified
+        (``nan`` for :func:`fit_capacities`).
+    reason : str
+        Why the data do not identify the fit (empty when ``"ok"``).
+    median_ci, beta_ci : tuple of float
+        Confidence intervals ``(low, high)`` at ``confidence``: profile likelihood for
+        :func:`fit_lognormal`, exact for :func:`fit_capacities`. Also given where the fit is
+        unidentified and the data still bound something: ``0`` and ``inf`` are open ends;
+        ``nan`` where there is no interval.
+    confidence : float
+        The intervals' confidence level.
 
     Examples
     --------
@@ -59,6 +81,11 @@ class LognormalFit:
     0.5
     >>> fit_lognormal([1, 2], [0, 0], [5, 5]).status        # no overturning: a bound only
     'all_survive'
+    >>> f = fit_lognormal([3.0], [1], [2])                  # one level: beta is not determined
+    >>> f.status, f.median, f.beta_ci
+    ('unidentified', nan, (0.0, inf))
+    >>> f.reason
+    'one intensity level: the likelihood is flat along a line of (median, beta)'
     """
 
     median: float
@@ -71,23 +98,26 @@ class LognormalFit:
     n_runs: int
     n_overturned: int
     log_likelihood: float
+    reason: str = ""
+    median_ci: tuple = _NAN2
+    beta_ci: tuple = _NAN2
+    confidence: float = CONFIDENCE
 
     def probability(self, x):
-        """The fitted ``P(overturn | IM = x)`` (``nan`` where there is no fit; a step for a
-        separated fit)."""
+        """The fitted ``P(overturn | IM = x)`` (``nan`` where there is no fit)."""
         x = np.asarray(x, dtype=float)
         if self.status == "ok":
             return ndtr(np.log(x / self.median) / self.beta)
-        if self.status == "separated":
-            return (x >= self.median).astype(float)
         return np.full(x.shape, np.nan)
 
     def to_dict(self):
         """JSON-ready."""
         return dict(median=self.median, beta=self.beta, se_median=self.se_median,
                     se_beta=self.se_beta, se_log_median=self.se_log_median,
-                    status=self.status, bound=self.bound, n_runs=self.n_runs,
-                    n_overturned=self.n_overturned, log_likelihood=self.log_likelihood)
+                    median_ci=list(self.median_ci), beta_ci=list(self.beta_ci),
+                    confidence=self.confidence, status=self.status, reason=self.reason,
+                    bound=self.bound, n_runs=self.n_runs, n_overturned=self.n_overturned,
+                    log_likelihood=self.log_likelihood)
 
 
 def _nll(mu, beta, lx, k, n):
@@ -96,26 +126,164 @@ def _nll(mu, beta, lx, k, n):
     return -float(np.sum(k * log_ndtr(z) + (n - k) * log_ndtr(-z)))
 
 
-def _hessian(fun, x, h):
-    """Central-difference Hessian of ``fun`` at ``x`` with steps ``h``."""
-    m = len(x)
-    H = np.empty((m, m))
-    f0 = fun(x)
-    for i in range(m):
-        ei = np.zeros(m)
-        ei[i] = h[i]
-        H[i, i] = (fun(x + ei) - 2.0 * f0 + fun(x - ei)) / h[i] ** 2
-        for j in range(i + 1, m):
-            ej = np.zeros(m)
-            ej[j] = h[j]
-            H[i, j] = H[j, i] = (fun(x + ei + ej) - fun(x + ei - ej) - fun(x - ei + ej)
-                                 + fun(x - ei - ej)) / (4.0 * h[i] * h[j])
-    return H
+class _Probit:
+    """The binomial log-likelihood of ``z_j = s (l_j - m)`` (``l`` the centred log-intensities),
+    with its derivatives in ``z``."""
+
+    def __init__(self, l, k, n):
+        self.l, self.k, self.f = l, k, n - k
+
+    def at(self, z):
+        """``(loglik, dl/dz, d2l/dz2)`` per level (the second derivative is negative)."""
+        lp, lm = log_ndtr(z), log_ndtr(-z)
+        lphi = -0.5 * z * z - _HALF_LN_2PI
+        lam_p, lam_m = np.exp(lphi - lp), np.exp(lphi - lm)     # phi / Phi: at most ~|z|
+        ll = np.where(self.k > 0, self.k * lp, 0.0) + np.where(self.f > 0, self.f * lm, 0.0)
+        d = self.k * lam_p - self.f * lam_m
+        # lam (z + lam) lies in (0, 1); the clip only guards the rounding at extreme |z|
+        w = -(self.k * np.minimum(np.maximum(lam_p * (z + lam_p), 0.0), 1.0)
+              + self.f * np.minimum(np.maximum(lam_m * (lam_m - z), 0.0), 1.0))
+        return float(ll.sum()), d, w
+
+    def ll(self, z):
+        return self.at(z)[0]
+
+    def fit(self, a, s):
+        """Newton's method in ``(a, s)``, ``z = s l - a`` (concave): the maximum."""
+        l = self.l
+        v, d, w = self.at(s * l - a)
+        for _ in range(200):
+            g = np.array([-d.sum(), (d * l).sum()])
+            H = np.array([[w.sum(), -(w * l).sum()], [-(w * l).sum(), (w * l * l).sum()]])
+            try:
+                step = np.linalg.solve(-H, g)
+            except np.linalg.LinAlgError:
+                break
+            t = 1.0
+            while True:
+                a1, s1 = a + t * step[0], s + t * step[1]
+                v1, d1, w1 = self.at(s1 * l - a1)
+                if v1 >= v - 1e-13 * (1 + abs(v)) or t < 1e-12:
+                    break
+                t *= 0.5
+            done = abs(v1 - v) <= 1e-14 * (1 + abs(v)) and np.all(np.abs(t * step) <=
+                                                                   1e-10 * (1 + abs(s)))
+            a, s, v, d, w = a1, s1, v1, d1, w1
+            if done:
+                break
+        return a, s, v, d, w
+
+    def profile_s(self, s, m):
+        """``max over m`` of the log-likelihood at fixed ``s > 0`` (Newton from ``m``)."""
+        l = self.l
+        v, d, w = self.at(s * (l - m))
+        for _ in range(200):
+            g, h = -s * d.sum(), s * s * w.sum()
+            dm = -g / h if h < 0 else math.copysign(1.0, g)
+            dm = max(-2.0, min(2.0, dm))
+            t = 1.0
+            while True:
+                v1, d1, w1 = self.at(s * (l - (m + t * dm)))
+                if v1 >= v - 1e-13 * (1 + abs(v)) or t < 1e-12:
+                    break
+                t *= 0.5
+            m += t * dm
+            gain, v, d, w = v1 - v, v1, d1, w1
+            if abs(t * dm) < 1e-12 or abs(gain) < 1e-14 * (1 + abs(v)):
+                break
+        return v, m
+
+    def profile_m(self, m, s, s_max):
+        """``max over 0 < s <= s_max`` of the log-likelihood at fixed ``m`` (Newton from
+        ``s``)."""
+        u = self.l - m
+        v, d, w = self.at(s * u)
+        for _ in range(200):
+            g, h = (d * u).sum(), (w * u * u).sum()
+            ds = -g / h if h < 0 else math.copysign(s, g)
+            s1 = min(max(s + ds, 0.25 * s), 4.0 * s, s_max)
+            t = 1.0
+            while True:
+                st = s + t * (s1 - s)
+                v1, d1, w1 = self.at(st * u)
+                if v1 >= v - 1e-13 * (1 + abs(v)) or t < 1e-12:
+                    break
+                t *= 0.5
+            gain, s, v, d, w = v1 - v, st, v1, d1, w1
+            if abs(gain) < 1e-14 * (1 + abs(v)) or s >= s_max:
+                break
+        return v, s
 
 
-def fit_lognormal(x, overturned, runs) -> LognormalFit:
+def _root(fun, lo, hi):
+    """The root of ``fun`` between ``lo`` and ``hi`` (signs differ)."""
+    from scipy.optimize import brentq
+    return brentq(fun, lo, hi, xtol=1e-10, rtol=1e-10)
+
+
+def _intervals(pr, ll_sup, ll_flat, m0, s0, s_max, q):
+    """Profile-likelihood intervals of ``m`` (centred ln median) and ``beta = 1/s``: where the
+    profile stays above ``ll_sup - q/2``; ``(m0, s0)`` a point inside. ``ll_flat`` is the
+    supremum as ``beta -> inf`` (a constant probability). Returns ``((m_lo, m_hi), (b_lo,
+    b_hi))`` with ``-inf``/``inf`` and ``0``/``inf`` for open ends."""
+    target = ll_sup - 0.5 * q
+    state = dict(m=m0, s=s0)
+
+    def gs(u):                       # u = ln s
+        v, state["m"] = pr.profile_s(math.exp(u), state["m"])
+        return v - target
+
+    def gm(m):
+        v, s = pr.profile_m(m, state["s"], s_max)
+        return v - target
+
+    # beta's upper end: s below s0
+    if ll_flat >= target:
+        b_hi = math.inf
+    else:
+        u0, step = math.log(s0), math.log(2.0)
+        state["m"] = m0
+        u = u0 - step
+        while gs(u) >= 0:
+            u0, u = u, u - step
+        b_hi = 1.0 / math.exp(_root(gs, u, u0))
+    # beta's lower end: s above s0
+    state["m"] = m0
+    u0, u, b_lo = math.log(s0), math.log(s0) + math.log(2.0), None
+    while u <= math.log(s_max):
+        if gs(u) < 0:
+            b_lo = 1.0 / math.exp(_root(gs, u0, u))
+            break
+        u0, u = u, u + math.log(2.0)
+    b_lo = 0.0 if b_lo is None else b_lo
+    # the median's ends
+    ends = []
+    for sign in (-1.0, 1.0):
+        state["s"] = s0
+        inner, d, end = m0, 0.05, sign * math.inf
+        while d <= 64.0:
+            m = m0 + sign * d
+            if gm(m) < 0:
+                state["s"] = s0
+                end = _root(gm, *sorted((inner, m)))
+                break
+            inner, d = m, 2.0 * d
+        ends.append(end)
+    return (ends[0], ends[1]), (b_lo, b_hi)
+
+
+def _ll_binomial(k, n):
+    """The binomial log-likelihood at the observed fractions (``0 log 0 = 0``)."""
+    p = k / n
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(k > 0, k * np.log(np.where(k > 0, p, 1.0)), 0.0) + \
+            np.where(k < n, (n - k) * np.log(np.where(k < n, 1 - p, 1.0)), 0.0)
+    return float(t.sum())
+
+
+def fit_lognormal(x, overturned, runs, *, confidence=CONFIDENCE) -> LognormalFit:
     """Fit a lognormal fragility curve to ``overturned[j]`` overturnings among ``runs[j]`` runs
-    at intensity ``x[j] > 0``, by maximum likelihood.
+    at intensity ``x[j] > 0``, by maximum likelihood, with profile-likelihood intervals.
 
     Parameters
     ----------
@@ -125,13 +293,16 @@ def fit_lognormal(x, overturned, runs) -> LognormalFit:
         How many runs overturned at each intensity, in ``[0, runs[j]]``.
     runs : array_like of int
         How many runs were made at each intensity (levels with none are left out).
+    confidence : float
+        The intervals' confidence level, in ``(0, 1)`` (default 0.95).
 
     Returns
     -------
     LognormalFit
-        The median and dispersion with their standard errors, or, where the likelihood has
-        no interior maximum, the status that says why (``"all_survive"``,
-        ``"all_overturn"``, ``"separated"``, ``"no_data"``).
+        The median and dispersion with their standard errors and intervals (status
+        ``"ok"``); or, where the data do not determine them, no estimate and the status that
+        says why (``"unidentified"`` with its ``reason``, ``"all_survive"``,
+        ``"all_overturn"``, ``"no_data"``).
 
     Examples
     --------
@@ -139,12 +310,18 @@ def fit_lognormal(x, overturned, runs) -> LognormalFit:
     >>> fit = fit_lognormal([1, 2, 3, 4], [0, 3, 7, 9], [10, 10, 10, 10])
     >>> fit.status, round(fit.median, 2), round(fit.beta, 2)
     ('ok', 2.47, 0.36)
+    >>> [round(v, 2) for v in fit.median_ci], [round(v, 2) for v in fit.beta_ci]
+    ([1.99, 2.98], [0.22, 0.69])
+    >>> fit_lognormal([1, 2, 3], [0, 5, 5], [5, 5, 5]).reason       # a clean cut
+    'complete separation between 1 and 2: beta -> 0 and any median in between fits'
     """
     x = np.asarray(x, dtype=float).ravel()
     k = np.asarray(overturned, dtype=float).ravel()
     n = np.asarray(runs, dtype=float).ravel()
     if not (x.shape == k.shape == n.shape):
         raise ValueError("x, overturned and runs must have the same length")
+    if not 0.0 < confidence < 1.0:
+        raise ValueError(f"confidence must be in (0, 1) (got {confidence!r})")
     use = n > 0
     x, k, n = x[use], k[use], n[use]
     if np.any(~np.isfinite(x)) or np.any(x <= 0):
@@ -154,8 +331,9 @@ def fit_lognormal(x, overturned, runs) -> LognormalFit:
     N, K = int(n.sum()), int(k.sum())
     nan = math.nan
 
-    def bare(status, median=nan, bound=nan, beta=nan):
-        return LognormalFit(median, beta, nan, nan, nan, status, bound, N, K, nan)
+    def bare(status, bound=nan):
+        return LognormalFit(nan, nan, nan, nan, nan, status, bound, N, K, nan,
+                            confidence=confidence)
 
     if N == 0:
         return bare("no_data")
@@ -164,63 +342,103 @@ def fit_lognormal(x, overturned, runs) -> LognormalFit:
     if K == N:
         return bare("all_overturn", bound=float(x.min()))
     lx = np.log(x)
-    # a clean cut: every level below some intensity survives, every level above overturns
+    c = float(np.sum(n * lx) / N)
+    pr = _Probit(lx - c, k, n)
+    q = float(_chi2_1(confidence))
+    ll_flat = _ll_binomial(np.array([K], float), np.array([N], float))
+    spread = float(np.ptp(lx))
+    s_max = 1e8 / max(spread, 1e-3)
+
+    def unidentified(reason, ll_sup, m0=None, s0=None):
+        mci = bci = _NAN2
+        if m0 is not None:
+            try:
+                (m_lo, m_hi), bci = _intervals(pr, ll_sup, ll_flat, m0, s0, s_max, q)
+                mci = (math.exp(m_lo + c), math.exp(m_hi + c))
+            except (ValueError, OverflowError, FloatingPointError):
+                mci = bci = _NAN2
+        return LognormalFit(nan, nan, nan, nan, nan, "unidentified", nan, N, K, ll_sup,
+                            reason, tuple(map(float, mci)), tuple(map(float, bci)), confidence)
+
+    if np.unique(lx).size == 1:
+        return unidentified("one intensity level: the likelihood is flat along a line of "
+                            "(median, beta)", ll_flat, 0.0, 1.0 / max(abs(c), 1.0))
+    # a cut: every run below survives, every run above overturns (one level may be mixed)
     survive_max = lx[k < n].max()   # the highest level with a survival
     over_min = lx[k > 0].min()      # the lowest level with an overturning
-    if survive_max < over_min and np.all(k[lx <= survive_max] == 0) and \
-            np.all(k[lx >= over_min] == n[lx >= over_min]):
-        return LognormalFit(float(np.exp(0.5 * (survive_max + over_min))), 0.0, nan, nan, nan,
-                            "separated", nan, N, K, 0.0)
-    # a start: the median where the empirical fraction crosses 1/2, beta from its spread
+    if survive_max <= over_min:
+        s0 = s_max * 1e-3
+        if survive_max < over_min:
+            return unidentified(
+                f"complete separation between {math.exp(survive_max):.6g} and "
+                f"{math.exp(over_min):.6g}: beta -> 0 and any median in between fits", 0.0,
+                0.5 * (survive_max + over_min) - c, s0)
+        mixed = lx == survive_max
+        km, nm = k[mixed].sum(), n[mixed].sum()
+        m0 = survive_max - c - float(ndtri(km / nm)) / s0
+        return unidentified(
+            f"quasi-complete separation at {math.exp(survive_max):.6g}: every run below "
+            f"survives and every run above overturns, the likelihood grows as beta -> 0",
+            _ll_binomial(k[mixed], n[mixed]), m0, s0)
+    # a start: the median where the empirical fraction crosses 1/2, beta from the spread
     frac = k / n
     order = np.argsort(lx)
-    mu0 = float(np.interp(0.5, np.maximum.accumulate(frac[order]), lx[order]))
-    beta0 = max(0.1, float(np.std(lx)) if lx.size > 1 else 0.3)
-
-    from scipy.optimize import minimize
-
-    def f(q):  # q = (mu, ln beta)
-        return _nll(q[0], math.exp(q[1]), lx, k, n)
-
-    best = None
-    for start in ((mu0, math.log(beta0)), (float(np.mean(lx)), math.log(0.4))):
-        r = minimize(f, np.array(start), method="Nelder-Mead",
-                     options=dict(xatol=1e-10, fatol=1e-12, maxiter=4000))
-        if best is None or r.fun < best.fun:
-            best = r
-    mu, beta = float(best.x[0]), float(math.exp(best.x[1]))
-    if beta < BETA_MIN:
-        return LognormalFit(float(math.exp(mu)), beta, nan, nan, nan, "separated", nan, N, K,
-                            -float(best.fun))
-    H = _hessian(lambda q: _nll(q[0], q[1], lx, k, n), np.array([mu, beta]),
-                 np.array([1e-4 * max(1.0, abs(mu)), 1e-4 * beta]))
+    m0 = float(np.interp(0.5, np.maximum.accumulate(frac[order]), lx[order])) - c
+    s0 = 1.0 / max(0.1, float(np.sqrt(np.sum(n * (lx - c) ** 2) / N)))
+    a, s, ll, d, w = pr.fit(s0 * m0, s0)
+    a, s = float(a), float(s)
+    if not (s > 0 and math.isfinite(s)):
+        return unidentified("the fraction overturned does not rise with the intensity",
+                            ll_flat)
+    m = a / s
+    if 2.0 * (ll - ll_flat) < q:
+        return unidentified(
+            f"nearly flat likelihood: a probability that does not change with the intensity "
+            f"fits about as well (likelihood ratio {2 * (ll - ll_flat):.3g} < {q:.3g}), so "
+            f"the data set no upper end to beta", ll, m, s)
+    # observed information in (a, s), then in (ln theta_m, beta) by the change of variables
+    l = pr.l
+    H = np.array([[w.sum(), -(w * l).sum()], [-(w * l).sum(), (w * l * l).sum()]])
+    J = np.array([[1.0 / s, -a / s ** 2], [0.0, -1.0 / s ** 2]])   # d(m, beta)/d(a, s)
     try:
-        cov = np.linalg.inv(H)
+        cov = J @ np.linalg.inv(-H) @ J.T
         se_mu, se_beta = (math.sqrt(v) if v > 0 else nan for v in np.diag(cov))
     except np.linalg.LinAlgError:
         se_mu = se_beta = nan
-    median = math.exp(mu)
-    return LognormalFit(median, beta, median * se_mu, se_beta, se_mu, "ok", nan, N, K,
-                        -float(best.fun))
+    (m_lo, m_hi), bci = _intervals(pr, ll, ll_flat, m, s, s_max, q)
+    median = math.exp(m + c)
+    return LognormalFit(median, 1.0 / s, median * se_mu, se_beta, se_mu, "ok", nan, N, K, ll,
+                        "", (math.exp(m_lo + c), math.exp(m_hi + c)),
+                        tuple(map(float, bci)), confidence)
 
 
-def fit_capacities(capacities) -> LognormalFit:
+def _chi2_1(p):
+    """The ``p`` quantile of the chi-square distribution with one degree of freedom."""
+    return float(ndtri(0.5 + 0.5 * p)) ** 2
+
+
+def fit_capacities(capacities, *, confidence=CONFIDENCE) -> LognormalFit:
     """The lognormal fit to one collapse capacity per record (docs/theory/ground-motions.md):
     ``ln theta_m`` the mean of ``ln x_i``, ``beta^2`` their variance (divided by ``n``);
-    standard errors ``beta / sqrt(n)`` and ``beta / sqrt(2 n)``. Capacities that are not finite
-    (``inf``: a record that never overturned the block; ``nan``: one whose capacity lies below
-    the intensities tried) are left out: ``n_runs`` counts every record, ``n_overturned`` those
-    used.
+    standard errors ``beta / sqrt(n)`` and ``beta / sqrt(2 n)``; exact intervals, from
+    Student's t for the median and the chi-square distribution for ``beta`` (normal
+    ``ln x_i``). Capacities that are not finite (``inf``: a record that never overturned the
+    block; ``nan``: one whose capacity lies below the intensities tried) are left out:
+    ``n_runs`` counts every record, ``n_overturned`` those used.
 
     Parameters
     ----------
     capacities : array_like of float
         Each record's collapse capacity: the intensity at which it first overturned the block.
+    confidence : float
+        The intervals' confidence level, in ``(0, 1)`` (default 0.95).
 
     Returns
     -------
     LognormalFit
-        Status ``"ok"``, or ``"no_data"`` with fewer than two finite capacities.
+        Status ``"ok"``; ``"no_data"`` with fewer than two finite capacities;
+        ``"unidentified"`` when they are all equal (``beta`` is below the resolution of the
+        intensities).
 
     Examples
     --------
@@ -228,18 +446,35 @@ def fit_capacities(capacities) -> LognormalFit:
     >>> fit = fit_capacities([2.0, 3.0, 4.5, float("inf")])    # the last never overturned
     >>> round(fit.median, 3), round(fit.beta, 3), fit.n_runs, fit.n_overturned
     (3.0, 0.331, 4, 3)
+    >>> [round(v, 2) for v in fit.median_ci], [round(v, 2) for v in fit.beta_ci]
+    ([1.1, 8.21], [0.21, 2.55])
     """
+    from scipy.stats import chi2, t as student
+
+    if not 0.0 < confidence < 1.0:
+        raise ValueError(f"confidence must be in (0, 1) (got {confidence!r})")
     c = np.asarray(capacities, dtype=float).ravel()
     fin = c[np.isfinite(c)]
     if np.any(fin <= 0):
         raise ValueError("capacities must be positive")
     n = fin.size
+    nan = math.nan
     if n < 2:
-        return LognormalFit(math.nan, math.nan, math.nan, math.nan, math.nan,
-                            "no_data", math.nan, int(c.size), n, math.nan)
+        return LognormalFit(nan, nan, nan, nan, nan, "no_data", nan, int(c.size), n, nan,
+                            confidence=confidence)
     lc = np.log(fin)
     mu = float(lc.mean())
-    beta = float(math.sqrt(np.mean((lc - mu) ** 2)))
+    ss = float(np.sum((lc - mu) ** 2))
+    if ss <= 1e-24 * max(1.0, mu * mu) * n:
+        return LognormalFit(nan, nan, nan, nan, nan, "unidentified", nan, int(c.size), n, nan,
+                            f"every capacity is {math.exp(mu):.6g}: the dispersion is below "
+                            f"the spacing of the intensities", confidence=confidence)
+    beta = math.sqrt(ss / n)
     se_mu = beta / math.sqrt(n)
+    alpha = 1.0 - confidence
+    half = float(student.ppf(1.0 - alpha / 2, n - 1)) * math.sqrt(ss / (n - 1) / n)
+    beta_ci = (math.sqrt(ss / float(chi2.ppf(1.0 - alpha / 2, n - 1))),
+               math.sqrt(ss / float(chi2.ppf(alpha / 2, n - 1))))
     return LognormalFit(math.exp(mu), beta, math.exp(mu) * se_mu, beta / math.sqrt(2 * n),
-                        se_mu, "ok", math.nan, int(c.size), n, math.nan)
+                        se_mu, "ok", nan, int(c.size), n, nan, "",
+                        (math.exp(mu - half), math.exp(mu + half)), beta_ci, confidence)
