@@ -24,8 +24,8 @@ from typing import Any, Callable
 
 from .validate import boolean, integer, pair, real
 
-__all__ = ["Classification", "Execution", "Integration", "Lattice", "MAX_N", "MAX_PERIODS",
-           "REST_SPEED_RANGE", "default_max_impacts"]
+__all__ = ["Classification", "Execution", "Integration", "Lattice", "MAX_IMPACTS", "MAX_N",
+           "MAX_PERIODS", "REST_SPEED_RANGE", "default_max_impacts"]
 
 #: Largest number of periods, and of steps per period, a run may ask for: bounds that keep the
 #: kernels' step counter in 64 bits. The memory check refuses most large requests first, with
@@ -39,11 +39,17 @@ MAX_N = 10**12
 REST_SPEED_RANGE = (1e-12, 0.1)
 
 
+#: Largest impact bound, explicit or default: the kernels count impacts in 64-bit integers.
+MAX_IMPACTS = 2**62
+
+
 def default_max_impacts(periods):
-    """The default impact bound: 10,000 impacts per period, at least 100,000. A Zeno cascade
-    from ``|theta'| ~ 1`` to the cut-off ``1e-6`` has ``ln(1e-6) / ln(e)`` impacts: ~10 for
-    ``e = 0.25``, ~75 for ``e = 0.83``, ~1,400 for ``e = 0.99``, at most two a period."""
-    return max(100_000, 10_000 * int(periods))
+    """The default impact bound: 10,000 impacts per period, at least 100,000, at most
+    ``MAX_IMPACTS`` (``2**62``: the bound of ``MAX_PERIODS`` periods would not fit the kernels'
+    64-bit counter). A Zeno cascade from ``|theta'| ~ 1`` to the cut-off ``1e-6`` has
+    ``ln(1e-6) / ln(e)`` impacts: ~10 for ``e = 0.25``, ~75 for ``e = 0.83``, ~1,400 for
+    ``e = 0.99``, at most two a period."""
+    return min(MAX_IMPACTS, max(100_000, 10_000 * int(periods)))
 
 
 def _set(obj, **values):
@@ -118,7 +124,7 @@ class Integration(_Replace):
         window = None if self.window is None else integer("window", self.window, 0,
                                                           periods - 1)
         max_impacts = None if self.max_impacts is None else \
-            integer("max_impacts", self.max_impacts, 1, 2**62)
+            integer("max_impacts", self.max_impacts, 1, MAX_IMPACTS)
         if isinstance(self.rest_speed, (int, float)) and self.rest_speed == 0:
             raise ValueError(
                 "rest_speed must be > 0 (got 0): with e < 1 the impacts of a Zeno cascade "

@@ -385,3 +385,65 @@ def test_equal_arguments_make_equal_blocks_and_refusals_repeat():
     with pytest.raises(ValueError, match="hb"):
         Block(0.5, "housner")  # below 1/sqrt(2) for Housner's law
     assert Block(0.5, "mao").hb == 0.5
+
+
+# ---- the ends of the documented ranges -------------------------------------------------------
+
+#: Dampings inside the documented range [0, 1e4] too small to change a run: the renormalisation
+#: interval's quotient QR_CONTRACTION / (3/4 xi h) overflows an integer (subnormal xi too)
+TINY_XI = [1e-320, 2e-308, 2e-307]
+
+
+@pytest.mark.parametrize("xi", TINY_XI)
+def test_a_damping_too_small_to_matter_runs_as_undamped(xi):
+    # it ended in OverflowError ("cannot convert float infinity to integer"); such a damping
+    # changes no rounded sum of the equations, so the run is the undamped one, bit for bit
+    kw = dict(hb=1.0, alpha=0.6, omega=1.3, periods=3, lyapunov=True)
+    got, undamped = simulate(xi=xi, **kw), simulate(xi=0.0, **kw)
+    assert got.status == undamped.status and got.n_impacts == undamped.n_impacts
+    np.testing.assert_array_equal(got.state, undamped.state)
+    np.testing.assert_array_equal(got.lyapunov, undamped.lyapunov)
+
+
+@pytest.mark.parametrize("xi", TINY_XI)
+def test_a_damping_too_small_to_matter_grids_as_undamped(xi):
+    forcing, lattice = Harmonic(alpha=0.66, omega=1.3), Lattice(2)
+    kw = dict(integration=Integration(periods=2), lyapunov=True,
+              execution=Execution(threads=1, progress=False))
+    got = rockjit.basin(Block(1.0, xi=xi), forcing, lattice, **kw)
+    undamped = rockjit.basin(Block(1.0, xi=0.0), forcing, lattice, **kw)
+    np.testing.assert_array_equal(got.label, undamped.label)
+    np.testing.assert_array_equal(got.lambda_max, undamped.lambda_max)
+    np.testing.assert_array_equal(got.t_end, undamped.t_end)
+
+
+def test_renormalisation_interval_by_brute_force():
+    # the interval is the largest k <= N/2 with k * 3/4 xi h <= QR_CONTRACTION (at least 1):
+    # counted here in exact rationals, over dampings from subnormal to the range's end
+    from fractions import Fraction
+
+    from rockjit._engine.kernel import QR_CONTRACTION, default_qr_every
+    for n_steps, h in ((64, 0.07), (160, 0.03), (8, 0.5)):
+        for xi in TINY_XI + [1e-300, 1e-6, 2.208e-4, 1.0, 105.0, 1e4]:
+            c = Fraction(0.75 * xi * h)  # the kernel's own rounded product
+            k = n_steps // 2
+            while k > 1 and k * c > Fraction(QR_CONTRACTION):
+                k -= 1
+            assert default_qr_every(n_steps, h, xi) == k, (n_steps, h, xi)
+
+
+def test_default_impact_bound_fits_the_kernels_counter_for_every_period_count():
+    # 10,000 x 922337203685478 periods overflowed int64 (OverflowError from numpy)
+    from rockjit.settings import MAX_PERIODS
+    for periods in (1, 10, 10**4, 922337203685478, MAX_PERIODS):
+        bound = Integration(periods=periods).impact_bound()
+        assert bound == min(2**62, max(100_000, 10_000 * periods)) and bound < 2**63
+
+
+@pytest.mark.parametrize("periods", [922337203685478, 10**15])
+def test_the_largest_period_counts_are_refused_by_their_memory_not_an_overflow(periods):
+    with pytest.raises(ValueError, match=r"would need .* fits"):
+        simulate(**{**BASE, "periods": periods})
+    with pytest.raises(ValueError, match=r"would need .* fits"):
+        rockjit.basin(Block(1.0), Harmonic(alpha=0.66, omega=1.3), Lattice(2),
+                      integration=Integration(periods=periods))

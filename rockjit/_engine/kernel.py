@@ -117,7 +117,11 @@ def default_qr_every(n_steps, h, xi):
     n = n_steps // 2
     c = 0.75 * xi * h
     if c > 0.0:
-        n = min(n, max(1, int(QR_CONTRACTION / c)))
+        # compared in floating point first: for a damping as small as 1e-320 the quotient is
+        # infinite (or beyond any integer a step counter holds), and then twice a period stays
+        q = QR_CONTRACTION / c
+        if q < n:
+            n = max(1, int(q))
     return n
 
 
