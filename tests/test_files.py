@@ -25,6 +25,7 @@ from rockjit import _jit
 from rockjit.grids import runner as grid_runner
 from rockjit.storage import chunkstore as chunks
 from rockjit.storage import files as rio
+from rockjit.storage.ownership import RECORD
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -129,12 +130,12 @@ def test_output_dir_follows_the_umask(tmp_path, umask):
         out.table("t", ["a"], [[1.0]])
     assert _mode(tmp_path / "deep") == d_mode and _mode(fresh) == d_mode
     assert {p.name: _mode(p) for p in fresh.iterdir()} == \
-        {"summary.json": f_mode, "t.csv": f_mode, "t.md": f_mode}
+        {"summary.json": f_mode, "t.csv": f_mode, "t.md": f_mode, RECORD: f_mode}
     existing = tmp_path / "existing"
     existing.mkdir()
     with rio.OutputDir(existing) as out:
         out.npz("x.npz", x=np.arange(2))
-    assert _mode(existing / "x.npz") == f_mode
+    assert _mode(existing / "x.npz") == f_mode and _mode(existing / RECORD) == f_mode
 
 
 def test_chunk_store_follows_the_umask(tmp_path, umask):
@@ -165,20 +166,21 @@ def test_publish_into_a_new_directory(tmp_path):
     stage = o.staging
     assert stage.parent == tmp_path and stage.name.startswith(".out.")
     assert o.publish() is None  # nothing to warn about
-    assert o.written == ["basin.npz", "basin.png", "summary.json"]
+    assert o.written == [RECORD, "basin.npz", "basin.png", "summary.json"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # the stage was renamed
-    assert sorted(p.name for p in out.iterdir()) == ["basin.npz", "basin.png", "summary.json"]
+    assert sorted(p.name for p in out.iterdir()) == \
+        [RECORD, "basin.npz", "basin.png", "summary.json"]
     assert np.load(out / "basin.npz")["label"].tolist() == [0, 1, 2, 3]
     assert json.loads((out / "summary.json").read_text())["files"] == \
-        ["basin.npz", "basin.png", "summary.json"]
+        [RECORD, "basin.npz", "basin.png", "summary.json"]
     assert o.published and o.interrupted is None and o.warning is None
 
 
 def test_publish_into_an_existing_directory_keeps_the_users_files(tmp_path, monkeypatch):
     out = tmp_path / "out"
-    out.mkdir()
+    with rio.OutputDir(out, command="basin") as o:  # an earlier run's basin.npz
+        o.npz("basin.npz", label=np.arange(5))
     (out / "notes.txt").write_text("mine")
-    (out / "basin.npz").write_bytes(b"old")
     moved = []
     real = os.replace
 
@@ -191,8 +193,9 @@ def test_publish_into_an_existing_directory_keeps_the_users_files(tmp_path, monk
         o.npz("basin.npz", label=np.arange(3))
         monkeypatch.setattr(os, "replace", record)
     monkeypatch.setattr(os, "replace", real)
-    assert moved[-2:] == ["basin.npz", "summary.json"]  # summary.json last
-    assert sorted(p.name for p in out.iterdir()) == ["basin.npz", "notes.txt", "summary.json"]
+    assert moved[-3:] == [RECORD, "basin.npz", "summary.json"]  # the record first
+    assert sorted(p.name for p in out.iterdir()) == \
+        [RECORD, "basin.npz", "notes.txt", "summary.json"]
     assert (out / "notes.txt").read_text() == "mine"
     assert np.load(out / "basin.npz")["label"].tolist() == [0, 1, 2]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
@@ -249,15 +252,16 @@ def test_signal_during_staging_leaves_out_untouched(tmp_path, existing, ctrl_c):
 @pytest.mark.parametrize("existing", [False, True])
 def test_signal_during_publish_is_deferred(tmp_path, monkeypatch, existing):
     out = tmp_path / "out"
-    if existing:
-        out.mkdir()
-        (out / "plane.npz").write_bytes(b"old")
+    if existing:  # an earlier run's
+        with rio.OutputDir(out) as o:
+            o.npz("plane.npz", label=np.arange(2))
     handler = signal.getsignal(signal.SIGINT)
     real = {"rename": os.rename, "replace": os.replace}
 
     def interrupting(name):
         def move(src, dst):
-            os.kill(os.getpid(), signal.SIGINT)  # arrives in the middle of the moves
+            if Path(dst) == out or Path(dst).parent == out:  # a move into out
+                os.kill(os.getpid(), signal.SIGINT)  # arrives in the middle of the moves
             return real[name](src, dst)
         return move
 
@@ -270,7 +274,7 @@ def test_signal_during_publish_is_deferred(tmp_path, monkeypatch, existing):
     monkeypatch.undo()
     assert o.published and o.interrupted == signal.SIGINT
     assert signal.getsignal(signal.SIGINT) is handler
-    assert sorted(p.name for p in out.iterdir()) == ["plane.npz", "summary.json"]
+    assert sorted(p.name for p in out.iterdir()) == [RECORD, "plane.npz", "summary.json"]
     assert np.load(out / "plane.npz")["label"].tolist() == list(range(6))
 
 
@@ -285,6 +289,8 @@ CHILD_PUBLISH = """
         time.sleep(60)  # SIGTERM's default action ends the process here
     real = os.replace
     def slow(src, dst):
+        if os.path.dirname(dst) != sys.argv[1]:
+            return real(src, dst)  # not a move into out
         print("publishing", flush=True)
         time.sleep(0.5)  # SIGTERM arrives while the files are being moved
         real(src, dst)
@@ -296,9 +302,9 @@ CHILD_PUBLISH = """
 
 def test_sigterm_in_another_process(tmp_path):
     out = tmp_path / "out"
-    out.mkdir()
-    (out / "a.txt").write_text("old a")
-    (out / "summary.json").write_text("old summary")
+    with rio.OutputDir(out) as o:  # an earlier run's
+        o.text("a.txt", "old a")
+        o.text("summary.json", "old summary")
     (out / "user.txt").write_text("mine")
     before = _snapshot(tmp_path)
     # killed while staging: --out untouched; the next run removes the dead run's stage
@@ -322,7 +328,8 @@ def test_sigterm_in_another_process(tmp_path):
     assert stdout.split("\n")[-2] == "published True"
     assert {f: (out / f).read_text() for f in ("a.txt", "summary.json", "user.txt")} == \
         {"a.txt": "new a", "summary.json": "new summary", "user.txt": "mine"}
-    assert sorted(p.name for p in out.iterdir()) == ["a.txt", "summary.json", "user.txt"]
+    assert sorted(p.name for p in out.iterdir()) == [RECORD, "a.txt", "summary.json",
+                                                     "user.txt"]
 
 
 def test_stale_stages_only_of_dead_runs_on_this_host(tmp_path):
@@ -346,11 +353,11 @@ def test_stale_stages_only_of_dead_runs_on_this_host(tmp_path):
 
 def test_stale_warning_names_files_of_another_command(tmp_path):
     out = tmp_path / "out"
-    out.mkdir()
     old = {"command": "sweep", "files": ["sweep.npz", "bifurcation.png", "summary.json"]}
-    (out / "summary.json").write_text(json.dumps(old))
-    (out / "sweep.npz").write_bytes(b"s")
-    (out / "bifurcation.png").write_bytes(b"b")
+    with rio.OutputDir(out) as o:  # an earlier run of another command
+        o.json("summary.json", old)
+        o.text("sweep.npz", "s")
+        o.text("bifurcation.png", "b")
     o = rio.OutputDir(out, command="basin")
     o.npz("basin.npz", x=np.arange(2))
     o.json("summary.json", {"command": "basin", "files": ["basin.npz", "summary.json"]})
@@ -449,7 +456,7 @@ def test_table_writes_csv_and_markdown(tmp_path):
         ["hb,e", "1,0.123456", "x,nan"]
     assert (tmp_path / "out" / "e_table.md").read_text() == \
         "| hb | e |\n|---|---|\n| 1 | 0.123 |\n| x | nan |\n"
-    assert o.written == ["e_table.csv", "e_table.md"]
+    assert o.written == [RECORD, "e_table.csv", "e_table.md"]
 
 
 # ---------------------------------------------------------------------------------------------

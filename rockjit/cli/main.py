@@ -7,7 +7,10 @@ having written nothing. Then it computes and writes its data, its figure(s) and
 ``summary.json`` into a hidden staging directory, published into ``--out`` as one unit at the
 end (:class:`rockjit.storage.files.OutputDir`). Every problem with ``--out`` itself (a file, a
 dangling or looping link, a name too long, a directory named like an output file, a place that
-cannot be written) is found before any work, with the rest of the input.
+cannot be written, a file rockjit did not write where it would write one, another rockjit run
+writing into it) is found before any work, with the rest of the input; ``--out`` stays this
+run's until it is published (:mod:`rockjit.storage.ownership`). A figure that cannot be drawn
+does not lose the data: they are published without it, a line says so, exit status 3.
 
 One outcome per run: the exit status says whether ``--out`` was published. A command
 interrupted before that (SIGINT, Ctrl-C: exit status 130; SIGTERM: 143) leaves ``--out`` as it
@@ -148,7 +151,8 @@ OUTPUTS = {
     "fragility": ("fragility.npz", "fragility.*", "rotation.*"),
 }
 #: The commands whose grids keep their finished chunks in <out>.chunks.
-CHUNKED = ("sweep", "basin", "plane", "erosion", "orbits", "chart", "paper")
+CHUNKED = ("sweep", "basin", "plane", "erosion", "orbits", "chart", "paper", "spectrum",
+           "fragility")
 
 
 def _check_run(args):
@@ -578,9 +582,10 @@ def _fragility_plan(args):
 def _fragility_run(args, p, out):
     from . import outputs
     from ..ground.fragility import run
+    path = "compiled path" if p.method == "rockjit" else f"scipy path ({p.method.method})"
     _say(args, f"fragility: {p.runs} runs ({len(p.records)} records x "
                f"{p.intensities.size} intensities x {p.sizes.size} sizes x "
-               f"{len(p.blocks)} laws) on the scipy path")
+               f"{len(p.blocks)} laws) on the {path}")
     t0 = time.perf_counter()
     res = _grid(args, run, p, "fragility")
     wall = time.perf_counter() - t0
@@ -880,7 +885,7 @@ def build_parser():
                  "Scale every record to each intensity, run the block from rest for each "
                  "size and law, and fit lognormal fragility curves (median and dispersion by "
                  "maximum likelihood) to overturning and to max|theta|/alpha >= 0.5, 1. Writes "
-                 "fragility.npz, fragility.png, rotation.png and summary.json. Scipy path.")
+                 "fragility.npz, fragility.png, rotation.png and summary.json.")
     _add_block(p, alpha=False, omega=False, laws="housner, mao, constant or both")
     p.add_argument("--size", type=float, nargs="+", required=True, metavar="R",
                    help="the block's half-diagonal R in metres (several: the size effect)")
@@ -1023,8 +1028,10 @@ def _compile(args):
 def main(argv=None):
     """Run the command line; returns the exit status: 0 done (``--out`` published, also when a
     signal arrives after that: the line says so), 1 an error while running (one line, the
-    traceback in a report file), 2 bad input, 130 / 143 interrupted by SIGINT / SIGTERM before
-    ``--out`` was published (``--out`` as it was)."""
+    traceback in a report file), 2 bad input (or an ``--out`` rockjit may not write: a file it
+    did not write in the way, another run writing it), 3 published but a figure could not be
+    drawn (one line says which; its data are written), 130 / 143 interrupted by SIGINT /
+    SIGTERM before ``--out`` was published (``--out`` as it was)."""
     from ..storage.files import command_interrupts
     with command_interrupts() as sig:
         try:
@@ -1076,6 +1083,10 @@ def _main(argv, sig):
     try:
         plan = args.plan(args)
         _check_run(args)
+        # --out taken for this run (its lock), refused if it holds files rockjit did not write
+        out = sig.out = OutputDir(args.out, command=args.command)
+        out.claim(files=OUTPUTS.get(args.command, ()),
+                  figure_format=getattr(args, "format", None), name="--out")
     except (UsageError, ValueError) as exc:
         return _error(exc)
     from .._jit import cached_kernels
@@ -1086,6 +1097,7 @@ def _main(argv, sig):
         if args.command == "paper":  # every variant, side by side
             rc = _compile(args)
             if rc:
+                out.discard()
                 return rc
     import matplotlib
     matplotlib.use("Agg")
@@ -1093,7 +1105,6 @@ def _main(argv, sig):
     from ..grids.runner import NoWorkers, worker_timeout
     from ..plotting import style
     timeout = getattr(args, "scheduler_timeout", None)
-    out = sig.out = OutputDir(args.out, command=args.command)
     out.figure_format = getattr(args, "format", None)
     out.dpi = style.STYLES[getattr(args, "style", "default")].rc["savefig.dpi"]
     n = n0 = len(sig.received)
@@ -1134,6 +1145,9 @@ def _main(argv, sig):
     try:
         if note:
             _warn(note)
+        for f in out.figure_errors:
+            _warn(f"{f['name']} could not be drawn ({f['error']}); the data were written "
+                  f"without it (exit status 3)")
         if args.command in CHUNKED:
             from ..storage.chunkstore import remove_stores
             remove_stores(_chunk_root(args), message=lambda m: _say(args, m))
@@ -1142,8 +1156,9 @@ def _main(argv, sig):
         _warn(f"{args.out} was written; cleaning up after it failed ({type(exc).__name__}: "
               f"{exc})")
     pause_for_tests("wrote", sig)
+    status = 3 if out.figure_errors else 0  # published, a figure missing
     late = ([out.interrupted] if out.interrupted else []) + sig.received[n:]
     if late:
         print(f"{PROG}: {signal_name(late[0])} arrived after {args.out} was written; the "
-              f"command has completed (exit status 0)", file=sys.stderr, flush=True)
-    return 0
+              f"command has completed (exit status {status})", file=sys.stderr, flush=True)
+    return status

@@ -6,9 +6,15 @@ One function per kind of result writes it into an output directory object
 The command line and the paper (:func:`rockjit.study.paper`) both write through these, so a
 sweep or a basin has the same files wherever it was computed. Every file is described
 (``out.describe``): ``summary.json`` lists each with what it holds.
+
+The data come first and never depend on a figure: a figure that cannot be drawn or written is
+left out and noted (``out.figure_failed``; ``summary.json``'s ``figures_failed``), and the
+command goes on (the command line publishes the data and says so, exit status 3).
 """
 
 from __future__ import annotations
+
+import functools
 
 import numpy as np
 
@@ -27,17 +33,32 @@ def manifest(out):
 
 def summary(out, command, inputs, wall, **results):
     """``summary.json``'s content: the command and its inputs, rockjit's version, the wall
-    time, the behaviour names, every file written with what it holds (``files``), and the
-    command's ``results``."""
+    time, the behaviour names, every file written with what it holds (``files``), the figures
+    that could not be drawn (``figures_failed``, only if any) and the command's ``results``."""
     from .. import __version__
     from ..result import BEHAVIOURS
+    failed = list(getattr(out, "figure_errors", []))
+    extra = dict(figures_failed=failed) if failed else {}
     return dict(command=command, rockjit_version=__version__, inputs=inputs, wall_s=wall,
-                behaviours=list(BEHAVIOURS), files=manifest(out), **results)
+                behaviours=list(BEHAVIOURS), files=manifest(out), **extra, **results)
 
 
-def _figure(out, name, fig, holds):
-    """Write a figure (in the output's format) and describe it; returns its name."""
-    written = out.figure(name, fig)
+def _figure(out, name, draw, holds):
+    """Draw a figure (``draw()``, or a figure already drawn), write it in the output's format
+    and describe it; returns its name. Where it cannot be drawn or written and ``out`` can note
+    that (``figure_failed``), it is noted and ``None`` returned: the data stay."""
+    fig = None
+    try:
+        fig = draw() if callable(draw) else draw
+        written = out.figure(name, fig)
+    except Exception as exc:  # any failure of a drawing: the data must not be lost with it
+        if not hasattr(out, "figure_failed"):
+            raise
+        if fig is not None:
+            import matplotlib.pyplot as plt
+            plt.close(fig)
+        out.figure_failed(name, exc)
+        return None
     written = written if isinstance(written, str) else name
     out.describe(written, holds)
     return written
@@ -57,7 +78,7 @@ def trajectory(out, res, *, npz="trajectory.npz", png="trajectory.png"):
     name, period = classify_result(res)
     _npz(out, npz, "the run's arrays: t, theta, dtheta, r, s (recorded trajectory), strobe, "
                    "strobe_half, impacts (t, dtheta-, dtheta+), lyapunov_running", **res.arrays())
-    _figure(out, png, fig_trajectory(res, (name, period)),
+    _figure(out, png, lambda: fig_trajectory(res, (name, period)),
             f"theta(t) over the first and the last periods, the running exponent and the "
             f"phase portrait (data: {npz})")
     return dict(res.summary(), behaviour=name, period=period)
@@ -70,7 +91,7 @@ def sweep(out, sw, *, npz="sweep.npz", png="bifurcation.png"):
                    "(exact where periodic), lambda_window (finite-window estimate), strobe "
                    "(theta, theta' at kT), impact_section, t_end, attractor", **sw.arrays())
     if png:
-        _figure(out, png, fig_bifurcation(sw),
+        _figure(out, png, lambda: fig_bifurcation(sw),
                 f"bifurcation diagram: theta'(kT) against alpha by behaviour, lambda_max "
                 f"below (data: {npz})")
     summary = dict(n_alpha=int(sw.alpha.size), fractions=sw.fractions(), settings=sw.settings,
@@ -107,7 +128,7 @@ def basins(out, res, *, npz="basin.npz", png="basin.png", attractors_png="attrac
     if len(res) == 1:
         arrays.update(of(first, ""))
         results = summary(first)
-        fig = fig_basin(first)
+        draw = functools.partial(fig_basin, first)
     else:
         for law, b in res.items():
             arrays.update(of(b, f"_{law}"))
@@ -116,16 +137,16 @@ def basins(out, res, *, npz="basin.npz", png="basin.png", attractors_png="attrac
         results["agreement"] = agreement(a.label, b.label)
         if a.attractor is not None and b.attractor is not None:
             results["attractor_agreement"] = attractor_agreement(a, b)
-        fig = fig_basin_compare(a, b)
+        draw = functools.partial(fig_basin_compare, a, b)
     laws = " per law (suffix _<law>)" if len(res) > 1 else ""
     _npz(out, npz, f"theta0, dtheta0 and{laws} label (label[i, j] of theta0[i], dtheta0[j]), "
                    f"period, t_end, attractor ids, exponents and uncertain cells when "
                    f"computed", **arrays)
-    _figure(out, png, fig, f"the behaviour of each initial state{laws}"
+    _figure(out, png, draw, f"the behaviour of each initial state{laws}"
                            + (" and where the laws agree" if len(res) > 1 else "")
                            + f" (data: {npz})")
     if attractors_png and first.attractor is not None:
-        _figure(out, attractors_png, fig_attractors(res),
+        _figure(out, attractors_png, lambda: fig_attractors(res),
                 f"the attractor each initial state reaches, by name, with basin entropy and "
                 f"integrity (data: {npz}, attractor)")
     results.update(r0=first.settings.get("r0"), s0=first.settings.get("s0"))
@@ -146,8 +167,8 @@ def plane(out, pl, *, npz="plane.npz", png="plane.png"):
     _npz(out, npz, "alpha, omega, z0, label (label[i, j] of alpha[i], omega[j]), period, "
                    "lambda_max (exact where periodic), lambda_window, t_end, attractor",
          **arrays)
-    _figure(out, png, fig_plane(pl), f"behaviour and lambda_max over the forcing plane "
-                                     f"(data: {npz})")
+    _figure(out, png, lambda: fig_plane(pl),
+            f"behaviour and lambda_max over the forcing plane (data: {npz})")
     summary = dict(fractions=pl.fractions(), settings=pl.settings,
                    restitution=pl.block.restitution, attractors=pl.attractor_summary())
     if pl.uncertain is not None:
@@ -165,8 +186,9 @@ def erosion(out, res, *, npz="erosion.npz", png="erosion.png"):
                    "attractor and label maps of every basin",
          alpha=first.alpha, theta0=first.theta0, dtheta0=first.dtheta0,
          **{k: v for law, r in res.items() for k, v in r.arrays(f"_{law}").items()})
-    _figure(out, png, fig_erosion(res), f"integrity (GIM, IF) against alpha and the basin of "
-                                        f"each attractor, stacked (data: {npz})")
+    _figure(out, png, lambda: fig_erosion(res),
+            f"integrity (GIM, IF) against alpha and the basin of each attractor, stacked "
+            f"(data: {npz})")
     return {law: r.to_summary() for law, r in res.items()}
 
 
@@ -177,8 +199,8 @@ def fate(out, fr, *, npz="fate.npz", png="fate.png"):
     _npz(out, npz, "the members' initial states, outcome ids (-1 overturn, -2 unresolved, "
                    "attractors from 0) and end times", initial=fr.initial, outcome=fr.outcome,
          t_end=fr.t_end)
-    _figure(out, png, fig_fate(fr), f"each outcome's probability and when each member's run "
-                                    f"ended (data: {npz})")
+    _figure(out, png, lambda: fig_fate(fr),
+            f"each outcome's probability and when each member's run ended (data: {npz})")
     return fr.to_summary()
 
 
@@ -193,9 +215,9 @@ def orbits(out, res, *, npz="orbits.npz", png="orbits.png", caption="orbits.md")
     _npz(out, npz, "per branch i: branch{i}_value, _cycle, _multipliers, _stable, ...; the "
                    "bifurcations: bif_type, bif_value, bif_period, bif_multipliers",
          **arrays)
-    _figure(out, png, fig_branches(cont, sw), f"branches of periodic orbits over the sweep, "
-                                              f"bifurcations marked (data: {npz}; list: "
-                                              f"{caption})")
+    _figure(out, png, lambda: fig_branches(cont, sw),
+            f"branches of periodic orbits over the sweep, bifurcations marked (data: {npz}; "
+            f"list: {caption})")
     out.text(caption, branch_caption(cont))
     out.describe(caption, "the branches' caption: every bifurcation with its multipliers and "
                           "where and why each branch stops")
@@ -226,9 +248,9 @@ def chart(out, res, *, npz="chart.npz", png="chart.png"):
     _npz(out, npz, "the charts' labels, periods and axes (suffix _<law> with two laws) and "
                    "every bifurcation curve: curve{i}_alpha, _omega, _state, _multipliers, "
                    "_condition; curve_type, curve_period, curve_law", **arrays)
-    figure = _figure(out, png, fig_chart(res), f"the behaviour chart over (alpha, omega) with "
-                                               f"its bifurcation curves, per law and both "
-                                               f"overlaid (data: {npz})")
+    figure = _figure(out, png, lambda: fig_chart(res),
+                     f"the behaviour chart over (alpha, omega) with its bifurcation curves, per "
+                     f"law and both overlaid (data: {npz})")
     return dict(curves=[c.to_dict() for c in curves], charts=charts, figure=figure)
 
 
@@ -250,9 +272,9 @@ def spectrum(out, res, *, npz="spectrum.npz", png="spectrum.png"):
                    "into outcomes), max rotation and the located minimum overturning amplitude "
                    "per ratio with its mode", **arrays)
     comparison = compare(*res.values()) if two else None
-    _figure(out, png, fig_spectrum(res, comparison), f"the overturning spectrum: the two modes "
-                                                     f"of overturning and the safe region, per "
-                                                     f"law (data: {npz})")
+    _figure(out, png, lambda: fig_spectrum(res, comparison),
+            f"the overturning spectrum: the two modes of overturning and the safe region, per "
+            f"law (data: {npz})")
     if len(res) == 1:
         return dict(first.summary(), outcomes=list(OUTCOMES))
     summary = {law: sp.summary() for law, sp in res.items()}
@@ -271,8 +293,10 @@ def fragility(out, fr, *, npz="fragility.npz", png="fragility.png", rotation_png
                    "law, outcome (index into outcomes), max rotation; the fitted fragility "
                    "curves' medians and dispersions", outcomes=np.asarray(OUTCOMES, dtype=str),
          **fr.arrays())
-    _figure(out, png, fig_fragility(fr), f"the overturning fraction against intensity with "
-                                         f"the lognormal fragility fits, both laws (data: {npz})")
-    _figure(out, rotation_png, fig_rotation(fr), f"rotation exceedance (max|theta|/alpha_s >= "
-                                                 f"0.5 and 1) against intensity (data: {npz})")
+    _figure(out, png, lambda: fig_fragility(fr),
+            f"the overturning fraction against intensity with the lognormal fragility fits, "
+            f"both laws (data: {npz})")
+    _figure(out, rotation_png, lambda: fig_rotation(fr),
+            f"rotation exceedance (max|theta|/alpha_s >= 0.5 and 1) against intensity "
+            f"(data: {npz})")
     return dict(fr.summary(), outcomes=list(OUTCOMES))

@@ -50,6 +50,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .ownership import RECORD, RECORD_HOLDS, PublishLock, Record, digest, refusal, unproven
+
 __all__ = ["OutputDir", "atomic_open", "boot_id", "boot_time", "check_out",
            "command_interrupts", "create_temp", "defer_signals", "host_name",
            "installed_interrupts", "interrupt_handler", "interrupted", "markdown_table",
@@ -505,7 +507,7 @@ def _remove_stale_stages(parent, prefix):
 
 def _check_name(name):
     if (not isinstance(name, str) or name in ("", ".", "..") or "/" in name or os.sep in name
-            or (os.altsep and os.altsep in name) or name.startswith(f".{_STAGE}")):
+            or (os.altsep and os.altsep in name) or name.startswith(".rockjit-")):
         raise ValueError(f"an output file name must be a plain file name (got {name!r})")
     return name
 
@@ -708,9 +710,19 @@ class OutputDir:
 
     On any failure or interrupt before :meth:`publish`, :meth:`discard` (called by the ``with``
     statement) removes the staging directory and any parent directories it made, and ``path``
-    is exactly as before. Only the files the command writes are replaced; other files in
-    ``path`` are never touched. Staging directories of runs that died (their pid no longer
-    exists on this host) are removed when the next run on the same ``path`` starts writing.
+    is exactly as before. Staging directories of runs that died (their pid no longer exists on
+    this host) are removed when the next run on the same ``path`` starts writing.
+
+    Only rockjit's own files are ever replaced (:mod:`rockjit.storage.ownership`): ``path``
+    holds rockjit's record of the files it wrote there (``.rockjit-files.json``, published
+    with the outputs and listed in ``written``), and a file the record does not prove
+    rockjit's (the user's, one changed since, one of a directory written before rockjit kept
+    a record) is never replaced: :meth:`claim` refuses it before any work, and
+    :meth:`publish` refuses the whole set (``ValueError``, nothing published) rather than
+    replace it. One command at a time: :meth:`claim` (or the first write) takes the lock of
+    ``path`` (:class:`rockjit.storage.ownership.PublishLock`), held until :meth:`publish`
+    or :meth:`discard`; a second :class:`OutputDir` on the same ``path`` is refused while it
+    is held, and :meth:`publish` refuses if another run published into ``path`` meanwhile.
 
     Parameters
     ----------
@@ -732,6 +744,8 @@ class OutputDir:
         if one did.
     warning : str or None
         :meth:`stale_warning` as it stood when :meth:`publish` began (what it returned).
+    figure_errors : list of dict
+        ``{"name", "error"}`` of each figure that could not be drawn (:meth:`figure_failed`).
 
     Examples
     --------
@@ -770,9 +784,49 @@ class OutputDir:
         self.published = False
         self.interrupted = None
         self.warning = None
+        self.figure_errors = []
+        self.name = "out"
         self._stage = None
         self._inside = False
         self._made = []
+        self._lock = None
+        self._seen = None
+
+    # -- the claim ------------------------------------------------------------------------------
+
+    def claim(self, files=None, figure_format=None, name="out"):
+        """Take ``path`` for this command, before any work: its lock, and the record's state.
+
+        Raises ``ValueError`` (one line naming ``name``) when another run holds the lock, when
+        rockjit's record there cannot be read, or, given ``files`` (the names or ``fnmatch``
+        patterns the command writes; ``stem.*`` stands for its data and figures in
+        ``figure_format``), when ``path`` holds a file of those names that is not provably
+        rockjit's. Called by the first write if not before; released by :meth:`publish` and
+        :meth:`discard`.
+        """
+        if self._lock is not None:
+            return
+        self.name = name
+        lock = PublishLock(self.path, name=name)
+        lock.acquire()
+        try:
+            rec = Record.read(self.path)
+            theirs = []
+            if files is not None and rec.state != "damaged":
+                theirs = unproven(self.path, files, figure_format or self.figure_format, rec)
+            if theirs or rec.state == "damaged":
+                raise ValueError(refusal(self.path, theirs, rec, name))
+        except BaseException:
+            lock.release()
+            raise
+        self._seen = rec.run if rec.state == "ok" else None
+        self._lock = lock
+
+    def _unlock(self, also=None):
+        for lock in (self._lock, also):
+            if lock is not None:
+                lock.release()
+        self._lock = None
 
     # -- staging --------------------------------------------------------------------------------
 
@@ -788,11 +842,25 @@ class OutputDir:
         if self._stage is not None:
             return self._stage
         out = self.path
+        if os.path.lexists(out) and not out.is_dir():
+            raise ValueError(f"out must be a directory (got {out}, an existing file)")
+        claimed = self._lock is None
+        self.claim()
+        try:
+            stage = self._make_stage()
+        except BaseException:
+            if claimed:
+                self._unlock()
+            raise
+        self._add(RECORD)  # written at publish
+        self.holds.setdefault(RECORD, RECORD_HOLDS)
+        return stage
+
+    def _make_stage(self):
+        out = self.path
         host, pid = host_name(), os.getpid()
         sibling = _sibling_prefix(out)
         if os.path.lexists(out):
-            if not out.is_dir():
-                raise ValueError(f"out must be a directory (got {out}, an existing file)")
             _remove_stale_stages(out, f".{_STAGE}-")
             if sibling:
                 _remove_stale_stages(out.parent, sibling)
@@ -851,6 +919,14 @@ class OutputDir:
         self._add(name)
         fig.clear()
         return name
+
+    def figure_failed(self, name, exc):
+        """Note that the figure ``name`` could not be drawn or written (``exc``): the command
+        goes on without it (its data are written all the same) and says so."""
+        if self.figure_format:
+            name = f"{Path(name).stem}.{self.figure_format}"
+        self.figure_errors.append(
+            {"name": name, "error": f"{type(exc).__name__}: {' '.join(str(exc).split())}"})
 
     def describe(self, name, holds):
         """Say what file ``name`` holds (one line), for the manifest of ``summary.json``."""
@@ -916,6 +992,10 @@ class OutputDir:
     def publish(self):
         """Move the staged files into ``path`` as one unit (see the class docstring).
 
+        Raises ``ValueError``, having published nothing, when ``path`` now holds a file this
+        run would replace that is not provably rockjit's, or another run published into
+        ``path`` since :meth:`claim`.
+
         Returns
         -------
         str or None
@@ -928,35 +1008,79 @@ class OutputDir:
         stage = self._stage
         if stage is None:  # nothing was written: nothing to create
             self.published = True
+            self._unlock()
             return None
-        missing = [n for n in self.written if not (stage / n).is_file()]
+        names = [n for n in self.written if n != RECORD]
+        missing = [n for n in names if not (stage / n).is_file()]
         if missing:
             raise FileNotFoundError(errno.ENOENT, "staged output never written",
                                     str(stage / missing[0]))
-        order = [n for n in self.written if n != SUMMARY] + \
-            [n for n in self.written if n == SUMMARY]
+        order = [n for n in names if n != SUMMARY] + [n for n in names if n == SUMMARY]
         self.warning = self.stale_warning()
         if self._inside:
             self._check_targets(order)
-        with defer_signals() as got:
-            moved = False
-            if not self._inside:
-                try:
-                    os.rename(stage, self.path)
-                    moved = True
-                except OSError as exc:  # --out appeared meanwhile: publish file by file
-                    if exc.errno not in (errno.EEXIST, errno.ENOTEMPTY):
-                        raise
-                    self._check_targets(order)
-            if not moved:
-                for n in order:
-                    os.replace(stage / n, self.path / n)
-                shutil.rmtree(stage, ignore_errors=True)
-            self._stage = None
-            self._made = []
-            self.published = True
+        self._stage_record(order)
+        inside = None  # the lock inside path, when path appeared while this run staged beside it
+        try:
+            with defer_signals() as got:
+                moved = False
+                if not self._inside:
+                    try:
+                        os.rename(stage, self.path)
+                        moved = True
+                    except OSError as exc:  # path appeared meanwhile: publish file by file
+                        if exc.errno not in (errno.EEXIST, errno.ENOTEMPTY):
+                            raise
+                        self._check_targets(order)
+                        inside = PublishLock(self.path, name=self.name)
+                        inside.acquire()
+                        self._stage_record(order)
+                if not moved:
+                    for n in [RECORD] + order:  # the record first: it proves old and new
+                        os.replace(stage / n, self.path / n)
+                    shutil.rmtree(stage, ignore_errors=True)
+                self._stage = None
+                self._made = []
+                self.published = True
+        finally:
+            if inside is not None:
+                inside.release()
+        self._unlock()
         self.interrupted = got[0] if got else None
         return self.warning
+
+    def _stage_record(self, order):
+        """Check that ``path`` is as :meth:`claim` saw it (no other run published there since)
+        and that each of ``order`` it holds is rockjit's; stage the record of the files rockjit
+        will have there: this run's, and the earlier ones still rockjit's."""
+        from .. import __version__
+        rec = Record.read(self.path)
+        now = rec.run if rec.state == "ok" else None
+        if rec.state == "damaged" or now != self._seen:
+            raise ValueError(f"{self.name} {self.path} was written by another rockjit run while "
+                             f"this one ran; nothing of this run was published: run it again, "
+                             f"or choose another {self.name}")
+        files, theirs = {}, []
+        for n, entry in rec.files.items():  # earlier files that stay, still rockjit's
+            if n not in order and rec.proves(self.path, n):
+                files[n] = {"versions": [v for v in entry["versions"]
+                                         if rec.proves(self.path, n, only=v)]}
+        for n in order:
+            size, sha = digest(self._stage / n)
+            versions = [{"size": size, "sha256": sha}]
+            target = self.path / n
+            if os.path.lexists(target):
+                have = digest(target)
+                if not rec.proves(self.path, n, have):
+                    theirs.append(n)
+                    continue
+                if have != (size, sha):  # until it is replaced, the old one is rockjit's too
+                    versions.append({"size": have[0], "sha256": have[1]})
+            files[n] = {"versions": versions}
+        if theirs:
+            raise ValueError(refusal(self.path, theirs, rec, self.name)
+                             + "; nothing of this run was published")
+        write_json(self._stage / RECORD, Record.write_data(files, self.command, __version__))
 
     def _check_targets(self, names):
         if not self.path.is_dir():
@@ -967,13 +1091,14 @@ class OutputDir:
                 raise ValueError(f"cannot write {t}: a directory of that name is in the way")
 
     def discard(self):
-        """Remove the staging directory and any parent directories it made: ``path`` is as
-        before."""
+        """Remove the staging directory and any parent directories it made, and give the lock
+        back: ``path`` is as before."""
         if self._stage is not None:
             shutil.rmtree(self._stage, ignore_errors=True)
             self._stage = None
         _rmdirs(self._made)
         self._made = []
+        self._unlock()
 
     def __enter__(self):
         return self
