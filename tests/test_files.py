@@ -980,3 +980,192 @@ def test_check_cache_user_wide_folder_when_pycache_is_unusable(tmp_path, monkeyp
     (pkg / "integrate.py").write_text("# edited\n")
     _jit.check_cache(pkg)
     assert sorted(p.name for p in folder.iterdir()) == sorted([_jit.STAMP, "other.f-1.py311.nbi"])
+
+
+# ---------------------------------------------------------------------------------------------
+# 6. only rockjit's own files are replaced; one command at a time per output directory
+# ---------------------------------------------------------------------------------------------
+
+SPECTRUM = ["spectrum", "--hb", "4", "--ratio-range", "1", "5", "--amplitude-range", "1.5", "9",
+            "--grid", "2", "2", "--tol", "1e-3", "--quiet"]
+
+
+def _no_work(monkeypatch):
+    """Any computation of a spectrum fails the test: the refusal must come before it."""
+    import importlib
+    spectrum_module = importlib.import_module("rockjit.ground.spectrum")
+    monkeypatch.setattr(spectrum_module, "run",
+                        lambda *a, **k: pytest.fail("not refused before any work"))
+
+
+def _published(out, files):
+    """An earlier rockjit run's ``files`` (name -> bytes) published into ``out``."""
+    with rio.OutputDir(out) as o:
+        for name, data in files.items():
+            with rio.atomic_open(o.file(name), "wb") as fh:
+                fh.write(data)
+
+
+def test_a_users_files_are_refused_before_any_work(tmp_path, monkeypatch, capsys):
+    # a user's summary.json and spectrum.png were replaced, exit 0, nothing said
+    from rockjit.cli.main import main
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "summary.json").write_text('{"mine": true}')
+    (out / "spectrum.png").write_bytes(b"my figure")
+    (out / "notes.txt").write_text("mine too")
+    before = _snapshot(tmp_path)
+    _no_work(monkeypatch)
+    assert main(SPECTRUM + ["--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"rockjit: error: --out {out} holds spectrum.png, summary.json") \
+        and err.count("\n") == 1, err
+    assert "notes.txt" not in err  # not a name spectrum writes
+    assert _snapshot(tmp_path) == before
+
+
+def test_a_file_changed_since_rockjit_wrote_it_is_the_users(tmp_path):
+    out = tmp_path / "o"
+    _published(out, {"summary.json": b"{}", "spectrum.png": b"rockjit's figure"})
+    patterns = ("spectrum.npz", "spectrum.*")
+    from rockjit.storage.ownership import unproven
+    assert unproven(out, patterns) == []  # both provably rockjit's: replaced without a word
+    with rio.OutputDir(out) as o:
+        o.claim(files=patterns)
+        o.text("spectrum.png", "a new figure")
+    assert (out / "spectrum.png").read_text() == "a new figure"
+    (out / "spectrum.png").write_text("a new figure, edited")  # same name, the user's bytes
+    os.symlink("summary.json", out / "spectrum.npz")  # a link is never rockjit's
+    assert unproven(out, patterns) == ["spectrum.npz", "spectrum.png"]
+    assert unproven(out, patterns, figure_format="pdf") == ["spectrum.npz"]
+    before = _snapshot(tmp_path)
+    with pytest.raises(ValueError, match=r"holds spectrum.npz, spectrum.png, which rockjit did "
+                                         r"not write \(or which changed since"):
+        rio.OutputDir(out).claim(files=patterns)
+    # written without a claim (the API): refused whole when publishing, nothing moved
+    o = rio.OutputDir(out)
+    o.text("summary.json", "new")
+    o.text("spectrum.png", "new")
+    with pytest.raises(ValueError, match="holds spectrum.png, .*nothing of this run was "
+                                         "published"):
+        o.publish()
+    o.discard()
+    assert _snapshot(tmp_path) == before
+
+
+def test_a_folder_of_an_older_version_is_refused_saying_how_to_proceed(tmp_path, monkeypatch,
+                                                                       capsys):
+    # written before rockjit kept a record: its files cannot be told from the user's
+    from rockjit.cli.main import main
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "summary.json").write_text(json.dumps({"command": "spectrum",
+                                                  "rockjit_version": "0.1.0"}))
+    (out / "spectrum.npz").write_bytes(b"PK\x03\x04")
+    before = _snapshot(tmp_path)
+    _no_work(monkeypatch)
+    assert main(SPECTRUM + ["--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "says rockjit 0.1.0 wrote" in err and "choose an empty or new --out" in err
+    assert err.count("\n") == 1 and _snapshot(tmp_path) == before
+    # a record that cannot be read proves nothing either
+    _published(tmp_path / "d", {"spectrum.npz": b"x"})
+    (tmp_path / "d" / RECORD).write_text("{not json")
+    with pytest.raises(ValueError, match="record of the files it wrote there .* cannot be read"):
+        rio.OutputDir(tmp_path / "d").claim(files=("spectrum.npz",))
+
+
+def test_the_record_lists_every_file_and_survives_a_run_killed_between_moves(tmp_path,
+                                                                            monkeypatch):
+    out = tmp_path / "o"
+    _published(out, {"a.npz": b"old a", "b.npz": b"old b", "summary.json": b"old"})
+    real = os.replace
+    moves = []
+
+    def dies_after_two(src, dst):
+        if Path(dst).parent == out:
+            moves.append(Path(dst).name)
+            if len(moves) == 3:
+                raise SystemExit("killed")  # as if the process died here
+        return real(src, dst)
+
+    o = rio.OutputDir(out)
+    o.text("a.npz", "new a")
+    o.text("b.npz", "new b")
+    o.text("summary.json", "new")
+    monkeypatch.setattr(os, "replace", dies_after_two)
+    with pytest.raises(SystemExit):
+        o.publish()
+    monkeypatch.undo()
+    o._unlock()
+    assert moves[:2] == [RECORD, "a.npz"]  # the record first
+    assert (out / "a.npz").read_text() == "new a" and (out / "b.npz").read_text() == "old b"
+    from rockjit.storage.ownership import unproven
+    assert unproven(out, ("*.npz",)) == []  # the new a and the old b: both rockjit's
+    record = json.loads((out / RECORD).read_text())
+    import hashlib
+    for name in ("a.npz", "b.npz", "summary.json"):  # against digests computed here
+        data = (out / name).read_bytes()
+        assert {"size": len(data), "sha256": hashlib.sha256(data).hexdigest()} in \
+            record["files"][name]["versions"]
+
+
+def test_one_command_at_a_time_per_output_directory(tmp_path):
+    for out in (tmp_path / "new", tmp_path / "existing"):
+        if out.name == "existing":
+            out.mkdir()
+        first = rio.OutputDir(out)
+        first.claim()
+        with pytest.raises(ValueError, match=f"^out {out} is being written by another rockjit "
+                                             f"run \\(pid {os.getpid()}, since "):
+            rio.OutputDir(out).claim()
+        first.text("summary.json", "first")
+        first.publish()
+        with rio.OutputDir(out) as second:  # free again once the first has published
+            second.text("summary.json", "second")
+        assert (out / "summary.json").read_text() == "second"
+    assert sorted(os.listdir(tmp_path)) == ["existing", "new"]  # no lock file left
+
+
+CHILD_CLAIM = """
+    import sys, time
+    from rockjit.storage import files as rio
+    out = rio.OutputDir(sys.argv[1])
+    out.claim(name="--out")
+    print("claimed", flush=True)
+    time.sleep(120)
+"""
+
+
+def test_a_second_command_is_refused_until_the_first_ends_however_it_ends(tmp_path, capsys):
+    from rockjit.cli.main import main
+    out = tmp_path / "o"
+    child = _run_child(CHILD_CLAIM, out)
+    _expect_line(child, "claimed")
+    assert main(["cor", "--quiet", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err == (f"rockjit: error: --out {out} is being written by another rockjit run "
+                   f"(pid {child.pid}, since {err.split('since ')[1].split(')')[0]}); wait for "
+                   f"it to finish, or choose another --out\n")
+    child.kill()  # SIGKILL: no clean-up of its own; the kernel gives its lock back
+    child.wait(timeout=60)
+    assert main(["cor", "--quiet", "--out", str(out)]) == 0
+    assert sorted(os.listdir(tmp_path)) == ["o"]
+
+
+def test_a_run_that_finds_out_published_by_another_meanwhile_refuses(tmp_path):
+    # --out absent when the first run took it (its lock beside --out); made and published into
+    # by a second run (its lock inside) before the first publishes
+    out = tmp_path / "o"
+    first = rio.OutputDir(out)
+    first.claim()
+    first.text("summary.json", "first")
+    out.mkdir()
+    with rio.OutputDir(out) as second:
+        second.text("summary.json", "second")
+    with pytest.raises(ValueError, match="was written by another rockjit run while this one "
+                                         "ran; nothing of this run was published"):
+        first.publish()
+    first.discard()
+    assert (out / "summary.json").read_text() == "second"
+    assert sorted(os.listdir(tmp_path)) == ["o"]

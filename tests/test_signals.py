@@ -86,12 +86,14 @@ def test_a_signal_during_the_imports(tmp_path, name):
 def test_a_signal_during_the_work_leaves_out_as_it_was(tmp_path, name, how):
     signum, status = SIGNALS[name]
     out = tmp_path / "o"
-    out.mkdir()
-    (out / "summary.json").write_text("an earlier run's")
+    from rockjit.storage.files import OutputDir
+    with OutputDir(out) as earlier:  # an earlier run's (rockjit replaces only its own files)
+        earlier.text("summary.json", "an earlier run's")
     rc, err = _signalled(COR + ["--out", "o"], tmp_path, "work", signum, how)
     assert rc == status and "Traceback" not in err, err
     assert f"rockjit: interrupted ({name}); --out is as it was" in err
-    assert _entries(tmp_path) == ["o"] and _entries(out) == ["summary.json"]
+    assert _entries(tmp_path) == ["o"] and _entries(out) == [".rockjit-files.json",
+                                                              "summary.json"]
     assert (out / "summary.json").read_text() == "an earlier run's"
 
 
