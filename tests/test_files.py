@@ -1169,3 +1169,41 @@ def test_a_run_that_finds_out_published_by_another_meanwhile_refuses(tmp_path):
     first.discard()
     assert (out / "summary.json").read_text() == "second"
     assert sorted(os.listdir(tmp_path)) == ["o"]
+
+
+# ---------------------------------------------------------------------------------------------
+# 7. a figure that cannot be drawn never loses the data
+# ---------------------------------------------------------------------------------------------
+
+def test_a_figure_that_cannot_be_drawn_keeps_a_trajectorys_data(tmp_path, monkeypatch, capsys):
+    import importlib
+    from rockjit.cli.main import main
+    argv = ["trajectory", "--hb", "1", "--alpha", "0.6", "--omega", "1.3", "--periods", "20",
+            "--n-steps", "64", "--quiet", "--format", "svg"]
+    assert main(argv + ["--out", str(tmp_path / "drawn")]) == 0
+
+    def broken(*a, **k):
+        raise RuntimeError("no room\nfor the legend")
+
+    monkeypatch.setattr(importlib.import_module("rockjit.plotting.figures"), "fig_trajectory",
+                        broken)
+    out = tmp_path / "failed"
+    capsys.readouterr()
+    assert main(argv + ["--out", str(out)]) == 3
+    assert capsys.readouterr().err == (
+        "rockjit: warning: trajectory.svg could not be drawn (RuntimeError: no room for the "
+        "legend); the data were written without it (exit status 3)\n")
+    assert sorted(os.listdir(out)) == [RECORD, "summary.json", "trajectory.npz"]
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["figures_failed"] == [{"name": "trajectory.svg",
+                                          "error": "RuntimeError: no room for the legend"}]
+    with np.load(out / "trajectory.npz") as got, \
+            np.load(tmp_path / "drawn" / "trajectory.npz") as ref:
+        assert sorted(got.files) == sorted(ref.files)
+        for k in ref.files:
+            assert np.array_equal(got[k], ref[k], equal_nan=True), k
+    # the record proves what was written: a rerun that can draw replaces the files
+    monkeypatch.undo()
+    assert main(argv + ["--out", str(out)]) == 0
+    assert sorted(os.listdir(out)) == [RECORD, "summary.json", "trajectory.npz",
+                                       "trajectory.svg"]

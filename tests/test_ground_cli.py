@@ -107,3 +107,33 @@ def test_the_scipy_path_on_request_and_a_bad_method(tmp_path, capsys):
     rc, err = _run(args + ["--method", "compiled", "--out", str(tmp_path / "x")], capsys)
     assert rc == 2 and err.count("\n") == 1 and "method must be" in err
     assert not (tmp_path / "x").exists()
+
+
+def test_a_figure_that_cannot_be_drawn_keeps_the_spectrums_data(tmp_path, monkeypatch, capsys):
+    # the spectrum was computed, then drawing it raised: "internal error", nothing written
+    import importlib
+    argv = ["spectrum", "--hb", "4", "--pulse", "sine", "--ratio-range", "1", "5",
+            "--amplitude-range", "1.5", "9", "--grid", "2", "2", "--tol", "1e-3", "--quiet"]
+    rc, err = _run(argv + ["--out", str(tmp_path / "drawn")], capsys)
+    assert rc == 0, err
+
+    def overflow(*a, **k):
+        raise OverflowError("math range error")
+
+    monkeypatch.setattr(importlib.import_module("rockjit.ground.figures"), "fig_spectrum",
+                        overflow)
+    out = tmp_path / "failed"
+    rc, err = _run(argv + ["--out", str(out)], capsys)
+    assert rc == 3
+    assert err == ("rockjit: warning: spectrum.png could not be drawn (OverflowError: math range "
+                   "error); the data were written without it (exit status 3)\n")
+    s = json.loads((out / "summary.json").read_text())
+    assert s["figures_failed"] == [{"name": "spectrum.png",
+                                    "error": "OverflowError: math range error"}]
+    assert "spectrum.png" not in {f["name"] for f in s["files"]}
+    assert sorted(p.name for p in out.iterdir()) == [".rockjit-files.json", "spectrum.npz",
+                                                     "summary.json"]
+    with np.load(out / "spectrum.npz") as got, np.load(tmp_path / "drawn" / "spectrum.npz") as ref:
+        assert sorted(got.files) == sorted(ref.files)
+        for k in ref.files:  # the data as the run that could draw them wrote them
+            assert np.array_equal(got[k], ref[k], equal_nan=got[k].dtype.kind == "f"), k
