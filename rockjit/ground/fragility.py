@@ -2,7 +2,8 @@
 
 :func:`fragility` scales every record of a set to each of a list of intensities, runs the
 block from rest under each scaled record (for each block size and each restitution law), and
-fits lognormal curves by maximum likelihood (:mod:`rockjit.ground.fitting`) to:
+fits lognormal curves by maximum likelihood (:mod:`rockjit.ground.fitting`; a curve the runs
+do not identify is reported as such, without an estimate) to:
 
 - the probability of overturning against the intensity (the fragility curve);
 - the probability that ``max |theta| / alpha_s`` reaches 0.5 and 1 (rotation exceedance; an
@@ -135,6 +136,10 @@ class FragilityResult:
     fits: dict = field(default_factory=dict)
     settings: dict = field(default_factory=dict)
     method: str = ""
+
+    def __repr__(self):
+        from ..reprs import text
+        return text(self)
 
     @property
     def overturned(self):
@@ -322,9 +327,11 @@ def fragility(block, records, sizes, intensities, *, measure="pga", laws=None,
     ...                        integration=Transient(free_time=20.0))
     >>> fr.fraction("overturn")[0, 0].tolist()      # per intensity
     [0.0, 0.0, 1.0]
-    >>> fit = fr.fits["housner"][0.5]["overturn"]
-    >>> fit.status, round(fit.median, 3)             # a clean cut between 2 and 4
-    ('separated', 2.828)
+    >>> fit = fr.fits["housner"][0.5]["overturn"]    # a clean cut between 2 and 4: no estimate
+    >>> fit.status, fit.median, [round(v, 2) for v in fit.median_ci]
+    ('unidentified', nan, [1.82, 4.52])
+    >>> fit.reason
+    'complete separation between 2 and 4: beta -> 0 and any median in between fits'
     """
     if not isinstance(block, Block):
         raise ValueError(f"block must be a rockjit.Block (got {type(block).__name__})")
