@@ -447,3 +447,59 @@ def test_the_largest_period_counts_are_refused_by_their_memory_not_an_overflow(p
     with pytest.raises(ValueError, match=r"would need .* fits"):
         rockjit.basin(Block(1.0), Harmonic(alpha=0.66, omega=1.3), Lattice(2),
                       integration=Integration(periods=periods))
+
+
+# ---- the closed forms of the pulses over the whole ratio range -------------------------------
+
+def _sine_reference(beta):
+    """The one-sine boundary in mpmath, straight from its definition: the root ``a`` of
+    ``(sqrt(a^2 - 1) - beta) exp((2 pi - arcsin(1/a)) / beta) = a`` by bisection (over
+    ``log(sqrt(a^2 - 1) - beta)``: the root lies as close as ``e^(-3 pi / (2 beta))`` above
+    ``sqrt(1 + beta^2)``), and the least ``phi = 1 - a sin(beta tau) / (1 + beta^2) +
+    A cosh(tau - tau_u) + B sinh(tau - tau_u)`` on the pulse's 2000 points, at enough digits
+    for ``cosh(2 pi / beta)`` to cancel."""
+    mp = pytest.importorskip("mpmath")
+    with mp.workdps(int(2 * math.pi / beta / math.log(10)) + 40):
+        b = mp.mpf(beta)
+        f = lambda a: (mp.sqrt(a * a - 1) - b) * mp.exp((2 * mp.pi - mp.asin(1 / a)) / b) - a
+        a_of = lambda t: mp.sqrt(1 + (b + mp.exp(t)) ** 2)
+        lo, hi = -2 * mp.pi / b - 10, mp.log(4 + b * b)
+        assert f(a_of(lo)) < 0 < f(a_of(hi))
+        for _ in range(200):
+            mid = (lo + hi) / 2
+            lo, hi = (mid, hi) if f(a_of(mid)) < 0 else (lo, mid)
+        a = a_of(lo)
+        tu = mp.asin(1 / a) / b
+        A, B = -b * b / (1 + b * b), a * b * mp.cos(b * tu) / (1 + b * b)
+        phi = min(1 - a * mp.sin(b * t) / (1 + b * b) + A * mp.cosh(t - tu) + B * mp.sinh(t - tu)
+                  for t in mp.linspace(tu, 2 * mp.pi / b, 2001)[1:])
+        return float(a), phi > 0
+
+
+def test_closed_forms_at_the_smallest_ratio_take_their_quasi_static_limit():
+    # at beta = 1e-3 (the range's end) the root lies within e^(-3 pi / (2 beta)) = e^-4712 of
+    # sqrt(1 + beta^2), the one-cosine boundary within e^(-2 pi / beta) of 1 + beta^2
+    from rockjit.ground.closed_forms import cosine_no_impact, sine_no_impact
+    from rockjit.ground.pulses import RATIO_RANGE
+    beta = RATIO_RANGE[0]
+    assert sine_no_impact(beta) == pytest.approx(math.sqrt(1 + beta * beta), rel=1e-15)
+    assert cosine_no_impact(beta) == pytest.approx(1 + beta * beta, rel=1e-15)
+
+
+@pytest.mark.parametrize("beta", [0.005, 0.01, 0.1, 1.0, 10.0, 1e3])
+def test_closed_forms_hold_over_the_whole_ratio_range(beta):
+    # exp(2 pi / beta) overflowed below beta ~ 0.009 (OverflowError after a spectrum's work),
+    # and cosh - sinh cancelled into a false "strikes the ground" at beta = 0.01 and 0.1
+    from rockjit.ground.closed_forms import cosine_no_impact, sine_no_impact
+    from rockjit.ground.pulses import RATIO_RANGE
+    assert RATIO_RANGE[0] <= beta <= RATIO_RANGE[1]
+    a_ref, applies = _sine_reference(beta)
+    if applies:
+        assert sine_no_impact(beta) == pytest.approx(a_ref, rel=1e-13)
+    else:
+        with pytest.raises(ValueError, match="closed form does not apply"):
+            sine_no_impact(beta)
+    mp = pytest.importorskip("mpmath")
+    with mp.workdps(40):
+        ref = (1 + mp.mpf(beta) ** 2) / (1 - mp.exp(-2 * mp.pi / beta))
+    assert cosine_no_impact(beta) == pytest.approx(float(ref), rel=1e-14)

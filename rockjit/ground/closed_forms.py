@@ -57,10 +57,59 @@ def cosine_no_impact(ratio):
     return (1.0 + b * b) / (-math.expm1(-2.0 * math.pi / b))
 
 
+def _sine_escape_log(s, b):
+    """The escape condition in logarithms, free of overflow at small ``beta`` (where
+    ``exp(2 pi / beta)`` exceeds any float): with ``u = sqrt(a^2 - 1) = beta + e^s`` the
+    condition ``(u - beta) exp((2 pi - arcsin(1/a)) / beta) = a`` reads
+    ``s - log(a) + (2 pi - arctan(1/u)) / beta = 0``, increasing in ``s``."""
+    u = b + math.exp(s)
+    return s - math.log(math.hypot(1.0, u)) + (2.0 * math.pi - math.atan2(1.0, u)) / b
+
+
+def _sine_root(b):
+    """``(a, d)``: the root ``a`` of the one-sine escape condition and ``d = sqrt(a^2 - 1) -
+    beta > 0``, found in ``s = log d`` (``d`` may be far below the smallest float: then ``a``
+    rounds to ``hypot(1, beta)`` and ``d`` to 0)."""
+    lo = -2.0 * math.pi / b - 1.0  # there the condition is < 0: each other term is <= 0
+    hi = math.log(1.0 + b * b) + 2.0
+    while _sine_escape_log(hi, b) < 0.0:
+        hi *= 2.0
+    s = brentq(_sine_escape_log, lo, hi, args=(b,), xtol=1e-15, rtol=4 * np.finfo(float).eps)
+    d = math.exp(s)
+    a = math.hypot(1.0, b + d)
+    if b > 1.0:
+        # here the condition is flat in s (a ~ beta^2 / (2 pi) grows as e^s): polished where
+        # it is steep, in a itself, whose exponential cannot overflow for beta > 1
+        lo, hi = a * (1.0 - 1e-9), a * (1.0 + 1e-9)
+        if _sine_escape(lo, b) < 0.0 < _sine_escape(hi, b):
+            a = brentq(_sine_escape, lo, hi, args=(b,), xtol=1e-14,
+                       rtol=4 * np.finfo(float).eps)
+            d = math.sqrt(a * a - 1.0) - b
+    return a, d
+
+
 def _sine_escape(a, b):
-    """``(sqrt(a^2 - 1) - beta) exp((2 pi - arcsin(1/a)) / beta) - a``, scaled by ``1/a``."""
+    """``(sqrt(a^2 - 1) - beta) exp((2 pi - arcsin(1/a)) / beta) - a``, scaled by ``1/a``
+    (for ``beta > 1`` only: smaller ratios overflow the exponential)."""
     return (math.sqrt(a * a - 1.0) - b) / a * math.exp((2.0 * math.pi - math.asin(1.0 / a)) / b) \
         - 1.0
+
+
+def _sine_phi(a, b, d, tau):
+    """:func:`sine_phi` with the growing and the decaying parts apart, each exponential taken
+    with its coefficient's logarithm so that neither overflows (``A cosh s + B sinh s =
+    (A + B)/2 e^s + (A - B)/2 e^-s``), and ``A + B = beta d / (1 + beta^2)`` without the
+    cancellation of ``A`` against ``B``."""
+    q = 1.0 + b * b
+    tu = math.asin(1.0 / a) / b
+    grow = 0.5 * b * d / q
+    decay = 0.5 * (-b * b - b * (b + d)) / q
+    tau = np.asarray(tau, dtype=float)
+    s = np.maximum(tau - tu, 0.0)
+    with np.errstate(over="ignore", under="ignore"):
+        g = np.exp(s + math.log(grow)) if grow > 0.0 else np.zeros_like(s)
+        phi = 1.0 - a * np.sin(b * tau) / q + g - np.exp(math.log(-decay) - s)
+    return np.where(tau >= tu, phi, 0.0)
 
 
 def sine_phi(a, ratio, tau):
@@ -68,13 +117,7 @@ def sine_phi(a, ratio, tau):
     amplitude ratio ``a`` and frequency ratio ``ratio``, at ``tau = p t`` (while it rocks on
     its first corner, during the pulse)."""
     b = float(ratio)
-    tu = math.asin(1.0 / a) / b
-    A = -b * b / (1.0 + b * b)
-    B = a * b * math.cos(b * tu) / (1.0 + b * b)
-    tau = np.asarray(tau, dtype=float)
-    s = tau - tu
-    return np.where(tau >= tu, 1.0 - a * np.sin(b * tau) / (1.0 + b * b) + A * np.cosh(s)
-                    + B * np.sinh(s), 0.0)
+    return _sine_phi(a, b, math.sqrt(a * a - 1.0) - b, tau)
 
 
 def sine_no_impact(ratio):
@@ -83,15 +126,9 @@ def sine_no_impact(ratio):
     ``(sqrt(a^2 - 1) - beta) exp((2 pi - arcsin(1/a)) / beta) = a``. Raises ``ValueError``
     where the block would strike the ground before the pulse ends."""
     b = float(ratio)
-    lo = max(1.0 + 1e-12, b)  # below sqrt(a^2 - 1) = beta the left side is negative
-    hi = max(2.0 * lo, b * b / (2.0 * math.pi) * 2.0 + 2.0)
-    while _sine_escape(hi, b) < 0.0:
-        hi *= 2.0
-    while _sine_escape(lo, b) > 0.0 and lo > 1.0 + 1e-9:
-        lo = 1.0 + (lo - 1.0) / 2.0
-    a = brentq(_sine_escape, lo, hi, args=(b,), xtol=1e-14, rtol=4 * np.finfo(float).eps)
+    a, d = _sine_root(b)
     tau = np.linspace(math.asin(1.0 / a) / b, 2.0 * math.pi / b, 2001)[1:]
-    if np.min(sine_phi(a, b, tau)) <= 0.0:
+    if not np.min(_sine_phi(a, b, d, tau)) > 0.0:
         raise ValueError(f"at ratio {b:g} the linearised block strikes the ground during the "
                          f"pulse: the closed form does not apply")
     return a
