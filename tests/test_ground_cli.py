@@ -84,7 +84,7 @@ def test_fragility_on_record_files(tmp_path, capsys):
         for size in ("0.5", "2"):
             d = s["laws"][law]["sizes"][size]
             assert d["fraction_overturned"][0] == 0.0  # below uplift: nothing moves
-            assert d["overturn"]["status"] in ("ok", "separated", "all_survive",
+            assert d["overturn"]["status"] in ("ok", "unidentified", "all_survive",
                                                "all_overturn")
     with np.load(out / "fragility.npz") as z:
         assert z["outcome"].shape == (2, 2, 2, 3) and z["scale"].shape == (2, 3)
@@ -137,3 +137,29 @@ def test_a_figure_that_cannot_be_drawn_keeps_the_spectrums_data(tmp_path, monkey
         assert sorted(got.files) == sorted(ref.files)
         for k in ref.files:  # the data as the run that could draw them wrote them
             assert np.array_equal(got[k], ref[k], equal_nan=got[k].dtype.kind == "f"), k
+
+
+def test_fragility_names_the_path_it_runs_on_and_writes_no_unidentified_estimate(tmp_path,
+                                                                                 capsys):
+    recs = [_csv(tmp_path / "a.csv", 1), _csv(tmp_path / "b.csv", 3)]
+    base = ["fragility", "--hb", "3", "--size", "1", "--records", *recs, "--intensities", "3",
+            "--free-time", "5"]
+    said = {}
+    for method in ("rockjit", "scipy"):
+        rc, err = _run(base + ["--method", method, "--out", str(tmp_path / method)], capsys)
+        assert rc == 0, err
+        said[method] = [line for line in err.splitlines() if " runs (" in line]
+    assert len(said["rockjit"]) == 1 and said["rockjit"][0].endswith("on the compiled path")
+    assert len(said["scipy"]) == 1 and said["scipy"][0].endswith("on the scipy path (DOP853)")
+    # two records at one intensity, one of them overturning the block: the likelihood is flat
+    # in beta, no fit is identified, and none is written as one
+    s = json.loads((tmp_path / "rockjit" / "summary.json").read_text())
+    d = s["laws"]["housner"]["sizes"]["1"]
+    assert d["fraction_overturned"] == [0.5]
+    assert d["overturn"]["status"] == "unidentified"
+    assert d["overturn"]["reason"].startswith("one intensity level")
+    for fit in d.values():
+        if isinstance(fit, dict):
+            assert fit["status"] != "ok"
+            assert fit["median"] == "nan" and fit["beta"] == "nan"
+            assert len(fit["median_ci"]) == 2 and len(fit["beta_ci"]) == 2
