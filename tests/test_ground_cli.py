@@ -163,3 +163,40 @@ def test_fragility_names_the_path_it_runs_on_and_writes_no_unidentified_estimate
             assert fit["status"] != "ok"
             assert fit["median"] == "nan" and fit["beta"] == "nan"
             assert len(fit["median_ci"]) == 2 and len(fit["beta_ci"]) == 2
+
+
+def test_an_interrupted_spectrum_command_resumes_from_its_chunks(tmp_path, monkeypatch, capsys):
+    # the rerun of an interrupted spectrum started from zero: no chunk store was kept
+    import importlib
+    batch = importlib.import_module("rockjit.ground.batch")
+    real = batch.KERNELS["scipy"]
+    grid_cells = []  # the grid's cells computed (the bisections' amplitudes lie between them)
+    stop = []
+
+    def kernel(blocks, sources, block_of, source_of, gain, *rest):
+        if np.isin(gain, (1.5, 9.0)).all():
+            grid_cells.append(len(gain))
+            if stop and len(grid_cells) == stop[0]:
+                raise KeyboardInterrupt
+        return real(blocks, sources, block_of, source_of, gain, *rest)
+
+    monkeypatch.setitem(batch.KERNELS, "scipy", kernel)
+    argv = ["spectrum", "--hb", "4", "--ratio-range", "1", "5", "--amplitude-range", "1.5", "9",
+            "--grid", "2", "2", "--tol", "1e-2", "--method", "scipy", "--quiet"]
+    rc, err = _run(argv + ["--out", str(tmp_path / "whole")], capsys)
+    assert rc == 0 and sum(grid_cells) == 4, err
+    grid_cells.clear()
+    stop.append(3)  # Ctrl-C as the third chunk starts
+    out = tmp_path / "o"
+    rc, err = _run(argv + ["--out", str(out)], capsys)
+    assert rc == 130 and f"finished chunks wait in {out}.chunks" in err, err
+    assert not out.exists() and grid_cells == [1, 1, 1]  # two chunks of one cell, then Ctrl-C
+    grid_cells.clear()
+    stop.clear()
+    rc, err = _run(argv + ["--out", str(out)], capsys)
+    assert rc == 0, err
+    assert sum(grid_cells) == 2  # only the two cells missing were computed
+    assert not (tmp_path / "o.chunks").exists()  # removed once published
+    with np.load(out / "spectrum.npz") as got, np.load(tmp_path / "whole" / "spectrum.npz") as ref:
+        for k in ref.files:
+            assert got[k].tobytes() == ref[k].tobytes(), k

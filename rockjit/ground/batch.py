@@ -27,7 +27,8 @@ the compiled kernel (:func:`rockjit.ground.compiled.compiled_kernel`, the defaul
 chunk's cells in parallel threads; :func:`kernel_for` registers it in :data:`KERNELS` under
 ``"rockjit"`` when first asked for it. :func:`run_batch`
 cuts a batch into chunks and runs them through a kernel, in this process or on a Dask cluster
-(``Execution.client`` or ``Execution.scheduler``), with progress.
+(``Execution.client`` or ``Execution.scheduler``), with progress, resumable from a chunk store
+(``Execution.store``).
 """
 
 from __future__ import annotations
@@ -150,10 +151,14 @@ def _threads(threads):
 def run_batch(batch, settings, method, execution=None, label="cells"):
     """Every cell of ``batch`` through the kernel of ``method``, chunk by chunk, as
     ``execution`` (a :class:`rockjit.Execution`) says: in this process (the compiled kernel on
-    ``threads`` numba threads) or on a Dask cluster, with progress. Returns the outputs by
-    name (:data:`OUTPUTS`)."""
+    ``threads`` numba threads) or on a Dask cluster, with progress, and with a chunk store
+    (``store``) where finished chunks are kept, so that the same batch run again with the same
+    store computes only the chunks missing (:class:`rockjit.storage.chunkstore.ChunkStore`:
+    a store of another computation is refused). Returns the outputs by name
+    (:data:`OUTPUTS`)."""
     from ..grids.runner import _client, run_chunks
     from ..settings import Execution
+    from ..storage import chunkstore
     ex = Execution() if execution is None else execution
     kernel = kernel_for(method)
     n = len(batch)
@@ -165,7 +170,14 @@ def run_batch(batch, settings, method, execution=None, label="cells"):
     with _client(ex) as client, _threads(ex.threads if client is None else None):
         local = client is None and method == "rockjit"
         chunk = default_chunk(n, local) if ex.chunk is None else ex.chunk
+        store = None
+        if ex.store is not None:  # every input of every cell, and the kernel's outputs
+            key = chunkstore.fingerprint_of("transient batch", batch.blocks, batch.sources,
+                                            batch.block_of, batch.source_of, batch.gain,
+                                            settings, method, sorted(OUTPUTS))
+            store = chunkstore.ChunkStore(ex.store, key, n, chunk, message=ex.message)
         run_chunks(kernel, (batch.blocks, batch.sources, batch.block_of, batch.source_of,
                             batch.gain, settings, method), n, chunk, outputs, client=client,
-                   progress=ex.progress, label=label, task_prefix=prefix)
+                   store=store, progress=ex.progress, label=label, task_prefix=prefix,
+                   message=ex.message)
     return outputs

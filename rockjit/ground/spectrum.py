@@ -138,6 +138,10 @@ class SpectrumResult:
     method: str = ""
     n_runs: int = 0
 
+    def __repr__(self):
+        from ..reprs import text
+        return text(self)
+
     def min_overturn_list(self):
         """``[{"ratio", "amplitude", "mode"}, ...]``: the minimum overturning amplitude at every
         ratio (``amplitude`` and ``mode`` ``None`` where the grid never overturns the block)."""
@@ -201,8 +205,9 @@ def run(p: SpectrumPlan, execution=None) -> SpectrumResult:
     min_mode = np.full(nr, UNRESOLVED, dtype=np.int8)
     min_ni = np.full(nr, np.nan)
     if p.locate:
-        # the bisections' batches are small and many: one line for all of them
-        quiet = None if execution is None else execution.replace(progress=False)
+        # the bisections' batches are small and many: one line for all of them; no store (the
+        # bisections are computed again on a rerun, from the grid's stored outcomes)
+        quiet = None if execution is None else execution.replace(progress=False, store=None)
         over = np.isin(outcome, (OVERTURN_IMPACT, OVERTURN_NO_IMPACT))
         min_k, min_mode, n1 = _bisect(p, sources, over, outcome,
                                       lambda o: (o == OVERTURN_IMPACT) | (o == OVERTURN_NO_IMPACT),
@@ -290,7 +295,10 @@ def spectrum(block, pulse, ratios, amplitudes, *, integration=None, method=None,
     locate : bool
         Locate the boundaries by bisection (default); ``False`` computes the grid alone.
     execution : Execution, optional
-        Where the batches run (this process, or a Dask cluster) and progress.
+        Where the batches run (this process, or a Dask cluster), progress, and a chunk store
+        (``store``) that keeps the grid's finished chunks: run again with the same store, an
+        interrupted spectrum computes only the chunks missing, with the same result bit for
+        bit.
 
     Returns
     -------

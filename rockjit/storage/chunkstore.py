@@ -1,6 +1,6 @@
 """The store of finished grid chunks: resumable grid computations, one run at a time.
 
-A grid (the cells of a sweep, a basin or a parameter plane) is cut into chunks of consecutive
+A grid (the cells of a sweep, a basin, a parameter plane, a spectrum) is cut into chunks of consecutive
 cells (:mod:`rockjit.grids.runner`). With a store directory (:class:`ChunkStore`), every finished chunk is written there atomically
 (:func:`rockjit.storage.files.atomic_open`, with the user's umask) beside a manifest holding a fingerprint
 of the whole computation (inputs, settings, chunking, rockjit's version). Running the same
@@ -26,6 +26,7 @@ deletes a store only when it can hold the lock, and only the files rockjit wrote
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import errno
 import hashlib
 import json
@@ -43,7 +44,7 @@ import numpy as np
 from .files import (atomic_open, boot_id, create_temp, host_name, pid_alive, process_start,
                     process_start_time, write_text)
 
-__all__ = ["ChunkStore", "DamagedChunk", "fingerprint", "remove_stores"]
+__all__ = ["ChunkStore", "DamagedChunk", "fingerprint", "fingerprint_of", "remove_stores"]
 
 
 def fingerprint(arrays, settings):
@@ -58,6 +59,35 @@ def fingerprint(arrays, settings):
     h.update(json.dumps(settings, sort_keys=True, default=str).encode())
     h.update(__version__.encode())
     return h.hexdigest()
+
+
+def fingerprint_of(*objects):
+    """:func:`fingerprint` of ``objects``: dataclasses by their type and fields, arrays by their
+    bytes, floats exactly (``repr``), containers item by item."""
+    arrays = []
+
+    def canonical(obj):
+        if isinstance(obj, np.ndarray):
+            arrays.append(obj)
+            return f"<array {len(arrays) - 1}>"
+        if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+            return {"type": f"{type(obj).__module__}.{type(obj).__qualname__}",
+                    **{f.name: canonical(getattr(obj, f.name))
+                       for f in dataclasses.fields(obj)}}
+        if isinstance(obj, (list, tuple)):
+            return [canonical(x) for x in obj]
+        if isinstance(obj, dict):
+            return {str(k): canonical(obj[k]) for k in sorted(obj, key=str)}
+        if isinstance(obj, np.generic):
+            obj = obj.item()
+        if isinstance(obj, float):
+            return repr(obj)
+        if obj is None or isinstance(obj, (bool, int, str)):
+            return obj
+        return repr(obj)
+
+    settings = canonical(list(objects))
+    return fingerprint(arrays, settings)
 
 
 class DamagedChunk(ValueError):
