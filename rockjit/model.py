@@ -40,7 +40,9 @@ __all__ = [
     "delta_e_percent",
     "e_housner",
     "e_mao",
+    "energy",
     "forcing_closed",
+    "free_rocking_decided",
     "initial_side",
     "jump",
     "near_poly",
@@ -483,6 +485,40 @@ def initial_side(theta0, dtheta0):
 def jump(dtheta_minus, e):
     """Impact map on ``theta = 0``: ``theta'(+) = e theta'(-)``; the side changes sign."""
     return e * dtheta_minus
+
+
+@jit
+def energy(theta, dtheta, thc):
+    """The mechanical energy ``1/2 theta'^2 + 3/4 sin(thc + |theta|)`` with the base still.
+
+    Kinetic energy and the potential of the centre of mass, which rises with ``|theta|`` to
+    ``3/4`` at the tipping angle ``|theta| = pi/2 - thc`` (docs/theory/model.md). Free rocking
+    never gains it: damping takes ``3/4 xi theta'^2`` per unit time, and an impact keeps the
+    fraction ``e^2 <= 1`` of the kinetic part (:func:`jump`, the potential is ``3/4 sin(thc)``
+    on either side of it).
+    """
+    return 0.5 * dtheta * dtheta + 0.75 * math.sin(thc + abs(theta))
+
+
+@jit
+def free_rocking_decided(theta, dtheta, max_theta, thc, th_top):
+    """Whether free rocking from ``(theta, theta')`` can neither reach ``th_top`` nor swing wider
+    than ``max_theta``, the largest ``|theta|`` so far.
+
+    ``th_top`` is at most the tipping angle ``pi/2 - thc``, below which the potential
+    ``3/4 sin(thc + |theta|)`` rises with ``|theta|``. The :func:`energy` ``E`` never grows in
+    free rocking, so every later swing, on either side, stays below the angle where the
+    potential equals ``E``. From inside ``th_top``, that angle lies below ``th_top`` when ``E``
+    is below the potential there, and at most at ``max_theta`` when ``E`` is at most the
+    potential there: at a turning point (``theta' = 0``) counted in ``max_theta`` the second
+    always holds. The comparison is of energies, so that a turning point decides exactly.
+    """
+    if not abs(theta) < th_top:
+        return False
+    en = energy(theta, dtheta, thc)
+    if not en < 0.75 * math.sin(thc + th_top):
+        return False
+    return en <= 0.75 * math.sin(thc + min(max_theta, th_top))
 
 
 @jit

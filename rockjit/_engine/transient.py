@@ -20,7 +20,10 @@ scipy reference path (:mod:`rockjit.ground.reference`, the specification):
   instant is the root of the event function of a genuine step of variable length from the
   step's start, found by Newton's iteration kept inside its bracket by bisection, so the
   event's state has the step's own order of accuracy;
-- **impact**: :func:`rockjit.model.jump` on the other corner, or rest below ``rest_speed``.
+- **impact**: :func:`rockjit.model.jump` on the other corner, or rest below ``rest_speed``;
+- **decided** (``decide``): after the excitation, the run stops at the first grid point, crest
+  or impact from which free rocking can neither overturn nor swing wider than the largest
+  ``|theta|`` so far (:func:`rockjit.model.free_rocking_decided`, the reference path's rule).
 
 The forcing may jump where the excitation ends (the one-cosine pulse ends on ``a_p``): the last
 step of the excitation sees its value there (its stages never pass the grid instant that ends
@@ -28,10 +31,11 @@ it), and free rocking starts from the still base, its first stage included.
 
 Every equation of the block comes from :mod:`rockjit.model` (:func:`~rockjit.model.corner`,
 :func:`~rockjit.model.accel_pq`, :func:`~rockjit.model.sincos`, :func:`~rockjit.model.jump`,
-:func:`~rockjit.model.accel`); this module writes none. The excitations are the one thing it
-writes again: :func:`forcing` and the uplift windows are the compiled twins of
-``Pulse.scalar``/``Pulse.windows`` and ``Record.scalar``/``Record.windows``, held to them by
-the tests that compare every cell with the scipy path, which evaluates those.
+:func:`~rockjit.model.accel`, :func:`~rockjit.model.free_rocking_decided`); this module writes
+none. The excitations are the one thing it writes again: :func:`forcing` and the uplift
+windows are the compiled twins of ``Pulse.scalar``/``Pulse.windows`` and
+``Record.scalar``/``Record.windows``, held to them by the tests that compare every cell with
+the scipy path, which evaluates those.
 
 The forcing of a cell is described by a row of ``xpar`` (columns ``X_*``): the kind (0, 1, 2:
 the pulses of :data:`rockjit.ground.pulses.KINDS`; 3: a record), its amplitude in ``g``, the
@@ -48,7 +52,7 @@ import numpy as np
 from numba import prange
 
 from .._jit import jit
-from ..model import accel, accel_pq, corner, jump, sincos
+from ..model import accel, accel_pq, corner, free_rocking_decided, jump, sincos
 from .integrate import A as _A, B as _B, C as _C
 
 # ---- the tableau, as scalars (numba freezes module floats into the code) ------------------------
@@ -67,9 +71,9 @@ K_SINE, K_COSINE, K_RICKER, K_RECORD = 0, 1, 2, 3
 X_KIND, X_AMP, X_OMEGA, X_END, X_DELAY, X_DT, X_OFF, X_N, X_STEPS = range(9)
 N_X = 9
 #: columns of a block's row ``bpar``: thc, xi, e, cot (uplift threshold), th_top (the tipping
-#: angle, or theta_over below it), e_top (the energy it takes to reach it), alpha_s
-B_THC, B_XI, B_E, B_COT, B_THTOP, B_ETOP, B_ALPHA = range(7)
-N_B = 7
+#: angle, or theta_over below it), alpha_s
+B_THC, B_XI, B_E, B_COT, B_THTOP, B_ALPHA = range(6)
+N_B = 6
 #: the run's settings ``spar``: theta_over, rest_speed, the step length of free rocking
 S_THOVER, S_REST, S_HFREE = range(3)
 N_S = 3
@@ -335,14 +339,6 @@ def next_uplift(t, x, rec, win, nwin, thc, xi, thr):
 # ---- one cell -----------------------------------------------------------------------------------
 
 @jit(nrt=False, inline=True)
-def _settled(th, v, side, thc, th_top, e_top):
-    """Free rocking from here can neither overturn nor swing wider (the reference path's
-    ``settled``): moving back towards theta = 0, inside the tipping angle, below its energy."""
-    return side * v <= 0.0 and abs(th) < th_top and \
-        0.5 * v * v + 0.75 * math.sin(thc + abs(th)) < e_top
-
-
-@jit(nrt=False, inline=True)
 def grid_next(t, end, h_exc, nsub, dt, h_free, t_lim):
     """The first grid instant after ``t``: during a pulse, multiples of ``h_exc`` up to
     ``end``; during a record, ``nsub`` equal steps per sample (``dt``), the samples exact; after
@@ -399,7 +395,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp,
     ``t, theta, theta'`` at the grid points and the events) keep what their lengths hold:
     buffers of no rows for a grid, which needs neither."""
     thc, xi, e, thr = b[B_THC], b[B_XI], b[B_E], b[B_COT]
-    th_top, e_top = b[B_THTOP], b[B_ETOP]
+    th_top = b[B_THTOP]
     sthc, cthc = math.sin(thc), math.cos(thc)
     thover, rest_speed = s[S_THOVER], s[S_REST]
     end = x[X_END]
@@ -455,7 +451,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp,
             v = 0.0
             a = acc(th, v, t, side, sthc, cthc, xi, x, rec)
             continue
-        if decide and t >= end and _settled(th, v, side, thc, th_top, e_top):
+        if decide and t >= end and free_rocking_decided(th, v, max_th, thc, th_top):
             status = ST_DECIDED
             break
         # ---- one step on corner `side` --------------------------------------------------------
@@ -475,7 +471,8 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp,
                                            sthc, cthc, xi, x, rec)
             n_step += ns
             max_th = max(max_th, abs(th_c))
-            if decide and t + tau >= end and _settled(th_c, 0.0, side, thc, th_top, e_top):
+            if decide and t + tau >= end and free_rocking_decided(th_c, 0.0, max_th, thc,
+                                                                  th_top):
                 t = t + tau
                 th, v = th_c, vc
                 n_tr = _keep(traj, n_tr, t, th, v)

@@ -25,9 +25,11 @@ from :mod:`rockjit.model` (``accel``, ``accel_jac``, ``jump``), as the harmonic 
   the Zeno cut-off ``rest_speed``.
 
 After the excitation, with ``stop_when_decided``, the run stops at the first instant the block
-is at rest, or moving back towards ``theta = 0`` inside the tipping angle ``alpha_s`` with less
-energy than it needs to reach it: free rocking only loses energy, so from there on it can
-neither overturn nor swing wider than it already has (docs/guide/earthquakes.md).
+is at rest, or at the first start of a flight (the excitation's end, an impact) or crest from
+which free rocking can neither overturn nor swing wider than the largest ``|theta|`` so far:
+its energy, which free rocking only loses, is below the energy it takes to reach the tipping
+angle ``alpha_s`` and at most the potential energy at that largest ``|theta|``
+(:func:`rockjit.model.free_rocking_decided`; docs/guide/earthquakes.md).
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from ..model import accel, accel_jac, initial_side, jump
+from ..model import accel, accel_jac, free_rocking_decided, initial_side, jump
 from .response import TransientResult, alpha_s
 
 __all__ = ["run_scipy"]
@@ -48,11 +50,6 @@ __all__ = ["run_scipy"]
 # impact event of the next flight is not found again at its starting instant
 _TINY = np.finfo(float).tiny
 _IMPLICIT = ("BDF", "Radau", "LSODA")
-
-
-def _energy(theta, dtheta, thc):
-    """Mechanical energy of free rocking, ``1/2 theta'^2 + 3/4 sin(thc + |theta|)``."""
-    return 0.5 * dtheta * dtheta + 0.75 * math.sin(thc + abs(theta))
 
 
 def run_scipy(block, excitation, state, settings, method) -> TransientResult:
@@ -65,13 +62,10 @@ def run_scipy(block, excitation, state, settings, method) -> TransientResult:
     t_lim = float(settings.limit(end))
     thover = settings.theta_over
     th_top = min(alpha_s(block.hb), thover)  # the tipping angle, or overturning before it
-    e_top = 0.75 * math.sin(thc + th_top)
 
     def settled(theta, dtheta):
-        """Free rocking from here can neither overturn nor swing wider: moving back towards
-        theta = 0, inside the tipping angle, below the energy needed to reach it."""
-        return side * dtheta <= 0.0 and abs(theta) < th_top and \
-            _energy(theta, dtheta, thc) < e_top
+        """Free rocking from here can neither overturn nor swing wider than max|theta| so far."""
+        return free_rocking_decided(float(theta), float(dtheta), float(max_th), thc, th_top)
     decide = settings.stop_when_decided
     keep_traj = settings.record
     rest_speed = settings.rest_speed
