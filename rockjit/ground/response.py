@@ -30,8 +30,9 @@ MODE_NAMES = {OVERTURN_IMPACT: "with impact", OVERTURN_NO_IMPACT: "without impac
 STATUSES = {
     "overturned": "the block overturned (|theta| reached theta_over)",
     "rest": "the block came to rest and the excitation can no longer lift it",
-    "decided": "stopped after the excitation: the block turned back towards theta = 0 below "
-               "the tipping energy, so neither the outcome nor max|theta| can change",
+    "decided": "stopped after the excitation: the block's energy is below the tipping energy "
+               "and no more than the potential energy at the largest |theta| so far, so free "
+               "rocking can neither overturn it nor swing it wider",
     "time_limit": "still rocking at the time limit",
     "max_impacts": "stopped at the impact bound max_impacts",
     "nonfinite": "a non-finite number appeared; this is a bug, please report the inputs",
