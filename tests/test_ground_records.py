@@ -12,6 +12,9 @@ scaling), to the interpolation error; the FEMA P695 sets when the ``records`` ex
 from __future__ import annotations
 
 import math
+import os
+import threading
+import tracemalloc
 
 import numpy as np
 import pytest
@@ -279,3 +282,126 @@ def test_a_pickled_record_is_the_same_read_only_record():
     assert not q.accel.flags.writeable
     with pytest.raises(ValueError, match="read-only"):
         q.accel[0] = 1.0
+
+
+# ---- what is not a record file: devices, pipes, other encodings, endless or huge files -------
+
+def _refusal(path, **kw):
+    with pytest.raises(ValueError) as info:
+        read_record(path, size=1.0, **kw)
+    msg = str(info.value)
+    assert "\n" not in msg, msg
+    return msg
+
+
+@pytest.mark.parametrize("path", ["/dev/null", "/dev/zero"])
+def test_a_device_is_refused_as_not_a_regular_file(path):
+    # /dev/zero and /dev/urandom were read to the end of memory (MemoryError); /dev/null
+    # read as an empty file. The device is refused before a byte is read
+    if not os.path.exists(path):
+        pytest.skip(f"no {path} here")
+    msg = _refusal(path)
+    assert path in msg and "character device, not a regular file" in msg, msg
+
+
+def test_a_directory_is_refused_as_not_a_regular_file(tmp_path):
+    assert "a directory, not a regular file" in _refusal(tmp_path)
+
+
+def test_a_fifo_is_refused_without_waiting_for_a_writer(tmp_path):
+    # opening a FIFO for reading blocked until some other process wrote to it
+    if not hasattr(os, "mkfifo"):
+        pytest.skip("no FIFOs here")
+    fifo = tmp_path / "motion.csv"
+    os.mkfifo(fifo)
+    got = []
+    reader = threading.Thread(target=lambda: got.append(_refusal(fifo)), daemon=True)
+    reader.start()
+    reader.join(10.0)
+    if reader.is_alive():  # release the blocked reader before failing
+        os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
+        reader.join(10.0)
+        pytest.fail("reading a FIFO waited for a writer")
+    assert got and "a pipe (FIFO), not a regular file" in got[0], got
+
+
+@pytest.mark.parametrize("path", [None, 3, "", b"motion.csv", 1.5])
+def test_a_path_that_is_not_a_path_is_a_value_error(path):
+    # None and 3 raised TypeError from inside pathlib
+    with pytest.raises(ValueError, match=r"^record path must be a file's path"):
+        read_record(path)
+
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-le", "utf-16-be", "utf-32"])
+def test_a_utf16_or_utf32_file_is_refused_naming_its_encoding(tmp_path, encoding):
+    p = tmp_path / "motion.csv"
+    p.write_bytes("time (s),acc (g)\n0,0\n0.01,0.1\n0.02,0\n".encode(encoding))
+    msg = _refusal(p)
+    assert str(p) in msg and f"{encoding[:6].upper()} encoded" in msg, msg
+
+
+def test_a_utf8_byte_order_mark_is_read_as_text(tmp_path):
+    p = tmp_path / "motion.csv"
+    p.write_bytes(b"\xef\xbb\xbf0,0\n0.01,0.1\n0.02,0\n")
+    np.testing.assert_array_equal(read_record(p, size=1.0).accel, [0.0, 0.1, 0.0])
+
+
+@pytest.mark.parametrize("value", ["1_0", "1_000.5", "\u0661", "\uff11", "0.1e1_0"])
+@pytest.mark.parametrize("kind", ["table", "at2"])
+def test_numbers_only_in_ascii_decimals(tmp_path, value, kind):
+    # Python's float() reads '1_0' as 10 and other scripts' digits as digits; the command
+    # line refuses them, and so does a record file
+    if kind == "table":
+        p = tmp_path / "motion.csv"
+        p.write_text(f"0,0\n0.01,{value}\n0.02,0\n", encoding="utf-8")
+    else:
+        p = _at2(tmp_path, f"0.0 {value} 0.0")
+    msg = _refusal(p)
+    assert repr(value) in msg and "not a number" in msg, msg
+
+
+def test_the_sample_limit_stops_the_reading(tmp_path, monkeypatch):
+    # the limit was checked after the whole file was read: here the rows past the limit are
+    # not even looked at (the bad row after them would be refused otherwise)
+    from rockjit.ground import records
+    monkeypatch.setattr(records, "MAX_SAMPLES", 1000)
+    p = tmp_path / "long.csv"
+    p.write_text("".join(f"{0.01 * k:.2f},0.1\n" for k in range(1500)) + "0.01,oops\n")
+    assert "more than 1000 samples" in _refusal(p)
+    q = _at2(tmp_path, " ".join(["0.1"] * 1500 + ["oops"]), head="NPTS= 1500, DT= .01 SEC")
+    assert "more than 1000 samples" in _refusal(q)
+
+
+def test_the_byte_limit_is_checked_while_reading(tmp_path, monkeypatch):
+    from rockjit.ground import records
+    monkeypatch.setattr(records, "MAX_BYTES", 4096)
+    p = tmp_path / "big.csv"
+    p.write_text("".join(f"{0.01 * k:.2f},0.1\n" for k in range(1000)))
+    assert "bytes, more than 4096" in _refusal(p)  # known from its size before reading
+    # a file that says it is empty and is not (the kernel's files): counted while read
+    status = "/proc/self/status"
+    if not os.path.exists(status) or os.stat(status).st_size:
+        pytest.skip("no regular file that understates its size here")
+    monkeypatch.setattr(records, "MAX_BYTES", 8)  # passed within the first line
+    assert "more than 8 bytes" in _refusal(status)
+
+
+def test_a_long_table_is_read_in_modest_memory(tmp_path):
+    # 10^7 lines peaked at 2.5 GB (a Python tuple per row), ~190 bytes a line here. The
+    # samples themselves take 16 bytes a line (time and acceleration), their checks and the
+    # record's own copy a few times that; allow 100
+    n = 20_000
+    p = tmp_path / "long.csv"
+    dt = 0.001
+    p.write_text("time (s),acc (g)\n" + "".join(f"{k * dt:.3f},{0.1 * (k % 7 - 3):.1f}\n"
+                                                for k in range(n)))
+    tracemalloc.start()
+    try:
+        rec = read_record(p, size=1.0)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert rec.n == n and rec.dt == pytest.approx(dt)
+    np.testing.assert_array_equal(rec.accel, [float(f"{0.1 * (k % 7 - 3):.1f}")
+                                              for k in range(n)])
+    assert peak < 100 * n, f"{peak / n:.0f} bytes a line"

@@ -11,13 +11,20 @@ Records come from arrays (:class:`Record`, :meth:`Record.from_arrays`), from a P
 acceleration in ``g`` (:func:`read_table`), or from the FEMA P695 record sets
 (:func:`rockjit.ground.fema.fema_set`). A bad record (empty, not finite, time not increasing or
 unevenly spaced, acceleration not in ``g``) is refused with one ``ValueError`` line that names the
-file and the problem.
+file and the problem. A record file must be a regular file of UTF-8 (or ASCII) text with numbers
+in ASCII decimals; it is read a line at a time and refused as soon as it passes
+``MAX_SAMPLES`` samples or ``MAX_BYTES`` bytes, so that a device, a pipe or a huge file
+neither blocks nor fills the memory.
 """
 
 from __future__ import annotations
 
+import codecs
 import math
+import os
 import re
+import stat
+from array import array
 from dataclasses import dataclass, replace
 from functools import cached_property
 from pathlib import Path
@@ -40,6 +47,11 @@ DT_RANGE = (1e-6, 10.0)
 EVEN_TOL = 1e-4
 #: Most samples a record may hold (a day at 1 kHz).
 MAX_SAMPLES = 10**8
+#: Largest record file read, in bytes: room for MAX_SAMPLES rows of two numbers and their
+#: separators. Both limits are checked while reading, which stops as soon as one is passed.
+MAX_BYTES = 40 * MAX_SAMPLES
+#: Longest line of a record file, in bytes.
+MAX_LINE = 2**20
 
 
 def _refuse(source, problem):
@@ -332,13 +344,111 @@ def _even_step(src, t):
     return float(dt)
 
 
-def _read_text(path):
+def _file_kind(mode):
+    for test, kind in ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a pipe (FIFO)"),
+                       (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+                       (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return kind
+    return "not a plain file"
+
+
+def _path_of(path):
+    """``path`` as a file name, or a ``ValueError`` naming what it is instead."""
+    if isinstance(path, os.PathLike):
+        path = os.fspath(path)
+    if not isinstance(path, str) or not path:
+        raise ValueError(f"record path must be a file's path, a non-empty str or a path "
+                         f"(got {path!r})")
+    return path
+
+
+def _encoding_problem(raw):
+    """Why the first line ``raw`` (bytes) is not UTF-8 text, or ``None``."""
+    for bom, name in ((codecs.BOM_UTF32_LE, "UTF-32"), (codecs.BOM_UTF32_BE, "UTF-32"),
+                      (codecs.BOM_UTF16_LE, "UTF-16"), (codecs.BOM_UTF16_BE, "UTF-16")):
+        if raw.startswith(bom):
+            return (f"it is {name} encoded (it starts with a {name} byte order mark); save it "
+                    f"as UTF-8 or ASCII text")
+    return None
+
+
+def _lines(path):
+    """The lines of a record file as ``(number, text)``, read one at a time: the file must be a
+    regular file (not a device, a pipe or a directory, which could be endless or block) of
+    UTF-8 or ASCII text, at most ``MAX_BYTES`` long, no line longer than ``MAX_LINE``."""
     src = str(path)
-    try:
-        with open(path, encoding="utf-8", errors="replace") as fh:
-            return fh.read()
+    try:  # O_NONBLOCK: opening a FIFO must not wait for a writer
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     except OSError as exc:
         raise ValueError(f"record {src}: cannot be read ({exc.strerror or exc})") from None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            _refuse(src, f"it is {_file_kind(st.st_mode)}, not a regular file")
+        if st.st_size > MAX_BYTES:
+            _refuse(src, f"it holds {st.st_size} bytes, more than {MAX_BYTES}")
+        fh = os.fdopen(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
+    with fh:
+        total = 0
+        lineno = 0
+        while True:
+            try:
+                raw = fh.readline(MAX_LINE + 1)
+            except OSError as exc:
+                raise ValueError(f"record {src}: cannot be read "
+                                 f"({exc.strerror or exc})") from None
+            if not raw:
+                return
+            lineno += 1
+            total += len(raw)
+            if total > MAX_BYTES:
+                _refuse(src, f"it holds more than {MAX_BYTES} bytes")
+            if len(raw) > MAX_LINE:
+                _refuse(src, f"line {lineno} is longer than {MAX_LINE} bytes")
+            if lineno == 1:
+                problem = _encoding_problem(raw)
+                if problem:
+                    _refuse(src, problem)
+                if raw.startswith(codecs.BOM_UTF8):
+                    raw = raw[len(codecs.BOM_UTF8):]
+            if b"\x00" in raw:
+                even, odd = raw[0::2].strip(b"\x00\r\n"), raw[1::2].strip(b"\x00\r\n")
+                utf16 = not even or not odd  # ASCII in UTF-16: every other byte is NUL
+                _refuse(src, f"line {lineno} holds NUL bytes: "
+                             + ("it looks UTF-16 encoded; save it as UTF-8 or ASCII text"
+                                if utf16 else "it is not a text file"))
+            yield lineno, raw.decode("utf-8", errors="replace")
+
+
+#: A number in a record file: ASCII decimal digits only (no ``_`` separators, no other
+#: scripts' digits), or ``nan`` / ``inf`` (refused as not finite, by name).
+_NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?"
+                     r"|[-+]?(?:nan|inf|infinity)", re.IGNORECASE)
+#: The same with Fortran's ``D`` exponents (``.AT2`` files).
+_NUMBER_D = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eEdD][-+]?[0-9]+)?"
+                       r"|[-+]?(?:nan|inf|infinity)", re.IGNORECASE)
+
+
+_SEPARATORS = re.compile(r"[,;\s]+")
+#: A row of a table that is two plain numbers (and nothing else but separators).
+_ROW = re.compile(r"[ \t]*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)"
+                  r"[ \t]*[,; \t][ \t]*"
+                  r"([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)[ \t]*\r?\n?")
+
+
+def _number(token, pattern=_NUMBER):
+    """``token`` as a float, or ``None`` where it is not a number as a record writes one."""
+    if pattern.fullmatch(token) is None:
+        return None
+    return float(token.replace("D", "E").replace("d", "e"))
+
+
+def _too_many(src):
+    _refuse(src, f"it holds more than {MAX_SAMPLES} samples")
 
 
 _FLOAT = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?"
@@ -379,8 +489,10 @@ def read_at2(path, *, size=None, p=None, name=None) -> Record:
     >>> rec, rec.pga
     (Record('example', n=5, dt=0.01, size=1), 0.2)
     """
+    path = _path_of(path)
     src = str(path)
-    lines = _read_text(path).splitlines()
+    stream = _lines(path)
+    lines = [text.rstrip("\r\n") for _, (_, text) in zip(range(4), stream)]
     if len(lines) < 4:
         _refuse(src, "not a PEER .AT2 file (fewer than four header lines)")
     units = lines[2].upper()
@@ -409,13 +521,16 @@ def read_at2(path, *, size=None, p=None, name=None) -> Record:
             npts = dt = None
         if npts is None:
             _refuse(src, f"line 4 does not give NPTS and DT ({lines[3].strip()!r})")
-    body = " ".join(lines[4:]).replace("D", "E").replace("d", "e")
-    tokens = body.split()
-    try:
-        values = np.array([float(x) for x in tokens], dtype=float)
-    except ValueError:
-        bad = next(x for x in tokens if not _is_float(x))
-        _refuse(src, f"{bad!r} among the accelerations is not a number")
+    got = array("d")
+    for _, text in stream:
+        for token in text.split():
+            v = _number(token, _NUMBER_D)
+            if v is None:
+                _refuse(src, f"{token!r} among the accelerations is not a number")
+            if len(got) >= MAX_SAMPLES:
+                _too_many(src)
+            got.append(v)
+    values = np.frombuffer(got, dtype=float) if got else np.zeros(0)
     if values.size == 0:
         _refuse(src, "it holds no samples")
     if values.size != npts:
@@ -522,17 +637,25 @@ def read_table(path, *, size=None, p=None, name=None) -> Record:
     ...
     ValueError: record ...cms2.csv: the acceleration column is in 'cm/s^2', not g (header 'a (cm/s^2)'); divide by 9.81 m/s^2 first
     """
+    path = _path_of(path)
     src = str(path)
-    text = _read_text(path)
-    rows = []
+    times, accels = array("d"), array("d")
     header = None
     units_col = None
-    for lineno, line in enumerate(text.splitlines(), 1):
+    row = _ROW.fullmatch
+    for lineno, line in _lines(path):
+        m = row(line) if units_col is None else None
+        if m is not None:  # the common row, two plain numbers: no more checks to make
+            if len(times) >= MAX_SAMPLES:
+                _too_many(src)
+            times.append(float(m.group(1)))
+            accels.append(float(m.group(2)))
+            continue
         line = line.split("#", 1)[0].strip()
         if not line:
             continue
-        fields = [x for x in re.split(r"[,;\s]+", line) if x]
-        if not rows and header is None and not all(_is_float(x) for x in fields[:2]):
+        fields = [x for x in _SEPARATORS.split(line) if x]
+        if not times and header is None and not all(_is_float(x) for x in fields[:2]):
             header = line
             cols = _header_units(src, header)
             for k, col in enumerate(cols):
@@ -553,15 +676,19 @@ def read_table(path, *, size=None, p=None, name=None) -> Record:
         if len(fields) > 2:
             _refuse(src, f"line {lineno} has {len(fields)} columns: two are expected "
                          f"(time in s, acceleration in g)")
-        try:
-            rows.append((float(fields[0]), float(fields[1])))
-        except ValueError:
-            bad = fields[0] if not _is_float(fields[0]) else fields[1]
-            _refuse(src, f"line {lineno}: {bad!r} is not a number")
-    if not rows:
+        t, a = _number(fields[0]), _number(fields[1])
+        if t is None or a is None:
+            bad = fields[0] if t is None else fields[1]
+            _refuse(src, f"line {lineno}: {bad!r} is not a number (ASCII digits, '.', "
+                         f"'e' and a sign)")
+        if len(times) >= MAX_SAMPLES:
+            _too_many(src)
+        times.append(t)
+        accels.append(a)
+    if not times:
         _refuse(src, "it holds no samples")
-    data = np.array(rows, dtype=float)
-    return Record.from_arrays(data[:, 0], data[:, 1], size=size, p=p,
+    return Record.from_arrays(np.frombuffer(times, dtype=float),
+                              np.frombuffer(accels, dtype=float), size=size, p=p,
                               name=name or Path(path).stem, source=src)
 
 
@@ -597,6 +724,7 @@ def read_record(path, *, size=None, p=None, name=None) -> Record:
     >>> rec.name, rec.n, rec.dt
     ('a text file', 3, 0.02)
     """
+    path = _path_of(path)
     if Path(path).suffix.lower() == ".at2":
         return read_at2(path, size=size, p=p, name=name)
     return read_table(path, size=size, p=p, name=name)

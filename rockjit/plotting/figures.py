@@ -884,15 +884,15 @@ def fig_erosion(profiles, title=None):
 # an ensemble's fates
 # ---------------------------------------------------------------------------------------------
 
-_OUTCOME = re.compile(r"^(?P<b>[a-z]+) p=(?P<p>\d+) #(?P<id>-?\d+)$")
+_OUTCOME = re.compile(r"^(?P<b>[a-z]+)(?: p=(?P<p>\d+))?(?: \([a-z]+\))?$")
 
 
 def _outcome_names(keys):
-    """An ensemble's outcome keys (``"multiperiodic p=7 #3"``) in words (``"period-7"``)."""
+    """An ensemble's outcome keys (``"multiperiodic p=7"``) in words (``"period-7"``)."""
     items = []
     for k in keys:
         m = _OUTCOME.match(k)
-        items.append(dict(behaviour=m["b"], period=int(m["p"]), multipliers=None) if m
+        items.append(dict(behaviour=m["b"], period=int(m["p"] or 0), multipliers=None) if m
                      else dict(behaviour=k, period=0, multipliers=None))
     return dict(zip(keys, S.attractor_names(items))), {k: it["behaviour"]
                                                          for k, it in zip(keys, items)}
@@ -916,14 +916,9 @@ def fig_fate(fate_result, title=None):
     d = np.abs(fr.initial - fr.initial[0]).max(axis=1)
     rel = d / max(np.abs(fr.initial[0]).max(), 1e-300)
     ok = rel > 0
-    by_id = {}
-    for k in keys:
-        m = _OUTCOME.match(k)
-        by_id[int(m["id"]) if m else {"overturn": -1, "unresolved": -2}.get(k, -3)] = k
+    by_id = {v: k for k, v in fr.ids.items()}
     for v in np.unique(fr.outcome):
         key = by_id.get(int(v))
-        if key is None:  # rest: its key has no id
-            key = next((k for k in keys if behs[k] == "rest"), None)
         m = ok & (fr.outcome == v)
         ax_t.scatter(rel[m], fr.t_end[m], s=14, color=colours.get(key, "0.5"),
                      edgecolor="0.3", lw=0.3, label=words.get(key, "other"))
