@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .excitation import Excitation
+from .reprs import text as _text
 from .model import Block
 from .settings import Integration
 
@@ -346,6 +347,9 @@ class SweepResult(GridResult):
     t_overturn: np.ndarray | None = None
     motion: np.ndarray | None = None
 
+    def __repr__(self):
+        return _text(self)
+
     def arrays(self):
         """The sweep's arrays by name, for an ``.npz``."""
         out = dict(alpha=self.alpha, label=self.label, period=self.period,
@@ -436,6 +440,9 @@ class BasinResult(GridResult):
     period: np.ndarray
     lambda_max: np.ndarray | None
     t_end: np.ndarray
+
+    def __repr__(self):
+        return _text(self)
 
     def summary(self):
         """JSON-ready: behaviours (percent and counts), settings, attractors and, when they
@@ -554,6 +561,9 @@ class PlaneResult(GridResult):
     period: np.ndarray
     lambda_max: np.ndarray
     t_end: np.ndarray
+
+    def __repr__(self):
+        return _text(self)
 
     def to_xarray(self):
         """The plane as a labelled ``xarray.Dataset`` (needs ``pip install rockjit[xarray]``).

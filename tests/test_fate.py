@@ -103,3 +103,30 @@ def test_each_member_of_an_ensemble_is_its_own_plain_run():
                                  (th, dth), **kw)
         assert alone.t == pytest.approx(t_end, abs=1e-9)
         assert (alone.status == "overturned") == (outcome == -1)
+
+
+def test_outcome_keys_name_attractors_by_what_they_are_not_by_their_ids():
+    from rockjit.basins.identity import Attractor
+
+    def att(i, behaviour, period, x):
+        return Attractor(id=i, behaviour=behaviour, period=period, points=np.array([[x, 0.1]]),
+                         fraction=10.0, n_cells=1, lam=np.zeros(2))
+
+    # a mirror pair, a period-7 orbit, rest and a chaotic cloud, numbered one way, then the other
+    found = [att(0, "asymmetric", 1, 0.2), att(1, "asymmetric", 1, -0.2),
+             att(2, "multiperiodic", 7, 0.0), att(3, "rest", 0, 0.0), att(4, "chaotic", 0, 0.3)]
+    keys = F.outcome_keys(found)
+    assert keys == {-1: "overturn", -2: "unresolved", 0: "asymmetric p=1 (b)",
+                    1: "asymmetric p=1 (a)", 2: "multiperiodic p=7", 3: "rest", 4: "chaotic"}
+    renumbered = [att(4 - a.id, a.behaviour, a.period, a.points[0, 0]) for a in found]
+    again = F.outcome_keys(renumbered)
+    by_position = {(a.behaviour, float(a.points[0, 0])): keys[a.id] for a in found}
+    assert {(a.behaviour, float(a.points[0, 0])): again[a.id] for a in renumbered} == by_position
+
+
+def test_an_ensembles_keys_are_readable_and_map_to_its_outcomes():
+    f = F.fate(BLOCK, TRANSIENT, ensemble=24, integration=Integration(periods=300))
+    assert all("#" not in k for k in f.probabilities)
+    assert set(f.ids) == set(f.probabilities)
+    for key, v in f.ids.items():
+        assert f.probabilities[key] == pytest.approx(np.mean(f.outcome == v))

@@ -104,6 +104,10 @@ class ErosionResult:
     forcing: object = None
     settings: dict = field(default_factory=dict)
 
+    def __repr__(self):
+        from ..reprs import text
+        return text(self)
+
     def fractions(self):
         """``(n_branches, na)``: each branch's percent of cells at each amplitude."""
         return np.array([b["fraction"] for b in self.branches]).reshape(-1, self.alpha.size)

@@ -37,7 +37,8 @@ from ..single import simulate
 from ..single import run as run_one
 from ..validate import integer, memory, pair
 
-__all__ = ["DEFAULT_SPREAD", "HORIZON_TOL", "FateResult", "fate", "horizon", "perturb"]
+__all__ = ["DEFAULT_SPREAD", "HORIZON_TOL", "FateResult", "fate", "horizon", "outcome_keys",
+           "perturb"]
 
 #: Relative perturbations of the ensemble's initial states: four units in the last place to
 #: 1e-10 (log-uniform).
@@ -59,6 +60,62 @@ def perturb(x, k, spread, seed):
     return out
 
 
+def outcome_keys(attractors):
+    """Readable, stable names of an ensemble's outcomes: ``{outcome id: key}``.
+
+    ``-1`` is ``"overturn"``, ``-2`` ``"unresolved"``; an attractor is named by its behaviour
+    and, when periodic, its period (``"asymmetric p=1"``; rest for good is ``"rest"``, a
+    chaotic or aperiodic cloud ``"chaotic"`` or ``"aperiodic"``). Attractors that would share
+    a name are told apart by ``" (a)"``, ``" (b)"``, ... in the order of their position in the
+    state plane: the smallest ``(theta, theta')`` of their points, compared as a pair. The ids
+    themselves (by decreasing basin) never appear, so that the same attractor has the same key
+    in ensembles of any size or seed.
+
+    Parameters
+    ----------
+    attractors : list of Attractor
+        As :func:`rockjit.basins.identity.identify` returns them.
+
+    Returns
+    -------
+    dict of int to str
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rockjit.basins.identity import Attractor
+    >>> a = [Attractor(id=k, behaviour="asymmetric", period=1, points=np.array([[x, 0.0]]),
+    ...                fraction=50.0, n_cells=1, lam=np.zeros(2)) for k, x in enumerate((0.1, -0.1))]
+    >>> outcome_keys(a)
+    {-1: 'overturn', -2: 'unresolved', 1: 'asymmetric p=1 (a)', 0: 'asymmetric p=1 (b)'}
+    """
+    names = {-1: "overturn", -2: "unresolved"}
+    base = {a.id: (a.behaviour if a.behaviour == "rest" or not a.period
+                   else f"{a.behaviour} p={a.period}") for a in attractors}
+
+    def position(a):
+        pts = np.asarray(a.points, dtype=float).reshape(-1, 2)
+        pts = pts[np.isfinite(pts).all(axis=1)]
+        return tuple(pts[np.lexsort((pts[:, 1], pts[:, 0]))[0]]) if len(pts) else (0.0, 0.0)
+
+    for name in dict.fromkeys(base.values()):
+        same = sorted((a for a in attractors if base[a.id] == name),
+                      key=lambda a: (position(a), a.id))
+        for k, a in enumerate(same):
+            names[a.id] = name if len(same) == 1 else f"{name} ({_letters(k)})"
+    return names
+
+
+def _letters(k):
+    """0 -> 'a', 25 -> 'z', 26 -> 'aa', ..."""
+    out = ""
+    k += 1
+    while k:
+        k, r = divmod(k - 1, 26)
+        out = chr(ord("a") + r) + out
+    return out
+
+
 @dataclass
 class FateResult:
     """The outcomes of an ensemble of nearby runs.
@@ -66,8 +123,15 @@ class FateResult:
     Attributes
     ----------
     probabilities : dict of str to float
-        Each outcome's share of the members: ``"overturn"``, ``"rest"``, ``"unresolved"``, or
-        an attractor ``"<behaviour> p=<period> #<id>"`` (sums to 1).
+        Each outcome's share of the members (sums to 1), most frequent first. The keys
+        (:func:`outcome_keys`): ``"overturn"``, ``"rest"``, ``"unresolved"``, a periodic
+        attractor ``"<behaviour> p=<period>"`` (``"symmetric p=1"``, ``"multiperiodic p=7"``),
+        a chaotic or aperiodic one by its behaviour (``"chaotic"``); attractors that would
+        share a key get ``" (a)"``, ``" (b)"``, ... in the order of their position in the
+        state plane, so that a key names the same attractor whatever the ensemble's size or
+        seed.
+    ids : dict of str to int
+        Each key's outcome id in :attr:`outcome`.
     outcome : ndarray of int, shape (K,)
         Each member's outcome id (``>= 0`` attractors, ``-1`` overturn, ``-2`` unresolved).
     t_end : ndarray, shape (K,)
@@ -98,6 +162,7 @@ class FateResult:
     """
 
     probabilities: dict
+    ids: dict
     outcome: np.ndarray
     t_end: np.ndarray
     initial: np.ndarray
@@ -108,6 +173,10 @@ class FateResult:
     block: object
     forcing: object = None
     settings: dict = field(default_factory=dict)
+
+    def __repr__(self):
+        from ..reprs import text
+        return text(self)
 
     def to_summary(self):
         """JSON-ready."""
@@ -138,13 +207,13 @@ def run(plan: FatePlan, execution=None) -> FateResult:
     else:  # the embedding: one compiled run per member (the grid kernels use the closed form)
         label, period, pts, n_got, t_end = _members_one_by_one(p, starts)
     ids, found = identify(label, period, pts, n_got)
-    names = {-1: "overturn", -2: "unresolved"}
-    names.update({a.id: a.behaviour if a.behaviour == "rest" else
-                  f"{a.behaviour} p={a.period} #{a.id}" for a in found})
-    probs = {names[int(v)]: float(np.mean(ids == v)) for v in np.unique(ids)}
+    names = outcome_keys(found)
+    order = sorted(np.unique(ids), key=lambda v: (-np.count_nonzero(ids == v), names[int(v)]))
+    probs = {names[int(v)]: float(np.mean(ids == v)) for v in order}
     lam_run = nominal.lyapunov_running
     lam1 = float(lam_run[-1, 0]) if lam_run is not None and len(lam_run) > 1 else math.nan
     return FateResult(probabilities=probs, outcome=ids, t_end=t_end, initial=starts,
+                      ids={names[int(v)]: int(v) for v in order},
                       lambda1=lam1, horizon=horizon(lam1, plan.spread[1]),
                       horizon_rounding=horizon(lam1, ROUNDING), nominal=nominal,
                       block=p.block, forcing=p.forcing,
@@ -187,7 +256,7 @@ def fate(block, forcing, state=None, *, integration=None, ensemble=64, spread=No
     >>> from rockjit import Block, Harmonic
     >>> f = rockjit.fate(Block(hb=1), Harmonic(alpha=0.6, omega=1.3), ensemble=4)
     >>> f.probabilities
-    {'symmetric p=1 #0': 1.0}
+    {'symmetric p=1': 1.0}
     """
     execution = Execution() if execution is None else execution
     ensemble = integer("ensemble", ensemble, 2, 10**6)

@@ -104,6 +104,10 @@ class Attractor:
     cell: int = -1
     extent: tuple | None = None
 
+    def __repr__(self):
+        from ..reprs import text
+        return text(self)
+
     def to_dict(self):
         """JSON-ready (complex multipliers as ``[re, im]`` pairs)."""
         mu = None if self.multipliers is None else \

@@ -192,6 +192,10 @@ class ChartResult:
     phase: float
     timing: dict = field(default_factory=dict)
 
+    def __repr__(self):
+        from ..reprs import text
+        return text(self)
+
     @property
     def law(self):
         """The block's restitution law."""

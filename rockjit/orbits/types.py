@@ -15,6 +15,7 @@ import numpy as np
 
 from ..excitation import Harmonic
 from ..model import Block
+from ..reprs import text as _text
 from ..settings import Integration
 from ..validate import boolean, integer, real
 
@@ -287,6 +288,9 @@ class PeriodicOrbit:
     block: Block | None = None
     forcing: Harmonic | None = None
 
+    def __repr__(self):
+        return _text(self)
+
     @property
     def impacts_per_period(self) -> float:
         """Impacts per forcing period (``impacts / p``)."""
@@ -367,6 +371,9 @@ class Branch:
     ends: tuple
     origin: str
     parent: int | None = None
+
+    def __repr__(self):
+        return _text(self)
 
     @property
     def state(self) -> np.ndarray:
@@ -454,6 +461,9 @@ class Bifurcation:
     has_mirror: bool = False
     new_branch: int | None = None
 
+    def __repr__(self):
+        return _text(self)
+
     def to_dict(self):
         """JSON-ready (complex multipliers as ``[re, im]`` pairs)."""
         mu = [[float(m.real), float(m.imag)] for m in self.multipliers]
@@ -525,6 +535,9 @@ class Continuation:
     wall_s: float
     seeds_tried: int = 0
     settings: dict = field(default_factory=dict)
+
+    def __repr__(self):
+        return _text(self)
 
     def to_summary(self):
         """``(summary, arrays)``; multipliers are written as ``[re, im]`` pairs.
