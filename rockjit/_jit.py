@@ -230,12 +230,14 @@ def _stamp_folder(folder, digest):
             pass  # read-only: numba then caches in the next folder, or not at all
 
 
-def cached_kernels(pkg=None):
+def cached_kernels(pkg=None, modules=("integrate", "kernel")):
     """Whether numba's cache already holds compiled kernels of the package (any cache file of
-    ``integrate.py``, where every kernel's loop lives): a cold first run compiles for a minute."""
+    ``modules`` in ``_engine``: by default ``integrate.py``, where every harmonic kernel's loop
+    lives; ``("transient",)`` for the pulses' and records' kernel): a cold first run compiles
+    for a minute."""
     pkg = Path(__file__).parent if pkg is None else Path(pkg)
     pkg = pkg / "_engine"
-    pattern = _cache_file_pattern(["integrate", "kernel"])
+    pattern = _cache_file_pattern(list(modules))
     root = os.environ.get("NUMBA_CACHE_DIR")
     for home in _cache_dirs(pkg):
         if root and Path(root) not in home.parents:

@@ -684,3 +684,17 @@ def test_out_problems_are_found_before_any_work(tmp_path, monkeypatch, capsys, s
     assert err.startswith("rockjit: error: ") and err.count("\n") == 1 and "--out" in err
     assert says in err, err
     assert sorted(str(p) for p in tmp_path.rglob("*")) == before
+
+
+def test_a_cold_cache_is_told_kernel_by_kernel(tmp_path, monkeypatch):
+    # the harmonic kernels cached and the pulses' kernel not: a spectrum's first run still
+    # compiles, and the check says so
+    from rockjit._jit import cached_kernels
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    cache = tmp_path / "pkg" / "_engine" / "__pycache__"
+    cache.mkdir(parents=True)
+    (cache / "integrate.run-12.py311.1.nbc").write_bytes(b"")
+    assert cached_kernels(tmp_path / "pkg")
+    assert not cached_kernels(tmp_path / "pkg", modules=("transient",))
+    (cache / "transient.run_cells-558.py311.1.nbc").write_bytes(b"")
+    assert cached_kernels(tmp_path / "pkg", modules=("transient",))

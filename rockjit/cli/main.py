@@ -1090,7 +1090,10 @@ def _main(argv, sig):
     except (UsageError, ValueError) as exc:
         return _error(exc)
     from .._jit import cached_kernels
-    if args.command != "cor" and not cached_kernels():
+    # spectra and fragility run the pulses' and records' kernel, the others the harmonic ones
+    engine = ("transient",) if args.command in ("spectrum", "fragility") else \
+        ("integrate", "kernel")
+    if args.command != "cor" and not cached_kernels(modules=engine):
         _say(args, "first run here: numba compiles rockjit's kernels into its cache, about "
                    "10-20 s per kernel variant on two cores, once (`rockjit compile` does it "
                    "ahead of time)")
