@@ -464,3 +464,67 @@ def test_integrity_rejects_bad_input_by_name(kwargs, word):
     args.update(kwargs)
     with pytest.raises(ValueError, match=word):
         integrity(**args)
+
+
+def slow_lim(ids, th, dth, cycle, own=None):
+    """Readable reference for the LIM, from its definition: for each cycle point, ``nan`` if it
+    lies outside the sampled rectangle, 0 if the node nearest to it (searched over every node,
+    Euclidean in state units) is outside the basin, else the smaller of its distance to the
+    region's edge and to the nearest node outside the basin; the LIM is the smallest over the
+    points, over the half-width. The basin is the safe cells, or the cells of ``own``."""
+    inside = [[(ids[i, j] >= 0) if own is None else (ids[i, j] == own)
+               for j in range(len(dth))] for i in range(len(th))]
+    nodes = [(th[i], dth[j], inside[i][j]) for i in range(len(th)) for j in range(len(dth))]
+    half = min(th[-1] - th[0], dth[-1] - dth[0]) / 2
+    worst = math.inf
+    for x, v in cycle:
+        if not (th[0] <= x <= th[-1] and dth[0] <= v <= dth[-1]):
+            return math.nan
+        nearest = min(nodes, key=lambda nd: math.hypot(nd[0] - x, nd[1] - v))
+        if not nearest[2]:
+            r = 0.0
+        else:
+            r = min(x - th[0], th[-1] - x, v - dth[0], dth[-1] - v)
+            for nx, nv, ok in nodes:
+                if not ok:
+                    r = min(r, math.hypot(nx - x, nv - v))
+        worst = min(worst, r)
+    return worst / half
+
+
+@pytest.mark.parametrize("seed, unsafe, lim_basin", [(3, 0.10, "safe"), (4, 0.25, "safe"),
+                                                     (5, 0.15, "own"), (6, 0.40, "own")])
+def test_lim_matches_a_brute_force_reference_between_nodes(seed, unsafe, lim_basin):
+    # random maps of two attractors and overturning cells on unequal spacings; the points lie
+    # between nodes, most of them nearer to the node above (in theta, theta' or both) than to
+    # the one below, where rounding to the nearest node and truncating to the one below differ
+    rng = np.random.default_rng(seed)
+    th = np.linspace(-0.6, 0.9, 16)
+    dth = np.linspace(-2.0, 1.0, 13)
+    h0, h1 = th[1] - th[0], dth[1] - dth[0]
+    ids = np.where(rng.random((16, 13)) < unsafe, -1, rng.integers(0, 2, (16, 13)))
+    frac = [(0.3, 0.2), (0.7, 0.2), (0.2, 0.8), (0.75, 0.65), (0.55, 0.45)]
+    points = {}
+    for n in range(40):
+        i, j = rng.integers(0, 15), rng.integers(0, 12)
+        fi, fj = frac[n % len(frac)]
+        points[n] = [(th[i] + fi * h0, dth[j] + fj * h1)]
+    # 2- and 3-cycles: the most exposed point decides
+    for n in range(40, 50):
+        k = rng.integers(0, 40, size=2 + n % 2)
+        points[n] = [points[int(q)][0] for q in k]
+    differs = 0
+    for n, cyc in points.items():
+        key = n % 2
+        own = None if lim_basin == "safe" else key
+        got = integrity(ids, th, dth, points={key: cyc}, lim_basin=lim_basin).LIM[key]
+        assert got == pytest.approx(slow_lim(ids, th, dth, cyc, own), rel=1e-12, abs=1e-15), \
+            (n, cyc)
+        # count the points whose node below (a truncated index) and nearest node differ in
+        # whether they lie in the basin
+        x, v = cyc[0]
+        lower = (int((x - th[0]) // h0), int((v - dth[0]) // h1))
+        near = (int(round((x - th[0]) / h0)), int(round((v - dth[0]) / h1)))
+        in_basin = (ids >= 0) if own is None else (ids == own)
+        differs += bool(in_basin[lower] != in_basin[near])
+    assert differs >= 5  # enough points where the two choices disagree on safety
