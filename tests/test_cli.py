@@ -34,7 +34,7 @@ def _summary(d):
     s = json.loads((d / "summary.json").read_text())
     # every file a command writes is one the command line checks for before any work (a
     # directory of that name inside --out is refused then, not when publishing)
-    declared = OUTPUTS[s["command"]] + ("summary.json",)
+    declared = OUTPUTS[s["command"]] + ("summary.json", ".rockjit-files.json")
     for entry in s["files"]:
         name = entry["name"]
         assert entry["holds"], f"{name}: summary.json says nothing of what it holds"
