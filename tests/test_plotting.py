@@ -161,13 +161,22 @@ def test_laws_timeseries(short_runs, ref_run):
     fig = P.fig_laws_timeseries([row], beh, periods=3)
     ax_h, ax_m = (ax for ax in fig.axes if "\\theta$" in ax.get_ylabel()
                   and ax.get_ylabel().count("\n"))
-    assert max(np.asarray(ln.get_xdata(), float).max() for ln in ax_h.get_lines()) <= \
-        3 * ref_run.period
+    # the run that went on: its last 3 periods, where it has settled, up to its end
+    x = np.concatenate([np.asarray(ln.get_xdata(), float) for ln in ax_h.get_lines()
+                        if len(ln.get_xdata()) > 2])
+    assert x.min() >= ref_run.t - 3 * ref_run.period - 1e-12
+    assert x.max() == pytest.approx(ref_run.t)
+    # the run that came to rest: the whole of it
+    rest = short_runs["rest"]
+    x = np.asarray(ax_m.get_lines()[0].get_xdata(), float)
+    assert x.min() == pytest.approx(0.0) and x.max() == pytest.approx(rest.t)
     assert ax_h.get_ylabel().startswith("Housner") and ax_m.get_ylabel().startswith("Housner")
-    cap = fig.subfigs[0].get_supxlabel()
-    assert cap == "a) Housner: symmetric, $p = 1$; Housner: rest."
+    # what each run does is said in its phase portrait's title; no caption inside the image
+    titles = [ax.get_title() for ax in fig.axes if ax.get_title()]
+    assert titles == ["Housner:\nsymmetric, $p = 1$", f"Housner:\nat rest from $t = {rest.t:.3g}$"]
+    assert fig.subfigs[0].get_supxlabel() == ""
     fig = P.fig_laws_timeseries([row], beh, ["both as said"])
-    assert fig.subfigs[0].get_supxlabel() == "a) both as said"
+    assert fig.subfigs[0].get_supxlabel() == ""
 
 
 def test_bifurcation_draws_every_finite_point_and_clips_rest():

@@ -131,26 +131,25 @@ def fig_restitution(hb_range=(1.0 / math.sqrt(2.0), 6.0), n=400, marks=(1.0, 2.0
     ax2.plot(deg, de, color="0.55", ls=":", lw=1.5, label=r"$\Delta e$ (right axis)")
     ax2.set_ylabel(r"$\Delta e$  [%]")
     ax2.set_ylim(0, max(1.0, float(np.nanmax(de))) * 1.05)
-    # the values at the marked slendernesses, in boxes in the empty lower right, each joined
-    # to its points by a thin line
-    for k, hb in enumerate(marks):
+    # the values at the marked slendernesses: the points on the curves, each line marked by
+    # its h/b on the top axis, and the values in one box in the empty lower right
+    rows = []
+    for hb in marks:
         t = float(thc_from_hb(hb))
         h, m = float(e_housner(t)), float(e_mao(t))
         x = np.degrees(t)
         ax.axvline(x, color="0.75", lw=0.8, ls="-", zorder=0)
-        ax.plot([x, x], [h, m], "o", color="k", ms=3.5, zorder=5)
-        ax2.annotate(f"$h/b = {hb:g}$: $e_H = {h:.3f}$, $e_M = {m:.3f}$,\n"
-                     f"$\\Delta e = {float(delta_e_percent(m, h)):.2f}$ %",
-                     xy=(x, h), xycoords=ax.transData,
-                     xytext=(0.97, 0.08 + 0.17 * (len(marks) - 1 - k)),
-                     textcoords="axes fraction", ha="right", va="bottom", fontsize="small",
-                     zorder=6, arrowprops=dict(arrowstyle="-", color="0.5", lw=0.6,
-                                               shrinkA=0, shrinkB=3),
-                     bbox=dict(boxstyle="round,pad=0.25", fc="white", ec="0.75", lw=0.6))
+        ax.plot([x, x], [h, m], "o", color="k", ms=3, zorder=5)
+        rows.append(f"$h/b = {hb:g}$: $e_H = {h:.3f}$, $e_M = {m:.3f}$, "
+                    f"$\\Delta e = {float(delta_e_percent(m, h)):.2f}$ %")
+    if rows:
+        ax.text(0.97, 0.05, "\n".join(rows), transform=ax.transAxes, ha="right", va="bottom",
+                fontsize=7, zorder=6,
+                bbox=dict(boxstyle="round,pad=0.25", fc="white", ec="0.75", lw=0.6))
     lines = ax.get_legend_handles_labels()
     lines2 = ax2.get_legend_handles_labels()
-    ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], loc="upper center",
-              bbox_to_anchor=(0.40, 1.0))
+    fig.legend(lines[0] + lines2[0], lines[1] + lines2[1], loc="outside lower center",
+               ncols=2)
     top = ax.secondary_xaxis("top", functions=(
         lambda d: np.tan(np.radians(np.clip(d, 1e-3, 89.9))),
         lambda hb: np.degrees(np.arctan(hb))))
@@ -245,8 +244,8 @@ def _phase_panel(ax, result, colour, strobe=True, whole=False, label=None):
         if s.shape[0]:
             ax.plot(s[:, 0], s[:, 1], "o", ms=4, mfc="none", mec="k", mew=0.8,
                     label=r"$t = kT$")
-    ax.set_xlabel(SYMBOLS["theta"])
-    ax.set_ylabel(SYMBOLS["dtheta"])
+    ax.set_xlabel(SYMBOLS["theta_unit"])
+    ax.set_ylabel(SYMBOLS["dtheta_unit"])
     return in_window
 
 
@@ -263,25 +262,24 @@ def _mark_end(ax, result):
 
 
 def _rest_inset(ax, result, colour):
-    """An inset of a run that came to rest: its impacts from the first one on, magnified (each
-    impact keeps ``e`` of the speed, so the rocking decays too fast to see at the fall's
-    scale)."""
+    """An inset of a run that came to rest: the speed before each of its impacts,
+    ``|theta'-|``, on a log scale against the impact's number (each impact keeps ``e`` of the
+    speed, so the rocking decays too fast to see at the fall's scale: on a log scale every
+    impact shows), in the empty upper right of the panel, joined to nothing."""
     imp = np.asarray(result.impacts).reshape(-1, 3)
-    if imp.shape[0] < 2:
+    speed = np.abs(imp[:, 1])
+    keep = speed > 0
+    if np.count_nonzero(keep) < 2:
         return
-    t0 = imp[0, 0]
-    t, th, _ = with_impacts(result, t0, result.t)
-    if t.size < 2:
-        return
-    ins = ax.inset_axes([0.07, 0.12, 0.36, 0.5])
-    ins.plot(t, th, color=colour, lw=0.9)
-    ins.axhline(0, color="0.8", lw=0.5, zorder=0)
-    ins.set_xlim(t0, result.t)
-    lim = max(float(np.abs(th).max()), 1e-12) * 1.15
-    ins.set_ylim(-lim, lim)
-    ins.tick_params(labelsize="x-small")
-    ins.set_title(f"{imp.shape[0]} impacts, magnified", fontsize="x-small")
-    ax.indicate_inset_zoom(ins, edgecolor="0.5")
+    k = np.arange(1, imp.shape[0] + 1)[keep]
+    ins = ax.inset_axes([0.7, 0.4, 0.28, 0.36])
+    ins.plot(k, speed[keep], "o-", color=colour, ms=2.5, lw=0.8)
+    ins.set_yscale("log")
+    ins.set_xlim(0.5, imp.shape[0] + 0.5)
+    ins.tick_params(labelsize=7)
+    ins.xaxis.get_major_locator().set_params(integer=True)
+    ins.set_xlabel("impact", fontsize=7, labelpad=1)
+    ins.set_title(f"$|\\theta'^-|$ at each of the {imp.shape[0]} impacts", fontsize=7)
 
 
 def _windows(result, first, last):
@@ -331,9 +329,9 @@ def fig_trajectory(result, behaviour, *, exponent=None, title=None, first=8, las
     for i, (ax, (t0, t1, what)) in enumerate(zip(axes_t, wins)):
         _time_panel(ax, result, t0, t1, colour)
         _mark_end(ax, result)
-        ax.set_xlabel(SYMBOLS["t"])
+        ax.set_xlabel(SYMBOLS["t_unit"])
         S.letter(ax, i, what)
-    axes_t[0].set_ylabel(r"$\theta$  [rad]")
+    axes_t[0].set_ylabel(SYMBOLS["theta_unit"])
     ax_l = fig.add_subplot(gs[1, :2])
     if lam is not None and lam.shape[0] > 1:
         k = np.arange(1, lam.shape[0])
@@ -342,8 +340,7 @@ def fig_trajectory(result, behaviour, *, exponent=None, title=None, first=8, las
         ax_l.axhline(0, color="0.6", lw=0.6)
         t_w = _window_start(result)
         if result.t > t_w:
-            ax_l.axvspan(t_w, result.t, color="0.92", lw=0, zorder=0,
-                         label="asymptotic window")
+            ax_l.axvspan(t_w, result.t, color="0.88", lw=0, zorder=0)
         if result.lyapunov is not None and np.isfinite(result.lyapunov[0]):
             ax_l.axhline(result.lyapunov[0], color=colour, lw=1.0, ls="--",
                          label=f"$\\lambda_\\mathrm{{max}}$ over the window "
@@ -355,14 +352,19 @@ def fig_trajectory(result, behaviour, *, exponent=None, title=None, first=8, las
         if fin.size:  # the estimate's range, with room for the legend above it
             lo, hi = float(fin.min()), float(fin.max())
             span = max(hi - lo, 0.05 * max(abs(lo), abs(hi), 1e-3))
-            ax_l.set_ylim(lo - 0.1 * span, hi + 0.6 * span)
-        ax_l.legend(loc="upper right", ncols=2)
+            ax_l.set_ylim(lo - 0.1 * span, hi + 0.1 * span)
+        hs, ls_ = ax_l.get_legend_handles_labels()
+        if result.t > t_w:
+            from matplotlib.patches import Patch
+            hs.append(Patch(facecolor="0.88", edgecolor="0.6", lw=0.5))
+            ls_.append("asymptotic window")
+        fig.legend(hs, ls_, loc="outside lower center", ncols=2)
         ax_l.set_ylabel(r"$\lambda_1$")
         ax_l.set_xlim(0, result.t)
     else:
         ax_l.text(0.5, 0.5, "Lyapunov exponents not computed", ha="center", va="center",
                   transform=ax_l.transAxes, color="0.4")
-    ax_l.set_xlabel(SYMBOLS["t"])
+    ax_l.set_xlabel(SYMBOLS["t_unit"])
     S.letter(ax_l, len(axes_t), "running largest Lyapunov exponent")
     ax_p = fig.add_subplot(gs[:, 2])
     in_window = _phase_panel(ax_p, result, colour)
@@ -411,11 +413,11 @@ def fig_gallery(results, behaviours, notes=None, *, first=8, last=4):
             _time_panel(ax, res, t0, t1, colour)
             _mark_end(ax, res)
             ax.text(0.99, 0.97, what, transform=ax.transAxes, ha="right", va="top",
-                    fontsize="small", color="0.35",
+                    fontsize=7, color="0.35",
                     bbox=dict(fc="white", ec="none", alpha=0.8, pad=1.0))
             if r == n - 1:
-                ax.set_xlabel(SYMBOLS["t"])
-        axes[0].set_ylabel(r"$\theta$")
+                ax.set_xlabel(SYMBOLS["t_unit"])
+        axes[0].set_ylabel(SYMBOLS["theta_unit"])
         b, f = res.block, res.forcing
         what = (f"overturns at $t = {res.t:.5g}$" if res.status == "overturned" else
                 f"at rest from $t = {res.t:.3g}$" if res.status == "rest" else
@@ -443,9 +445,11 @@ def fig_gallery(results, behaviours, notes=None, *, first=8, last=4):
 
 def fig_laws_timeseries(runs, behaviours, captions=None, *, periods=8):
     """Figure 4: the two laws from the same initial states, one row per initial state: each
-    law's ``theta(t)`` over the first ``periods`` periods (one above the other, so that neither
-    hides the other) and its phase portrait, each run in its behaviour's colour, with a line
-    under the row saying what it shows.
+    law's ``theta(t)`` over the last ``periods`` periods of its run, where it has settled (the
+    whole run when it overturns or comes to rest sooner), one above the other so that neither
+    hides the other, and its phase portrait, each run in its behaviour's colour. What each run
+    does is said in its phase portrait's title; the figure's caption belongs outside the
+    image.
 
     Parameters
     ----------
@@ -454,7 +458,9 @@ def fig_laws_timeseries(runs, behaviours, captions=None, *, periods=8):
     behaviours : sequence of dict law -> (str, int)
         Each run's behaviour and period.
     captions : sequence of str, optional
-        The line under each row (default: each law's outcome).
+        Not drawn: the caption of each row, for the text beside the figure
+        (:func:`rockjit.study.paper.laws_captions` writes them); accepted so that a caller can
+        pass the figure and its captions together.
     periods : int
         Forcing periods of ``theta(t)`` shown.
     """
@@ -462,43 +468,43 @@ def fig_laws_timeseries(runs, behaviours, captions=None, *, periods=8):
     if not runs:
         raise ValueError("runs must hold at least one initial state")
     n = len(runs)
-    fig = _figure("double", 0.30 * n + 0.05)
+    fig = _figure("double", 0.27 * n + 0.04)
     subs = np.atleast_1d(fig.subfigures(n, 1))
     for i, (row, sub) in enumerate(zip(runs, subs)):
         laws = list(row)
         gs = sub.add_gridspec(len(laws), 1 + len(laws), width_ratios=(2.4,) + (1.0,) * len(laws))
         z = None
         ax_first = None
-        words = []
         for k, law in enumerate(laws):
             res = row[law]
             _need_traj(res)
             beh = behaviours[i][law]
             colour = LINE_COLOURS[beh[0]]
-            ax = sub.add_subplot(gs[k, 0], sharex=ax_first)
+            ax = sub.add_subplot(gs[k, 0])
             ax_first = ax_first or ax
-            t1 = periods * res.period
-            _time_panel(ax, res, 0.0, t1, colour)
+            T = res.period
+            settled = res.status not in ("overturned", "rest") and res.t > (periods + 1) * T
+            t0, t1 = (res.t - periods * T, res.t) if settled else (0.0, max(res.t, 1e-3 * T))
+            _time_panel(ax, res, t0, t1, colour)
             _mark_end(ax, res)
-            ax.set_ylabel(f"{S.law_name(res.block)}\n" + r"$\theta$")
-            if k < len(laws) - 1:
-                ax.tick_params(labelbottom=False)
-            else:
-                ax.set_xlabel(SYMBOLS["t"])
+            ax.text(0.99, 0.95, f"last {periods} periods" if settled else "whole run",
+                    transform=ax.transAxes, ha="right", va="top", fontsize=7, color="0.35",
+                    bbox=dict(fc="white", ec="none", alpha=0.8, pad=1.0))
+            ax.set_ylabel(f"{S.law_name(res.block)}\n" + SYMBOLS["theta_unit"])
+            if k == len(laws) - 1:
+                ax.set_xlabel(SYMBOLS["t_unit"])
             ax_p = sub.add_subplot(gs[:, 1 + k])
             _phase_panel(ax_p, res, colour, strobe=False)
-            ax_p.set_title(S.law_name(res.block), fontsize="medium")
+            what = _behaviour_words(beh)
+            if res.status == "overturned":
+                what = f"overturns at $t = {res.t:.3g}$"
+            elif res.status == "rest":
+                what = f"at rest from $t = {res.t:.3g}$"
+            ax_p.set_title(f"{S.law_name(res.block)}:\n{what}", fontsize=7)
             if k:
                 ax_p.set_ylabel("")
             z = res.trajectory[0, 1:3]
-            w = f"{S.law_name(res.block)}: {_behaviour_words(beh)}"
-            if res.status == "overturned":
-                w += f" (overturns at $t = {res.t:.3g}$)"
-            words.append(w)
         S.letter(ax_first, i, f"from $(\\theta_0, \\theta'_0) = ({z[0]:.4f}, {z[1]:.4f})$")
-        cap = captions[i] if captions is not None else "; ".join(words) + "."
-        sub.supxlabel(_wrap(f"{'abcdefghij'[i]}) {cap}", fig), fontsize="medium",
-                      ha="center")
     r0 = next(iter(runs[0].values()))
     b, f = r0.block, r0.forcing
     S.suptitle(fig, f"Housner against Mao et al. in time: $h/b = {b.hb:g}$, "
@@ -552,7 +558,7 @@ def _bifurcation_column(fig, gs_col, sw, alpha_limits, show_y, col, short=False)
     ax_s.pcolormesh(edges, [0, 1], label[None, :], cmap=cmap, norm=norm, rasterized=True)
     # the strip's name as its one tick label (a horizontal axis label is laid out badly)
     ax_s.set_yticks([0.5], ["class"] if show_y else [""])
-    ax_s.tick_params(axis="y", length=0, labelsize="small")
+    ax_s.tick_params(axis="y", length=0, labelsize=7)
     ax_s.tick_params(labelbottom=False)
 
     lam = np.asarray(sw.lambda_window if published and sw.lambda_window is not None
@@ -781,7 +787,7 @@ def fig_attractors(basins, measures=None, title=None):
                         f"GIM $= {m['integrity']['GIM']:.3f}$, "
                         f"IF $= {m['integrity']['IF']:.3f}$")
         ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncols=1,
-                  title=f"of the {_cells(b)}", title_fontsize="small")
+                  title=f"of the {_cells(b)}")
     b0 = next(iter(basins.values()))
     blk, frc = b0.block, b0.forcing
     S.suptitle(fig, title or f"Attractors, $h/b = {blk.hb:g}$, $\\alpha = {frc.alpha:g}$, "
@@ -793,29 +799,32 @@ def fig_attractors(basins, measures=None, title=None):
 # Figure 8: erosion profiles
 # ---------------------------------------------------------------------------------------------
 
-#: Branches whose basin never reaches this percent of the cells are drawn together, per
-#: behaviour (one area and one legend entry each).
-SMALL_BRANCH = 1.0
+#: What the erosion profiles call a basin with no period up to ``pmax``: the basins compute no
+#: exponent, so chaotic motion is counted as aperiodic there (docs/theory/behaviours.md).
+APERIODIC_NOTE = "aperiodic: no period up to 16\n(no exponents: chaotic motion counts here)"
 
 
 def _erosion_areas(r):
-    """``[(label, colour, fractions over alpha)]`` of a profile's stack: each branch that
-    reaches :data:`SMALL_BRANCH` % by name, the smaller ones together per behaviour."""
+    """``[(label, colour, hatch, [fractions over alpha of each attractor])]`` of a profile's
+    stack: one area per kind of attractor (behaviour, period, whether it passes through rest),
+    its attractors stacked inside it, in the behaviours' order."""
     fr = r.fractions()
-    big = [i for i, b in enumerate(r.branches) if fr[i].max() >= SMALL_BRANCH]
-    small = [i for i in range(len(r.branches)) if i not in big]
-    brs = [r.branches[i] for i in big]
-    colours = S.attractor_colours(brs)
-    names = S.attractor_names(brs)
+    kinds = {}
+    for i, br in enumerate(r.branches):
+        rest = bool(S._through_rest(br))
+        key = (BEHAVIOURS.index(br["behaviour"]), int(br.get("period") or 0), rest)
+        kinds.setdefault(key, []).append(i)
     areas = []
-    for beh in BEHAVIOURS:  # in the behaviours' order, each behaviour's small ones last
-        areas += [(n, c, fr[i]) for n, c, i in zip(names, colours, big)
-                  if r.branches[i]["behaviour"] == beh]
-        idx = [i for i in small if r.branches[i]["behaviour"] == beh]
-        if idx:
-            areas.append((f"{beh}, {len(idx)} small attractor{'s' if len(idx) > 1 else ''} "
-                          f"(each < {SMALL_BRANCH:g} %)", S.tint(BEHAVIOUR_COLOURS[beh], 0.3),
-                          fr[idx].sum(axis=0)))
+    for key in sorted(kinds):
+        idx = kinds[key]
+        br = r.branches[idx[0]]
+        beh = br["behaviour"]
+        name = APERIODIC_NOTE if beh == "aperiodic" else S._base_name(br)
+        n = len(idx)
+        if n > 1:
+            name += f" ({n} attractors)"
+        colour = BEHAVIOUR_COLOURS.get(beh, "#999999")
+        areas.append((name, colour, "//////" if key[2] else None, [fr[i] for i in idx]))
     return areas
 
 
@@ -853,12 +862,19 @@ def fig_erosion(profiles, title=None):
         bottom = np.zeros(r.alpha.size)
         from matplotlib.patches import Patch
         handles = []
-        for name, colour, f in areas:
-            axk.stairs(bottom + f, edges, baseline=bottom.copy(), fill=True, color=colour,
-                       lw=0)
-            handles.append(Patch(facecolor=colour, edgecolor="0.5", lw=0.4,
-                                 label=f"{name}, up to {f.max():.1f} %"))
-            bottom = bottom + f
+        for name, colour, hatch, parts in areas:
+            top = bottom + np.sum(parts, axis=0)
+            axk.stairs(top, edges, baseline=bottom.copy(), fill=True, facecolor=colour,
+                       edgecolor=S.shade(colour, 0.5) if hatch else colour, hatch=hatch, lw=0)
+            # the attractors of one kind, each its own band, parted by thin white lines
+            inner = bottom.copy()
+            for f in parts[:-1]:
+                inner = inner + f
+                axk.stairs(inner, edges, baseline=None, color="white", lw=0.4)
+            handles.append(Patch(facecolor=colour, edgecolor=S.shade(colour, 0.5) if hatch
+                                 else "0.5", hatch=hatch, lw=0.4,
+                                 label=f"{name}, up to {(top - bottom).max():.1f} %"))
+            bottom = top
         axk.stairs(np.full(r.alpha.size, 100.0), edges, baseline=bottom, fill=True,
                    color=BEHAVIOUR_COLOURS["overturn"], lw=0)
         handles.append(Patch(facecolor=BEHAVIOUR_COLOURS["overturn"], edgecolor="0.5", lw=0.4,
@@ -870,7 +886,7 @@ def fig_erosion(profiles, title=None):
         g = r.attractor.shape[1]
         S.letter(axk, 2 + k, f"{S.law_name(r.block)}: basin of each attractor, ${g} \\times "
                              f"{g}$ cells every $\\Delta\\alpha = {r.settings.get('alpha_step'):g}$")
-        ax_leg.legend(handles=handles, loc="center left", ncols=1, fontsize="small")
+        ax_leg.legend(handles=handles, loc="center left", ncols=1)
     r0 = next(iter(profiles.values()))
     g = r0.attractor.shape[1]
     step = r0.settings.get("alpha_step")
@@ -1001,24 +1017,35 @@ END_MARKERS = {"overturn": ("^", "branch ends: the block overturns"),
                "budget": ("x", "branch ends: the point budget")}
 
 
-def _branch_colour(br):
-    """A branch in its behaviour's colour (the behaviour its orbits have while stable),
-    darkened to stand out over the sweep's dots; periods 2, 3, ... in tints and shades of the
-    multiperiodic colour."""
+#: How the branches of each period are told apart: colour (the behaviour their stable orbits
+#: have), and for periods past 2 a marker along the line; periods from 5 on are one group (more
+#: shades of one green than a reader can tell apart).
+GROUPED_PERIOD = 5
+
+
+def _branch_group(br):
+    """``(label, colour, marker)`` of a branch's group."""
+    green = BEHAVIOUR_COLOURS["multiperiodic"]
     if br.period == 1:
-        return S.shade(BEHAVIOUR_COLOURS["symmetric" if br.symmetric else "asymmetric"],
-                        0.0 if br.symmetric else 0.35)
-    kind, amount = {2: ("tint", 0.0), 4: ("shade", 0.45), 8: ("tint", 0.4),
-                    3: ("shade", 0.7), 6: ("tint", 0.2), 7: ("shade", 0.25)}.get(
-        br.period, ("tint", 0.3))
-    colour = BEHAVIOUR_COLOURS["multiperiodic"]
-    return S.tint(colour, amount) if kind == "tint" else S.shade(colour, amount)
+        if br.symmetric:
+            return "period 1, symmetric", BEHAVIOUR_COLOURS["symmetric"], None
+        return "period 1, asymmetric", S.shade(BEHAVIOUR_COLOURS["asymmetric"], 0.35), None
+    if br.period == 2:
+        return "period 2", green, None
+    if br.period == 3:
+        return "period 3", S.shade(green, 0.45), "^"
+    if br.period == 4:
+        return "period 4", S.shade(green, 0.45), "s"
+    return f"period $\\geq {GROUPED_PERIOD}$", S.tint(green, 0.4), "o"
+
+
+def _branch_colour(br):
+    """A branch's colour (:func:`_branch_group`)."""
+    return _branch_group(br)[1]
 
 
 def _branch_kind(br):
-    if br.period == 1:
-        return f"period 1, {'symmetric' if br.symmetric else 'asymmetric'}"
-    return f"period {br.period}"
+    return _branch_group(br)[0]
 
 
 def _branch_runs(value, y, stable, t_next, period, mu=None):
@@ -1098,9 +1125,15 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
         raise ValueError(f"component must be 0 (theta) or 1 (theta') (got {component!r})")
     pname = c.parameter
     sym = SYMBOLS.get(pname, pname)
-    fig = _figure("double", 0.5)
+    fig = _figure("double", 0.52)
     ax = fig.add_subplot()
-    handles = []
+    # legend entry -> (handle, artists it names): an entry is kept when one of its artists
+    # draws within the view
+    entries = {}
+
+    def entry(key, handle, artist):
+        entries.setdefault(key, (handle, []))[1].append(artist)
+
     if sweep is not None:
         alpha = np.asarray(sweep.alpha)
         label = np.asarray(sweep.label)
@@ -1115,17 +1148,18 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
             ok = np.isfinite(yv)
             if not ok.any():
                 continue
-            ax.scatter(a[ok], yv[ok], s=2.5, color=S.tint(BEHAVIOUR_COLOURS[name], 0.35), lw=0,
-                       rasterized=True, zorder=2)
-            handles.append(Line2D([], [], ls="", marker="o", ms=4,
-                                  color=S.tint(BEHAVIOUR_COLOURS[name], 0.35),
-                                  label=f"sweep: {name}"))
-    kinds = {}
+            dots = ax.scatter(a[ok], yv[ok], s=2.0, color=S.tint(BEHAVIOUR_COLOURS[name], 0.35),
+                              lw=0, rasterized=True, zorder=2)
+            entry(f"sweep {name}", Line2D([], [], ls="", marker="o", ms=3.5,
+                                          color=S.tint(BEHAVIOUR_COLOURS[name], 0.35),
+                                          label=f"sweep: {name}"), dots)
+    groups = {}
     for br in sorted(c.branches, key=lambda b: (b.period, not b.symmetric)):
-        kinds.setdefault(_branch_kind(br), _branch_colour(br))
+        groups.setdefault(_branch_group(br), None)
     for br in c.branches:
         T = 2.0 * np.pi / np.asarray(br.omega)
-        colour = _branch_colour(br)
+        group = _branch_group(br)
+        _, colour, mk = group
         mu_abs = np.abs(np.asarray(br.multipliers)).max(axis=1)
         cycles = [(br.cycle, br.t_next_impact)]
         if mirrors and br.mirror_cycle is not None:
@@ -1135,8 +1169,34 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
             for k in range(br.period):
                 for x, yv, st in _branch_runs(np.asarray(br.value), cyc[:, k, comp],
                                               np.asarray(br.stable), tn[:, k], T, mu_abs):
-                    ax.plot(x, yv, ls="-" if st else (0, (3.5, 2.0)), lw=1.3 if st else 1.0,
-                            color=colour, zorder=4)
+                    line, = ax.plot(x, yv, ls="-" if st else (0, (3.0, 1.5)),
+                                    lw=1.1 if st else 0.8, color=colour, zorder=4,
+                                    marker=mk or "", ms=2.6, markevery=0.07, mew=0.5,
+                                    mfc=colour if st else "white")
+                    entry(group, None, line)
+    for group in groups:
+        lab, colour, mk = group
+        if group in entries:
+            entries[group] = (Line2D([], [], color=colour, lw=1.4, marker=mk or "", ms=3.5,
+                                     label=lab), entries[group][1])
+    stab = [(Line2D([], [], color="0.3", lw=1.1, ls="-", label="stable orbits: solid"), True),
+            (Line2D([], [], color="0.3", lw=0.8, ls=(0, (3.0, 1.5)),
+                    label="unstable orbits: dashed"), False)]
+    bifs = sorted(c.bifurcations, key=lambda b: b.value)
+    for bf in bifs:
+        mk = BIFURCATION_MARKERS.get(bf.type, "o")
+        pts_b = [np.asarray(bf.cycle)]
+        if mirrors and bf.has_mirror and getattr(bf, "cycle_half", None) is not None:
+            pts_b.append(-np.asarray(bf.cycle_half))
+        for cy in pts_b:
+            dots = ax.scatter(np.full(cy.shape[0], bf.value), cy[:, comp], marker=mk,
+                              s=22 if bf.period <= 2 else 11, facecolor="white", edgecolor="k",
+                              lw=0.8, zorder=5)
+            entry(f"bif {bf.type}", Line2D([], [], ls="", marker=mk, ms=4.5,
+                                           markerfacecolor="white", markeredgecolor="k",
+                                           label=_BIF_WORDS.get(bf.type, bf.type)), dots)
+    # where a branch stops inside the range, and why: each point once (branches that stop at
+    # one point, each cycle point of a period-p orbit, pile up otherwise)
     ends = {}
     for br in c.branches:
         cycles = [br.cycle] + ([br.mirror_cycle] if mirrors and br.mirror_cycle is not None
@@ -1145,35 +1205,10 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
             if why not in END_MARKERS:
                 continue
             mk, words = END_MARKERS[why]
-            ends.setdefault(words, mk)
+            got = ends.setdefault((mk, words), dict(points=[], branches=0))
+            got["branches"] += 1
             for cyc in cycles:
-                ax.plot(np.full(br.period, br.value[side]), cyc[side, :, comp], ls="",
-                        marker=mk, ms=6, color="k", mew=1.2, zorder=6)
-    for kind, colour in kinds.items():
-        handles.append(Line2D([], [], color=colour, lw=2.0, label=kind))
-    handles.append(Line2D([], [], color="0.3", lw=1.3, ls="-", label="stable orbits: solid"))
-    handles.append(Line2D([], [], color="0.3", lw=1.0, ls=(0, (3.5, 2.0)),
-                          label="unstable orbits: dashed"))
-    bifs = sorted(c.bifurcations, key=lambda b: b.value)
-    present = []
-    for bf in bifs:
-        mk = BIFURCATION_MARKERS.get(bf.type, "o")
-        pts_b = [np.asarray(bf.cycle)]
-        if mirrors and bf.has_mirror and getattr(bf, "cycle_half", None) is not None:
-            pts_b.append(-np.asarray(bf.cycle_half))
-        for cy in pts_b:
-            ax.scatter(np.full(cy.shape[0], bf.value), cy[:, comp], marker=mk,
-                       s=36 if bf.period <= 2 else 18, facecolor="white", edgecolor="k",
-                       lw=1.0, zorder=5)
-        if bf.type not in present:
-            present.append(bf.type)
-    for t in present:
-        handles.append(Line2D([], [], ls="", marker=BIFURCATION_MARKERS.get(t, "o"), ms=6,
-                              markerfacecolor="white", markeredgecolor="k",
-                              label=_BIF_WORDS.get(t, t)))
-    for words, mk in ends.items():
-        handles.append(Line2D([], [], ls="", marker=mk, ms=6, color="k", mew=1.2,
-                              label=words))
+                got["points"] += [(float(br.value[side]), float(v)) for v in cyc[side, :, comp]]
     ax.set_xlabel(sym)
     ax.set_ylabel(SYMBOLS["strobe"] if comp == 1 else SYMBOLS["strobe_theta"])
     xlim = tuple(float(v) for v in (limits if limits is not None else c.bounds))
@@ -1192,13 +1227,45 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
             lo, hi = float(ys.min()), float(ys.max())
             pad = 0.05 * max(hi - lo, 1e-3)
             ax.set_ylim(lo - pad, hi + pad)
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    for (mk, words), got in ends.items():
+        p = np.unique(np.round(np.asarray(got["points"]) /
+                               [(x1 - x0) * 2e-3, (y1 - y0) * 2e-3]), axis=0) * \
+            [(x1 - x0) * 2e-3, (y1 - y0) * 2e-3]
+        line, = ax.plot(p[:, 0], p[:, 1], ls="", marker=mk, ms=4.5, color="k", mew=1.0,
+                        zorder=6)
+        n = got["branches"]
+        entry(f"end {words}", Line2D([], [], ls="", marker=mk, ms=4.5, color="k", mew=1.0,
+                                     label=f"{words} ({n} branch{'es' if n > 1 else ''})"),
+              line)
+
+    def in_view(artist):
+        if hasattr(artist, "get_offsets"):
+            xy = np.asarray(artist.get_offsets(), float).reshape(-1, 2)
+        else:
+            xy = np.column_stack([np.asarray(v, float) for v in artist.get_data()])
+        return bool(np.any((xy[:, 0] >= min(x0, x1)) & (xy[:, 0] <= max(x0, x1))
+                           & (xy[:, 1] >= min(y0, y1)) & (xy[:, 1] <= max(y0, y1))))
+
+    handles = []
+    shown = [key for key, (_, arts) in entries.items() if any(in_view(a) for a in arts)]
+    for key in shown:
+        if isinstance(key, str) and key.startswith("sweep "):
+            handles.append(entries[key][0])
+    branch_lines = [ln for key in shown if isinstance(key, tuple) for ln in entries[key][1]
+                    if in_view(ln)]
+    handles += [entries[key][0] for key in groups if key in shown]
+    for h, stable in stab:
+        if any((ln.get_linestyle() == "-") == stable for ln in branch_lines):
+            handles.append(h)
+    handles += [entries[key][0] for key in shown if isinstance(key, str)
+                and not key.startswith("sweep ")]
     fig.legend(handles=handles, loc="outside right center", ncols=1)
     b, f = c.block, c.forcing
     fixed = (f"$\\omega = {f.omega:g}$" if pname == "alpha" else f"$\\alpha = {f.alpha:g}$")
-    ax.set_title(title or f"Periodic orbits, {S.law_name(b)}, $h/b = {b.hb:g}$, {fixed};\n"
-                          f"sampled at $t = kT$ at the forcing phase $\\varphi = {c.phase:.4g}$ "
-                          f"of the study's $z_0$",
-                 fontsize="medium")
+    S.suptitle(fig, title or f"Periodic orbits, {S.law_name(b)}, $h/b = {b.hb:g}$, {fixed}; "
+                             f"sampled at $t = kT$ at the forcing phase "
+                             f"$\\varphi = {c.phase:.4g}$ of the study's $z_0$")
     return fig
 
 

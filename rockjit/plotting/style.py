@@ -22,8 +22,9 @@ protanopia.
 - Symbols are mathtext (:data:`SYMBOLS`); panels are lettered a), b), c) as in the study
   (:func:`letter`).
 
-Two styles (:func:`use`): ``"default"`` (screen: titles, a double-column figure 11 inches
-wide) and ``"paper"`` (a journal's column: no suptitles, 3.5 and 7.2 inches, 8-point type).
+Two styles (:func:`use`), both sized for a journal's column (3.5 in) or page (7.2 in) with
+7-9 pt type (:data:`WIDTHS`, :data:`TEXT_POINTS`): ``"default"`` (figure titles, 200 dpi) and
+``"paper"`` (no figure titles, the journal's caption replaces them; 300 dpi).
 A figure function reads the style in force when it is called (:func:`current`); save it
 inside the same :func:`use` block.
 """
@@ -38,9 +39,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 __all__ = ["AGREE_COLOUR", "BEHAVIOUR_COLOURS", "DISAGREE_COLOUR", "FORMATS", "LAW_COLOURS",
-           "LAW_LINES",
-           "LAW_NAMES", "STYLES", "SYMBOLS", "Style", "attractor_colours", "attractor_names",
-           "behaviour_cmap", "current", "cvd_distances", "law_name", "letter", "shade",
+           "LAW_LINES", "LAW_NAMES", "STYLES", "SYMBOLS", "Style", "TEXT_POINTS", "WIDTHS",
+           "attractor_colours", "attractor_names", "behaviour_cmap", "current", "cvd_distances", "law_name", "letter", "shade",
            "suptitle", "texts_outside", "tint", "use", "variant"]
 
 #: One colour per behaviour (rockjit.result.BEHAVIOURS), in every figure and command.
@@ -75,7 +75,11 @@ SYMBOLS = {"theta": r"$\theta$", "dtheta": r"$\theta'$", "theta0": r"$\theta_0$"
            "t": r"$t$", "lambda_max": r"$\lambda_\mathrm{max}$", "lambda1": r"$\lambda_1$",
            "thc": r"$\theta_c$", "hb": r"$h/b$", "e_H": r"$e_H$", "e_M": r"$e_M$",
            "delta_e": r"$\Delta e$", "strobe": r"$\theta'(kT)$", "strobe_theta": r"$\theta(kT)$",
-           "S_b": r"$S_b$", "S_bb": r"$S_{bb}$"}
+           "S_b": r"$S_b$", "S_bb": r"$S_{bb}$",
+           # with their units: the model's time is dimensionless (unit sqrt(R/g)), and so is
+           # the angular velocity theta' = d theta / dt
+           "t_unit": r"$t$ (dimensionless, unit $\sqrt{R/g}$)", "theta_unit": r"$\theta$ [rad]",
+           "dtheta_unit": r"$\theta'$ (dimensionless)"}
 
 #: Figure formats every command can write.
 FORMATS = ("png", "pdf", "svg")
@@ -111,23 +115,30 @@ class Style:
 
     def size(self, width, aspect):
         """``(w, h)``: ``width`` ``"single"``, ``"double"`` or a fraction of the double width,
-        ``h = aspect * w``."""
+        ``h = aspect * w``. A fraction is rounded to the column or the page, whichever is
+        nearer (a journal has no other width)."""
         w = {"single": self.single, "double": self.double}.get(width)
-        w = self.double * float(width) if w is None else w
+        if w is None:
+            want = self.double * float(width)
+            w = self.single if abs(want - self.single) <= abs(want - self.double) else \
+                self.double
         return (w, aspect * w)
 
 
 _COMMON_RC = {"axes.titlesize": "medium", "legend.frameon": False, "axes.spines.top": True,
-              "savefig.dpi": 150, "pdf.fonttype": 42, "svg.fonttype": "none"}
+              "font.size": 8.0, "legend.fontsize": 7.0, "legend.title_fontsize": 7.0,
+              "legend.handlelength": 3.0,
+              "axes.labelsize": 8.0, "xtick.labelsize": 7.0, "ytick.labelsize": 7.0,
+              "figure.titlesize": 9.0, "axes.linewidth": 0.6, "lines.linewidth": 1.0,
+              "xtick.major.width": 0.6, "ytick.major.width": 0.6,
+              "pdf.fonttype": 42, "svg.fonttype": "none"}
+#: The smallest and largest type any figure sets, in points (a journal's 7-9 pt at print size).
+TEXT_POINTS = (7.0, 9.0)
+#: The widths a figure may have, in inches: a journal's column and its page.
+WIDTHS = (3.5, 7.2)
 STYLES = {
-    "default": Style("default", True, 5.5, 11.0, 1.0,
-                     {**_COMMON_RC, "font.size": 10.0, "legend.fontsize": 8.5,
-                      "axes.labelsize": 10.0, "xtick.labelsize": 9.0, "ytick.labelsize": 9.0}),
-    "paper": Style("paper", False, 3.5, 7.2, 1.0,
-                   {**_COMMON_RC, "font.size": 8.0, "legend.fontsize": 6.5,
-                    "axes.labelsize": 8.0, "xtick.labelsize": 7.0, "ytick.labelsize": 7.0,
-                    "axes.linewidth": 0.6, "lines.linewidth": 1.0, "xtick.major.width": 0.6,
-                    "ytick.major.width": 0.6, "savefig.dpi": 300}),
+    "default": Style("default", True, 3.5, 7.2, 1.0, {**_COMMON_RC, "savefig.dpi": 200}),
+    "paper": Style("paper", False, 3.5, 7.2, 1.0, {**_COMMON_RC, "savefig.dpi": 300}),
 }
 _CURRENT = contextvars.ContextVar("rockjit_style", default=STYLES["default"])
 

@@ -36,7 +36,7 @@ from ..validate import integer, memory, pair, real
 
 __all__ = ["ALPHA_STEP", "BASIN_CASES", "BASIN_GRID", "EROSION", "EROSION_GRID", "EROSION_STEP",
            "GALLERY", "LAWS_IC", "LAWS_RUN", "PERIODS", "REFERENCE_RUN", "STUDY", "Z0", "ZOOM",
-           "PaperPlan", "after_the_fall", "e_table", "paper", "plan_paper"]
+           "PaperPlan", "after_the_fall", "draw_fig5", "e_table", "paper", "plan_paper"]
 
 #: The initial state of the single runs and sweeps, ``(theta, theta', r, s)``. (Defined in
 #: rockjit.single, whose default it is.)
@@ -223,6 +223,15 @@ def plan_paper(*, grid=None, periods=PERIODS, n_steps=None, alpha_step=ALPHA_STE
                      zoom=zoom, zoom_step=zoom_step, sweeps=sweeps, zoom_sweep=zoom_sweep,
                      basins=basins, erosions=erosions, stride=stride, published=published,
                      memory_bytes=total, erosion_grid=erosion_grid, erosion_step=erosion_step)
+
+
+def draw_fig5(sweeps, hb):
+    """Figure 5 at slenderness ``hb``: the bifurcation diagrams of ``sweeps`` (``{law:
+    SweepResult}``, the paper's sweeps) side by side. The paper draws its figure 5 with it,
+    and so does the README's headline image (docs/_static/make_headline.py)."""
+    from ..plotting.figures import fig_bifurcation
+    return fig_bifurcation(sweeps, title=f"Bifurcation diagrams, $h/b = {hb:g}$, "
+                                         f"$\\omega = {STUDY[hb]['omega']}$")
 
 
 def after_the_fall(sw):
@@ -539,9 +548,8 @@ def paper(out, plan=None, *, execution=None, say=None):
                            int(alphas.size)] + [fr[n] for n in BEHAVIOURS])
     for hb in STUDY:
         figures[5].append(_figure(
-            out, f"fig5_bifurcation_hb{hb}.png", fig_bifurcation(
-                {law: sweeps[(hb, law)] for law in ("housner", "mao")},
-                title=f"Bifurcation diagrams, $h/b = {hb}$, $\\omega = {STUDY[hb]['omega']}$"),
+            out, f"fig5_bifurcation_hb{hb}.png",
+            draw_fig5({law: sweeps[(hb, law)] for law in ("housner", "mao")}, hb),
             f"figure 5: bifurcation diagrams of both laws at h/b = {hb} with lambda_max (data: "
             f"fig5_sweep_hb{hb}_housner.npz, fig5_sweep_hb{hb}_mao.npz)"))
     zoom = p.zoom_sweep.axes["alpha"]
