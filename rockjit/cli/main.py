@@ -872,8 +872,8 @@ def build_parser():
     p.add_argument("--amplitude-range", type=float, nargs=2, required=True,
                    metavar=("START", "END"),
                    help="amplitude ratios a_p/(g tan alpha) (ends included; 1 is uplift)")
-    p.add_argument("--grid", type=int, nargs=2, default=(16, 16), metavar=("NR", "NK"),
-                   help="points along the ratios and the amplitudes (default 16 16)")
+    p.add_argument("--grid", type=int, nargs=2, default=(100, 100), metavar=("NR", "NK"),
+                   help="points along the ratios and the amplitudes (default 100 100)")
     p.add_argument("--tol", type=float, default=1e-6,
                    help="relative width of the located boundaries (default 1e-6)")
     _add_transient(p)

@@ -203,7 +203,8 @@ def _captions(results, plan):
            f"{html.escape(fw)}); e) overturn.",
         4: "Housner against Mao et al. in time: <i>h/b</i> = 2, &alpha; = 0.2, &omega; = 1.6, "
            "(<i>r</i><sub>0</sub>, <i>s</i><sub>0</sub>) = (0, 1), from three initial states. "
-           "Each row: each law's &theta;(<i>t</i>) over the first 8 periods and its phase "
+           "Each row: each law's &theta;(<i>t</i>) over the last 8 periods of its run, where "
+           "it has settled (the whole run when it overturns or rests sooner), and its phase "
            f"portrait, in its behaviour's colour. {caps4}",
         5: "Bifurcation diagrams: &theta;'(<i>kT</i>) over the classified stretch against "
            "&alpha;, coloured by behaviour, the behaviour of every amplitude in the strip, "
@@ -220,7 +221,9 @@ def _captions(results, plan):
         "5b": "Beyond the study: the branches of periodic orbits continued in &alpha; over "
               "each diagram's points (stable solid, unstable dashed; the mirror image of "
               "every asymmetric orbit too, so both arms of each pitchfork), each branch in "
-              "the colour of the behaviour its stable orbits have. Markers: the located "
+              "the colour of the behaviour its stable orbits have, periods 3 and 4 with "
+              "triangles and squares along the line and periods 5 and more as one group "
+              "(circles). Markers: the located "
               "bifurcations, and where a branch stops (the block overturns or comes to rest, "
               "an impact grazes). Each figure's list of bifurcations with their multipliers, "
               "and of branches with where they stop, is its <code>.md</code> file.",
@@ -238,14 +241,19 @@ def _captions(results, plan):
         8: f"Beyond the study: erosion profiles, a {eg} &times; {eg} basin every &Delta;&alpha; "
            f"= {es:g}. a) GIM and b) IF against &alpha; for both laws; below, for each law, "
            "the basin of each attractor followed across the amplitudes, stacked as steps "
-           "(each basin holds for its own amplitude), overturn on top. Attractors whose "
-           "basin never reaches 1 % are drawn together per behaviour.",
+           "(each basin holds for its own amplitude), overturn on top. Attractors of one kind "
+           "(behaviour, period, rocking or through rest: hatched) share one colour and one "
+           "legend entry, parted by thin white lines. The basins compute no Lyapunov "
+           "exponent, so what figure 5 calls chaotic is counted as aperiodic here (no period "
+           "up to 16).",
         9: "Beyond the study: the forcing plane (&alpha;, &omega;) of both laws at <i>h/b</i> "
            "= 1 and 2, from the study's <i>z</i><sub>0</sub>, a coarse brute-force chart of "
            "behaviours with the bifurcation curves of the period-1 orbits followed across it "
            "by two-parameter continuation (fold solid, symmetry breaking dashed, period "
            "doubling dash-dotted, grazing dotted), seeded on the lines &omega; = 1.3 and 2.4; "
-           "left and middle each law alone, right both laws' curves overlaid. "
+           "a) and b) each law alone, c) both laws' curves overlaid (hatched: the laws' "
+           "behaviours differ). Cells are drawn six times finer, each behaviour's share "
+           "interpolated linearly between the computed cells. "
            "<code>rockjit chart</code> computes the 200 &times; 200 chart and the period-2 "
            "curves.",
     }
