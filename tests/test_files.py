@@ -1275,3 +1275,20 @@ def test_an_interrupted_fragility_analysis_resumes_bit_for_bit(tmp_path):
     with pytest.raises(ValueError, match="holds the chunks of a different computation"):
         fragility(Block(hb=3), records, [0.5], [1.0, 2.5, 4.5], laws=("housner", "mao"),
                   execution=Execution(chunk=2, store=tmp_path / "store", progress=False))
+
+
+def test_a_run_whose_out_appeared_after_its_claim_respects_the_lock_inside(tmp_path):
+    out = tmp_path / "o"
+    first = rio.OutputDir(out)
+    first.claim()  # --out absent: the lock beside it
+    out.mkdir()
+    second = rio.OutputDir(out)
+    second.claim()  # --out present: the lock inside it
+    first.text("summary.json", "first")  # staged inside --out now
+    with pytest.raises(ValueError, match="is being written by another rockjit run"):
+        first.publish()
+    first.discard()
+    second.text("summary.json", "second")
+    second.publish()
+    assert (out / "summary.json").read_text() == "second"
+    assert sorted(os.listdir(out)) == [RECORD, "summary.json"]

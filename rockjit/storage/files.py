@@ -50,7 +50,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .ownership import RECORD, RECORD_HOLDS, PublishLock, Record, digest, refusal, unproven
+from .ownership import (RECORD, RECORD_HOLDS, PublishLock, Record, digest, lock_path, refusal,
+                        unproven)
 
 __all__ = ["OutputDir", "atomic_open", "boot_id", "boot_time", "check_out",
            "command_interrupts", "create_temp", "defer_signals", "host_name",
@@ -1017,11 +1018,14 @@ class OutputDir:
                                     str(stage / missing[0]))
         order = [n for n in names if n != SUMMARY] + [n for n in names if n == SUMMARY]
         self.warning = self.stale_warning()
-        if self._inside:
-            self._check_targets(order)
-        self._stage_record(order)
-        inside = None  # the lock inside path, when path appeared while this run staged beside it
+        inside = None  # the lock inside path, when path appeared after this run's claim
         try:
+            if self._inside and self._lock.path != lock_path(self.path):
+                inside = PublishLock(self.path, name=self.name)
+                inside.acquire()
+            if self._inside:
+                self._check_targets(order)
+            self._stage_record(order)
             with defer_signals() as got:
                 moved = False
                 if not self._inside:
@@ -1062,9 +1066,11 @@ class OutputDir:
                              f"or choose another {self.name}")
         files, theirs = {}, []
         for n, entry in rec.files.items():  # earlier files that stay, still rockjit's
-            if n not in order and rec.proves(self.path, n):
-                files[n] = {"versions": [v for v in entry["versions"]
-                                         if rec.proves(self.path, n, only=v)]}
+            if n not in order:
+                have = digest(self.path / n)
+                versions = [v for v in entry["versions"] if have == (v["size"], v["sha256"])]
+                if versions:
+                    files[n] = {"versions": versions}
         for n in order:
             size, sha = digest(self._stage / n)
             versions = [{"size": size, "sha256": sha}]

@@ -128,15 +128,15 @@ class Record:
         run = data.get("run") if isinstance(data.get("run"), str) else None
         return cls("ok", files, run)
 
-    def proves(self, out, name, have=None, only=None):
+    def proves(self, out, name, have=None):
         """Whether ``out/name`` is rockjit's: named here, with a recorded size and digest
-        (``have``: its :func:`digest`, if known; ``only``: that version alone)."""
+        (``have``: its :func:`digest`, if known)."""
         entry = self.files.get(name)
         if entry is None:
             return False
         have = digest(Path(out) / name) if have is None else have
         return have is not None and any(have == (v["size"], v["sha256"])
-                                        for v in ([only] if only else entry["versions"]))
+                                        for v in entry["versions"])
 
     @staticmethod
     def write_data(files, command, version):
