@@ -96,3 +96,21 @@ def test_index_html_in_a_headless_browser(paper_dir):
     # the study's numbers beside this run's
     for number in ("0.250", "0.582", "79.85", "0.700", "0.830", "17.03", "0.7797983"):
         assert number in text, number
+
+
+def test_the_fates_beside_the_reference_say_why_they_differ():
+    from rockjit.study import report
+    closed = dict(probabilities={"overturn": 61 / 64, "multiperiodic p=7": 3 / 64},
+                  settings=dict(ensemble=64), lambda1=0.2133, horizon=86.6,
+                  nominal=dict(t_end=110.4059))
+    pub = report.published_beside({"fig3_fates": {"closed": closed}})
+    rows = {(r["forcing"], r["outcome"]): r for r in pub["fates"]}
+    assert rows[("closed", "overturn")]["rockjit"] == 61 / 64
+    assert rows[("closed", "period-7")]["rockjit"] == 3 / 64
+    note = pub["fates_note"]
+    # 0.91 of 64 members is 58.24: this run's 61 is 3 members away, each worth 1.6 points
+    assert "3 members" in note and "1.6 points" in note and "64 members" in note
+    assert "0.21" in note and "t</i> = 87" in note and "t</i> = 110.4" in note
+    assert "interpolant" in note and "rockjit 0.1.0" in note
+    page = report._published_html(pub)
+    assert note in page and "reference (rockjit 0.1.0)" in page
