@@ -509,3 +509,108 @@ def test_orbits_of_sweep_plans_then_runs_the_sweep_and_its_branches():
         assert np.array_equal(a.value, b.value) and np.array_equal(a.cycle, b.cycle)
     assert [b.type for b in cont.bifurcations] == [b.type for b in ref.bifurcations]
     assert cont.forcing.omega == OMEGA and cont.forcing.alpha is None
+
+
+# --------------------------------------------------------------------------- steps and reports
+
+#: short steps, so that a branch has many of them between its bifurcations
+FINE = ContinuationSettings(ds0=0.002, ds_max=0.005, max_period=2)
+
+
+@pytest.fixture(scope="module")
+def fine(asym08):
+    """The study's asymmetric orbit followed at phase 0 over (0.77, 0.92) with short steps:
+    its symmetry-breaking pitchfork (0.7798) and period doubling (0.9115), and the branches
+    followed from there."""
+    return orbits.continuation(BLOCK, SWEEP_FORCING, [asym08], bounds=(0.77, 0.92),
+                               settings=FINE)
+
+
+#: long steps
+COARSE = ContinuationSettings(ds0=0.02, ds_max=0.05, switch=False)
+
+
+@pytest.fixture(scope="module")
+def coarse():
+    """Long steps from a sweep's attractors over (0.55, 0.6), seeds on either side of the
+    symmetric branch's fold (0.5573): the seed nearest to it lies close to the branch already
+    followed from the other but far from the chord between that branch's points."""
+    sw = rockjit.sweep(BLOCK, SWEEP_FORCING, rockjit.alpha_grid((0.55, 0.6), 0.002))
+    return orbits.continue_branches(BLOCK, SWEEP_FORCING, (0.55, 0.6), sweep=sw,
+                                    settings=COARSE)
+
+
+def continued(request, which):
+    """A continuation fixture by name, and the largest step it was asked for."""
+    cont = request.getfixturevalue(which)
+    if which == "study":
+        return cont[1], ContinuationSettings().ds_max
+    return cont, {"fine": FINE, "coarse": COARSE}[which].ds_max
+
+
+def impact_phases(cont, br, k):
+    """Impact instants of point ``k`` of a branch over its period, as fractions of ``T`` after
+    the section (a plain run from the point's state)."""
+    w = float(br.omega[k])
+    r = rockjit.simulate(cont.block, Harmonic(alpha=float(br.alpha[k]), omega=w,
+                                              phase=cont.phase), br.cycle[k, 0],
+                         integration=Integration(periods=br.period, n_steps=4096))
+    assert r.status == "done" and r.n_impacts == br.impacts[k]
+    return (r.impacts[:, 0] % (2 * math.pi / w)) * w / (2 * math.pi)
+
+
+def test_no_step_is_longer_than_ds_max(fine):
+    """The step is measured in (theta, theta', alpha) at the section (the norm of
+    ContinuationSettings), from each branch's returned points. Each corrected point lies on the
+    hyperplane ``ds`` from the last one along the secant, so the chord between neighbours is
+    ``ds`` over the cosine of a small angle: at most ``ds_max`` to within 1e-3."""
+    ds_max = FINE.ds_max
+    longest = 0.0
+    for br in fine.branches:
+        for k in range(len(br.value)):
+            # no impact within 0.15 T of the section: the continuation keeps working at the
+            # output section (it moves its section only when an impact comes near), so the
+            # branch's points are in the coordinates the steps were taken in
+            ph = impact_phases(fine, br, k)
+            assert np.min(np.minimum(ph, 1.0 - ph)) >= 0.15, (br.period, k)
+        y = np.column_stack([br.cycle[:, 0], br.value])
+        chord = np.linalg.norm(np.diff(y, axis=0), axis=1)
+        assert chord.max() <= ds_max * (1 + 1e-3), (br.period, br.symmetric, chord.max())
+        longest = max(longest, float(chord.max()))
+    # the steps do grow to the bound (so that the bound is what is tested)
+    assert longest >= 0.95 * ds_max
+
+
+@pytest.mark.parametrize("which", ["study", "coarse"])
+def test_no_step_moves_the_parameter_by_more_than_ds_max(which, request):
+    # whatever section a step was taken at, alpha is one of the step's coordinates
+    cont, ds_max = continued(request, which)
+    for br in cont.branches:
+        assert np.abs(np.diff(br.value)).max() <= ds_max * (1 + 1e-3), br.origin
+
+
+def same_bifurcation(a, b):
+    """One bifurcation reported twice: the same type and period, alpha within 1e-6 and the
+    same orbit to 1e-4 of its size, under any cyclic shift or as its mirror image (the mirror
+    of ``x(t)`` is ``-x(t + T/2)``, whose cycle is ``-cycle_half``)."""
+    if a.type != b.type or a.period != b.period or abs(a.value - b.value) > 1e-6:
+        return False
+    scale = float(np.abs(a.cycle).max())
+    for other in (b.cycle, -b.cycle_half):
+        d = min(float(np.abs(a.cycle - np.roll(other, s, axis=0)).max())
+                for s in range(a.period))
+        if d <= 1e-4 * scale:
+            return True
+    return False
+
+
+@pytest.mark.parametrize("which", ["study", "fine", "coarse"])
+def test_no_bifurcation_is_reported_twice(which, request):
+    cont, _ = continued(request, which)
+    # real bifurcations passed
+    assert any(b.located and b.type in ("fold", "period_doubling", "symmetry_breaking")
+               for b in cont.bifurcations)
+    bifs = cont.bifurcations
+    for i in range(len(bifs)):
+        for j in range(i + 1, len(bifs)):
+            assert not same_bifurcation(bifs[i], bifs[j]), (bifs[i].type, bifs[i].value)

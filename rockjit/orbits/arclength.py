@@ -18,7 +18,8 @@ Continuation
     end, at a branch point (a doubled or asymmetric branch folding back onto the orbit it was
     born from, which is then seeded too), on joining a branch already computed (or its mirror
     image: cycles compared by :func:`rockjit.basins.cycles.cycle_distance`), or on closing a
-    loop.
+    loop. A bifurcation met again on a stretch that retraces a branch already followed (a seed
+    next to a fold of that branch, before it joins it) is reported once.
 Seeds
     A seed is solved by shooting (:mod:`.shooting`) and followed both ways unless its orbit lies
     on a branch already followed; a sweep seeds one branch per distinct periodic attractor.
@@ -235,9 +236,40 @@ class Continuer(Locator):
         idx = len(self.branches)
         self.branches.append(br)
         for bf in bifs:
+            if self.reported(bf):
+                continue
             bf.branch = idx
             self.bifs.append(bf)
         return idx
+
+    def reported(self, bf):
+        """Whether ``bf`` was located already, on a branch followed before.
+
+        A seed whose orbit lies close to a fold of a branch already followed can escape
+        :meth:`known` (the branch's points, linear in the parameter between them, are far from
+        its orbit where the branch turns) and be followed again until it joins that branch,
+        meeting the same bifurcations on the way: those are reported once. The same one is of
+        the same type and period, at a parameter value within ``100 param_tol`` (or inside the
+        other's bracket when either was not located) and at the same orbit, or its mirror
+        image, within ``join_tol`` of its size (any cyclic shift).
+        """
+        scale = max(float(np.abs(bf.cycle).max()), 1e-12)
+        for other in self.bifs:
+            if other.type != bf.type or other.period != bf.period:
+                continue
+            if bf.located and other.located:
+                near = abs(other.value - bf.value) <= 100 * self.param_tol * max(
+                    1.0, abs(bf.value))
+            else:
+                near = any(min(o.neighbours) <= v <= max(o.neighbours)
+                           for o, v in ((other, bf.value), (bf, other.value)))
+            if not near:
+                continue
+            d = min(cycle_distance(other.cycle, bf.cycle),
+                    cycle_distance(-other.cycle_half, bf.cycle))
+            if d <= self.join_tol * scale:
+                return True
+        return False
 
     def follow_seed(self, lam, x, p, origin):
         """Solve a seed; if it is new, follow its branch both ways. Returns the branch index."""
