@@ -767,7 +767,7 @@ class OutputDir:
     ...     out.discard()
     ...     raise
     >>> sorted(p.name for p in out.path.iterdir()), note is None
-    (['basin.npz', 'summary.json'], True)
+    (['.rockjit-files.json', 'basin.npz', 'summary.json'], True)
     """
 
     def __init__(self, path, command=None):
