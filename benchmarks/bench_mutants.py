@@ -1,27 +1,34 @@
 """Mutation testing: small deliberate bugs that the independent tests must catch.
 
 Each *mutant* replaces one exact piece of text, found exactly once, in one source file of the
-package (the vector field, its Jacobian, the jump map and the saltation matrix, rest and uplift,
-the Dormand–Prince tableau, the event location, the tangent dynamics and exponents, the
-classification). For each, the package and its tests are copied to a fresh temporary folder,
-the mutation is applied there (the working tree is never touched), and a chosen subset of the
-tests that check rockjit against something independent of it (``tests/physics.py``, the
-``spec`` fixture of ``tests/conftest.py``, the slow classifier of ``tests/test_grids.py``,
-closed forms, libm, the order conditions) runs in a fresh process with its own numba cache
-(``NUMBA_CACHE_DIR`` inside the copy: rockjit caches compiled code with ``cache=True``, so a
-shared cache could serve the unmutated kernels). A mutant is *caught* when that run fails, and
-*survived* when it passes: a survivor is a weak test, to be strengthened against an independent
-reference.
+package: in the engine (the vector field, its Jacobian, the jump map and the saltation matrix,
+rest and uplift, the Dormand–Prince tableau, the event location, the tangent dynamics and
+exponents, the classification) and in the analyses built on it (the fragility fits and
+capacities, the ground-motion path's stopping rule, the continuation of periodic orbits and its
+bifurcations, the basin measures, the explorer). For each, the package and its tests are
+copied to a fresh temporary folder, the mutation is applied there (the working tree is never
+touched), and a chosen subset of the tests that check rockjit against something independent
+of it (``tests/physics.py``, the ``spec`` fixture of ``tests/conftest.py``, the slow
+classifier of ``tests/test_grids.py``, closed forms, libm, the order conditions, the scipy
+path, brute-force references, Monte-Carlo calibration) runs in a fresh process with its own
+numba cache (``NUMBA_CACHE_DIR`` inside the copy: rockjit caches compiled code with
+``cache=True``, so a shared cache could serve the unmutated kernels). A mutant is *caught* when
+that run fails, and *survived* when it passes: a survivor is a weak test, to be strengthened
+against an independent reference.
 
 Before the mutants, the same test subsets run on an unmutated copy (the *baseline*), which must
 pass: otherwise every mutant would look caught.
 
-    python benchmarks/bench_mutants.py           # every mutant (~15 min on 2 cores)
+    python benchmarks/bench_mutants.py           # every mutant (~25 min on 2 cores)
     python benchmarks/bench_mutants.py --quick   # smoke: the baseline and three cheap mutants
     python benchmarks/bench_mutants.py --only housner-restitution saltation-entry
+    python benchmarks/bench_mutants.py --areas continuation integrity   # those areas' mutants
 
 Writes mutants.{md,csv,json} to benchmarks/results/ (benchmarks/results/quick/ with --quick,
-or --out DIR). Exits 1 if a mutant survived or the baseline failed.
+or --out DIR). A run of some of the mutants (``--only``, ``--areas``) into a folder that holds
+an earlier run's mutants.json keeps that run's rows for the others (the same mutant, text for
+text), so that the page lists every mutant; the page says which rows ran when. Exits 1 if a
+mutant survived or the baseline failed.
 """
 
 from __future__ import annotations
@@ -195,6 +202,83 @@ MUTANTS = [
        ["tests/test_grids.py::test_gallery_labels[symmetric]"]),
 ]
 
+FITTING = "rockjit/ground/fitting.py"
+FRAGILITY = "rockjit/ground/fragility.py"
+TRANSIENT = "rockjit/_engine/transient.py"
+ARCLENGTH = "rockjit/orbits/arclength.py"
+BIFURCATIONS = "rockjit/orbits/bifurcations.py"
+MEASURES = "rockjit/basins/measures.py"
+EXPLORER = "rockjit/explorer/requests.py"
+TO = "tests/test_orbits.py::"
+TM = "tests/test_measures.py::"
+TF = "tests/test_ground_fragility.py::"
+
+MUTANTS += [
+    # ---- ground motions: fits, capacities, the compiled path's stopping rule
+    _m("fit-se-beta", "fitting", FITTING,
+       "beta / math.sqrt(2 * n),", "beta / math.sqrt(n),",
+       "the capacity fit's standard error of beta 41 % too large (beta / sqrt(n))",
+       [TF + "test_capacity_fit_standard_errors_and_intervals_by_monte_carlo"]),
+    _m("fit-beta-ci", "fitting", FITTING,
+       "math.sqrt(ss / float(chi2.ppf(alpha / 2, n - 1))))",
+       "math.sqrt(ss / float(chi2.ppf(alpha / 2, n))))",
+       "the upper end of beta's interval from chi-square with n degrees of freedom, not n - 1",
+       [TF + "test_capacity_fit_standard_errors_and_intervals_by_monte_carlo"]),
+    _m("capacity-below-list", "fragility", FRAGILITY,
+       "if np.argmax(o) > 0 else np.nan", "if np.argmax(o) >= 0 else np.nan",
+       "a record that overturns at the lowest intensity gets it as its capacity, not 'below "
+       "the list'", [TF + "test_capacity_below_the_list"]),
+    _m("transient-decided-mirror", "transient", TRANSIENT,
+       "free_rocking_decided(th, v, max_th, thc, th_top)",
+       "free_rocking_decided(max(th, 0.0), v, max_th, thc, th_top)",
+       "the compiled path's stopping rule takes a block on the theta < 0 side for upright",
+       ["tests/test_ground_compiled.py::test_a_dozen_pulses_agree_with_the_scipy_path"]),
+    # ---- periodic orbits: continuation and bifurcations
+    _m("arclength-step-bound", "continuation", ARCLENGTH,
+       "ds = min(1.3 * ds, self.ds_max)", "ds = min(1.3 * ds, 1.1 * self.ds_max)",
+       "the continuation's step grows to 1.1 ds_max",
+       [TO + "test_no_step_is_longer_than_ds_max"]),
+    _m("arclength-step-unbounded", "continuation", ARCLENGTH,
+       "ds = min(1.3 * ds, self.ds_max)", "ds = 1.3 * ds",
+       "the continuation's step grows without bound",
+       [TO + "test_no_step_moves_the_parameter_by_more_than_ds_max[study]"]),
+    _m("bifurcation-twice", "continuation", ARCLENGTH,
+       "            if self.reported(bf):\n                continue\n", "",
+       "a bifurcation met again on a branch that retraces another is reported twice",
+       [TO + "test_no_bifurcation_is_reported_twice[coarse]"]),
+    _m("pitchfork-or-fold", "bifurcations", BIFURCATIONS,
+       "and jb is not None and ja * jb < 0)", "and jb is not None and ja * jb > 0)",
+       "a symmetric orbit's multiplier +1 classed as a fold where the half map's is -1 "
+       "(a symmetry-breaking pitchfork), and the reverse",
+       [TO + "test_symmetry_breaking_near_078"]),
+    _m("bifurcation-tolerance", "bifurcations", BIFURCATIONS,
+       "xtol = min(1e-6, max(1e-13, 0.1 * self.param_tol",
+       "xtol = min(1e-3, max(1e-13, 1e5 * self.param_tol",
+       "Brent's method on the test function stops at 1e-3 of the chord, not 1e-8 in alpha",
+       [TO + "test_located_to_1e8_by_independent_shooting"]),
+    # ---- basin measures
+    _m("lim-truncation", "integrity", MEASURES,
+       "    i = np.clip(np.rint((cycle[:, 0] - th[0]) / h0).astype(int), 0, th.size - 1)\n"
+       "    j = np.clip(np.rint((cycle[:, 1] - dth[0]) / h1).astype(int), 0, dth.size - 1)",
+       "    i = np.clip(((cycle[:, 0] - th[0]) / h0).astype(int), 0, th.size - 1)\n"
+       "    j = np.clip(((cycle[:, 1] - dth[0]) / h1).astype(int), 0, dth.size - 1)",
+       "the local integrity measure takes the node below a cycle point, not the nearest",
+       [TM + "test_lim_matches_a_brute_force_reference_between_nodes"]),
+    _m("if-spacings", "integrity", MEASURES,
+       "np.minimum(_edt(safe, (h0, h1)), border)", "np.minimum(_edt(safe, (h1, h0)), border)",
+       "the integrity factor's distances with the two grid spacings swapped",
+       [TM + "test_integrity_factor_matches_a_brute_force_search"]),
+    _m("entropy-boundary", "entropy", MEASURES,
+       "boundary = n_outcomes > 1", "boundary = n_outcomes > 0",
+       "every box counted as a boundary box in the boundary basin entropy",
+       [TM + "test_entropy_matches_a_slow_reference_on_random_maps"]),
+    # ---- the explorer
+    _m("explorer-nearest-cell", "explorer", EXPLORER,
+       "k = int(round((v - axis[0]) / step))", "k = int((v - axis[0]) / step)",
+       "a click picks the lattice point below it, not the nearest",
+       ["tests/test_explore.py::test_nearest_cell"]),
+]
+
 QUICK_NAMES = ("housner-restitution", "saltation-entry", "uplift-time")
 
 
@@ -261,8 +345,37 @@ def is_caught(row) -> bool:
 
 # --------------------------------------------------------------------------- the report
 
+def carried_rows(path: Path, chosen, date):
+    """The rows of an earlier run's ``mutants.json`` for the mutants not run now, each marked
+    with the date it ran: only a mutant still defined with the same file and text, in the
+    order of :data:`MUTANTS`. Empty when there is no such file."""
+    if not path.is_file():
+        return []
+    import json
+    old = json.loads(path.read_text(encoding="utf-8"))
+    then = old.get("environment", {}).get("date", "")
+    by_name = {r["name"]: r for r in old.get("mutants", [])}
+    ran = {m.name for m in chosen}
+    out = []
+    for m in MUTANTS:
+        r = by_name.get(m.name)
+        if m.name in ran or r is None or (r["file"], r["old"], r["new"]) != (m.file, m.old,
+                                                                            m.new):
+            continue
+        out.append(dict(r, ran=r.get("ran", then)))
+    return out
+
+
+def in_order(rows):
+    """``rows`` in the order of :data:`MUTANTS`."""
+    rank = {m.name: k for k, m in enumerate(MUTANTS)}
+    return sorted(rows, key=lambda r: rank[r["name"]])
+
+
 def markdown(rows, baseline, total_s, env):
     caught = sum(is_caught(r) for r in rows)
+    now = [r for r in rows if r["ran"] == env["date"]]
+    earlier = sorted({r["ran"] for r in rows} - {env["date"]})
     body = [[r["name"], r["area"], f"`{r['file']}`", r["breaks"],
              ", ".join(f"`{t.split('/')[-1]}`" for t in r["tests"]),
              r["outcome"] + ("" if is_caught(r) else " ✗"), f"{r['seconds']:.1f}"]
@@ -272,13 +385,16 @@ def markdown(rows, baseline, total_s, env):
         "Each row is one small bug put into a fresh copy of the package (never the working "
         "tree), and the subset of the independent tests that must catch it (rockjit against "
         "tests/physics.py, the `spec` fixture's solve_ivp integration, the slow classifier, "
-        "closed forms, libm, the order conditions), run with a fresh numba cache. *caught*: "
+        "closed forms, libm, the order conditions, the scipy path, brute-force references "
+        "and Monte-Carlo calibration), run with a fresh numba cache. *caught*: "
         "the tests failed; *survived* ✗: they passed, a weak test.\n\n",
         H.md_table(["mutant", "area", "file", "what it breaks", "tests", "outcome", "s"], body),
-        f"\n**{caught} of {len(rows)} caught**; baseline (every subset, unmutated): "
-        f"{baseline['outcome']} in {baseline['seconds']:.1f} s; the whole run "
-        f"{total_s / 60:.1f} min (each row's time includes a cold compile of the kernels its "
-        "tests need).\n",
+        f"\n**{caught} of {len(rows)} caught**; baseline (every subset of this run, "
+        f"unmutated): {baseline['outcome']} in {baseline['seconds']:.1f} s; this run "
+        f"{total_s / 60:.1f} min for {len(now)} mutants (each row's time includes a cold "
+        "compile of the kernels its tests need).",
+        (f" The other {len(rows) - len(now)} rows are kept from the run of "
+         f"{', '.join(earlier)}." if earlier else ""), "\n",
         "\n`python benchmarks/bench_mutants.py` (one mutant: `--only NAME`).\n",
         f"\n{H.env_line(env)}\n"])
 
@@ -286,6 +402,8 @@ def markdown(rows, baseline, total_s, env):
 def options(p):
     p.add_argument("--only", nargs="+", metavar="NAME", default=None,
                    help="run only these mutants (names from the table)")
+    p.add_argument("--areas", nargs="+", metavar="AREA", default=None,
+                   help="run only the mutants of these areas (the table's area column)")
 
 
 def main(argv=None):
@@ -299,8 +417,15 @@ def main(argv=None):
         unknown = set(b.args.only) - set(names)
         if unknown:
             b.parser.error(f"unknown mutants: {', '.join(sorted(unknown))}")
-        chosen = [m for m in MUTANTS if m.name in b.args.only]
-    elif b.quick:
+        chosen = [m for m in chosen if m.name in b.args.only]
+    if b.args.areas:
+        areas = {m.area for m in MUTANTS}
+        unknown = set(b.args.areas) - areas
+        if unknown:
+            b.parser.error(f"unknown areas: {', '.join(sorted(unknown))} (the areas are "
+                           f"{', '.join(sorted(areas))})")
+        chosen = [m for m in chosen if m.area in b.args.areas]
+    if not (b.args.only or b.args.areas) and b.quick:
         chosen = [m for m in MUTANTS if m.name in QUICK_NAMES]
 
     t_start = time.perf_counter()
@@ -318,9 +443,11 @@ def main(argv=None):
             outcome, f"caught ({outcome})")
         rows.append(dict(name=m.name, area=m.area, file=m.file, old=m.old, new=m.new,
                          breaks=m.breaks, tests=list(m.tests), outcome=verdict,
-                         seconds=dt, failure=first_failure(tail)))
-        print(f"{m.name:22s} {verdict:18s} {dt:6.1f} s  {rows[-1]['failure']}", flush=True)
+                         seconds=dt, failure=first_failure(tail), ran=b.env["date"]))
+        print(f"{m.name:24s} {verdict:18s} {dt:6.1f} s  {rows[-1]['failure']}", flush=True)
     total = time.perf_counter() - t_start
+    if len(chosen) < len(MUTANTS) and not b.quick:
+        rows = in_order(rows + carried_rows(b.out / "mutants.json", chosen, b.env["date"]))
 
     b.report("mutants",
              markdown=markdown(rows, baseline, total, b.env),
@@ -330,7 +457,8 @@ def main(argv=None):
              data=dict(baseline=baseline, mutants=rows, total_s=total,
                        caught=sum(is_caught(r) for r in rows), total=len(rows),
                        environment=b.env))
-    ok = baseline["outcome"] == "passed" and all(is_caught(r) for r in rows)
+    ok = baseline["outcome"] == "passed" and all(is_caught(r) for r in rows
+                                                 if r["ran"] == b.env["date"])
     return 0 if ok else 1
 
 
