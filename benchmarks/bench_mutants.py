@@ -345,15 +345,16 @@ def is_caught(row) -> bool:
 
 # --------------------------------------------------------------------------- the report
 
-def carried_rows(path: Path, chosen, date):
+def carried_rows(path: Path, chosen):
     """The rows of an earlier run's ``mutants.json`` for the mutants not run now, each marked
-    with the date it ran: only a mutant still defined with the same file and text, in the
-    order of :data:`MUTANTS`. Empty when there is no such file."""
+    with what it ran on and when (``ran``): only a mutant still defined with the same file and
+    text, in the order of :data:`MUTANTS`. Empty when there is no such file."""
     if not path.is_file():
         return []
     import json
     old = json.loads(path.read_text(encoding="utf-8"))
-    then = old.get("environment", {}).get("date", "")
+    env = old.get("environment", {})
+    then = H.env_line(env) if env else "an earlier run"
     by_name = {r["name"]: r for r in old.get("mutants", [])}
     ran = {m.name for m in chosen}
     out = []
@@ -374,8 +375,9 @@ def in_order(rows):
 
 def markdown(rows, baseline, total_s, env):
     caught = sum(is_caught(r) for r in rows)
-    now = [r for r in rows if r["ran"] == env["date"]]
-    earlier = sorted({r["ran"] for r in rows} - {env["date"]})
+    stamp = H.env_line(env)
+    now = [r for r in rows if r["ran"] == stamp]
+    earlier = sorted({r["ran"] for r in rows} - {stamp})
     body = [[r["name"], r["area"], f"`{r['file']}`", r["breaks"],
              ", ".join(f"`{t.split('/')[-1]}`" for t in r["tests"]),
              r["outcome"] + ("" if is_caught(r) else " ✗"), f"{r['seconds']:.1f}"]
@@ -393,9 +395,10 @@ def markdown(rows, baseline, total_s, env):
         f"unmutated): {baseline['outcome']} in {baseline['seconds']:.1f} s; this run "
         f"{total_s / 60:.1f} min for {len(now)} mutants (each row's time includes a cold "
         "compile of the kernels its tests need).",
-        (f" The other {len(rows) - len(now)} rows are kept from the run of "
-         f"{', '.join(earlier)}." if earlier else ""), "\n",
-        "\n`python benchmarks/bench_mutants.py` (one mutant: `--only NAME`).\n",
+        (f" The other {len(rows) - len(now)} rows are kept from an earlier run. "
+         f"{'; '.join(earlier)}" if earlier else ""), "\n",
+        "\n`python benchmarks/bench_mutants.py` (one mutant: `--only NAME`; some areas: "
+        "`--areas AREA ...`).\n",
         f"\n{H.env_line(env)}\n"])
 
 
@@ -428,6 +431,7 @@ def main(argv=None):
     if not (b.args.only or b.args.areas) and b.quick:
         chosen = [m for m in MUTANTS if m.name in QUICK_NAMES]
 
+    stamp = H.env_line(b.env)
     t_start = time.perf_counter()
     all_tests = list(dict.fromkeys(t for m in chosen for t in m.tests))
     outcome, dt, tail = run_tests(all_tests)
@@ -443,11 +447,11 @@ def main(argv=None):
             outcome, f"caught ({outcome})")
         rows.append(dict(name=m.name, area=m.area, file=m.file, old=m.old, new=m.new,
                          breaks=m.breaks, tests=list(m.tests), outcome=verdict,
-                         seconds=dt, failure=first_failure(tail), ran=b.env["date"]))
+                         seconds=dt, failure=first_failure(tail), ran=stamp))
         print(f"{m.name:24s} {verdict:18s} {dt:6.1f} s  {rows[-1]['failure']}", flush=True)
     total = time.perf_counter() - t_start
     if len(chosen) < len(MUTANTS) and not b.quick:
-        rows = in_order(rows + carried_rows(b.out / "mutants.json", chosen, b.env["date"]))
+        rows = in_order(rows + carried_rows(b.out / "mutants.json", chosen))
 
     b.report("mutants",
              markdown=markdown(rows, baseline, total, b.env),
@@ -458,7 +462,7 @@ def main(argv=None):
                        caught=sum(is_caught(r) for r in rows), total=len(rows),
                        environment=b.env))
     ok = baseline["outcome"] == "passed" and all(is_caught(r) for r in rows
-                                                 if r["ran"] == b.env["date"])
+                                                 if r["ran"] == stamp)
     return 0 if ok else 1
 
 
