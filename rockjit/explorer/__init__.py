@@ -4,7 +4,8 @@ browser, recomputed as the parameters change.
 The compute side (:mod:`.requests`: parameters, coarse-to-fine stages, the Python call of each
 view; :mod:`.worker`: the worker thread, newer requests superseding older ones) needs nothing
 beyond rockjit; the user interface (:mod:`.app`) and its server (:mod:`.server`) need Bokeh, the
-``explore`` extra: ``pip install 'rockjit[explore]'``.
+``explore`` extra: ``pip install 'rockjit[explore]'``. What the server lets in is
+:mod:`.guard`'s; how many pages compute at once, :mod:`.pages`.
 
 ``rockjit.explore()`` starts the server (:func:`explore`).
 """
@@ -14,7 +15,8 @@ from __future__ import annotations
 __all__ = ["explore"]
 
 
-def explore(*, port=0, address="127.0.0.1", browser=True, block=False, quiet=False):
+def explore(*, port=0, address="127.0.0.1", browser=True, block=False, quiet=False,
+            allow_hosts=()):
     """Start the explorer's web server and return its handle.
 
     Parameters
@@ -23,6 +25,13 @@ def explore(*, port=0, address="127.0.0.1", browser=True, block=False, quiet=Fal
         Port to listen on; 0 (default) takes a free one.
     address : str
         Address to bind; default ``127.0.0.1``, so that only this machine can connect.
+        ``"::1"`` is IPv6's loopback; ``"0.0.0.0"`` (or ``"::"``) listens on every address of
+        the machine, so that other machines can connect: a warning says so.
+    allow_hosts : sequence of str
+        More host names to accept in a request's ``Host`` header, beyond the bound address,
+        ``localhost`` for a loopback address, and this machine's host name for another (for
+        instance the name other machines use for this one). Every request naming another
+        host is refused (a defence against DNS rebinding: docs/guide/explore.md).
     browser : bool
         Open the system's web browser on the explorer's address.
     block : bool
@@ -48,4 +57,5 @@ def explore(*, port=0, address="127.0.0.1", browser=True, block=False, quiet=Fal
     False
     """
     from .server import start
-    return start(port=port, address=address, browser=browser, block=block, quiet=quiet)
+    return start(port=port, address=address, browser=browser, block=block, quiet=quiet,
+                 allow_hosts=allow_hosts)

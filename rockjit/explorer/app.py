@@ -1,7 +1,9 @@
 """The explorer's page: Bokeh widgets and plots over the compute side (:mod:`.requests`,
 :mod:`.worker`).
 
-One :class:`ExplorerApp` per browser tab. A change of a control is checked by the library first
+One :class:`ExplorerApp` per browser tab, built once the tab's websocket is open and the page
+has loaded (:func:`document`; until then a request of the page holds a placeholder and computes
+nothing), stopped when the websocket closes (:mod:`.pages`). A change of a control is checked by the library first
 (a refused value is shown under its control with the library's message, and nothing else
 changes); an accepted change marks the views it affects as updating and submits their
 computations to the tab's worker thread; results come back through the document's next-tick
@@ -20,7 +22,7 @@ import threading
 from functools import partial
 
 import numpy as np
-from bokeh.events import RangesUpdate, Tap
+from bokeh.events import DocumentReady, RangesUpdate, Tap
 from bokeh.layouts import column, row
 from bokeh.models import (Button, ColumnDataSource, CustomJS, Div, NumericInput, PreText,
                           RadioButtonGroup, Range1d, Select, Slider, Span, Toggle)
@@ -39,6 +41,28 @@ AGREE_COLOURS = {"same": style.AGREE_COLOUR, "different": style.DISAGREE_COLOUR}
 STALE_ALPHA = 0.35
 BASIN_SIZE = 400
 LAW_NAMES = {"housner": "Housner", "mao": "Mao", "constant": "constant e"}
+#: How often a page looks whether its websocket is still open, in milliseconds.
+WATCH_MS = 400
+#: Mathematical notation of the figures' labels (matplotlib's ``$...$``) in plain text.
+_TEX = ((r"\theta", "θ"), (r"\alpha", "α"), (r"\omega", "ω"), (r"\lambda", "λ"),
+        (r"\xi", "ξ"), (r"\Delta", "Δ"), (r"\mathrm", ""), ("$", ""), ("{", ""), ("}", ""))
+
+
+def plain_text(label):
+    """A figure's label as plain text for the page: ``'symmetric $p = 1$'`` is
+    ``'symmetric p = 1'``."""
+    text = str(label)
+    for tex, out in _TEX:
+        text = text.replace(tex, out)
+    return text
+
+
+def _finite(*values):
+    """Whether every value is a finite number (a browser event may carry None, NaN or ±inf)."""
+    try:
+        return all(v is not None and math.isfinite(float(v)) for v in values)
+    except (TypeError, ValueError):
+        return False
 
 
 def behaviour_colours():
@@ -139,8 +163,10 @@ def _fig(title, width, height, tools="save", x_label=None, y_label=None, toolbar
 class ExplorerApp:
     """The page of one browser tab (see the module's docstring)."""
 
-    def __init__(self, doc, params=None):
+    def __init__(self, doc, params=None, pages=None, root=None):
         self.doc = doc
+        self.pages = pages
+        self._placeholder = root
         self.params = (params or R.Params()).check()
         self.default_alpha_range = self.params.alpha_range
         self.basin_view = None      # the BasinView shown
@@ -150,11 +176,50 @@ class ExplorerApp:
         self.state = None           # the selected (theta0, theta0')
         self.colour_by = "behaviour"
         self._quiet = False         # widget updates made by the app, not by the user
-        self.computer = Computer(self._from_worker, progress_every=0.25)
+        self.computer = None        # the worker: started by start()
+        self.closed = False
+        self._watch = None
         self._build()
-        doc.on_session_destroyed(lambda ctx: self.computer.close())
+
+    def start(self):
+        """Start computing: the worker thread, the basin and the bifurcation diagram; and watch
+        the page's websocket (when it closes, :meth:`close`)."""
+        if self.computer is not None or self.closed:
+            return
+        self.computer = Computer(self._from_worker, progress_every=0.25)
+        if self.pages is not None:
+            self.pages.started(self.computer)
+        self.doc.on_session_destroyed(lambda ctx: self.close())
+        if self._session() is not None:
+            self._watch = self.doc.add_periodic_callback(self._watch_connection, WATCH_MS)
         self.submit_basin()
         self.submit_sweep()
+
+    def _session(self):
+        ctx = self.doc.session_context
+        return None if ctx is None else getattr(ctx, "session", None)
+
+    def _watch_connection(self):
+        session = self._session()
+        if session is None or session.connection_count == 0:
+            self.close()
+
+    def close(self):
+        """Stop computing (the tab was closed or reloaded, or the server stops): the worker ends
+        at its current piece of work's end, and the page gives its place back."""
+        if self.closed:
+            return
+        self.closed = True
+        if self.computer is not None:
+            self.computer.close(timeout=0)
+        if self.pages is not None:
+            self.pages.release(self)
+        if self._watch is not None:
+            try:
+                self.doc.remove_periodic_callback(self._watch)
+            except ValueError:  # already gone with its session
+                pass
+            self._watch = None
 
     # ---------------------------------------------------------------------------------------
     # the worker's events, on the document's loop
@@ -163,7 +228,7 @@ class ExplorerApp:
         self.doc.add_next_tick_callback(partial(self._on_event, event))
 
     def _on_event(self, event):
-        if not self.computer.is_current(event.channel, event.request):
+        if self.closed or not self.computer.is_current(event.channel, event.request):
             return  # superseded meanwhile: never shown
         status = self.status[event.channel]
         if event.kind == "progress":
@@ -218,7 +283,10 @@ class ExplorerApp:
         controls.append(Div(text="<b>Integration</b>"))
         controls.append(number("n_steps", "N (steps per period)", p.n_steps, mode="int",
                                placeholder="default"))
-        controls.append(number("periods", "periods", p.periods, mode="int"))
+        controls.append(number("periods", f"periods (at most {R.MAX_PERIODS:,})", p.periods,
+                               mode="int"))
+        self.limits = Div(text=self._limits_html(), width=215, css_classes=["rj-limits"])
+        controls.append(self.limits)
         controls.append(Div(text='<div style="color:#666;font-size:11px;max-width:215px">'
                                  'A value the library refuses is shown here with its message '
                                  'and the views keep the last accepted parameters.</div>'))
@@ -250,6 +318,8 @@ class ExplorerApp:
             'then 200²). Click a cell of the basin for its run; box-zoom the bifurcation '
             'diagram to recompute it on that range, click it to set α. Every view gives its '
             'figure as a PNG and the Python call that reproduces it.</div>'), width=1200)
+        if self._placeholder is not None:
+            self.doc.remove_root(self._placeholder)
         self.doc.add_root(column(
             header,
             row(self.controls, column(row(self.basin_panel, self.sweep_panel), self.run_panel,
@@ -271,6 +341,14 @@ class ExplorerApp:
         self.sweep_state.js_on_change("text", CustomJS(code=stamp.format(
             what="sweep", value="cb_obj.text")))
         self.doc.title = "rockjit explore"
+
+    def _limits_html(self):
+        p = self.params
+        n = p.grid_n_steps()
+        return (f'<div class="rj-limits-text" style="color:#666;font-size:11px;max-width:215px">'
+                f'Limits of the explorer: '
+                f'{html.escape(R.limits_text())}. Now {p.periods:,} × {n} = '
+                f'<span class="rj-cell-steps">{p.periods * n:,}</span>.</div>')
 
     def _with_error(self, name, widget):
         err = Div(text="", visible=False, css_classes=[f"rj-error-{name}"], width=215)
@@ -316,11 +394,11 @@ class ExplorerApp:
         mode = RadioButtonGroup(labels=["behaviour", "attractor"], active=0, width=200,
                                 css_classes=["rj-colour-by"])
         mode.on_change("active", lambda attr, old, new: self._colour_by(new))
-        self.basin_info = Div(text="", width=250, css_classes=["rj-basin-info"])
+        self.basin_info = Div(text="", width=290, css_classes=["rj-basin-info"])
         self.basin_state = Div(text="", css_classes=["rj-basin-state"], width=250, height=20)
         buttons, self.basin_code = self._export_row("basin", width=680)
         side = column(Div(text="<b>colour by</b>"), mode, self.basin_state, self.status["basin"],
-                      self.basin_info, buttons, width=250)
+                      self.basin_info, buttons, width=290)
         self.basin_panel = column(row(p, side), self.basin_code,
                                   css_classes=["rj-view", "rj-view-basin"])
 
@@ -361,12 +439,17 @@ class ExplorerApp:
             acol = attractor_colours(res.attractors)
             names = style.attractor_names(res.attractors)
             lim = m.get("integrity", {}).get("LIM", {})
+            num = "text-align:right;white-space:nowrap;padding-left:6px"
             arows = "".join(
-                f"<tr><td>{_swatch(acol[a.id])}{names[i]}</td>"
-                f"<td style='text-align:right'>{a.fraction:.1f} %</td>"
-                f"<td style='text-align:right'>LIM {_fmt(lim.get(a.id), 3)}</td></tr>"
+                f"<tr><td>{_swatch(acol[a.id])}{html.escape(plain_text(names[i]))}</td>"
+                f"<td style='{num}'>{a.fraction:.1f} %</td>"
+                f"<td style='{num}' class='rj-lim'>{_fmt(lim.get(a.id), 3)}</td></tr>"
                 for i, a in enumerate(res.attractors))
-            out += f"<b>attractors</b><table style='font-size:12px'>{arows}</table>"
+            out += ("<b>attractors</b><table class='rj-attractors' style='font-size:12px;"
+                    "border-collapse:collapse;width:100%'>"
+                    f"<tr><th></th><th style='{num}'>basin</th>"
+                    f"<th style='{num}' title='local integrity measure'>LIM</th></tr>"
+                    f"{arows}</table>")
             integ = m.get("integrity", {})
             out += ("<b>measures</b><table style='font-size:12px'>"
                     f"<tr><td>basin entropy S<sub>b</sub></td><td>{_fmt(m['basin_entropy'], 3)}"
@@ -428,9 +511,12 @@ class ExplorerApp:
 
     def _basin_tap(self, event):
         view = self.basin_view
-        if view is None or event.x is None:
+        if view is None:
             return
-        cell = R.nearest_cell(view.result, event.x, event.y)
+        if not _finite(event.x, event.y):
+            self._ignored("basin", "a click outside the plot's finite coordinates")
+            return
+        cell = R.nearest_cell(view.result, float(event.x), float(event.y))
         if cell is None:
             return
         i, j = cell
@@ -572,11 +658,22 @@ class ExplorerApp:
                                   row(buttons, self.status["sweep"], self.sweep_state),
                                   self.sweep_code, css_classes=["rj-view", "rj-view-sweep"])
 
+    def _ignored(self, channel, what):
+        """Say in the view's status line that an event was ignored (the app goes on)."""
+        self.status[channel].text = (f'<div class="rj-ignored" style="color:#8a5a00;'
+                                     f'font-size:12px">ignored: {html.escape(what)}</div>')
+
     def _bif_range(self, event):
-        if event.x0 is None or event.x1 is None:
+        if event.x0 is None and event.x1 is None:
+            return
+        if not _finite(event.x0, event.x1):
+            self._ignored("sweep", "a zoom to a range that is not finite")
             return
         a0, a1 = self.params.alpha_range
         x0, x1 = max(0.0, float(event.x0)), float(event.x1)
+        if not x1 > x0:
+            self._ignored("sweep", "a zoom to an empty range of α")
+            return
         if abs(x0 - a0) + abs(x1 - a1) <= 1e-9 * max(a1 - a0, 1e-12):
             return
         digits = max(0, int(-math.floor(math.log10(max(x1 - x0, 1e-12) / 1e4))))
@@ -589,13 +686,13 @@ class ExplorerApp:
         self.submit_sweep()
 
     def _bif_tap(self, event):
-        if event.x is None:
+        if not _finite(event.x):
+            self._ignored("sweep", "a click outside the plot's finite coordinates")
             return
         a0, a1 = self.params.alpha_range
         digits = max(0, int(-math.floor(math.log10(max(a1 - a0, 1e-12) / 1e3))))
         alpha = round(max(0.0, float(event.x)), digits)
-        self._set_widgets(alpha=alpha)
-        self._control("alpha", alpha, source="bifurcation")
+        self._control("alpha", alpha, source="bifurcation")  # checked, then shown
 
     def _show_sweep(self, v):
         self.sweep_view = v
@@ -672,7 +769,8 @@ class ExplorerApp:
         if on:
             self.submit_compare()
         else:
-            self.computer.cancel("compare")
+            if self.computer is not None:
+                self.computer.cancel("compare")
             self.status["compare"].text = ""
 
     def _show_compare(self, v):
@@ -724,8 +822,9 @@ class ExplorerApp:
         err = self.errors["alpha" if name == "alpha" else name]
         try:
             new = self.params.with_(**{name: value}).check()
-        except ValueError as exc:
-            err.text = _error_html(str(exc))
+        except Exception as exc:  # refused: the message under the control, the app goes on
+            msg = str(exc) if isinstance(exc, ValueError) else f"{type(exc).__name__}: {exc}"
+            err.text = _error_html(msg)
             err.visible = True
             return
         err.text, err.visible = "", False
@@ -750,22 +849,31 @@ class ExplorerApp:
             self.submit_sweep()
         for s in self.alpha_spans:
             s.location = new.alpha
+        self.limits.text = self._limits_html()
         if self.compare_toggle.active:
             self.submit_compare()
 
     def submit_basin(self):
+        if self.computer is None or self.closed:
+            return
         _dim([self.basin_fig], True)
         self.computer.submit("basin", R.basin_stages(self.params))
 
     def submit_run(self):
+        if self.computer is None or self.closed:
+            return
         _dim(self.run_figs, True)
         self.computer.submit("run", R.run_stages(self.params, self.state))
 
     def submit_sweep(self):
+        if self.computer is None or self.closed:
+            return
         _dim(self.bif_figs, True)
         self.computer.submit("sweep", R.sweep_stages(self.params))
 
     def submit_compare(self):
+        if self.computer is None or self.closed:
+            return
         _dim(self.cmp_figs.values(), True)
         self.computer.submit("compare", R.compare_stages(self.params))
 
@@ -820,6 +928,31 @@ def _png(view, shown, colour_by):
     return base64.b64encode(buf.getvalue()).decode("ascii"), name
 
 
-def document(doc):
-    """The Bokeh application's function: one explorer per tab."""
-    ExplorerApp(doc)
+def document(doc, pages=None):
+    """The Bokeh application's function, one call per session: a placeholder until the page's
+    websocket is open and the page has loaded (Bokeh's ``DocumentReady``, which only the
+    browser's websocket can carry), then the explorer, computing, if fewer than
+    ``pages.limit`` pages compute already (:class:`.pages.Pages`)."""
+    doc.title = "rockjit explore"
+    wait = Div(text='<div class="rj-connecting" style="color:#555">rockjit explore: '
+                    'connecting…</div>', width=600)
+    doc.add_root(wait)
+    if pages is not None:
+        pages.opened()
+        doc.on_session_destroyed(lambda ctx: pages.closed())
+    built = []
+
+    def ready(event):
+        if built:
+            return
+        if pages is not None and not pages.room():
+            wait.text = (f'<div class="rj-full" style="color:#b00020">rockjit explore computes '
+                         f'for at most {pages.limit} pages at once: close one of them and '
+                         f'reload this page.</div>')
+            return
+        app = ExplorerApp(doc, pages=pages, root=wait)
+        built.append(app)
+        if pages is not None:
+            pages.claim(app)
+        app.start()
+    doc.on_event(DocumentReady, ready)

@@ -19,9 +19,9 @@ from ..excitation import Harmonic
 from ..model import XI_STUDY, Block
 from ..settings import Execution, Integration, Lattice
 
-__all__ = ["BasinView", "CompareView", "LAWS", "Params", "REFINE", "RunView", "SweepView",
-           "basin_stages", "clean_number", "compare_stages", "python_number", "run_stages",
-           "sweep_stages"]
+__all__ = ["BasinView", "CompareView", "LAWS", "MAX_CELL_STEPS", "MAX_PERIODS", "Params",
+           "REFINE", "RunView", "SweepView", "basin_stages", "chunk_for", "clean_number",
+           "compare_stages", "limits_text", "python_number", "run_stages", "sweep_stages"]
 
 #: The basin's lattices, coarse to fine: a change shows 50² at once, then refines.
 REFINE = (50, 100, 200)
@@ -33,6 +33,38 @@ SWEEP_POINTS = 500
 RUN_POINTS = 20_000
 #: The laws the law control offers.
 LAWS = ("housner", "mao", "constant")
+
+# The explorer's own limits, narrower than the library's: they keep every view interactive and
+# every piece of work that cannot be interrupted (a chunk of a grid's cells, a cell's run, a
+# basin's measures) well under a second, so that a change or a closed tab stops the work
+# within a second.
+#: Most periods a view integrates.
+MAX_PERIODS = 4000
+#: Most steps of one cell's run: periods times the steps per period N (N as the grids resolve
+#: it: raised for slow forcing and strong damping when left to the library).
+MAX_CELL_STEPS = 256_000
+#: Cells per chunk of a basin and of a bifurcation diagram at the default settings (500
+#: periods of 64 steps): a chunk of a grid with more work per cell has fewer cells
+#: (:func:`chunk_for`), so that a chunk takes about as long whatever the settings.
+CHUNK = 512
+SWEEP_CHUNK = 64
+_DEFAULT_WORK = 500 * 64
+#: The controls that must hold a number (an empty box is refused); ``n_steps`` empty is the
+#: library's default.
+_NUMBERS = ("hb", "e", "alpha", "omega", "xi", "phase", "periods")
+
+
+def limits_text():
+    """The explorer's limits in words, shown beside the integration's controls."""
+    return (f"periods ≤ {MAX_PERIODS:,}; periods × N ≤ {MAX_CELL_STEPS:,} steps per cell "
+            f"(the library itself takes more: use it from Python for longer runs)")
+
+
+def chunk_for(periods, n_steps, base=CHUNK):
+    """Cells per chunk of a grid whose cells run ``periods`` of ``n_steps``: ``base`` at the
+    default work per cell (500 × 64 steps), fewer as each cell's work grows (at least 2)."""
+    work = int(periods) * max(int(n_steps), 64)
+    return max(2, min(int(base), int(base) * _DEFAULT_WORK // max(work, 1)))
 
 
 def clean_number(value):
@@ -80,9 +112,11 @@ class Params:
         """A copy with some fields changed; floats cleaned (:func:`clean_number`), unknown names
         refused."""
         names = {f.name for f in fields(self)}
-        for k in changes:
+        for k, v in changes.items():
             if k not in names:
                 raise ValueError(f"unknown parameter {k!r}")
+            if k in _NUMBERS and (v is None or (isinstance(v, str) and not v.strip())):
+                raise ValueError(f"{k} must be a number (the box is empty)")
         return replace(self, **{k: clean_number(v) for k, v in changes.items()})
 
     # the library's objects -------------------------------------------------------------------
@@ -115,6 +149,27 @@ class Params:
             raise ValueError(f"alpha_range must run from a smaller to a larger amplitude "
                              f"(got {a0!r}, {a1!r})")
         sweep.plan(block, self.sweep_forcing(), self.alphas(), integration=integration)
+        self.check_limits()
+        return self
+
+    def grid_n_steps(self):
+        """Steps per period of the basin, its cells' runs and the bifurcation diagram: ``n_steps``,
+        or the library's default for grids (:func:`run_n_steps`)."""
+        return run_n_steps(self)
+
+    def check_limits(self):
+        """The explorer's limits (:data:`MAX_PERIODS`, :data:`MAX_CELL_STEPS`); ``ValueError``
+        naming ``periods`` or ``n_steps`` beyond them."""
+        if self.periods > MAX_PERIODS:
+            raise ValueError(f"periods must be in [1, {MAX_PERIODS}] in the explorer (got "
+                             f"{self.periods}); rockjit itself, from Python, takes more")
+        n = self.grid_n_steps()
+        if self.periods * n > MAX_CELL_STEPS:
+            why = "; N, left to the library, is raised for slow forcing or strong damping" \
+                if self.n_steps is None and n > 64 else ""
+            raise ValueError(f"periods × n_steps must be at most {MAX_CELL_STEPS:,} steps per "
+                             f"cell in the explorer (got {self.periods} × {n} = "
+                             f"{self.periods * n:,}{why}); give fewer periods or a smaller N")
         return self
 
     # the Python call of each view -------------------------------------------------------------
@@ -244,14 +299,13 @@ class CompareView:
     extra: dict = field(default_factory=dict)
 
 
-#: Cells per chunk of the app's grids: a superseded grid stops at its next chunk, so chunks
-#: small enough to stop within a few tens of milliseconds (a 200² basin in 80 chunks), large
-#: enough that the threads stay busy.
-CHUNK = 512
-
-
-def _execution(progress):
-    return Execution(progress=progress, chunk=CHUNK) if progress is not None else Execution()
+def _execution(progress, params, base=CHUNK):
+    """The grids' execution: a superseded or closed request stops at its grid's next chunk (a
+    200² basin at the default settings in 80 chunks of a few tens of milliseconds each)."""
+    if progress is None:
+        return Execution()
+    return Execution(progress=progress,
+                     chunk=chunk_for(params.periods, params.grid_n_steps(), base))
 
 
 def basin_stages(params, levels=REFINE):
@@ -262,7 +316,7 @@ def basin_stages(params, levels=REFINE):
     def stage(grid, final):
         def compute(progress=None):
             res = basin(params.block(), params.forcing(), grid,
-                        integration=params.integration(), execution=_execution(progress))
+                        integration=params.integration(), execution=_execution(progress, params))
             return BasinView(params, grid, res, res.measures(), basin_call(params, grid),
                              final=final)
         compute.label = f"basin {grid}\u00b2"
@@ -279,7 +333,8 @@ def sweep_stages(params):
 
     def compute(progress=None):
         res = sweep(params.block(), params.sweep_forcing(), params.alphas(),
-                    integration=params.integration(), execution=_execution(progress))
+                    integration=params.integration(),
+                    execution=_execution(progress, params, SWEEP_CHUNK))
         return SweepView(params, res, sweep_call(params))
     compute.label = f"bifurcation diagram, {SWEEP_POINTS} amplitudes"
     return [compute]
@@ -324,7 +379,8 @@ def compare_stages(params, grid=COMPARE_GRID):
             part = None if progress is None else \
                 (lambda done, total, k=k: progress(k * total + done, 2 * total))
             out[law] = basin(params.block(law), params.forcing(), grid,
-                             integration=params.integration(), execution=_execution(part))
+                             integration=params.integration(),
+                             execution=_execution(part, params))
         same = np.asarray(out["housner"].label) == np.asarray(out["mao"].label)
         return CompareView(params, out["housner"], out["mao"], same,
                            100.0 * float(same.mean()), compare_call(params, grid), grid)

@@ -115,6 +115,12 @@ class Computer:
             self._pending.pop(channel, None)
             self._cond.notify_all()
 
+    @property
+    def alive(self):
+        """Whether the worker thread still runs (after :meth:`close`, until the piece of work
+        it is in ends)."""
+        return self._thread.is_alive()
+
     def is_current(self, channel, number):
         """Whether request ``number`` is still the channel's newest."""
         with self._cond:
@@ -137,7 +143,9 @@ class Computer:
             return True
 
     def close(self, timeout=5.0):
-        """Cancel everything and stop the thread."""
+        """Cancel everything and stop the thread: it ends at the current stage's next progress
+        call (a grid's next chunk). Waits up to ``timeout`` seconds for it (0: does not wait, as
+        on a server's event loop)."""
         with self._cond:
             self._closed = True
             for c in CHANNELS:
@@ -145,7 +153,8 @@ class Computer:
                 self._latest[c] = self._counter
             self._pending.clear()
             self._cond.notify_all()
-        self._thread.join(timeout)
+        if timeout and threading.current_thread() is not self._thread:
+            self._thread.join(timeout)
 
     # the worker -------------------------------------------------------------------------------
     def _emit(self, event):
