@@ -493,7 +493,8 @@ def _explore_plan(args):
     error (exit status 2) like any other."""
     from ..explorer import explore
     try:
-        explore(port=args.port, address=args.address, browser=not args.no_browser, block=True)
+        explore(port=args.port, address=args.address, browser=not args.no_browser, block=True,
+                allow_hosts=args.allow_host or ())
     except ImportError as exc:  # the explore extra is not installed
         raise UsageError(str(exc)) from None
     except KeyboardInterrupt:
@@ -953,7 +954,13 @@ def build_parser():
     p.add_argument("--port", type=int, default=0,
                    help="port to listen on (default 0: a free one; the address is printed)")
     p.add_argument("--address", default="127.0.0.1",
-                   help="address to bind (default 127.0.0.1: only this machine can connect)")
+                   help="address to bind (default 127.0.0.1: only this machine can connect; "
+                        "::1 for IPv6's loopback; 0.0.0.0 lets other machines connect, with a "
+                        "warning)")
+    p.add_argument("--allow-host", action="append", metavar="NAME",
+                   help="also accept requests that name this host (repeatable; by default "
+                        "only the bound address, localhost for a loopback one, and this "
+                        "machine's host name for another)")
     p.add_argument("--no-browser", action="store_true",
                    help="do not open the system's web browser")
     return parser
