@@ -28,7 +28,6 @@ from rockjit.plotting import style  # noqa: E402
 from rockjit.result import BEHAVIOURS  # noqa: E402
 
 RUN = dict(integration=Integration(periods=20, n_steps=64), record_stride=4, lyapunov=True)
-STYLES = ("default", "paper")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -310,10 +309,10 @@ def _builders():
     }
 
 
-@pytest.mark.parametrize("style_name", STYLES)
 @pytest.mark.parametrize("name", list(_builders()))
-def test_every_figure_reads_in_a_journal(runs, grids, name, style_name):
-    with style.use(style_name):
+def test_every_figure_reads_in_a_journal(runs, grids, name):
+    # the default style: the paper's differs only in leaving the figures' titles out
+    with style.use("default"):
         fig = _builders()[name](runs, grids)
         assert L.problems(fig) == []
 
@@ -396,3 +395,37 @@ def test_the_spectrum_command_draws_a_fine_map_by_default():
     args = build_parser().parse_args(["spectrum", "--hb", "4", "--ratio-range", "0.5", "8",
                                       "--amplitude-range", "1", "25", "--out", "x"])
     assert min(args.grid) >= 100
+
+
+def test_the_headline_image_is_drawn_by_figure_5s_function(monkeypatch, tmp_path):
+    """docs/_static/make_headline.py writes the README's image with the function that draws
+    the paper's fig5_bifurcation_hb1.png, from the paper's h/b = 1 sweeps."""
+    import importlib.util
+    import inspect
+    from pathlib import Path
+
+    from rockjit.study import paper
+    script = Path(__file__).resolve().parents[1] / "docs" / "_static" / "make_headline.py"
+    spec = importlib.util.spec_from_file_location("make_headline", script)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    drawn = []
+    real = paper.draw_fig5
+
+    def spy(sweeps, hb):
+        fig = real(sweeps, hb)
+        drawn.append((sorted(sweeps), hb, fig))
+        return fig
+
+    monkeypatch.setattr(paper, "draw_fig5", spy)
+    out = mod.make(tmp_path / "headline.png", periods=20, alpha_step=0.1)
+    assert [(laws, hb) for laws, hb, _ in drawn] == [(["housner", "mao"], 1)]
+    fig = drawn[0][2]
+    # the file is that figure: its size in pixels is the figure's at the default style's dpi
+    from PIL import Image
+    with Image.open(out) as im:
+        w, h = im.size
+    dpi = style.STYLES["default"].rc["savefig.dpi"]
+    assert (w, h) == (round(fig.get_figwidth() * dpi), round(fig.get_figheight() * dpi))
+    # and the paper draws its figure 5 with the same function
+    assert "draw_fig5(" in inspect.getsource(paper.paper)

@@ -291,7 +291,7 @@ def fig_chart(results, title=None):
         ax.set_ylim(*first.alpha_range)
         ax.set_xlabel("$\\omega$")
         ax.set_ylabel("$\\alpha$")
-        letter(ax, 2, f"both laws' curves; grey: the behaviours differ "
+        letter(ax, 2, f"both laws' curves; hatched: the behaviours differ "
                       f"({_share_words(100.0 * differ.mean())} of cells)")
         h = _legend_handles(res)
         h += [Line2D([], [], color=LAW_COLOURS.get(law, "k"), lw=1.6,

@@ -782,10 +782,12 @@ def fig_attractors(basins, measures=None, title=None):
         handles = _attractor_panel(ax, b.attractor, b.theta0, b.dtheta0, b.attractors,
                                    show_y=i == 0)
         m = measures[law]
-        S.letter(ax, i, f"{S.law_name(b.block)}: $S_b = {m['basin_entropy']:.3f}$, "
-                        f"$S_{{bb}} = {m['boundary_basin_entropy']:.3f}$,\n"
-                        f"GIM $= {m['integrity']['GIM']:.3f}$, "
-                        f"IF $= {m['integrity']['IF']:.3f}$")
+        S.letter(ax, i, f"{S.law_name(b.block)}\n"
+                        f"basin entropy $S_b = {m['basin_entropy']:.3f}$, boundary basin "
+                        f"entropy $S_{{bb}} = {m['boundary_basin_entropy']:.3f}$;\n"
+                        f"safe basin's integrity: global measure GIM $= "
+                        f"{m['integrity']['GIM']:.3f}$, factor IF $= "
+                        f"{m['integrity']['IF']:.3f}$")
         ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncols=1,
                   title=f"of the {_cells(b)}")
     b0 = next(iter(basins.values()))
@@ -801,7 +803,7 @@ def fig_attractors(basins, measures=None, title=None):
 
 #: What the erosion profiles call a basin with no period up to ``pmax``: the basins compute no
 #: exponent, so chaotic motion is counted as aperiodic there (docs/theory/behaviours.md).
-APERIODIC_NOTE = "aperiodic: no period up to 16\n(no exponents: chaotic motion counts here)"
+APERIODIC_NOTE = "(no period up to 16; no exponents computed,\nso chaotic motion counts here)"
 
 
 def _erosion_areas(r):
@@ -819,7 +821,7 @@ def _erosion_areas(r):
         idx = kinds[key]
         br = r.branches[idx[0]]
         beh = br["behaviour"]
-        name = APERIODIC_NOTE if beh == "aperiodic" else S._base_name(br)
+        name = S._base_name(br)
         n = len(idx)
         if n > 1:
             name += f" ({n} attractors)"
@@ -873,7 +875,9 @@ def fig_erosion(profiles, title=None):
                 axk.stairs(inner, edges, baseline=None, color="white", lw=0.4)
             handles.append(Patch(facecolor=colour, edgecolor=S.shade(colour, 0.5) if hatch
                                  else "0.5", hatch=hatch, lw=0.4,
-                                 label=f"{name}, up to {(top - bottom).max():.1f} %"))
+                                 label=f"{name}, up to {(top - bottom).max():.1f} %"
+                                 + ("\n" + APERIODIC_NOTE if name.startswith("aperiodic")
+                                    else "")))
             bottom = top
         axk.stairs(np.full(r.alpha.size, 100.0), edges, baseline=bottom, fill=True,
                    color=BEHAVIOUR_COLOURS["overturn"], lw=0)
@@ -1013,6 +1017,9 @@ END_MARKERS = {"overturn": ("^", "branch ends: the block overturns"),
                "grazing": ("|", "branch ends: an impact grazes"),
                "no_convergence": ("x", "branch ends: no convergence"),
                "max_impacts": ("x", "branch ends: no convergence"),
+               "nonfinite": ("x", "branch ends: no convergence"),
+               "singular": ("x", "branch ends: no convergence"),
+               "unstable": ("x", "branch ends: no convergence"),
                "max_points": ("x", "branch ends: the point budget"),
                "budget": ("x", "branch ends: the point budget")}
 
@@ -1032,11 +1039,13 @@ def _branch_group(br):
         return "period 1, asymmetric", S.shade(BEHAVIOUR_COLOURS["asymmetric"], 0.35), None
     if br.period == 2:
         return "period 2", green, None
+    # three prongs for period 3, four for period 4, a hexagon for the longer ones: shapes
+    # that no bifurcation or branch end uses
     if br.period == 3:
-        return "period 3", S.shade(green, 0.45), "^"
+        return "period 3", S.shade(green, 0.45), "2"
     if br.period == 4:
-        return "period 4", S.shade(green, 0.45), "s"
-    return f"period $\\geq {GROUPED_PERIOD}$", S.tint(green, 0.4), "o"
+        return "period 4", S.shade(green, 0.45), "+"
+    return f"period $\\geq {GROUPED_PERIOD}$", S.tint(green, 0.4), "h"
 
 
 def _branch_colour(br):
@@ -1125,7 +1134,7 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
         raise ValueError(f"component must be 0 (theta) or 1 (theta') (got {component!r})")
     pname = c.parameter
     sym = SYMBOLS.get(pname, pname)
-    fig = _figure("double", 0.52)
+    fig = _figure("double", 0.66)
     ax = fig.add_subplot()
     # legend entry -> (handle, artists it names): an entry is kept when one of its artists
     # draws within the view
@@ -1171,7 +1180,7 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
                                               np.asarray(br.stable), tn[:, k], T, mu_abs):
                     line, = ax.plot(x, yv, ls="-" if st else (0, (3.0, 1.5)),
                                     lw=1.1 if st else 0.8, color=colour, zorder=4,
-                                    marker=mk or "", ms=2.6, markevery=0.07, mew=0.5,
+                                    marker=mk or "", ms=3.2, markevery=0.07, mew=0.7,
                                     mfc=colour if st else "white")
                     entry(group, None, line)
     for group in groups:
@@ -1260,7 +1269,7 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
             handles.append(h)
     handles += [entries[key][0] for key in shown if isinstance(key, str)
                 and not key.startswith("sweep ")]
-    fig.legend(handles=handles, loc="outside right center", ncols=1)
+    fig.legend(handles=handles, loc="outside lower center", ncols=3)
     b, f = c.block, c.forcing
     fixed = (f"$\\omega = {f.omega:g}$" if pname == "alpha" else f"$\\alpha = {f.alpha:g}$")
     S.suptitle(fig, title or f"Periodic orbits, {S.law_name(b)}, $h/b = {b.hb:g}$, {fixed}; "

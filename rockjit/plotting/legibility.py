@@ -15,12 +15,15 @@ import itertools
 
 import numpy as np
 
-from .style import TEXT_POINTS, WIDTHS
-
-__all__ = ["LEGEND_DELTA", "canvas_problems", "colour_distance", "legend_colour_problems",
+__all__ = ["LEGEND_DELTA", "TEXT_POINTS", "WIDTHS", "canvas_problems", "colour_distance", "legend_colour_problems",
            "legend_handle_problems", "legend_over_data", "problems", "text_overlaps",
            "type_problems"]
 
+#: The smallest and largest type a figure may set, in points (a journal's 7-9 pt at print
+#: size).
+TEXT_POINTS = (7.0, 9.0)
+#: The widths a figure may have, in inches: a journal's column and its page.
+WIDTHS = (3.5, 7.2)
 #: Smallest CAM02-UCS distance between two legend entries that differ in colour only, and
 #: between an entry without an edge and the legend's background.
 LEGEND_DELTA = 12.0

@@ -38,6 +38,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .legibility import TEXT_POINTS, WIDTHS
+
 __all__ = ["AGREE_COLOUR", "BEHAVIOUR_COLOURS", "DISAGREE_COLOUR", "FORMATS", "LAW_COLOURS",
            "LAW_LINES", "LAW_NAMES", "STYLES", "SYMBOLS", "Style", "TEXT_POINTS", "WIDTHS",
            "attractor_colours", "attractor_names", "behaviour_cmap", "current", "cvd_distances", "law_name", "letter", "shade",
@@ -132,10 +134,6 @@ _COMMON_RC = {"axes.titlesize": "medium", "legend.frameon": False, "axes.spines.
               "figure.titlesize": 9.0, "axes.linewidth": 0.6, "lines.linewidth": 1.0,
               "xtick.major.width": 0.6, "ytick.major.width": 0.6,
               "pdf.fonttype": 42, "svg.fonttype": "none"}
-#: The smallest and largest type any figure sets, in points (a journal's 7-9 pt at print size).
-TEXT_POINTS = (7.0, 9.0)
-#: The widths a figure may have, in inches: a journal's column and its page.
-WIDTHS = (3.5, 7.2)
 STYLES = {
     "default": Style("default", True, 3.5, 7.2, 1.0, {**_COMMON_RC, "savefig.dpi": 200}),
     "paper": Style("paper", False, 3.5, 7.2, 1.0, {**_COMMON_RC, "savefig.dpi": 300}),
