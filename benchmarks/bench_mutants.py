@@ -232,7 +232,7 @@ MUTANTS += [
        "free_rocking_decided(th, v, max_th, thc, th_top)",
        "free_rocking_decided(max(th, 0.0), v, max_th, thc, th_top)",
        "the compiled path's stopping rule takes a block on the theta < 0 side for upright",
-       ["tests/test_ground_compiled.py::test_a_dozen_pulses_agree_with_the_scipy_path"]),
+       ["tests/test_ground_stopping.py::test_the_compiled_path_decides_as_the_full_run_ends"]),
     # ---- periodic orbits: continuation and bifurcations
     _m("arclength-step-bound", "continuation", ARCLENGTH,
        "ds = min(1.3 * ds, self.ds_max)", "ds = min(1.3 * ds, 1.1 * self.ds_max)",
