@@ -139,7 +139,7 @@ NAMES = {
     "--records": r"\brecords?\b", "--measure": r"\bmeasure\b",
     "--intensities": r"\bintensit(y|ies)\b",
     "--style": r"--style\b", "--format": r"--format\b", "--port": r"\bport\b",
-    "--address": r"\baddress\b|cannot listen on",
+    "--address": r"\baddress\b|cannot listen on", "--allow-host": r"allow[-_]hosts?",
 }
 
 NARGS = {"--alpha-range": 2, "--omega-range": 2, "--theta-range": 2, "--dtheta-range": 2,
@@ -739,6 +739,7 @@ def _explore():
                 + _not_ascii(cmd, "--port"), quiet)
     # not a host address, or not one of this machine's (the OS's choice of port)
     c += _values(cmd, "--address", ["", " ", "a b", "999.1.1.1", "8.8.8.8"], quiet)
+    c += _values(cmd, "--allow-host", ["", "a b", "*.lab", "x" * 300], quiet)
     return c
 
 
