@@ -25,6 +25,15 @@ The cases (``CASES``, printable with ``pytest --collect-only -q``):
   is really invalid.
 - ``numbers: ...``: non-ASCII numbers in single and multi-valued options, literally.
 
+The edges (``EDGE_CASES``): every option of every command that takes numbers (read from the
+parser, so that a new one cannot escape) has its documented range in ``RANGES`` (built from the
+library's constants); each is given both ends of its range, the numbers just outside them, and
+``1e-320``, ``1e308``, ``-1e308``, ``-0.0``, ``nan``, ``inf`` (integers: ``0``, ``-1``, ``1e15``
+and a 20-digit one), inside a small valid command line. Each must end in exit status 2 with one
+line, or reach its (guarded) work; a seeded draw of the accepted ones, with the values that
+once crashed after validation (``EDGE_REGRESSIONS``), runs for real on small grids and must
+end in exit status 0 with its outputs written, or 2 with one line: never a traceback.
+
 Options the command line did not have but its documented model implies carry ``[guessed --NAME]``
 in their ids: ``--max-impacts`` must exist; ``--xi`` cases are skipped while the parser does not
 have it; ``--rest-speed`` is tried only on ``trajectory``, the one command that has it.
@@ -926,6 +935,18 @@ def reached():
                  "orbits.arclength", "orbits.plane_chart", "cli.outputs", "plotting.figures",
                  "study.paper"):
         importlib.import_module(f"rockjit.{name}")
+    _GUARDS["calls"] = calls
+    _GUARDS["mp"] = _install_guards(calls)
+    yield calls
+    _GUARDS.pop("mp").undo()
+
+
+#: The sentinels in place (``mp``) and the list they record into (``calls``), while ``reached``
+#: is: :func:`unguarded` lifts them for the tests that run real work.
+_GUARDS = {}
+
+
+def _install_guards(calls):
     mp = pytest.MonkeyPatch()
     for target in GUARDED + GUARDED_IF_PRESENT:
         mod, attr = _resolve(target)
@@ -940,8 +961,20 @@ def reached():
         if hasattr(getattr(mod, attr), "plan"):
             sentinel.plan = getattr(mod, attr).plan
         mp.setattr(mod, attr, sentinel)
-    yield calls
-    mp.undo()
+    return mp
+
+
+@pytest.fixture
+def unguarded():
+    """The real entry points of work for one test, the sentinels put back after it."""
+    mp = _GUARDS.pop("mp", None)
+    if mp is not None:
+        mp.undo()
+    try:
+        yield
+    finally:
+        if mp is not None:
+            _GUARDS["mp"] = _install_guards(_GUARDS["calls"])
 
 
 def _snapshot(root):
@@ -1185,3 +1218,236 @@ def test_guard_stops_a_valid_command(reached, tmp_path):
                                      reached, tmp_path)
     assert isinstance(exc, NotRefused) and reached[0] in GUARDED + GUARDED_IF_PRESENT
     assert err == "" and not (tmp_path / "o").exists()
+
+
+# ---------------------------------------------------------------------------------------------
+# The edges of every documented range: refused in one line, or run to the end
+# ---------------------------------------------------------------------------------------------
+
+def _ranges():
+    """Every numeric option's documented range, ``option -> (kind, lo, hi)`` (``None``: no
+    bound on that side), read from the library's own constants where it has them (a moved
+    bound moves the edges tried); ``(command, option)`` where a command differs."""
+    from rockjit.excitation import ALPHA_MAX, OMEGA_RANGE
+    from rockjit.ground.pulses import AMPLITUDE_MAX, RATIO_RANGE
+    from rockjit.ground.records import SIZE_RANGE
+    from rockjit.ground.settings import TIME_MAX
+    from rockjit.model import HB_RANGE, XI_MAX
+    from rockjit.settings import MAX_IMPACTS, MAX_N, MAX_PERIODS, REST_SPEED_RANGE
+    half_pi = 0.5 * math.pi
+    common = {
+        "--hb": ("real", *HB_RANGE), "--e": ("real", 0.0, 1.0), "--xi": ("real", 0.0, XI_MAX),
+        "--alpha": ("real", 0.0, ALPHA_MAX), "--omega": ("real", *OMEGA_RANGE),
+        "--theta0": ("real", -half_pi, half_pi), "--dtheta0": ("real", -1e6, 1e6),
+        "--phase": ("real", None, None), "--r0": ("real", -1e3, 1e3),
+        "--s0": ("real", -1e3, 1e3), "--periods": ("int", 1, MAX_PERIODS),
+        "--n-steps": ("int", 8, MAX_N), "--max-impacts": ("int", 1, MAX_IMPACTS),
+        "--threads": ("int", 1, MAX_THREADS), "--rtol": ("real", 0.0, 1.0),
+        "--atol": ("real", 0.0, None), "--rest-speed": ("real", *REST_SPEED_RANGE),
+        "--max-points": ("int", 2, None), "--alpha-range": ("real", 0.0, ALPHA_MAX),
+        "--alpha-step": ("real", 0.0, None), "--grid": ("int", 1, 10**9),
+        "--theta-range": ("real", -half_pi, half_pi), "--dtheta-range": ("real", -1e6, 1e6),
+        "--omega-range": ("real", *OMEGA_RANGE), "--uncertainty": ("real", 1e-15, 0.5),
+        "--scheduler-timeout": ("real", 0.0, 1e6), "--max-period": ("int", 1, 256),
+        "--seed-omegas": ("real", *OMEGA_RANGE), "--ensemble": ("int", 2, 10**6),
+        "--spread": ("real", 0.0, 1e-2), "--seed": ("int", 0, 2**63 - 1),
+        "--ratio-range": ("real", *RATIO_RANGE), "--amplitude-range": ("real", 0, AMPLITUDE_MAX),
+        "--tol": ("real", 1e-12, 0.1), "--free-time": ("real", 0.0, TIME_MAX),
+        "--size": ("real", *SIZE_RANGE), "--intensities": ("real", 0.0, 1e6),
+        "--hb-values": ("real", 1 / math.sqrt(2), HB_RANGE[1]),
+        "--hb-max": ("real", 1 / math.sqrt(2), 100.0), "--zoom": ("real", 0.5, 1.0),
+        "--zoom-step": ("real", 0.0, 1.0), "--erosion-step": ("real", 0.0, 1.0),
+        "--erosion-grid": ("int", 2, 10**5), "--port": ("int", 0, 65535),
+    }
+    by_command = {("chart", "--max-period"): ("int", 1, 16),
+                  ("plane", "--grid"): ("int", 1, 10**18), ("chart", "--grid"): ("int", 1, 10**18),
+                  ("spectrum", "--grid"): ("int", 1, 10**4), ("paper", "--grid"): ("int", 2, 10**5),
+                  ("paper", "--alpha-step"): ("real", 0.0, 1.0)}
+    return common, by_command
+
+
+RANGES, RANGES_BY_COMMAND = _ranges()
+
+
+def range_of(cmd, opt):
+    return RANGES_BY_COMMAND.get((cmd, opt), RANGES.get(opt))
+
+
+def _numeric_options():
+    """``(command, option, nargs)`` of every option of the parser that takes numbers."""
+    import argparse
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    return [(cmd, a.option_strings[-1], a.nargs) for cmd, p in sorted(sub.choices.items())
+            for a in p._actions if a.type in (int, float) and a.option_strings]
+
+
+#: Values at the edge of every range, whatever the range: tiny (subnormal too), huge, signed
+#: zero, non-finite
+EDGE_REALS = ["1e-320", "1e308", "-1e308", "-0.0", "nan", "inf"]
+EDGE_INTS = ["0", "-1", "1000000000000000", HUGE_INT]
+
+
+def _edge_values(kind, lo, hi):
+    """The range's ends and the numbers just outside them, and the generic edges."""
+    vals = []
+    for bound, outward in ((lo, -math.inf), (hi, math.inf)):
+        if bound is None:
+            continue
+        if kind == "int":
+            vals += [str(int(bound)), str(int(bound) + (1 if outward > 0 else -1))]
+        else:
+            vals += [repr(float(bound)), repr(math.nextafter(float(bound), outward))]
+    vals += EDGE_INTS if kind == "int" else EDGE_REALS
+    return list(dict.fromkeys(vals))
+
+
+#: Small valid command lines the edge values are put into: where a run happens it is short
+EDGE_BASES = {
+    "trajectory": "--hb 2 --alpha 0.2 --omega 1.3 --periods 1 --max-points 100",
+    "sweep": "--hb 2 --omega 1.3 --alpha-range 0.1 0.1 --alpha-step 0.05 --periods 1",
+    "basin": "--hb 2 --alpha 0.2 --omega 1.3 --grid 2 --periods 1",
+    "plane": "--hb 2 --alpha-range 0.1 0.2 --omega-range 1.2 1.3 --grid 2 2 --periods 1",
+    "erosion": "--hb 2 --omega 1.3 --alpha-range 0.1 0.1 --alpha-step 0.05 --grid 2 --periods 1",
+    "orbits": "--hb 2 --omega 1.3 --alpha-range 0.1 0.11 --alpha-step 0.01 --periods 2 "
+              "--max-period 1",
+    "chart": "--hb 2 --alpha-range 0.1 0.2 --omega-range 1.2 1.3 --grid 2 2 --periods 2 "
+             "--max-period 1 --seed-omegas 1.25",
+    "fate": "--hb 2 --alpha 0.2 --omega 1.3 --periods 1 --ensemble 2",
+    "spectrum": "--hb 4 --ratio-range 1 2 --amplitude-range 1 2 --grid 2 2 --free-time 5",
+    "fragility": f"--hb 3 --size 1 --records {RECORD_OK} --intensities 1.5 --free-time 5",
+    "cor": "--hb-values 2 --hb-max 3",
+    "paper": "--grid 2 --periods 1 --alpha-step 0.5 --erosion-grid 2 --erosion-step 0.5",
+    "explore": "--no-browser",
+}
+#: Commands whose accepted edge values are taken to their (guarded) work and not further: the
+#: paper's whole set of figures and the explorer's server are not short runs
+GUARD_ONLY = {"paper", "explore"}
+#: Accepted edge values that ask for much legitimate work (minutes, not years, or a server):
+#: checked as far as the start of the work
+LONG_EDGES = {("fate", "--ensemble", "1000000"), ("spectrum", "--grid", "10000"),
+              ("fragility", "--size", "0.001")}  # a 1 mm block: about a minute
+
+
+def _long(case):
+    cmd, opt, vals = case
+    return any((cmd, opt, v) in LONG_EDGES for v in vals)
+
+
+def _edge_cases():
+    cases = []
+    for cmd, opt, nargs in _numeric_options():
+        rng = range_of(cmd, opt)
+        assert rng is not None, f"{cmd} {opt}: add its documented range to RANGES"
+        kind, lo, hi = rng
+        for v in _edge_values(kind, lo, hi):
+            vals = [v, v] if nargs == 2 else [v]
+            cases.append((cmd, opt, vals))
+        if nargs == 2 and lo is not None and hi is not None:
+            cases.append((cmd, opt, [_edge_values(kind, lo, hi)[0],
+                                     _edge_values(kind, lo, hi)[2]]))
+    return cases
+
+
+EDGE_CASES = _edge_cases()
+
+
+def _edge_argv(cmd, opt, vals, out):
+    words = shlex.split(EDGE_BASES[cmd])
+    if opt in words:  # the edge value replaces the base's
+        k = words.index(opt)
+        n = 1
+        while k + n < len(words) and not words[k + n].startswith("--"):
+            n += 1
+        del words[k:k + n]
+    return [cmd] + words + [opt] + vals + (["--out", out] if cmd != "explore" else []) \
+        + ["--quiet"] * (cmd != "explore")
+
+
+def test_every_numeric_option_has_a_documented_range():
+    # a new option cannot escape the edge test: its range must be listed here
+    missing = [(c, o) for c, o, _ in _numeric_options() if range_of(c, o) is None]
+    assert not missing, missing
+    assert set(EDGE_BASES) == {c for c, _, _ in _numeric_options()} | {"explore"} - {""}
+
+
+def _edge_id(case):
+    cmd, opt, vals = case
+    return f"{cmd} {opt} {' '.join(vals)}"
+
+
+def _run_edge(cmd, opt, vals, tmp_path, guarded):
+    """``main`` on the edge case, the work's entry points guarded or real; the problem found,
+    or ``None``: exit status 0 (with its summary written), or 2 with one line, or its
+    (guarded) work reached."""
+    argv = _edge_argv(cmd, opt, vals, str(tmp_path / "out"))
+    if guarded and "mp" not in _GUARDS:
+        _GUARDS["mp"] = _install_guards(_GUARDS["calls"])
+    rc, exc, stdout, stderr, _, _ = run_main(argv, _GUARDS["calls"], tmp_path)
+    where = f"\nargv = {argv!r}\nstderr = {stderr!r}"
+    if isinstance(exc, NotRefused):
+        return None if guarded else f"reached a guard while unguarded{where}"
+    if exc is not None:
+        return f"raised {type(exc).__name__}: {exc}{where}"
+    if "Traceback" in stdout + stderr or "internal error" in stderr:
+        return f"a traceback or an internal error{where}"
+    if rc == 0:
+        return None if (tmp_path / "out" / "summary.json").exists() else f"no summary{where}"
+    if rc != 2:
+        return f"exit status {rc}{where}"
+    if not (stderr.startswith("rockjit: error:") and stderr.count("\n") == 1):
+        return f"not one line 'rockjit: error: ...'{where}"
+    return None
+
+
+@pytest.mark.parametrize("case", EDGE_CASES, ids=[_edge_id(c) for c in EDGE_CASES])
+def test_the_edges_of_every_range_are_refused_in_one_line_or_accepted(case, tmp_path,
+                                                                      reached):
+    """Every edge value: exit status 2 with one line, or let through to the work (guarded)."""
+    problem = _run_edge(*case, tmp_path, guarded=True)
+    if problem:
+        pytest.fail(problem, pytrace=False)
+
+
+def _inside(case):
+    cmd, opt, vals = case
+    kind, lo, hi = range_of(cmd, opt)
+    x = [float(v) for v in vals]
+    return all(math.isfinite(v) and (lo is None or v >= lo) and (hi is None or v <= hi)
+               for v in x)
+
+
+#: Edge values that once ended in a traceback after validation, run for real on every command
+#: that takes them (the rest of the accepted edge values are drawn, EDGE_RUNS_PER_COMMAND a
+#: command, with the seed)
+EDGE_REGRESSIONS = {("--xi", ("1e-320",)), ("--periods", ("922337203685478",)),
+                    ("--ratio-range", ("0.005", "0.01"))}
+EDGE_RUNS_PER_COMMAND = 2
+
+
+def _edge_runs():
+    rng = random.Random(f"{SEED}:edges")
+    runs = []
+    for cmd in sorted(EDGE_BASES):
+        if cmd in GUARD_ONLY:
+            continue
+        inside = [c for c in EDGE_CASES if c[0] == cmd and _inside(c)
+                  and not _long(c)]
+        runs += rng.sample(inside, min(EDGE_RUNS_PER_COMMAND, len(inside)))
+        for opt, vals in sorted(EDGE_REGRESSIONS):
+            if any(o == opt for c, o, _ in _numeric_options() if c == cmd):
+                case = (cmd, opt, list(vals))
+                if case not in runs:
+                    runs.append(case)
+    return runs
+
+
+EDGE_RUNS = _edge_runs()
+
+
+@pytest.mark.parametrize("case", EDGE_RUNS, ids=[_edge_id(c) for c in EDGE_RUNS])
+def test_accepted_edges_run_to_the_end(case, tmp_path, reached, unguarded):
+    """Accepted edge values, run for real on small grids: exit status 0 with the outputs
+    written, or 2 with one line (a check only the run can make); never a traceback."""
+    problem = _run_edge(*case, tmp_path, guarded=False)
+    if problem:
+        pytest.fail(problem, pytrace=False)
