@@ -38,7 +38,7 @@ PUBLIC_MODULES = [
     "rockjit.orbits.curves", "rockjit.orbits.plane_chart", "rockjit.ground.pulses",
     "rockjit.ground.records", "rockjit.ground.fema", "rockjit.ground.settings",
     "rockjit.ground.response", "rockjit.ground.spectrum", "rockjit.ground.fitting",
-    "rockjit.ground.fragility",
+    "rockjit.ground.fragility", "rockjit.reprs",
 ]
 if importlib.util.find_spec("bokeh") is not None:  # the explorer's example starts its server
     PUBLIC_MODULES.append("rockjit.explorer")
@@ -124,11 +124,11 @@ def test_public_object_is_documented(name, obj):
 
 
 def test_the_reference_lists_every_public_name():
-    text = (DOCS / "reference" / "index.md").read_text()
+    text = "\n".join(p.read_text() for p in sorted((DOCS / "reference").glob("*.md")))
     listed = set(re.findall(r"^\s+([A-Za-z_][\w.]*)\s*$", text, re.M))
     listed |= set(re.findall(r"py:data:: (\w+)", text))
     missing = [n for n in rockjit.__all__ if n not in listed]
-    assert not missing, f"add to docs/reference/index.md: {missing}"
+    assert not missing, f"add to a page of docs/reference/: {missing}"
 
 
 # ------------------------------------------------------------------------------- outputs page
@@ -349,3 +349,68 @@ def test_no_control_characters_in_the_texts():
             bad += [f"{path.relative_to(ROOT)}: {hex(ord(c))}" for c in set(text)
                     if ord(c) < 32 and c not in "\n\t\r"]
     assert not bad, bad
+
+
+# ------------------------------------------------------------------------------- offline site
+
+def _ext(name):
+    pytest.importorskip("sphinx")
+    sys.path.insert(0, str(DOCS / "_ext"))
+    try:
+        return importlib.import_module(name)
+    finally:
+        sys.path.remove(str(DOCS / "_ext"))
+
+
+def test_the_formulas_render_from_the_site_itself(tmp_path):
+    """MathJax is installed with the docs extra and served with the site: the pages load it
+    from ``_static``, and the files it loads on demand (fonts, TeX extensions) are there too."""
+    mj = _ext("rockjit_mathjax")
+    extra = (ROOT / "pyproject.toml").read_text()
+    assert re.search(r'^docs = \[[^\]]*"django-static-mathjax', extra, re.M | re.S)
+    assert not mj.MATHJAX_PATH.startswith(("http:", "https:", "//"))
+    es5 = mj.source()
+    if es5 is None:
+        pytest.skip("the docs extra is not installed here")
+    names = mj.collect(es5, tmp_path)
+    assert mj.MATHJAX_PATH == "mathjax/tex-chtml.js" and "tex-chtml.js" in names
+    assert (tmp_path / mj.MATHJAX_PATH).read_bytes() == (es5 / "tex-chtml.js").read_bytes()
+    fonts = [n for n in names if n.startswith("output/chtml/fonts/woff-v2/")]
+    assert any("MathJax_Main-Regular" in n for n in fonts), fonts[:5]
+    assert any(n.startswith("input/tex/extensions/") for n in names)
+    # nothing copied again where nothing changed
+    before = {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*") if p.is_file()}
+    mj.collect(es5, tmp_path)
+    assert {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*") if p.is_file()} == before
+
+
+def test_conf_points_mathjax_and_the_kernels_at_local_settings():
+    conf = (DOCS / "conf.py").read_text()
+    assert "rockjit_mathjax" in conf and "cdn" not in conf.lower()
+    # the executed pages' kernels log errors only (each warned about its local TCP link)
+    assert "c.IPKernelApp.log_level = 'ERROR'" in conf and 'os.environ["IPYTHONDIR"]' in conf
+    css = (DOCS / "_css" / "rockjit.css").read_text()
+    assert re.search(r"div\.highlight pre,[^{]*\{[^}]*white-space: pre-wrap", css, re.S)
+
+
+def _toctree(text):
+    return re.search(r"```\{toctree\}\n(?::[^\n]*\n)*\n(.*?)```", text, re.S).group(1).split()
+
+
+def test_the_reference_is_grouped_as_the_guide_is():
+    pages = _toctree((DOCS / "reference" / "index.md").read_text())
+    assert len(pages) >= 6
+    listed = {}
+    for page in pages:
+        text = (DOCS / "reference" / f"{page}.md").read_text()
+        assert text.startswith(("# ", "(api-orbits)=\n# ")), page
+        listed[page] = set(re.findall(r"^\s+([A-Za-z_]\w*)\s*$", text, re.M))
+    assert {"simulate", "sweep", "basin", "fate", "spectrum"} <= listed["entry-points"]
+    assert max(len(v) for v in listed.values()) < 25  # no page is one flat list of everything
+
+
+def test_the_gallery_index_shows_a_thumbnail_per_page():
+    index = (DOCS / "gallery" / "index.md").read_text()
+    grid = re.search(r"```\{rockjit-gallery\}\n(.*?)```", index, re.S).group(1).split()
+    assert grid == _toctree(index)
+    assert _ext("rockjit_gallery").ENV_KEY

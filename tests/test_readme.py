@@ -8,6 +8,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text(encoding="utf-8")
 
@@ -83,22 +85,41 @@ def test_one_version_everywhere():
     assert importlib.metadata.version("rockjit") == rockjit.__version__
 
 
-def _number(pattern):
-    m = re.search(pattern, " ".join(README.split()))
+#: The pages that quote the same results as the README, in the same words.
+CLAIMS = {"README.md": README, **{name: (ROOT / "docs" / name).read_text(encoding="utf-8")
+                                  for name in ("study.md", "theory/study.md")}}
+
+
+def _number(pattern, text=README):
+    m = re.search(pattern, " ".join(text.split()))
     assert m, pattern
     return m
+
+
+def _every(pattern, names=tuple(CLAIMS)):
+    """Each page's quote of a result: ``{page: match}``; every page in ``names`` quotes it."""
+    return {name: _number(pattern, CLAIMS[name]) for name in names}
 
 
 def test_the_multiperiodic_examples_fate_is_todays():
     import rockjit
     from rockjit import Block, Harmonic
-    m = _number(r"of (\d+) runs within \$10\^\{-10\}\$ of its initial state, (\d+) % overturn "
-                r"and (\d+) % settle on a period-(\d+) orbit")
-    n, over, other, period = (int(v) for v in m.groups())
+    quotes = _every(r"of (\d+) runs within \$10\^\{-10\}\$ of its initial state, (\d+) % "
+                    r"overturn and (\d+) % settle on a period-(\d+) orbit")
+    assert len({m.groups() for m in quotes.values()}) == 1, quotes
+    n, over, other, period = (int(v) for v in quotes["README.md"].groups())
     f = rockjit.fate(Block(hb=1), Harmonic(alpha=0.969, omega=1.3), ensemble=n)
     assert f.settings["spread"][1] == 1e-10
     assert round(100 * f.probabilities["overturn"]) == over
     assert round(100 * f.probabilities[f"multiperiodic p={period}"]) == other
+    # with the study's embedded forcing (the docs quote it)
+    emb = _every(r"embedded forcing[^.]*?(\d+) % overturn and (\d+) % period 7",
+                 ("study.md", "theory/study.md"))
+    assert len({m.groups() for m in emb.values()}) == 1, emb
+    e = rockjit.fate(Block(hb=1), Harmonic(alpha=0.969, omega=1.3, embedded=True), ensemble=n)
+    assert (round(100 * e.probabilities["overturn"]),
+            round(100 * e.probabilities["multiperiodic p=7"])) == \
+        tuple(int(v) for v in emb["study.md"].groups())
     assert "64 runs within 1e-10 of z0" in README  # the quickstart's call: the default ensemble
     assert f.settings["ensemble"] == rockjit.fate.plan(
         Block(hb=1), Harmonic(alpha=0.969, omega=1.3)).ensemble
@@ -109,13 +130,14 @@ def test_the_integrity_of_both_laws_is_as_quoted():
 
     import rockjit
     from rockjit import Block, Harmonic
-    m = _number(r"global integrity \(GIM\) is ([\d.]+) of Housner's at \$\\alpha = ([\d.]+)\$ and "
-                r"([\d.]+) of it at \$\\alpha = ([\d.]+)\$, while its integrity factor \(IF\) "
-                r"stays within ([\d.]+) of Housner's up to \$\\alpha = ([\d.]+)\$ and falls to "
-                r"([\d.]+)–([\d.]+) of it from \$\\alpha = ([\d.]+)\$ to \$([\d.]+)\$ "
-                r"\((\d+) × \d+ basins, (\d+) periods\)")
+    quotes = _every(r"global integrity \(GIM\) is ([\d.]+) of Housner's at \$\\alpha = ([\d.]+)\$ "
+                    r"and ([\d.]+) of it at \$\\alpha = ([\d.]+)\$, while its integrity factor "
+                    r"\(IF\) stays within ([\d.]+) of Housner's up to \$\\alpha = ([\d.]+)\$ and "
+                    r"falls to ([\d.]+)–([\d.]+) of it from \$\\alpha = ([\d.]+)\$ to \$([\d.]+)\$ "
+                    r"\((\d+) × \d+ basins, (\d+) periods\)")
+    assert len({m.groups() for m in quotes.values()}) == 1, quotes
     r_lo, a_lo, r_hi, a_hi, tol, a_same, if_lo, if_hi, a_half, a_end, grid, periods = \
-        m.groups()
+        quotes["README.md"].groups()
     step = 0.1
     alphas = np.round(np.arange(float(a_lo), float(a_end) + step / 2, step), 10)
     assert float(a_hi) in alphas and float(a_same) in alphas and float(a_half) in alphas
@@ -130,6 +152,37 @@ def test_the_integrity_of_both_laws_is_as_quoted():
     late = alphas >= float(a_half) - 1e-9
     ratio = prof["mao"].IF[late] / prof["housner"].IF[late]
     assert (f"{ratio.min():.2f}", f"{ratio.max():.2f}") == (if_lo, if_hi)
+    # the study page quotes each law's GIM at both ends
+    ends = _number(r"GIM falls from ([\d.]+) to ([\d.]+) over \$\\alpha = 0.3\$–\$0.9\$ under "
+                   r"Housner's law and from ([\d.]+) to ([\d.]+) under Mao's", CLAIMS["study.md"])
+    got = [f"{prof[law].GIM[alphas == a][0]:.2f}" for law in ("housner", "mao")
+           for a in (0.3, 0.9)]
+    assert got == list(ends.groups())
+
+
+@pytest.mark.slow
+def test_the_mean_integrity_at_the_studys_resolution_is_as_quoted():
+    import numpy as np
+
+    import rockjit
+    from rockjit import Block, Harmonic
+    pages = {"study.md": r"\(mean ([\d.]+) against ([\d.]+)\)",
+             "theory/study.md": r"the mean GIM over \$\\alpha = 0.3\$–\$0.9\$ is ([\d.]+) "
+                                r"against Housner's ([\d.]+)",
+             "guide/erosion.md": r"the mean GIM over \$\\alpha \\in \[0.3, 0.9\]\$ is ([\d.]+) "
+                                 r"under Housner's law and ([\d.]+) under Mao's"}
+    mean = {law: rockjit.erosion(Block(hb=1, law=law), Harmonic(omega=1.3),
+                                 rockjit.alpha_grid((0.3, 0.9), 0.01), 100).GIM.mean()
+            for law in ("housner", "mao")}
+    for page, pattern in pages.items():
+        text = (ROOT / "docs" / page).read_text(encoding="utf-8")
+        a, b = _number(pattern, text).groups()
+        order = ("mao", "housner") if page == "theory/study.md" else ("housner", "mao")
+        assert (a, b) == tuple(f"{mean[law]:.2f}" for law in order), page
+    # and the reference that index.html puts beside a paper's own profiles
+    from rockjit.study.report import GIM_PUBLISHED
+    assert {law: f"{v:.2f}" for law, v in GIM_PUBLISHED.items()} == \
+        {law: f"{v:.2f}" for law, v in mean.items()}
 
 
 def test_maos_overturning_onset_is_as_quoted():
@@ -137,7 +190,12 @@ def test_maos_overturning_onset_is_as_quoted():
 
     import rockjit
     from rockjit import Block, Harmonic
-    onset = float(_number(r"overturns at every amplitude from α = ([\d.]+)").group(1))
+    pages = [README] + [(ROOT / "docs" / n).read_text(encoding="utf-8")
+                        for n in ("index.md", "theory/study.md")]
+    quoted = {_number(r"overturns at every amplitude from α = ([\d.]+)", p).group(1)
+              for p in pages}
+    assert len(quoted) == 1, quoted
+    onset = float(quoted.pop())
     sw = rockjit.sweep(Block(hb=1, law="mao"), Harmonic(omega=1.3),
                        rockjit.alpha_grid((0.5, 1.0), 0.001))
     over = sw.names[sw.label] == "overturn"
