@@ -273,10 +273,10 @@ def test_an_empty_box_is_refused_with_the_controls_name():
 def test_the_heaviest_grids_stop_within_a_chunk_of_bounded_work(periods, n_steps, view):
     """The real library's progress calls: a grid at the explorer's heaviest settings reports
     (and can be stopped) after chunks no larger in work than the default settings' chunk
-    (512 cells of 500 × 64 steps for a basin, 64 for a bifurcation diagram)."""
+    (256 cells of 500 × 64 steps for a basin, 32 for a bifurcation diagram)."""
     p = R.Params(periods=periods, n_steps=n_steps).check()
     stage = R.sweep_stages(p)[0] if view == "sweep" else R.basin_stages(p, levels=(40,))[0]
-    base = 64 if view == "sweep" else 512
+    base = 32 if view == "sweep" else 256
     done = []
 
     def progress(d, total):

@@ -204,16 +204,19 @@ class ExplorerApp:
         if session is None or session.connection_count == 0:
             self.close()
 
-    def close(self):
-        """Stop computing (the tab was closed or reloaded, or the server stops): the worker ends
-        at its current piece of work's end, and the page gives its place back."""
-        if self.closed:
-            return
+    def stop_work(self):
+        """Stop computing, from any thread: the worker ends at its current piece of work's end
+        (a grid's chunk), and the page gives its place back."""
         self.closed = True
         if self.computer is not None:
             self.computer.close(timeout=0)
         if self.pages is not None:
             self.pages.release(self)
+
+    def close(self):
+        """Stop computing and watching (the tab was closed or reloaded, or its session ended);
+        on the document's loop."""
+        self.stop_work()
         if self._watch is not None:
             try:
                 self.doc.remove_periodic_callback(self._watch)

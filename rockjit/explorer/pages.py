@@ -76,7 +76,7 @@ class Pages:
         with self._lock:
             live = list(self._live)
         for page in live:
-            page.close()
+            page.stop_work()
 
     def stats(self):
         """``sessions`` open, ``pages`` computing, ``workers``: worker threads still running

@@ -43,11 +43,13 @@ MAX_PERIODS = 4000
 #: Most steps of one cell's run: periods times the steps per period N (N as the grids resolve
 #: it: raised for slow forcing and strong damping when left to the library).
 MAX_CELL_STEPS = 256_000
-#: Cells per chunk of a basin and of a bifurcation diagram at the default settings (500
-#: periods of 64 steps): a chunk of a grid with more work per cell has fewer cells
-#: (:func:`chunk_for`), so that a chunk takes about as long whatever the settings.
-CHUNK = 512
-SWEEP_CHUNK = 64
+#: Cells per chunk of a basin and of a bifurcation diagram (whose cells also compute their
+#: Lyapunov exponents) at the default settings (500 periods of 64 steps): a few tenths of a
+#: second on two cores where every cell runs to the end (a chaotic region). A grid with more
+#: work per cell has fewer cells per chunk (:func:`chunk_for`), so that a chunk takes about as
+#: long whatever the settings.
+CHUNK = 256
+SWEEP_CHUNK = 32
 _DEFAULT_WORK = 500 * 64
 #: The controls that must hold a number (an empty box is refused); ``n_steps`` empty is the
 #: library's default.
@@ -301,7 +303,7 @@ class CompareView:
 
 def _execution(progress, params, base=CHUNK):
     """The grids' execution: a superseded or closed request stops at its grid's next chunk (a
-    200² basin at the default settings in 80 chunks of a few tens of milliseconds each)."""
+    200² basin at the default settings in 157 chunks)."""
     if progress is None:
         return Execution()
     return Execution(progress=progress,
