@@ -4,7 +4,7 @@ printed over each other, no legend over the data (rockjit.plotting.legibility).
 
 Each figure function is drawn from small inputs: short runs, small grids, and synthetic
 results where a computed one would be slow (a continuation with branches of seven periods, an
-erosion profile with seventeen attractors, two laws' charts, spectra and fragility fits). The
+erosion profile with twenty attractors, two laws' charts, spectra and fragility fits). The
 checks themselves are tested on figures made to fail each one.
 """
 
@@ -193,8 +193,8 @@ def _continuation():
 
 
 def _erosion():
-    """A profile with seventeen attractors, most of them aperiodic and small, as the study's
-    h/b = 1 Housner profile has."""
+    """A profile with twenty attractors, most of them aperiodic and small, as the study's
+    h/b = 1 Housner profile has, and orbits of periods 2, 3, 7 and 8."""
     alpha = np.round(np.arange(0.3, 1.0, 0.05), 2)
     na = alpha.size
     brs, fr = [], []
@@ -212,6 +212,9 @@ def _erosion():
     add("asymmetric", 1, 8 * ramp)
     add("asymmetric", 1, 7 * ramp)
     add("multiperiodic", 2, 4 * ramp)
+    add("multiperiodic", 3, 2 * ramp)
+    add("multiperiodic", 7, 0.5 * ramp)
+    add("multiperiodic", 8, 0.5 * ramp)
     for k in range(10):
         add("aperiodic", 0, (0.3 + 0.1 * k) * ramp)
     fr = np.array(fr)
@@ -360,8 +363,10 @@ def test_erosion_groups_attractors_by_kind_and_names_aperiodic_as_the_behaviours
     texts = _legend_texts(fig)
     stack = [t for t in texts if "up to" in t or t.startswith("overturn")]
     # rest, symmetric rocking, symmetric through rest (2), asymmetric (2), period-2,
-    # aperiodic (10), overturn: seven entries for seventeen attractors
-    assert len(stack) == 7
+    # period-3, periods 7 and 8 together, aperiodic (10), overturn: nine entries for twenty
+    # attractors
+    assert len(stack) == 9
+    assert any(t.startswith(r"period $\geq 5$ (2 attractors)") for t in texts)
     assert any(t.startswith("aperiodic") and "(10 attractors)" in t for t in texts)
     assert any("through rest" in t and "(2 attractors)" in t for t in texts)
     assert not any("chaotic" in t.split("(")[0] for t in texts)

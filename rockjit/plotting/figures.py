@@ -117,7 +117,7 @@ def fig_restitution(hb_range=(1.0 / math.sqrt(2.0), 6.0), n=400, marks=(1.0, 2.0
     thc = np.linspace(thc_from_hb(lo), thc_from_hb(hi), n)
     eh, em = e_housner(thc), e_mao(thc)
     de = delta_e_percent(em, eh)
-    fig = _figure("single" if S.current().name == "paper" else 0.64, 0.62)
+    fig = _figure("single", 0.95)
     ax = fig.add_subplot()
     deg = np.degrees(thc)
     ax.plot(deg, eh, color="k", ls=LAW_LINES["housner"]["ls"], lw=1.5,
@@ -126,11 +126,16 @@ def fig_restitution(hb_range=(1.0 / math.sqrt(2.0), 6.0), n=400, marks=(1.0, 2.0
             label=r"$e_M$, Mao et al. (2024)")
     ax.set_xlabel(r"$\theta_c = \arctan(h/b)$  [degrees]")
     ax.set_ylabel(r"coefficient of restitution $e$")
-    ax.set_ylim(0, 1.02)
+    # room above the curves for the values at the marked slendernesses
+    ax.set_ylim(0, 1.4)
+    ax.set_yticks(np.linspace(0, 1, 6))
     ax2 = ax.twinx()
     ax2.plot(deg, de, color="0.55", ls=":", lw=1.5, label=r"$\Delta e$ (right axis)")
     ax2.set_ylabel(r"$\Delta e$  [%]")
-    ax2.set_ylim(0, max(1.0, float(np.nanmax(de))) * 1.05)
+    top_de = max(1.0, float(np.nanmax(de)))
+    ax2.set_ylim(0, top_de * 1.4)
+    from matplotlib.ticker import MaxNLocator
+    ax2.set_yticks([v for v in MaxNLocator(5).tick_values(0, top_de) if v <= top_de * 1.001])
     # the values at the marked slendernesses: the points on the curves, each line marked by
     # its h/b on the top axis, and the values in one box in the empty lower right
     rows = []
@@ -143,7 +148,7 @@ def fig_restitution(hb_range=(1.0 / math.sqrt(2.0), 6.0), n=400, marks=(1.0, 2.0
         rows.append(f"$h/b = {hb:g}$: $e_H = {h:.3f}$, $e_M = {m:.3f}$, "
                     f"$\\Delta e = {float(delta_e_percent(m, h)):.2f}$ %")
     if rows:
-        ax.text(0.97, 0.05, "\n".join(rows), transform=ax.transAxes, ha="right", va="bottom",
+        ax.text(0.97, 0.97, "\n".join(rows), transform=ax.transAxes, ha="right", va="top",
                 fontsize=7, zorder=6,
                 bbox=dict(boxstyle="round,pad=0.25", fc="white", ec="0.75", lw=0.6))
     lines = ax.get_legend_handles_labels()
@@ -333,6 +338,7 @@ def fig_trajectory(result, behaviour, *, exponent=None, title=None, first=8, las
         S.letter(ax, i, what)
     axes_t[0].set_ylabel(SYMBOLS["theta_unit"])
     ax_l = fig.add_subplot(gs[1, :2])
+    fig_legend = None
     if lam is not None and lam.shape[0] > 1:
         k = np.arange(1, lam.shape[0])
         ax_l.plot(k * result.period, lam[1:, 0], color="k", lw=1.0,
@@ -358,7 +364,7 @@ def fig_trajectory(result, behaviour, *, exponent=None, title=None, first=8, las
             from matplotlib.patches import Patch
             hs.append(Patch(facecolor="0.88", edgecolor="0.6", lw=0.5))
             ls_.append("asymptotic window")
-        fig.legend(hs, ls_, loc="outside lower center", ncols=2)
+        fig_legend = (hs, ls_)
         ax_l.set_ylabel(r"$\lambda_1$")
         ax_l.set_xlim(0, result.t)
     else:
@@ -370,7 +376,12 @@ def fig_trajectory(result, behaviour, *, exponent=None, title=None, first=8, las
     in_window = _phase_panel(ax_p, result, colour)
     S.letter(ax_p, len(axes_t) + 1, "phase portrait,\n" + ("asymptotic window" if in_window
                                                             else "whole run"))
-    ax_p.legend(loc="lower right")
+    hp, lp = ax_p.get_legend_handles_labels()
+    if fig_legend is not None:  # one legend below the figure, off the data
+        fig.legend(fig_legend[0] + hp, fig_legend[1] + lp, loc="outside lower center",
+                   ncols=3)
+    elif hp:
+        fig.legend(hp, lp, loc="outside lower center")
     S.suptitle(fig, title or f"{_params(result)}: {_behaviour_words(behaviour)}")
     return fig
 
@@ -782,12 +793,12 @@ def fig_attractors(basins, measures=None, title=None):
         handles = _attractor_panel(ax, b.attractor, b.theta0, b.dtheta0, b.attractors,
                                    show_y=i == 0)
         m = measures[law]
-        S.letter(ax, i, f"{S.law_name(b.block)}\n"
-                        f"basin entropy $S_b = {m['basin_entropy']:.3f}$, boundary basin "
-                        f"entropy $S_{{bb}} = {m['boundary_basin_entropy']:.3f}$;\n"
-                        f"safe basin's integrity: global measure GIM $= "
-                        f"{m['integrity']['GIM']:.3f}$, factor IF $= "
-                        f"{m['integrity']['IF']:.3f}$")
+        S.letter(ax, i, f"{S.law_name(b.block)}: basin entropy $S_b = "
+                        f"{m['basin_entropy']:.3f}$,\n"
+                        f"boundary basin entropy $S_{{bb}} = "
+                        f"{m['boundary_basin_entropy']:.3f}$,\n"
+                        f"global integrity measure GIM $= {m['integrity']['GIM']:.3f}$,\n"
+                        f"integrity factor IF $= {m['integrity']['IF']:.3f}$")
         ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncols=1,
                   title=f"of the {_cells(b)}")
     b0 = next(iter(basins.values()))
@@ -814,7 +825,10 @@ def _erosion_areas(r):
     kinds = {}
     for i, br in enumerate(r.branches):
         rest = bool(S._through_rest(br))
-        key = (BEHAVIOURS.index(br["behaviour"]), int(br.get("period") or 0), rest)
+        period = int(br.get("period") or 0)
+        if br["behaviour"] == "multiperiodic":
+            period = min(period, GROUPED_PERIOD)
+        key = (BEHAVIOURS.index(br["behaviour"]), period, rest)
         kinds.setdefault(key, []).append(i)
     areas = []
     for key in sorted(kinds):
@@ -822,11 +836,18 @@ def _erosion_areas(r):
         br = r.branches[idx[0]]
         beh = br["behaviour"]
         name = S._base_name(br)
+        colour = BEHAVIOUR_COLOURS.get(beh, "#999999")
+        hatch = "//////" if key[2] else None
+        if beh == "multiperiodic":
+            # periods 2, 3 and 4 told apart by lightness, the longer ones together, dotted
+            colour = {3: S.shade(colour, 0.45), 4: S.tint(colour, 0.5)}.get(key[1], colour)
+            if key[1] >= GROUPED_PERIOD:
+                name = f"period $\\geq {GROUPED_PERIOD}$" + (" through rest" if key[2] else "")
+                hatch = hatch or "...."
         n = len(idx)
         if n > 1:
             name += f" ({n} attractors)"
-        colour = BEHAVIOUR_COLOURS.get(beh, "#999999")
-        areas.append((name, colour, "//////" if key[2] else None, [fr[i] for i in idx]))
+        areas.append((name, colour, hatch, [fr[i] for i in idx]))
     return areas
 
 
@@ -866,15 +887,17 @@ def fig_erosion(profiles, title=None):
         handles = []
         for name, colour, hatch, parts in areas:
             top = bottom + np.sum(parts, axis=0)
+            edge = S.shade(colour, 0.5) if hatch == "//////" else ("white" if hatch else
+                                                                    colour)
             axk.stairs(top, edges, baseline=bottom.copy(), fill=True, facecolor=colour,
-                       edgecolor=S.shade(colour, 0.5) if hatch else colour, hatch=hatch, lw=0)
+                       edgecolor=edge, hatch=hatch, lw=0)
             # the attractors of one kind, each its own band, parted by thin white lines
             inner = bottom.copy()
             for f in parts[:-1]:
                 inner = inner + f
                 axk.stairs(inner, edges, baseline=None, color="white", lw=0.4)
-            handles.append(Patch(facecolor=colour, edgecolor=S.shade(colour, 0.5) if hatch
-                                 else "0.5", hatch=hatch, lw=0.4,
+            handles.append(Patch(facecolor=colour, edgecolor=edge if hatch else "0.5",
+                                 hatch=hatch, lw=0.4,
                                  label=f"{name}, up to {(top - bottom).max():.1f} %"
                                  + ("\n" + APERIODIC_NOTE if name.startswith("aperiodic")
                                     else "")))
