@@ -201,3 +201,96 @@ def test_maos_overturning_onset_is_as_quoted():
     over = sw.names[sw.label] == "overturn"
     first = np.flatnonzero(~over)[-1] + 1  # every amplitude from here on overturns
     assert round(float(sw.alpha[first]), 3) == onset
+
+
+# ---- the speed table: each figure as the committed benchmark results state it -------------
+
+RESULTS = ROOT / "benchmarks" / "results"
+
+
+def _row(what):
+    """The README speed table's cell beside ``what``."""
+    for line in README.splitlines():
+        if line.startswith(f"| {what} |"):
+            return line.split("|")[2]
+    raise AssertionError(f"no row {what!r} in the README's speed table")
+
+
+def _results(name, pattern):
+    m = re.search(pattern, (RESULTS / name).read_text(encoding="utf-8"))
+    assert m, (name, pattern)
+    return m
+
+
+def _decade(v):
+    import math
+    return math.floor(math.log10(float(v)) + 1e-9)
+
+
+def test_the_reference_run_figures_are_the_benchmarks():
+    cell = _row("the study's reference run, 500 periods")
+    ms, err, speed, bdf = re.search(r"about (\d+) ms at an error of (\S+): some \*\*(\d+)x\*\* "
+                                    r"faster .* whose error is (\S+)", cell).groups()
+    row = _results("reference_run.md", r"\| rockjit \| N=160 \(default\) \| closed \| (\S+) \|"
+                                       r"(?:[^|]*\|){2} (\S+) \|")
+    assert round(float(row.group(1)) * 1000) == int(ms)
+    assert _decade(row.group(2)) == _decade(err)
+    got = float(_results("reference_run.md", r"rockjit is \*\*(\d+)x\*\* faster").group(1))
+    assert int(speed) <= got < 1.1 * int(speed)  # "some 2000x": the measured 2097x, rounded down
+    bdf_err = _results("reference_run.md",
+                       r"\| scipy BDF \(the study's\) \|(?:[^|]*\|){5} (\S+) \|")
+    assert _decade(bdf_err.group(1)) == _decade(bdf)
+
+
+def test_the_grid_figures_are_the_benchmarks():
+    basin = re.search(r"\*\*([\d.]+) s\*\*", _row("the study's 100 × 100 basin, 500 periods"))
+    sweep = re.search(r"\*\*([\d.]+) s\*\*", _row("its 501-amplitude sweep with λmax"))
+    reached = re.findall(r"\*\*reached\*\* \(([\d.]+) s\)", (RESULTS / "grids.md").read_text())
+    assert [basin.group(1), sweep.group(1)] == reached[:2]
+
+
+def test_the_paper_figures_are_the_benchmarks():
+    warm, cold = re.search(r"\*\*(\d+) s\*\* once the kernels are cached \((\d+) s cold\)",
+                           _row("`rockjit paper`, every figure and table")).groups()
+    got = _results("paper.md", r"\*\*end to end\*\*[^|]*\| ([\d.]+) \| ([\d.]+) \|")
+    assert (round(float(got.group(1))), round(float(got.group(2)))) == (int(cold), int(warm))
+
+
+def test_the_peers_basin_figures_are_the_benchmarks():
+    lo, hi = re.search(r"about (\d+)x to (\d+)x on the basin",
+                       _row("the same block in numbakit-ode, diffrax, SUNDIALS CVODE")).groups()
+    text = (RESULTS / "peers.md").read_text()
+    table = text[text.index("At equal label accuracy"):]
+    ratios = [float(v) for v in re.findall(r"^\| (?:nbkode|diffrax|cvode) \|.*\| (\S+) \|$",
+                                           table, re.M)]
+    assert ratios and (int(lo), int(hi)) == (int(min(ratios) // 100 * 100),
+                                             int(max(ratios) // 100 * 100))
+
+
+def test_the_ground_figures_are_the_benchmarks():
+    rows = {"a 200 × 200 overturning spectrum of a one-sine pulse, every boundary located":
+            r"\| spectrum: 200 x 200 one-sine[^|]*\| [^|]* \| ([\d.]+) \|(?:[^|]*\|){4} ([\d.]+) \|",
+            "fragility over the FEMA P695 far-field set, 50 intensities, both laws":
+            r"\| IDA: 44 records x 50 intensities x 2 laws[^|]*\| [^|]* \| ([\d.]+) \|"
+            r"(?:[^|]*\|){4} ([\d.]+) \|"}
+    for what, pattern in rows.items():
+        fast, slow = re.search(r"\*\*(\d+) s\*\* \(the scipy path: about (\d+) min\)",
+                               _row(what)).groups()
+        got = _results("ground.md", pattern)
+        assert round(float(got.group(1))) == int(fast), what
+        assert round(float(got.group(2)) / 60) == int(slow), what
+
+
+def test_the_peers_single_run_figures_are_the_benchmarks():
+    # every peer's cheapest run at each error target over rockjit's, per scene
+    lo, hi = re.search(r"rockjit (\d+)x to (\d+)x faster on single runs",
+                       _row("the same block in numbakit-ode, diffrax, SUNDIALS CVODE")).groups()
+    text = (RESULTS / "peers.md").read_text()
+    table = text[text.index("Every method's cheapest run per target"):]
+    ratios = []
+    for line in re.findall(r"^\| 1e-\d+ \|.*$", table, re.M):
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        times = [float(c.split()[0]) if re.match(r"[\d.]", c) else None for c in cells[2:8]]
+        ratios += [t / times[0] for t in times[1:] if t]  # the five peers, not scipy's
+    assert ratios
+    assert (int(lo), int(hi)) == (round(min(ratios)), int(float(f"{max(ratios):.2g}")))
