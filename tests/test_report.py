@@ -114,3 +114,14 @@ def test_the_fates_beside_the_reference_say_why_they_differ():
     assert "interpolant" in note and "rockjit 0.1.0" in note
     page = report._published_html(pub)
     assert note in page and "reference (rockjit 0.1.0)" in page
+
+
+def test_the_gallery_caption_counts_the_runs_it_was_given():
+    from types import SimpleNamespace
+
+    from rockjit.study import report
+    plan = SimpleNamespace(grid=6, erosion_grid=6, erosion_step=0.2, zoom=(0.9, 0.95),
+                           zoom_step=0.01, published=False)
+    fates = {"closed": dict(settings=dict(ensemble=48), probabilities={"overturn": 0.75})}
+    caption = report._captions({"fig3_fates": fates}, plan)[3]
+    assert "over 48 runs within" in caption and "overturn 75%" in caption

@@ -207,6 +207,7 @@ def _captions(results, plan):
     fw = "; ".join(f"{k}: " + ", ".join(f"{n} {v:.0%}" for n, v in
                                         f.get("probabilities", {}).items())
                    for k, f in fates.items())
+    n_fate = (fates.get("closed", {}).get("settings") or {}).get("ensemble", "the")
     caps4 = " ".join(f"{'abc'[i]}) {html.escape(r.get('caption', ''))}"
                      for i, r in enumerate(results.get("fig4", [])))
     g, eg, es = plan.grid, plan.erosion_grid, plan.erosion_step
@@ -230,7 +231,7 @@ def _captions(results, plan):
            "after damped rocking, from a tilt &theta;<sub>0</sub> = 0.7 (the study's 0.05 "
            "rests within 0.73 time units); b) asymmetric; c) a robust period-2 orbit of the "
            "multiperiodic family; d) the study's 'multiperiodic' example, transient chaos "
-           f"that overturns (over 64 runs within 10<sup>-10</sup> of <i>z</i><sub>0</sub>: "
+           f"that overturns (over {n_fate} runs within 10<sup>-10</sup> of <i>z</i><sub>0</sub>: "
            f"{html.escape(fw)}); e) overturn.",
         4: "Housner against Mao et al. in time: <i>h/b</i> = 2, &alpha; = 0.2, &omega; = 1.6, "
            "(<i>r</i><sub>0</sub>, <i>s</i><sub>0</sub>) = (0, 1), from three initial states. "
