@@ -444,3 +444,15 @@ def test_a_closed_tab_stops_its_work(server):
             assert stats["pages"] == 0 and stats["workers"] == 0
         finally:
             b.close()
+
+
+def test_a_page_draws_one_png_at_a_time(app):
+    app.basin_view = R.basin_stages(R.Params(periods=20).check(), levels=(10,))[0]()
+    before = {t for t in threading.enumerate() if t.name == "rockjit-explore-png"}
+    for _ in range(5):
+        app.export_png("basin")
+    drawing = {t for t in threading.enumerate() if t.name == "rockjit-explore-png"} - before
+    assert len(drawing) <= 1
+    assert "another PNG is being drawn" in app.status["basin"].text
+    for t in drawing:
+        t.join(60)

@@ -179,6 +179,7 @@ class ExplorerApp:
         self.computer = None        # the worker: started by start()
         self.closed = False
         self._watch = None
+        self._drawing = False       # a PNG is being drawn
         self._build()
 
     def start(self):
@@ -887,24 +888,33 @@ class ExplorerApp:
         """The view's figure drawn by rockjit.plotting, sent to the browser as a PNG file."""
         shown = {"basin": self.basin_view, "run": self.run_view, "sweep": self.sweep_view,
                  "compare": self.compare_view}[view]
-        if shown is None:
+        if shown is None or self.closed:
             return
+        if self._drawing:  # one PNG at a time per page
+            self._ignored(view, "another PNG is being drawn")
+            return
+        self._drawing = True
         colour_by = self.colour_by
         self.status[view].text = _progress_html("drawing the PNG", 0.0)
+
+        def done(update):
+            def later():
+                self._drawing = False
+                update()
+            self.doc.add_next_tick_callback(later)
 
         def draw():
             try:
                 data, name = _png(view, shown, colour_by)
             except Exception as exc:  # said in the page; the app goes on
                 msg = f"{type(exc).__name__}: {exc}"
-                self.doc.add_next_tick_callback(
-                    lambda: setattr(self.status[view], "text", _error_html(msg)))
+                done(lambda: setattr(self.status[view], "text", _error_html(msg)))
                 return
 
             def send():
                 self.download.data = dict(name=[name], b64=[data], mime=["image/png"])
                 self.status[view].text = ""
-            self.doc.add_next_tick_callback(send)
+            done(send)
         threading.Thread(target=draw, daemon=True, name="rockjit-explore-png").start()
 
 
