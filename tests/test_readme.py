@@ -294,3 +294,15 @@ def test_the_peers_single_run_figures_are_the_benchmarks():
         ratios += [t / times[0] for t in times[1:] if t]  # the five peers, not scipy's
     assert ratios
     assert (int(lo), int(hi)) == (round(min(ratios)), int(float(f"{max(ratios):.2g}")))
+
+
+def test_the_sites_front_page_quotes_the_readmes_figures():
+    # docs/index.md repeats four of the speed table's figures (held to the results above)
+    page = " ".join((ROOT / "docs" / "index.md").read_text(encoding="utf-8").split())
+    ms, speed, basin, paper = re.search(
+        r"takes about (\d+) ms, some (\d+) times faster .* 500 periods about ([\d.]+) s on two "
+        r"cores; every figure and table of the study in about (\d+) s", page).groups()
+    assert f"about {ms} ms" in _row("the study's reference run, 500 periods")
+    assert f"**{speed}x**" in _row("the study's reference run, 500 periods")
+    assert f"**{basin} s**" in _row("the study's 100 × 100 basin, 500 periods")
+    assert f"**{paper} s**" in _row("`rockjit paper`, every figure and table")
