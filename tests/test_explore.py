@@ -2,7 +2,9 @@
 request never publishing, the Python call text reproducing each view, the library's messages
 for bad values), then the app in a real headless Chromium: it starts bound to 127.0.0.1, the
 basin renders, moving alpha recomputes it, a click on a cell shows the run the library gives for
-that cell, a box zoom recomputes the bifurcation diagram, and the console stays free of errors.
+that cell, a box zoom recomputes the bifurcation diagram, and the console stays free of errors;
+``--address ::1`` serves on IPv6's loopback. The server's defences (Host and Origin checks,
+limits, cancellation, a closed tab) are ``test_explore_security.py``'s.
 
 The browser part needs the ``explore`` extra (Bokeh), Playwright and a system Chromium
 (``apt-get install chromium``; Playwright's own browsers are never downloaded); it is skipped,
@@ -566,3 +568,45 @@ def test_the_app_in_a_browser(server, tmp_path):
     if path:
         Path(path).write_text(json.dumps(timings, indent=1))
     assert errors == [], errors
+
+
+def _ipv6_loopback():
+    try:
+        with socket.socket(socket.AF_INET6, socket.SOCK_STREAM) as s:
+            s.bind(("::1", 0))
+        return True
+    except OSError:
+        return False
+
+
+@pytest.mark.skipif(importlib.util.find_spec("bokeh") is None or not _ipv6_loopback(),
+                    reason="needs the explore extra and an IPv6 loopback")
+def test_the_command_serves_on_the_ipv6_loopback():
+    """``rockjit explore --address ::1``: the address printed, the page served to a request
+    naming it, and one naming another host refused."""
+    import http.client
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    proc = subprocess.Popen([sys.executable, "-m", "rockjit", "explore", "--no-browser",
+                             "--address", "::1"], cwd=ROOT, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        line = proc.stdout.readline()
+        m = re.search(r"serving on http://\[::1\]:(\d+)/", line)
+        assert m, (line, proc.stderr.read() if proc.poll() is not None else "")
+        port = int(m.group(1))
+        assert _listening_addresses(port) == ["::1"]
+        for host, status in ((f"[::1]:{port}", 200), (f"evil.example:{port}", 403)):
+            c = http.client.HTTPConnection("::1", port, timeout=30)
+            c.putrequest("GET", "/", skip_host=True)
+            c.putheader("Host", host)
+            c.endheaders()
+            r = c.getresponse()
+            r.read()
+            c.close()
+            assert r.status == status, host
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
