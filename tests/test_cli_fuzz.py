@@ -26,13 +26,15 @@ The cases (``CASES``, printable with ``pytest --collect-only -q``):
 - ``numbers: ...``: non-ASCII numbers in single and multi-valued options, literally.
 
 The edges (``EDGE_CASES``): every option of every command that takes numbers (read from the
-parser, so that a new one cannot escape) has its documented range in ``RANGES`` (built from the
-library's constants); each is given both ends of its range, the numbers just outside them, and
-``1e-320``, ``1e308``, ``-1e308``, ``-0.0``, ``nan``, ``inf`` (integers: ``0``, ``-1``, ``1e15``
-and a 20-digit one), inside a small valid command line. Each must end in exit status 2 with one
-line, or reach its (guarded) work; a seeded draw of the accepted ones, with the values that
-once crashed after validation (``EDGE_REGRESSIONS``), runs for real on small grids and must
-end in exit status 0 with its outputs written, or 2 with one line: never a traceback.
+parser, so that a new one cannot escape) has its documented range in
+``rockjit.cli.ranges.RANGES`` (built from the library's constants); each is given both ends of
+its range, the numbers just outside them, and ``1e-320``, ``1e308``, ``-1e308``, ``-0.0``,
+``nan``, ``inf`` (integers: ``0``, ``-1``, ``1e15`` and a 20-digit one), inside a small valid
+command line. Each must end in exit status 2 with one line (naming the option where the value
+is outside its range), or reach its (guarded) work; a seeded draw of the accepted ones, with
+the values that once crashed after validation (``EDGE_REGRESSIONS``), runs for real on small
+grids and must end in exit status 0 with its outputs written, or 2 with one line: never a
+traceback.
 
 Options the command line did not have but its documented model implies carry ``[guessed --NAME]``
 in their ids: ``--max-impacts`` must exist; ``--xi`` cases are skipped while the parser does not
@@ -68,6 +70,7 @@ import numba
 import pytest
 
 from rockjit.cli.main import build_parser, main
+from rockjit.cli.ranges import range_of
 
 # ---------------------------------------------------------------------------------------------
 # The entry points of real work: reaching one means the input was not refused before work.
@@ -1224,55 +1227,6 @@ def test_guard_stops_a_valid_command(reached, tmp_path):
 # The edges of every documented range: refused in one line, or run to the end
 # ---------------------------------------------------------------------------------------------
 
-def _ranges():
-    """Every numeric option's documented range, ``option -> (kind, lo, hi)`` (``None``: no
-    bound on that side), read from the library's own constants where it has them (a moved
-    bound moves the edges tried); ``(command, option)`` where a command differs."""
-    from rockjit.excitation import ALPHA_MAX, OMEGA_RANGE
-    from rockjit.ground.pulses import AMPLITUDE_MAX, RATIO_RANGE
-    from rockjit.ground.records import SIZE_RANGE
-    from rockjit.ground.settings import TIME_MAX
-    from rockjit.model import HB_RANGE, XI_MAX
-    from rockjit.settings import MAX_IMPACTS, MAX_N, MAX_PERIODS, REST_SPEED_RANGE
-    half_pi = 0.5 * math.pi
-    common = {
-        "--hb": ("real", *HB_RANGE), "--e": ("real", 0.0, 1.0), "--xi": ("real", 0.0, XI_MAX),
-        "--alpha": ("real", 0.0, ALPHA_MAX), "--omega": ("real", *OMEGA_RANGE),
-        "--theta0": ("real", -half_pi, half_pi), "--dtheta0": ("real", -1e6, 1e6),
-        "--phase": ("real", None, None), "--r0": ("real", -1e3, 1e3),
-        "--s0": ("real", -1e3, 1e3), "--periods": ("int", 1, MAX_PERIODS),
-        "--n-steps": ("int", 8, MAX_N), "--max-impacts": ("int", 1, MAX_IMPACTS),
-        "--threads": ("int", 1, MAX_THREADS), "--rtol": ("real", 0.0, 1.0),
-        "--atol": ("real", 0.0, None), "--rest-speed": ("real", *REST_SPEED_RANGE),
-        "--max-points": ("int", 2, None), "--alpha-range": ("real", 0.0, ALPHA_MAX),
-        "--alpha-step": ("real", 0.0, None), "--grid": ("int", 1, 10**9),
-        "--theta-range": ("real", -half_pi, half_pi), "--dtheta-range": ("real", -1e6, 1e6),
-        "--omega-range": ("real", *OMEGA_RANGE), "--uncertainty": ("real", 1e-15, 0.5),
-        "--scheduler-timeout": ("real", 0.0, 1e6), "--max-period": ("int", 1, 256),
-        "--seed-omegas": ("real", *OMEGA_RANGE), "--ensemble": ("int", 2, 10**6),
-        "--spread": ("real", 0.0, 1e-2), "--seed": ("int", 0, 2**63 - 1),
-        "--ratio-range": ("real", *RATIO_RANGE), "--amplitude-range": ("real", 0, AMPLITUDE_MAX),
-        "--tol": ("real", 1e-12, 0.1), "--free-time": ("real", 0.0, TIME_MAX),
-        "--size": ("real", *SIZE_RANGE), "--intensities": ("real", 0.0, 1e6),
-        "--hb-values": ("real", 1 / math.sqrt(2), HB_RANGE[1]),
-        "--hb-max": ("real", 1 / math.sqrt(2), 100.0), "--zoom": ("real", 0.5, 1.0),
-        "--zoom-step": ("real", 0.0, 1.0), "--erosion-step": ("real", 0.0, 1.0),
-        "--erosion-grid": ("int", 2, 10**5), "--port": ("int", 0, 65535),
-    }
-    by_command = {("chart", "--max-period"): ("int", 1, 16),
-                  ("plane", "--grid"): ("int", 1, 10**18), ("chart", "--grid"): ("int", 1, 10**18),
-                  ("spectrum", "--grid"): ("int", 1, 10**4), ("paper", "--grid"): ("int", 2, 10**5),
-                  ("paper", "--alpha-step"): ("real", 0.0, 1.0)}
-    return common, by_command
-
-
-RANGES, RANGES_BY_COMMAND = _ranges()
-
-
-def range_of(cmd, opt):
-    return RANGES_BY_COMMAND.get((cmd, opt), RANGES.get(opt))
-
-
 def _numeric_options():
     """``(command, option, nargs)`` of every option of the parser that takes numbers."""
     import argparse
@@ -1376,34 +1330,42 @@ def _edge_id(case):
 
 
 def _run_edge(cmd, opt, vals, tmp_path, guarded):
-    """``main`` on the edge case, the work's entry points guarded or real; the problem found,
-    or ``None``: exit status 0 (with its summary written), or 2 with one line, or its
-    (guarded) work reached."""
+    """``main`` on the edge case, the work's entry points guarded or real: ``(problem, the
+    error line)``; no problem is exit status 0 (with its summary written), or 2 with one line,
+    or its (guarded) work reached."""
     argv = _edge_argv(cmd, opt, vals, str(tmp_path / "out"))
     if guarded and "mp" not in _GUARDS:
         _GUARDS["mp"] = _install_guards(_GUARDS["calls"])
     rc, exc, stdout, stderr, _, _ = run_main(argv, _GUARDS["calls"], tmp_path)
     where = f"\nargv = {argv!r}\nstderr = {stderr!r}"
     if isinstance(exc, NotRefused):
-        return None if guarded else f"reached a guard while unguarded{where}"
+        return (None if guarded else f"reached a guard while unguarded{where}"), None
     if exc is not None:
-        return f"raised {type(exc).__name__}: {exc}{where}"
+        return f"raised {type(exc).__name__}: {exc}{where}", None
     if "Traceback" in stdout + stderr or "internal error" in stderr:
-        return f"a traceback or an internal error{where}"
+        return f"a traceback or an internal error{where}", None
     if rc == 0:
-        return None if (tmp_path / "out" / "summary.json").exists() else f"no summary{where}"
+        return (None if (tmp_path / "out" / "summary.json").exists()
+                else f"no summary{where}"), None
     if rc != 2:
-        return f"exit status {rc}{where}"
+        return f"exit status {rc}{where}", None
     if not (stderr.startswith("rockjit: error:") and stderr.count("\n") == 1):
-        return f"not one line 'rockjit: error: ...'{where}"
-    return None
+        return f"not one line 'rockjit: error: ...'{where}", None
+    return None, stderr
 
 
 @pytest.mark.parametrize("case", EDGE_CASES, ids=[_edge_id(c) for c in EDGE_CASES])
 def test_the_edges_of_every_range_are_refused_in_one_line_or_accepted(case, tmp_path,
                                                                       reached):
-    """Every edge value: exit status 2 with one line, or let through to the work (guarded)."""
-    problem = _run_edge(*case, tmp_path, guarded=True)
+    """Every edge value: exit status 2 with one line, or let through to the work (guarded);
+    a value outside its range refused, naming the option."""
+    problem, line = _run_edge(*case, tmp_path, guarded=True)
+    if problem is None and not _inside(case):
+        cmd, opt, vals = case
+        if line is None:
+            problem = f"accepted outside its documented range {range_of(cmd, opt)}"
+        elif not re.search(NAMES[opt], line.removeprefix("rockjit: error:")):
+            problem = f"the message does not name {opt}: {line!r}"
     if problem:
         pytest.fail(problem, pytrace=False)
 
@@ -1411,9 +1373,12 @@ def test_the_edges_of_every_range_are_refused_in_one_line_or_accepted(case, tmp_
 def _inside(case):
     cmd, opt, vals = case
     kind, lo, hi = range_of(cmd, opt)
-    x = [float(v) for v in vals]
-    return all(math.isfinite(v) and (lo is None or v >= lo) and (hi is None or v <= hi)
-               for v in x)
+    try:
+        x = [(int if kind == "int" else float)(v) for v in vals]
+    except (ValueError, OverflowError):
+        return False
+    return all((kind == "int" or math.isfinite(v)) and (lo is None or v >= lo)
+               and (hi is None or v <= hi) for v in x)
 
 
 #: Edge values that once ended in a traceback after validation, run for real on every command
@@ -1448,6 +1413,6 @@ EDGE_RUNS = _edge_runs()
 def test_accepted_edges_run_to_the_end(case, tmp_path, reached, unguarded):
     """Accepted edge values, run for real on small grids: exit status 0 with the outputs
     written, or 2 with one line (a check only the run can make); never a traceback."""
-    problem = _run_edge(*case, tmp_path, guarded=False)
+    problem, _ = _run_edge(*case, tmp_path, guarded=False)
     if problem:
         pytest.fail(problem, pytrace=False)
