@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from ..settings import REST_SPEED_RANGE
+from ..settings import MAX_IMPACTS, REST_SPEED_RANGE
 from ..validate import boolean, integer, real
 
 __all__ = ["DEFAULT_MAX_IMPACTS", "TIME_MAX", "Transient"]
@@ -79,7 +79,7 @@ class Transient:
         _set(stop_when_decided=boolean("stop_when_decided", self.stop_when_decided),
              record=boolean("record", self.record))
         if self.max_impacts is not None:
-            _set(max_impacts=integer("max_impacts", self.max_impacts, 1, 2**62))
+            _set(max_impacts=integer("max_impacts", self.max_impacts, 1, MAX_IMPACTS))
         if isinstance(self.rest_speed, (int, float)) and self.rest_speed == 0:
             raise ValueError("rest_speed must be > 0 (got 0): with e < 1 the impacts of a Zeno "
                              "cascade accumulate in finite time")
