@@ -434,3 +434,13 @@ def test_the_headline_image_is_drawn_by_figure_5s_function(monkeypatch, tmp_path
     assert (w, h) == (round(fig.get_figwidth() * dpi), round(fig.get_figheight() * dpi))
     # and the paper draws its figure 5 with the same function
     assert "draw_fig5(" in inspect.getsource(paper.paper)
+
+
+def test_a_figure_drawn_outside_a_style_block_keeps_the_styles_type():
+    """A figure function called without ``style.use`` (in a notebook, say, whose matplotlib
+    defaults are 10 pt and larger) still sets 7-9 pt type, tick labels included."""
+    with matplotlib.rc_context({"font.size": 12.0, "xtick.labelsize": 11.0,
+                                "ytick.labelsize": 11.0, "legend.fontsize": 12.0}):
+        fig = P.fig_restitution()
+        assert L.type_problems(fig) == []
+        assert L.canvas_problems(fig) == []

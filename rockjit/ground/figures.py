@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..plotting.style import styled as _styled
 from .response import OUTCOMES
 
 __all__ = ["OUTCOME_COLOURS", "fig_fragility", "fig_rotation", "fig_spectrum",
@@ -93,6 +94,7 @@ def _closed_form(ax, sp):
     ax.plot(r, k, color="0.3", lw=0.8, ls=":", label="slender linearised block, without impact")
 
 
+@_styled
 def fig_spectrum(results, comparison=None):
     """Overturning spectra: per law, the outcome of every cell over
     ``(omega_p / p, a_p / (g tan theta_c))`` with the located boundaries; with two laws, a
@@ -179,6 +181,7 @@ def _xlabel(res):
     return r"PGA / $(g \tan\theta_c)$" if res.measure == "pga" else "PGV [m/s]"
 
 
+@_styled
 def fig_fragility(res):
     """The fragility curves of a :class:`~rockjit.ground.fragility.FragilityResult`: the
     fraction of records that overturned the block at each intensity (circles) and the fitted
@@ -203,6 +206,7 @@ def fig_fragility(res):
     return fig
 
 
+@_styled
 def fig_rotation(res):
     """Rotation exceedance: ``P(max |theta| / theta_c >= level)`` for each fitted level, one
     panel each, laws and sizes as in :func:`fig_fragility`."""
@@ -227,6 +231,7 @@ def fig_rotation(res):
     return fig
 
 
+@_styled
 def fig_transient(result):
     """One transient run: ``theta / theta_c`` and the base acceleration ``f / tan theta_c``
     against time, the impacts marked."""

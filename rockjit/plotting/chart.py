@@ -18,6 +18,8 @@ try:  # the palette's home after the figures' rework; figures.py's until then
 except ImportError:  # pragma: no cover - depends on the rework's state
     from .figures import BEHAVIOUR_COLOURS, LAW_COLOURS
 
+from .style import styled as _styled
+
 __all__ = ["CURVE_LABELS", "CURVE_STYLES", "fig_chart"]
 
 #: Line style of each curve type.
@@ -204,6 +206,7 @@ def _legend_handles(results):
     return h
 
 
+@_styled
 def fig_chart(results, title=None):
     """The chart(s) of behaviours with the bifurcation curves over them.
 

@@ -99,6 +99,7 @@ def _edges(x):
 # Figure 1: restitution laws
 # ---------------------------------------------------------------------------------------------
 
+@S.styled
 def fig_restitution(hb_range=(1.0 / math.sqrt(2.0), 6.0), n=400, marks=(1.0, 2.0)):
     """Figure 1: ``e_H`` and ``e_M`` against ``theta_c``, with ``Delta e %`` on a twin axis.
 
@@ -301,6 +302,7 @@ def _windows(result, first, last):
 # Figure 2: one run
 # ---------------------------------------------------------------------------------------------
 
+@S.styled
 def fig_trajectory(result, behaviour, *, exponent=None, title=None, first=8, last=4):
     """Figure 2: ``theta(t)`` over the transient's first periods and over the last periods,
     the running exponent ``lambda_1(t)``, and the phase portrait of the asymptotic window with
@@ -390,6 +392,7 @@ def fig_trajectory(result, behaviour, *, exponent=None, title=None, first=8, las
 # Figure 3: behaviour gallery
 # ---------------------------------------------------------------------------------------------
 
+@S.styled
 def fig_gallery(results, behaviours, notes=None, *, first=8, last=4):
     """Figure 3: one row per run: ``theta(t)`` over its first and its last periods (the whole
     run when it is short) and its phase portrait, coloured by its behaviour.
@@ -454,6 +457,7 @@ def fig_gallery(results, behaviours, notes=None, *, first=8, last=4):
 # Figure 4: Housner vs Mao time series
 # ---------------------------------------------------------------------------------------------
 
+@S.styled
 def fig_laws_timeseries(runs, behaviours, captions=None, *, periods=8):
     """Figure 4: the two laws from the same initial states, one row per initial state: each
     law's ``theta(t)`` over the last ``periods`` periods of its run, where it has settled (the
@@ -607,6 +611,7 @@ def _bifurcation_column(fig, gs_col, sw, alpha_limits, show_y, col, short=False)
     return present, any_rest
 
 
+@S.styled
 def fig_bifurcation(sweeps, alpha_limits=None, title=None):
     """Figure 5: stroboscopic ``theta'`` against ``alpha``, coloured by behaviour, a strip with
     every amplitude's behaviour, and ``lambda_max`` below.
@@ -684,6 +689,7 @@ def _cells(b):
     return f"${n[0]} \\times {n[1]}$ initial states"
 
 
+@S.styled
 def fig_basin(basin_result, title=None):
     """Figure 6 (one law): the behaviour of each ``(theta0, theta0')``, with percentages."""
     b = basin_result
@@ -696,6 +702,7 @@ def fig_basin(basin_result, title=None):
     return fig
 
 
+@S.styled
 def fig_basin_compare(housner_basin, mao_basin, title=None):
     """Figure 6: the basins under both laws and where they agree.
 
@@ -778,6 +785,7 @@ def _attractor_panel(ax, ids, theta0, dtheta0, attractors, show_y=True):
     return handles
 
 
+@S.styled
 def fig_attractors(basins, measures=None, title=None):
     """Attractor maps of one or two basins (a dict ``law: BasinResult``, or one result), each
     with its basin entropy and integrity.
@@ -851,6 +859,7 @@ def _erosion_areas(r):
     return areas
 
 
+@S.styled
 def fig_erosion(profiles, title=None):
     """Erosion profiles (a dict ``law: ErosionResult``, or one): the global integrity measure
     GIM and the integrity factor IF against the amplitude for each law, and below, for each
@@ -941,6 +950,7 @@ def _outcome_names(keys):
                                                          for k, it in zip(keys, items)}
 
 
+@S.styled
 def fig_fate(fate_result, title=None):
     """An ensemble of nearby runs: each outcome's probability, and when each member stopped
     against its initial perturbation, with the predictability horizon marked."""
@@ -985,6 +995,7 @@ def fig_fate(fate_result, title=None):
 # Parameter plane (rocking chart)
 # ---------------------------------------------------------------------------------------------
 
+@S.styled
 def fig_plane(plane_result, state=0, title=None):
     """Behaviour over the forcing plane (``omega`` across, ``alpha`` up) and ``lambda_max``
     beside it (exact where a cell is periodic).
@@ -1117,6 +1128,7 @@ def _branch_runs(value, y, stable, t_next, period, mu=None):
     return runs
 
 
+@S.styled
 def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=None,
                  mirrors=True):
     """Branches of periodic orbits drawn over a sweep's dots, bifurcations and branch ends

@@ -43,7 +43,7 @@ from .legibility import TEXT_POINTS, WIDTHS
 __all__ = ["AGREE_COLOUR", "BEHAVIOUR_COLOURS", "DISAGREE_COLOUR", "FORMATS", "LAW_COLOURS",
            "LAW_LINES", "LAW_NAMES", "STYLES", "SYMBOLS", "Style", "TEXT_POINTS", "WIDTHS",
            "attractor_colours", "attractor_names", "behaviour_cmap", "current", "cvd_distances", "law_name", "letter", "shade",
-           "suptitle", "texts_outside", "tint", "use", "variant"]
+           "styled", "suptitle", "texts_outside", "tint", "use", "variant"]
 
 #: One colour per behaviour (rockjit.result.BEHAVIOURS), in every figure and command.
 BEHAVIOUR_COLOURS = {
@@ -177,6 +177,28 @@ def use(name="default"):
             yield st
     finally:
         _CURRENT.reset(token)
+
+
+def styled(fn):
+    """Decorate a figure function so that it draws in the style in force (:func:`current`)
+    whether or not it is called within :func:`use`: its type sizes, line widths and legends
+    are the style's, not matplotlib's defaults, and so are the tick labels matplotlib makes
+    when the figure is drawn."""
+    import functools
+
+    @functools.wraps(fn)
+    def drawn_in_style(*args, **kwargs):
+        import matplotlib
+        st = current()
+        with matplotlib.rc_context(st.rc):
+            fig = fn(*args, **kwargs)
+            for ax in fig.get_axes():
+                for axis in ("x", "y"):
+                    size = st.rc.get(f"{axis}tick.labelsize")
+                    if size is not None:
+                        ax.tick_params(axis=axis, which="both", labelsize=size)
+        return fig
+    return drawn_in_style
 
 
 def suptitle(fig, text, **kw):
