@@ -20,7 +20,9 @@ line of ``(theta_m, beta)``); complete separation (every level below a cut survi
 level above overturns: the likelihood grows as ``beta -> 0``, with any median in the gap);
 quasi-complete separation (the same, with one level mixed); an overturning fraction that does
 not rise with the intensity; or a nearly flat likelihood (a probability that does not change
-with the intensity fits about as well: the interval of ``beta`` has no upper end).
+with the intensity fits about as well: the interval of ``beta`` has no upper end; or the
+interval of the median has no end within ``MEDIAN_REACH``). The intervals are still given
+where the data bound something.
 :func:`fit_capacities` is the closed form from one collapse capacity per record, with exact
 intervals (Student's t and chi-square).
 """
@@ -39,6 +41,8 @@ __all__ = ["CONFIDENCE", "LognormalFit", "fit_capacities", "fit_lognormal"]
 CONFIDENCE = 0.95
 _NAN2 = (math.nan, math.nan)
 _HALF_LN_2PI = 0.5 * math.log(2.0 * math.pi)
+#: How far (in ln intensity) the median's interval is followed: beyond, an open end.
+MEDIAN_REACH = 64.0
 
 
 @dataclass(frozen=True)
@@ -173,44 +177,48 @@ class _Probit:
                 break
         return a, s, v, d, w
 
-    def profile_s(self, s, m):
-        """``max over m`` of the log-likelihood at fixed ``s > 0`` (Newton from ``m``)."""
+    def profile_s(self, s, a):
+        """``max over a`` of the log-likelihood at fixed ``s > 0``, ``z = s l - a`` (concave in
+        ``a``; Newton from ``a``): ``(value, a)``."""
         l = self.l
-        v, d, w = self.at(s * (l - m))
-        for _ in range(200):
-            g, h = -s * d.sum(), s * s * w.sum()
-            dm = -g / h if h < 0 else math.copysign(1.0, g)
-            dm = max(-2.0, min(2.0, dm))
+        v, d, w = self.at(s * l - a)
+        for _ in range(500):
+            g, h = -d.sum(), w.sum()
+            da = -g / h if h < 0 else math.copysign(1.0, g)
+            da = max(-2.0, min(2.0, da))
             t = 1.0
-            while True:
-                v1, d1, w1 = self.at(s * (l - (m + t * dm)))
-                if v1 >= v - 1e-13 * (1 + abs(v)) or t < 1e-12:
+            for _ in range(30):
+                v1, d1, w1 = self.at(s * l - (a + t * da))
+                if v1 >= v:
                     break
                 t *= 0.5
-            m += t * dm
-            gain, v, d, w = v1 - v, v1, d1, w1
-            if abs(t * dm) < 1e-12 or abs(gain) < 1e-14 * (1 + abs(v)):
+            if not v1 > v:        # no gain left at the rounding level: the maximum
                 break
-        return v, m
+            a, gain, v, d, w = a + t * da, v1 - v, v1, d1, w1
+            if abs(t * da) <= 1e-13 * (1.0 + abs(a)) or gain <= 1e-14 * (1.0 + abs(v)):
+                break
+        return v, a
 
     def profile_m(self, m, s, s_max):
-        """``max over 0 < s <= s_max`` of the log-likelihood at fixed ``m`` (Newton from
-        ``s``)."""
+        """``max over 0 < s <= s_max`` of the log-likelihood at fixed ``m``, ``z = s (l - m)``
+        (concave in ``s``; Newton from ``s``): ``(value, s)``."""
         u = self.l - m
         v, d, w = self.at(s * u)
-        for _ in range(200):
+        for _ in range(500):
             g, h = (d * u).sum(), (w * u * u).sum()
             ds = -g / h if h < 0 else math.copysign(s, g)
             s1 = min(max(s + ds, 0.25 * s), 4.0 * s, s_max)
             t = 1.0
-            while True:
+            for _ in range(30):
                 st = s + t * (s1 - s)
                 v1, d1, w1 = self.at(st * u)
-                if v1 >= v - 1e-13 * (1 + abs(v)) or t < 1e-12:
+                if v1 >= v:
                     break
                 t *= 0.5
-            gain, s, v, d, w = v1 - v, st, v1, d1, w1
-            if abs(gain) < 1e-14 * (1 + abs(v)) or s >= s_max:
+            if not v1 > v:        # no gain left at the rounding level: the maximum
+                break
+            step, gain, s, v, d, w = abs(st - s), v1 - v, st, v1, d1, w1
+            if step <= 1e-13 * s or gain <= 1e-14 * (1.0 + abs(v)) or s >= s_max:
                 break
         return v, s
 
@@ -221,50 +229,44 @@ def _root(fun, lo, hi):
     return brentq(fun, lo, hi, xtol=1e-10, rtol=1e-10)
 
 
-def _intervals(pr, ll_sup, ll_flat, m0, s0, s_max, q):
+def _intervals(pr, ll_sup, ll_flat, m0, s0, s_max, q, beta_to_zero=False):
     """Profile-likelihood intervals of ``m`` (centred ln median) and ``beta = 1/s``: where the
     profile stays above ``ll_sup - q/2``; ``(m0, s0)`` a point inside. ``ll_flat`` is the
     supremum as ``beta -> inf`` (a constant probability). Returns ``((m_lo, m_hi), (b_lo,
-    b_hi))`` with ``-inf``/``inf`` and ``0``/``inf`` for open ends."""
+    b_hi))`` with ``-inf``/``inf`` and ``0``/``inf`` for open ends (the median's beyond
+    ``MEDIAN_REACH`` log units of ``m0``). ``beta_to_zero``: the supremum is reached as
+    ``beta -> 0`` (separation, or a flat likelihood), so beta's interval starts at 0."""
     target = ll_sup - 0.5 * q
-    state = dict(m=m0, s=s0)
+    step = math.log(2.0)
 
-    def gs(u):                       # u = ln s
-        v, state["m"] = pr.profile_s(math.exp(u), state["m"])
-        return v - target
+    def gs(u):                       # u = ln s; each profile from the same start: one function
+        return pr.profile_s(math.exp(u), m0 * math.exp(u))[0] - target
 
     def gm(m):
-        v, s = pr.profile_m(m, state["s"], s_max)
-        return v - target
+        return pr.profile_m(m, s0, s_max)[0] - target
 
-    # beta's upper end: s below s0
+    # beta's upper end: s below s0 (the profile falls to ll_flat as s -> 0)
     if ll_flat >= target:
         b_hi = math.inf
     else:
-        u0, step = math.log(s0), math.log(2.0)
-        state["m"] = m0
-        u = u0 - step
-        while gs(u) >= 0:
+        u0, u = math.log(s0), math.log(s0) - step
+        while gs(u) >= 0 and u > math.log(s0) - 200.0:
             u0, u = u, u - step
-        b_hi = 1.0 / math.exp(_root(gs, u, u0))
+        b_hi = 1.0 / math.exp(_root(gs, u, u0)) if gs(u) < 0 else math.inf
     # beta's lower end: s above s0
-    state["m"] = m0
-    u0, u, b_lo = math.log(s0), math.log(s0) + math.log(2.0), None
-    while u <= math.log(s_max):
+    u0, u, b_lo = math.log(s0), math.log(s0) + step, 0.0
+    while u <= math.log(s_max) and not beta_to_zero:
         if gs(u) < 0:
             b_lo = 1.0 / math.exp(_root(gs, u0, u))
             break
-        u0, u = u, u + math.log(2.0)
-    b_lo = 0.0 if b_lo is None else b_lo
+        u0, u = u, u + step
     # the median's ends
     ends = []
     for sign in (-1.0, 1.0):
-        state["s"] = s0
         inner, d, end = m0, 0.05, sign * math.inf
-        while d <= 64.0:
+        while d <= MEDIAN_REACH:
             m = m0 + sign * d
             if gm(m) < 0:
-                state["s"] = s0
                 end = _root(gm, *sorted((inner, m)))
                 break
             inner, d = m, 2.0 * d
@@ -349,11 +351,12 @@ def fit_lognormal(x, overturned, runs, *, confidence=CONFIDENCE) -> LognormalFit
     spread = float(np.ptp(lx))
     s_max = 1e8 / max(spread, 1e-3)
 
-    def unidentified(reason, ll_sup, m0=None, s0=None):
+    def unidentified(reason, ll_sup, m0=None, s0=None, beta_to_zero=False):
         mci = bci = _NAN2
         if m0 is not None:
             try:
-                (m_lo, m_hi), bci = _intervals(pr, ll_sup, ll_flat, m0, s0, s_max, q)
+                (m_lo, m_hi), bci = _intervals(pr, ll_sup, ll_flat, m0, s0, s_max, q,
+                                               beta_to_zero)
                 mci = (math.exp(m_lo + c), math.exp(m_hi + c))
             except (ValueError, OverflowError, FloatingPointError):
                 mci = bci = _NAN2
@@ -362,7 +365,7 @@ def fit_lognormal(x, overturned, runs, *, confidence=CONFIDENCE) -> LognormalFit
 
     if np.unique(lx).size == 1:
         return unidentified("one intensity level: the likelihood is flat along a line of "
-                            "(median, beta)", ll_flat, 0.0, 1.0 / max(abs(c), 1.0))
+                            "(median, beta)", ll_flat, 0.0, 1.0 / max(abs(c), 1.0), True)
     # a cut: every run below survives, every run above overturns (one level may be mixed)
     survive_max = lx[k < n].max()   # the highest level with a survival
     over_min = lx[k > 0].min()      # the lowest level with an overturning
@@ -372,14 +375,14 @@ def fit_lognormal(x, overturned, runs, *, confidence=CONFIDENCE) -> LognormalFit
             return unidentified(
                 f"complete separation between {math.exp(survive_max):.6g} and "
                 f"{math.exp(over_min):.6g}: beta -> 0 and any median in between fits", 0.0,
-                0.5 * (survive_max + over_min) - c, s0)
+                0.5 * (survive_max + over_min) - c, s0, True)
         mixed = lx == survive_max
         km, nm = k[mixed].sum(), n[mixed].sum()
         m0 = survive_max - c - float(ndtri(km / nm)) / s0
         return unidentified(
             f"quasi-complete separation at {math.exp(survive_max):.6g}: every run below "
             f"survives and every run above overturns, the likelihood grows as beta -> 0",
-            _ll_binomial(k[mixed], n[mixed]), m0, s0)
+            _ll_binomial(k[mixed], n[mixed]), m0, s0, True)
     # a start: the median where the empirical fraction crosses 1/2, beta from the spread
     frac = k / n
     order = np.argsort(lx)
@@ -406,10 +409,15 @@ def fit_lognormal(x, overturned, runs, *, confidence=CONFIDENCE) -> LognormalFit
     except np.linalg.LinAlgError:
         se_mu = se_beta = nan
     (m_lo, m_hi), bci = _intervals(pr, ll, ll_flat, m, s, s_max, q)
+    mci = (math.exp(m_lo + c), math.exp(m_hi + c))
+    if not (mci[0] > 0.0 and mci[1] < math.inf):
+        # the profile of the median falls too slowly: it is not bounded within reach
+        side = "lower" if mci[0] == 0.0 else "upper"
+        return unidentified(f"nearly flat likelihood: the data set no {side} end to the "
+                            f"median", ll, m, s)
     median = math.exp(m + c)
     return LognormalFit(median, 1.0 / s, median * se_mu, se_beta, se_mu, "ok", nan, N, K, ll,
-                        "", (math.exp(m_lo + c), math.exp(m_hi + c)),
-                        tuple(map(float, bci)), confidence)
+                        "", mci, tuple(map(float, bci)), confidence)
 
 
 def _chi2_1(p):
