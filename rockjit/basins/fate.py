@@ -124,14 +124,15 @@ class FateResult:
     ----------
     probabilities : dict of str to float
         Each outcome's share of the members (sums to 1), most frequent first. The keys
-        (:func:`outcome_keys`): ``"overturn"``, ``"rest"``, ``"unresolved"``, a periodic
-        attractor ``"<behaviour> p=<period>"`` (``"symmetric p=1"``, ``"multiperiodic p=7"``),
+        (``rockjit.basins.fate.outcome_keys``): ``"overturn"``, ``"rest"``, ``"unresolved"``,
+        a periodic attractor ``"<behaviour> p=<period>"`` (``"symmetric p=1"``,
+        ``"multiperiodic p=7"``),
         a chaotic or aperiodic one by its behaviour (``"chaotic"``); attractors that would
         share a key get ``" (a)"``, ``" (b)"``, ... in the order of their position in the
         state plane, so that a key names the same attractor whatever the ensemble's size or
         seed.
     ids : dict of str to int
-        Each key's outcome id in :attr:`outcome`.
+        Each key's outcome id in ``outcome``.
     outcome : ndarray of int, shape (K,)
         Each member's outcome id (``>= 0`` attractors, ``-1`` overturn, ``-2`` unresolved).
     t_end : ndarray, shape (K,)
