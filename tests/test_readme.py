@@ -306,3 +306,18 @@ def test_the_sites_front_page_quotes_the_readmes_figures():
     assert f"**{speed}x**" in _row("the study's reference run, 500 periods")
     assert f"**{basin} s**" in _row("the study's 100 × 100 basin, 500 periods")
     assert f"**{paper} s**" in _row("`rockjit paper`, every figure and table")
+
+
+def test_the_multiperiodic_examples_accurate_overturning_time_is_as_quoted():
+    import rockjit
+    from rockjit import Block, Harmonic, Integration
+    text = CLAIMS["theory/study.md"]
+    t, n1, n2, exp = _number(r"overturns at \$t = ([\d.]+)\$\. rockjit at \$N = (\d+)\$ and "
+                             r"\$(\d+)\$ agrees to \$10\^\{-(\d+)\}\$", text).groups()
+    ends = [rockjit.simulate(Block(hb=1), Harmonic(alpha=0.969, omega=1.3),
+                             integration=Integration(n_steps=int(n))) for n in (n1, n2)]
+    assert all(r.status == "overturned" for r in ends)
+    assert abs(ends[0].t - ends[1].t) < 10.0 ** -int(exp)
+    assert f"{ends[1].t:.{len(t.split('.')[1])}f}" == t
+    short = _number(r"overturns at \$t = ([\d.]+)\$; the outcome", CLAIMS["study.md"]).group(1)
+    assert f"{ends[1].t:.{len(short.split('.')[1])}f}" == short
