@@ -1,5 +1,5 @@
-"""Every figure ``rockjit paper`` and each command draws keeps its text on the canvas, in both
-styles; every figure has its data file; every file is described.
+"""Every figure ``rockjit paper`` and each command draws keeps its text on the canvas and reads in
+a journal, in both styles; every figure has its data file; every file is described.
 
 The figures are caught as they are written (an output directory that keeps them instead of
 saving them) and each visible text artist's drawn extent is compared with the figure's
@@ -18,7 +18,7 @@ matplotlib.use("Agg")
 import rockjit  # noqa: E402
 from rockjit import Block, Harmonic, Integration  # noqa: E402
 from rockjit.cli import outputs  # noqa: E402
-from rockjit.plotting import style  # noqa: E402
+from rockjit.plotting import legibility, style  # noqa: E402
 from rockjit.study import paper as study  # noqa: E402
 
 STYLES = ("default", "paper")
@@ -30,6 +30,7 @@ class CaughtOut:
 
     def __init__(self):
         self.written, self.holds, self.outside, self.figures = [], {}, {}, []
+        self.problems = {}
 
     def _add(self, name):
         if name not in self.written:
@@ -37,6 +38,7 @@ class CaughtOut:
 
     def figure(self, name, fig, *, dpi=None):
         self.outside[name] = style.texts_outside(fig)
+        self.problems[name] = legibility.problems(fig)
         self.figures.append(name)
         self._add(name)
         return name
@@ -82,6 +84,16 @@ def test_every_paper_figure_keeps_its_text_on_the_canvas(paper_out):
     out, _ = paper_out
     assert len(out.figures) == 22  # figures 1-9, the as-published pair and the branches
     _assert_fits(out)
+
+
+@pytest.mark.slow
+def test_every_paper_figure_reads_in_a_journal(paper_out):
+    """A column or page wide, 7-9 pt type, legends that name what is drawn and tell their
+    entries apart, no overprinted labels, no legend over the data
+    (rockjit.plotting.legibility)."""
+    out, _ = paper_out
+    bad = {k: v for k, v in out.problems.items() if v}
+    assert not bad, bad
 
 
 @pytest.mark.slow

@@ -434,6 +434,9 @@ def test_the_headline_image_is_drawn_by_figure_5s_function(monkeypatch, tmp_path
     assert (w, h) == (round(fig.get_figwidth() * dpi), round(fig.get_figheight() * dpi))
     # and the paper draws its figure 5 with the same function
     assert "draw_fig5(" in inspect.getsource(paper.paper)
+    # the image in the repository is that figure's size: made by the script, not by hand
+    with Image.open(mod.HEADLINE) as im:
+        assert im.size[0] == round(fig.get_figwidth() * dpi)
 
 
 def test_a_figure_drawn_outside_a_style_block_keeps_the_styles_type():

@@ -278,14 +278,13 @@ def _rest_inset(ax, result, colour):
     if np.count_nonzero(keep) < 2:
         return
     k = np.arange(1, imp.shape[0] + 1)[keep]
-    ins = ax.inset_axes([0.7, 0.4, 0.28, 0.36])
+    ins = ax.inset_axes([0.7, 0.3, 0.28, 0.4])
     ins.plot(k, speed[keep], "o-", color=colour, ms=2.5, lw=0.8)
     ins.set_yscale("log")
     ins.set_xlim(0.5, imp.shape[0] + 0.5)
     ins.tick_params(labelsize=7)
     ins.xaxis.get_major_locator().set_params(integer=True)
-    ins.set_xlabel("impact", fontsize=7, labelpad=1)
-    ins.set_title(f"$|\\theta'^-|$ at each of the {imp.shape[0]} impacts", fontsize=7)
+    ins.set_title(f"$|\\theta'^-|$ at impacts 1 to {imp.shape[0]}", fontsize=7)
 
 
 def _windows(result, first, last):
@@ -681,7 +680,7 @@ def _basin_legend(ax, b):
     fr = fractions(b.label)
     names = [n for n in BEHAVIOURS if fr[n] > 0]
     ax.legend(handles=_behaviour_handles(names, [f"{n} {fr[n]:.1f} %" for n in names]),
-              loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=2)
+              loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=1)
 
 
 def _cells(b):
@@ -727,12 +726,13 @@ def fig_basin_compare(housner_basin, mao_basin, title=None):
                    aspect="auto", cmap=ListedColormap([DISAGREE_COLOUR, AGREE_COLOUR]),
                    vmin=0, vmax=1, extent=_extent(np.asarray(a.theta0), np.asarray(a.dtheta0)))
     axes[2].set_xlabel(SYMBOLS["theta0"])
-    S.letter(axes[2], 2, f"agreement: {pct:.1f} %\nof the {_cells(a)}")
+    S.letter(axes[2], 2, f"agreement: {pct:.1f} %")
     axes[2].legend(handles=[Patch(facecolor=AGREE_COLOUR, edgecolor="0.5", lw=0.5,
                                   label=f"same behaviour {pct:.1f} %"),
                             Patch(facecolor=DISAGREE_COLOUR, edgecolor="0.5", lw=0.5,
                                   label=f"different {100 - pct:.1f} %")],
-                   loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=1)
+                   loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=1,
+                   title=f"of the {_cells(a)}")
     blk, frc = a.block, a.forcing
     S.suptitle(fig, title or f"Basins of attraction, $h/b = {blk.hb:g}$, "
                              f"$\\alpha = {frc.alpha:g}$, $\\omega = {frc.omega:g}$, "

@@ -16,7 +16,7 @@ import itertools
 import numpy as np
 
 __all__ = ["LEGEND_DELTA", "TEXT_POINTS", "WIDTHS", "canvas_problems", "colour_distance", "legend_colour_problems",
-           "legend_handle_problems", "legend_over_data", "problems", "text_overlaps",
+           "legend_handle_problems", "legend_over_data", "problems", "text_outside", "text_overlaps",
            "type_problems"]
 
 #: The smallest and largest type a figure may set, in points (a journal's 7-9 pt at print
@@ -419,8 +419,14 @@ def legend_over_data(fig):
     return bad
 
 
+def text_outside(fig):
+    """Every text lies on the canvas (:func:`rockjit.plotting.style.texts_outside`)."""
+    from .style import texts_outside
+    return [f"text {t[:40]!r} leaves the canvas" for t, _ in texts_outside(fig)]
+
+
 def problems(fig):
     """Every check's problems together."""
     _renderer(fig, again=True)
-    return (canvas_problems(fig) + type_problems(fig) + text_overlaps(fig)
+    return (canvas_problems(fig) + type_problems(fig) + text_outside(fig) + text_overlaps(fig)
             + legend_handle_problems(fig) + legend_colour_problems(fig) + legend_over_data(fig))
