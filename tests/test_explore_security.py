@@ -456,3 +456,76 @@ def test_a_page_draws_one_png_at_a_time(app):
     assert "another PNG is being drawn" in app.status["basin"].text
     for t in drawing:
         t.join(60)
+
+
+def _frame_server(address, html_text):
+    """A plain HTTP server on ``address`` (loopback) serving ``html_text`` at ``/``; ``None``
+    where that address cannot be bound."""
+    import functools
+    import http.server
+    body = html_text.encode()
+
+    class Page(http.server.BaseHTTPRequestHandler):
+        def do_GET(self):
+            self.send_response(200)
+            self.send_header("Content-Type", "text/html")
+            self.send_header("Content-Length", str(len(body)))
+            self.end_headers()
+            self.wfile.write(body)
+
+        def log_message(self, *args):
+            pass
+    try:
+        srv = http.server.ThreadingHTTPServer((address, 0), functools.partial(Page))
+    except OSError:
+        return None
+    threading.Thread(target=srv.serve_forever, daemon=True).start()
+    return srv
+
+
+@pytest.mark.skipif(_browser_missing() is not None, reason=str(_browser_missing()))
+def test_another_sites_page_cannot_frame_the_explorer(server):
+    """A page of another origin (here 127.0.0.2, which the explorer does not accept) showing the
+    explorer in a frame gets no page: the browser refuses to render it (the response's
+    frame-ancestors). A page served by this machine's own name (``localhost``), as a notebook's
+    inline view is, gets the explorer."""
+    import shutil
+
+    from playwright.sync_api import sync_playwright
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+    frame = (f'<html><body><iframe src="{server.url}" width="1200" height="900"></iframe>'
+             f'</body></html>')
+    other, own = _frame_server("127.0.0.2", frame), _frame_server("127.0.0.1", frame)
+    if other is None:
+        own.shutdown()
+        pytest.skip("127.0.0.2 cannot be bound here")
+    try:
+        with sync_playwright() as pw:
+            b = pw.chromium.launch(executable_path=chromium,
+                                   args=["--no-sandbox", "--disable-gpu"])
+            try:
+                page = b.new_page()
+                s0 = server.stats()["sessions"]
+                page.goto(f"http://127.0.0.2:{other.server_address[1]}/")
+                page.wait_for_load_state("load")
+                deadline = time.time() + 30  # the frame's request reaches the server...
+                while time.time() < deadline and server.stats()["sessions"] == s0:
+                    time.sleep(0.05)
+                assert server.stats()["sessions"] > s0
+                child = page.frames[1]
+                child.wait_for_load_state("load")
+                assert child.url != server.url  # ...and its answer is not rendered
+                assert not child.locator(".rj-connecting, .rj-view").count()
+                assert server.stats()["pages"] == 0
+                page.goto(f"http://localhost:{own.server_address[1]}/")
+                page.frames[1].wait_for_selector(".rj-basin-shown", timeout=120_000)
+                assert server.stats()["pages"] == 1
+                page.close()
+            finally:
+                b.close()
+    finally:
+        other.shutdown()
+        own.shutdown()
+    deadline = time.time() + 20
+    while time.time() < deadline and server.stats()["pages"]:
+        time.sleep(0.1)

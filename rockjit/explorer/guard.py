@@ -12,7 +12,9 @@ therefore checks, on every HTTP request and on the websocket's opening request:
   machine's host name; and any name given in ``allow_hosts``. The port is not compared, so
   that a forwarded port (``ssh -L``) works;
 - an ``Origin`` header, where there is one, is the same origin as the ``Host`` (``http`` or
-  ``https``, the same host and port), and the websocket's opening request must have one.
+  ``https``, the same host and port), and the websocket's opening request must have one;
+- and every response says which pages may show it in a frame (:meth:`HostPolicy.
+  frame_ancestors`), so that another site cannot run the explorer in a hidden frame of its own.
 
 Nothing here imports a web framework: :class:`HostPolicy` decides from the header values, and
 :mod:`.server` applies it to every request before Bokeh sees it.
@@ -155,6 +157,15 @@ class HostPolicy:
         if origin is not None and not self.allows_origin(origin, host):
             return f"Origin {_quote(origin)} is not this server's page"
         return None
+
+    def frame_ancestors(self):
+        """The pages that may show the explorer in a frame (a ``Content-Security-Policy``'s
+        ``frame-ancestors``): its own, and pages served by this machine's loopback or by the
+        names it accepts (a notebook's inline view), so that another site's page cannot run it
+        in a hidden frame."""
+        hosts = {"localhost", "127.0.0.1"} | {n for n in self.names if not n.startswith("[")}
+        return " ".join(["'self'"] + [f"{scheme}://{h}:*" for h in sorted(hosts)
+                                      for scheme in ("http", "https")])
 
     def websocket_origins(self):
         """Patterns for Bokeh's own websocket origin check (``host:port``, ``*`` a wildcard),

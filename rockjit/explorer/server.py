@@ -161,6 +161,7 @@ def _guarded(app, policy):
             self.conn.write_headers(
                 httputil.ResponseStartLine("HTTP/1.1", 403, "Forbidden"),
                 httputil.HTTPHeaders({"Content-Type": "text/plain; charset=utf-8",
+                                      "X-Content-Type-Options": "nosniff",
                                       "Content-Length": str(len(body))}), body)
             self.conn.finish()
             return None
@@ -187,6 +188,20 @@ class _Server:
         self.base.stop()
 
 
+def _headers(policy):
+    """A Tornado output transform that adds the explorer's headers to every response of the
+    application: who may frame it, and no guessing of content types."""
+    from tornado.web import OutputTransform
+    ancestors = f"frame-ancestors {policy.frame_ancestors()}"
+
+    class Headers(OutputTransform):
+        def transform_first_chunk(self, status_code, headers, chunk, finishing):
+            headers["Content-Security-Policy"] = ancestors
+            headers["X-Content-Type-Options"] = "nosniff"
+            return status_code, headers, chunk
+    return Headers
+
+
 def _serve(address, port, policy, pages, ready, box):
     import asyncio
     from functools import partial
@@ -211,7 +226,8 @@ def _serve(address, port, policy, pages, ready, box):
                            extra_websocket_origins=policy.websocket_origins(),
                            websocket_max_message_size_bytes=MAX_BODY,
                            unused_session_lifetime_milliseconds=UNUSED_SESSION_MS,
-                           check_unused_sessions_milliseconds=CHECK_SESSIONS_MS)
+                           check_unused_sessions_milliseconds=CHECK_SESSIONS_MS,
+                           transforms=[_headers(policy)])
         guarded = _guarded(app, policy)
         http = HTTPServer(guarded, xheaders=False, max_body_size=MAX_BODY)
         http.add_sockets(sockets)
