@@ -423,3 +423,36 @@ def test_ida_capacities_match_a_loop(ida):
             want = _capacities_by_loop(ida.intensity, ida.overturned[li, si])
             for g, w in zip(got, want):
                 assert math.isnan(g) if w == "below" else g == w
+
+
+@pytest.mark.parametrize("levels, curves", [(([1, 3], [2, 3]), 1), (([2, 3], [3]), 0)])
+def test_the_figure_draws_a_curve_only_for_an_identified_fit(levels, curves):
+    import matplotlib
+    matplotlib.use("Agg")
+    from matplotlib import pyplot as plt
+    from rockjit.ground.figures import fig_fragility
+    from rockjit.ground.fragility import FragilityResult
+    from rockjit.ground.response import OVERTURN_IMPACT
+    # two records at four intensities, each overturning the block at the levels given (0 is
+    # 1.5): in the first pair record 0 survives at 3.0 above its overturning at 2.0 (the data
+    # overlap: a fit); the second pair is quasi-separated at 3.0 (no fit)
+    x = np.array([1.5, 2.0, 3.0, 4.0])
+    o = np.full((1, 1, 2, 4), SAFE, dtype=np.int8)
+    for r, js in enumerate(levels):
+        o[0, 0, r, js] = OVERTURN_IMPACT
+    fr = FragilityResult(block=Block(hb=3), laws=("housner",), sizes=np.array([1.0]),
+                         records=(), intensity=x, measure="pga", outcome=o,
+                         max_rotation=np.zeros(o.shape), t_overturn=np.zeros(o.shape),
+                         scale=np.ones((2, 4)))
+    fit = fit_lognormal(x, fr.overturned[0, 0].sum(axis=0), np.full(4, 2))
+    assert fit.status == ("ok" if curves else "unidentified")
+    fr.fits = {"housner": {1.0: {"overturn": fit}}}
+    fig = fig_fragility(fr)
+    try:
+        ax = fig.axes[0]
+        drawn = [ln for ln in ax.get_lines() if ln.get_linestyle() not in ("None", "", " ")]
+        assert len(drawn) == curves
+        texts = [t.get_text() for t in ax.get_legend().get_texts()]
+        assert any(("median" in t) == bool(curves) for t in texts), texts
+    finally:
+        plt.close(fig)
