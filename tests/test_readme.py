@@ -112,6 +112,12 @@ def test_the_multiperiodic_examples_fate_is_todays():
     assert f.settings["spread"][1] == 1e-10
     assert round(100 * f.probabilities["overturn"]) == over
     assert round(100 * f.probabilities[f"multiperiodic p={period}"]) == other
+    # its transient's exponent and horizons (the theory page quotes them)
+    lam, t_round, t_pert = _number(r"exponent is \$\\lambda_1 \\approx ([\d.]+)\$\. Rounding .*? by "
+                                   r"\$t\^\* \\approx (\d+)\$, and a perturbation of \$10\^\{-10\}\$ by "
+                                   r"\$t\^\* \\approx (\d+)\$", CLAIMS["theory/study.md"]).groups()
+    assert f"{f.lambda1:.2f}" == lam
+    assert (round(f.horizon_rounding), round(f.horizon)) == (int(t_round), int(t_pert))
     # with the study's embedded forcing (the docs quote it)
     emb = _every(r"embedded forcing[^.]*?(\d+) % overturn and (\d+) % period 7",
                  ("study.md", "theory/study.md"))
