@@ -3,9 +3,9 @@
 
 One :class:`ExplorerApp` per browser tab, built once the tab's websocket is open and the page
 has loaded (:func:`document`; until then a request of the page holds a placeholder and computes
-nothing), stopped when the websocket closes (:mod:`.pages`). A change of a control is checked by the library first
-(a refused value is shown under its control with the library's message, and nothing else
-changes); an accepted change marks the views it affects as updating and submits their
+nothing), stopped when the websocket closes (:mod:`.pages`). A change of a control is checked
+by the library first (a refused value is shown under its control with the library's message,
+and nothing else changes); an accepted change marks the views it affects as updating and submits their
 computations to the tab's worker thread; results come back through the document's next-tick
 callbacks and are shown only while their request is still the newest (:meth:`Computer.
 is_current`). Behaviour colours come from :data:`rockjit.plotting.style.BEHAVIOUR_COLOURS`,
