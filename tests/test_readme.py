@@ -327,3 +327,27 @@ def test_the_multiperiodic_examples_accurate_overturning_time_is_as_quoted():
     assert f"{ends[1].t:.{len(t.split('.')[1])}f}" == t
     short = _number(r"overturns at \$t = ([\d.]+)\$; the outcome", CLAIMS["study.md"]).group(1)
     assert f"{ends[1].t:.{len(short.split('.')[1])}f}" == short
+
+
+def test_the_study_pages_basin_measures_are_todays():
+    # "What the attractor view adds": per basin and law, the behaviours' shares, the basin
+    # entropies, the uncertainty exponent and the integrity, at 100 x 100 cells, 500 periods
+    import rockjit
+    from rockjit import Block, Harmonic
+    text = CLAIMS["study.md"]
+    rows = re.findall(r"^\|\s*(\$h/b = [^|]*?)?\s*\| (Housner|Mao) \| ([^|]*) \| [^|]* \| "
+                      r"([\d.]+) / ([\d.]+) \| ([\d.]+) \| ([\d.]+) / ([\d.]+) \|$", text, re.M)
+    assert len(rows) == 4, rows
+    case = None
+    for where, law, shares, sb, sbb, unc, gim, if_ in rows:
+        if where:
+            case = [float(v) for v in re.findall(r"= ([\d.]+)\$", where)]
+        hb, alpha, omega = case
+        b = rockjit.basin(Block(hb=hb, law=law.lower()),
+                          Harmonic(alpha=alpha, omega=omega, r0=0.0, s0=1.0), 100)
+        fr, m = b.fractions(), b.measures()
+        for pct, name in re.findall(r"([\d.]+) % (\w+)", shares):
+            assert f"{fr[name]:.1f}" == pct, (case, law, name)
+        assert (f"{m['basin_entropy']:.3f}", f"{m['boundary_basin_entropy']:.3f}") == (sb, sbb)
+        assert f"{m['uncertainty_exponent']['alpha']:.2f}" == unc, (case, law)
+        assert (f"{m['integrity']['GIM']:.3f}", f"{m['integrity']['IF']:.3f}") == (gim, if_)
