@@ -529,3 +529,34 @@ def test_another_sites_page_cannot_frame_the_explorer(server):
     deadline = time.time() + 20
     while time.time() < deadline and server.stats()["pages"]:
         time.sleep(0.1)
+
+
+def test_pages_beyond_the_limit_are_told_to_close_one():
+    """The document function of each session: a placeholder until the page is ready in the
+    browser; then the explorer, while fewer than the limit compute; else a message."""
+    from bokeh.document import Document
+    from bokeh.events import DocumentReady
+
+    from rockjit.explorer.app import document
+    from rockjit.explorer.pages import Pages
+    pages = Pages(limit=1)
+    docs = [Document(), Document()]
+    for d in docs:
+        document(d, pages=pages)
+    assert pages.stats() == dict(sessions=2, pages=0, workers=0, busy=0)
+    assert _workers() == []
+    try:
+        for d in docs:
+            d.callbacks.trigger_event(DocumentReady())
+        first = docs[0].select_one({"css_classes": ["rj-controls"]})
+        assert first is not None  # the first page was built
+        full = [r for r in docs[1].roots]
+        assert len(full) == 1 and "at most 1 pages" in full[0].text
+        stats = pages.stats()
+        assert stats["pages"] == 1 and stats["workers"] == 1 and len(_workers()) == 1
+    finally:
+        pages.close_all()
+    deadline = time.time() + 30
+    while time.time() < deadline and _workers():
+        time.sleep(0.05)
+    assert _workers() == [] and pages.stats()["pages"] == 0 and pages.room()
