@@ -152,7 +152,10 @@ def grids():
                              lyapunov=True) for law in ("housner", "mao")}
     bs = {law: rockjit.basin(Block(hb=1.0, law=law), Harmonic(alpha=0.66, omega=1.3), 8,
                              integration=integ) for law in ("housner", "mao")}
-    return dict(sweeps=sw, basins=bs)
+    pl = rockjit.plane(Block(hb=1.0), (0.5, 0.9), (1.2, 1.4), grid=(3, 3), integration=integ)
+    fr = rockjit.fate(Block(hb=1.0), Harmonic(alpha=0.969, omega=1.3),
+                      integration=Integration(periods=60), ensemble=8)
+    return dict(sweeps=sw, basins=bs, plane=pl, fate=fr)
 
 
 def _branch(period, symmetric, value, y0, slope, ends=("range", "range"), stable=None):
@@ -305,6 +308,8 @@ def _builders():
         "fig9": lambda r, g: fig_chart({"housner": _chart("housner"),
                                         "mao": _chart("mao", 0.05)}),
         "chart": lambda r, g: fig_chart(_chart("housner")),
+        "plane": lambda r, g: P.fig_plane(g["plane"]),
+        "fate": lambda r, g: P.fig_fate(g["fate"]),
         "spectrum": lambda r, g: fig_spectrum({"housner": _spectrum("housner"),
                                                "mao": _spectrum("mao")}),
         "fragility": lambda r, g: fig_fragility(_fragility()),
