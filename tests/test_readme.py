@@ -351,3 +351,27 @@ def test_the_study_pages_basin_measures_are_todays():
         assert (f"{m['basin_entropy']:.3f}", f"{m['boundary_basin_entropy']:.3f}") == (sb, sbb)
         assert f"{m['uncertainty_exponent']['alpha']:.2f}" == unc, (case, law)
         assert (f"{m['integrity']['GIM']:.3f}", f"{m['integrity']['IF']:.3f}") == (gim, if_)
+
+
+def test_the_share_plotted_after_the_fall_is_todays():
+    # the study's sweeps integrated on past overturning: what they plot after the block fell
+    import rockjit
+    from rockjit import Block, Harmonic, Integration
+    from rockjit.study.paper import ALPHA_STEP, PERIODS, STUDY, after_the_fall
+    rows = re.findall(r"^\s*\| (\d) \| (Housner|Mao) \| ([\d.]+) % \| (.*?); \$\\lambda > 0\$ for "
+                      r"(\d+) of (\d+) \|$", CLAIMS["theory/study.md"], re.M)
+    assert len(rows) == 4, rows
+    for hb, law, share, motions, positive, total in rows:
+        hb, law = int(hb), law.lower()
+        sw = rockjit.sweep(Block(hb=float(hb), law=law), Harmonic(omega=STUDY[hb]["omega"]),
+                           rockjit.alpha_grid(STUDY[hb]["alpha_range"][law], ALPHA_STEP),
+                           integration=Integration(periods=PERIODS, stop_at_overturn=False),
+                           lyapunov=True)
+        a = after_the_fall(sw)
+        assert f"{a['plotted_after_fall_percent']:.1f}" == share, (hb, law)
+        quoted = {name: int(n) for n, name in re.findall(r"(\d+) (\w+)", motions)}
+        assert quoted == a["motions"], (hb, law)
+        assert (a["lambda_positive"], sum(quoted.values())) == (int(positive), int(total))
+    short = _number(r"(\d+) % of that diagram's amplitudes plot what followed an overturn",
+                    CLAIMS["study.md"]).group(1)
+    assert short == f"{float(rows[1][2]):.0f}"
