@@ -338,19 +338,29 @@ def test_the_study_pages_basin_measures_are_todays():
     rows = re.findall(r"^\|\s*(\$h/b = [^|]*?)?\s*\| (Housner|Mao) \| ([^|]*) \| [^|]* \| "
                       r"([\d.]+) / ([\d.]+) \| ([\d.]+) \| ([\d.]+) / ([\d.]+) \|$", text, re.M)
     assert len(rows) == 4, rows
-    case = None
+    case, basins = None, {}
     for where, law, shares, sb, sbb, unc, gim, if_ in rows:
         if where:
             case = [float(v) for v in re.findall(r"= ([\d.]+)\$", where)]
         hb, alpha, omega = case
-        b = rockjit.basin(Block(hb=hb, law=law.lower()),
-                          Harmonic(alpha=alpha, omega=omega, r0=0.0, s0=1.0), 100)
+        b = basins[hb, law] = rockjit.basin(Block(hb=hb, law=law.lower()),
+                                            Harmonic(alpha=alpha, omega=omega, r0=0.0, s0=1.0),
+                                            100)
         fr, m = b.fractions(), b.measures()
         for pct, name in re.findall(r"([\d.]+) % (\w+)", shares):
             assert f"{fr[name]:.1f}" == pct, (case, law, name)
         assert (f"{m['basin_entropy']:.3f}", f"{m['boundary_basin_entropy']:.3f}") == (sb, sbb)
         assert f"{m['uncertainty_exponent']['alpha']:.2f}" == unc, (case, law)
         assert (f"{m['integrity']['GIM']:.3f}", f"{m['integrity']['IF']:.3f}") == (gim, if_)
+    # the two laws' agreement on the behaviour and on the attractor, h/b = 1 and 2
+    from rockjit.basins.identity import agreement, attractor_agreement
+    quoted = _number(r"agree on the behaviour of ([\d.]+) % \(\$h/b = 1\$\) and ([\d.]+) % "
+                     r"\(\$h/b = 2\$\) of the cells and on the attractor \(matched by kind\) of "
+                     r"([\d.]+) % and ([\d.]+) %", text).groups()
+    got = [agreement(basins[hb, "Housner"].label, basins[hb, "Mao"].label) for hb in (1, 2)]
+    got += [attractor_agreement(basins[hb, "Housner"], basins[hb, "Mao"])["percent"]
+            for hb in (1, 2)]
+    assert tuple(f"{v:.1f}" for v in got) == quoted
 
 
 def test_the_share_plotted_after_the_fall_is_todays():
