@@ -108,11 +108,18 @@ def slow_entropy(ids, b):
     return sum(ent) / len(ent), (sum(bnd) / len(bnd) if bnd else math.nan)
 
 
-@pytest.mark.parametrize("shape, b, k", [((23, 31), 5, 3), ((40, 40), 4, 7), ((9, 17), 3, 40)])
-def test_entropy_matches_a_slow_reference_on_random_maps(shape, b, k):
-    ids = np.random.default_rng(7).integers(-2, k, size=shape)
+@pytest.mark.parametrize("shape, b, k, patch", [((23, 31), 5, 3, 1), ((40, 40), 4, 7, 1),
+                                               ((9, 17), 3, 40, 1), ((42, 36), 4, 3, 6)])
+def test_entropy_matches_a_slow_reference_on_random_maps(shape, b, k, patch):
+    # patch > 1: the map is made of patch x patch squares of one outcome, so that some boxes
+    # hold one outcome and others straddle a square's edge (Sbb differs from Sb)
+    n, m = -(-shape[0] // patch), -(-shape[1] // patch)
+    coarse = np.random.default_rng(7).integers(-2, k, size=(n, m))
+    ids = np.kron(coarse, np.ones((patch, patch), dtype=int))[:shape[0], :shape[1]]
     sb, sbb = basin_entropy(ids, box=b)
     ref_sb, ref_sbb = slow_entropy(ids, b)
+    if patch > 1:
+        assert 0 < ref_sb < ref_sbb
     assert sb == pytest.approx(ref_sb, rel=1e-12)
     assert sbb == pytest.approx(ref_sbb, rel=1e-12)
 
