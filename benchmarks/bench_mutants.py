@@ -271,7 +271,8 @@ MUTANTS += [
     _m("entropy-boundary", "entropy", MEASURES,
        "boundary = n_outcomes > 1", "boundary = n_outcomes > 0",
        "every box counted as a boundary box in the boundary basin entropy",
-       [TM + "test_entropy_matches_a_slow_reference_on_random_maps"]),
+       [TM + "test_entropy_matches_a_slow_reference_on_random_maps",
+        TM + "test_half_plane_entropy_counts_the_straddling_boxes"]),
     # ---- the explorer
     _m("explorer-nearest-cell", "explorer", EXPLORER,
        "k = int(round((v - axis[0]) / step))", "k = int((v - axis[0]) / step)",
@@ -378,6 +379,8 @@ def markdown(rows, baseline, total_s, env):
     stamp = H.env_line(env)
     now = [r for r in rows if r["ran"] == stamp]
     earlier = sorted({r["ran"] for r in rows} - {stamp})
+    kept = "; ".join(f"{sum(r['ran'] == e for r in rows)} of them {e[0].lower()}{e[1:]}"
+                     .rstrip(".") for e in earlier)
     body = [[r["name"], r["area"], f"`{r['file']}`", r["breaks"],
              ", ".join(f"`{t.split('/')[-1]}`" for t in r["tests"]),
              r["outcome"] + ("" if is_caught(r) else " ✗"), f"{r['seconds']:.1f}"]
@@ -393,10 +396,10 @@ def markdown(rows, baseline, total_s, env):
         H.md_table(["mutant", "area", "file", "what it breaks", "tests", "outcome", "s"], body),
         f"\n**{caught} of {len(rows)} caught**; baseline (every subset of this run, "
         f"unmutated): {baseline['outcome']} in {baseline['seconds']:.1f} s; this run "
-        f"{total_s / 60:.1f} min for {len(now)} mutants (each row's time includes a cold "
-        "compile of the kernels its tests need).",
-        (f" The other {len(rows) - len(now)} rows are kept from an earlier run. "
-         f"{'; '.join(earlier)}" if earlier else ""), "\n",
+        f"{total_s / 60:.1f} min for {len(now)} mutant{'s' * (len(now) != 1)} (each row's "
+        "time includes a cold compile of the kernels its tests need).",
+        (f" The other {len(rows) - len(now)} rows are kept from earlier runs: {kept}."
+         if earlier else ""), "\n",
         "\n`python benchmarks/bench_mutants.py` (one mutant: `--only NAME`; some areas: "
         "`--areas AREA ...`).\n",
         f"\n{H.env_line(env)}\n"])
