@@ -278,11 +278,12 @@ def _rest_inset(ax, result, colour):
     if np.count_nonzero(keep) < 2:
         return
     k = np.arange(1, imp.shape[0] + 1)[keep]
-    ins = ax.inset_axes([0.7, 0.3, 0.28, 0.4])
+    ins = ax.inset_axes([0.72, 0.45, 0.2, 0.28])
     ins.plot(k, speed[keep], "o-", color=colour, ms=2.5, lw=0.8)
     ins.set_yscale("log")
     ins.set_xlim(0.5, imp.shape[0] + 0.5)
     ins.tick_params(labelsize=7)
+    ins.yaxis.tick_right()  # the labels away from the falling curve on the left
     ins.xaxis.get_major_locator().set_params(integer=True)
     ins.set_title(f"$|\\theta'^-|$ at impacts 1 to {imp.shape[0]}", fontsize=7)
 
