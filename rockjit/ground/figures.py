@@ -159,21 +159,29 @@ def fig_spectrum(results, comparison=None):
     return fig
 
 
-def _curve(ax, x, frac, fit, colour, ls, label):
+def _law_marker(law):
+    """The law's marker (:data:`rockjit.plotting.style.LAW_LINES`): two laws' points that
+    coincide stay both visible."""
+    from ..plotting.style import LAW_LINES
+    return LAW_LINES.get(law, LAW_LINES["constant"])["marker"]
+
+
+def _curve(ax, x, frac, fit, colour, ls, label, marker="o"):
     """The fraction observed at each intensity (open circles) and, where the fit's status is
     ``"ok"``, the fitted curve over the intensities of the data only; returns the legend
     entry."""
     from matplotlib.lines import Line2D
     x = np.asarray(x, float)
-    ax.plot(x, frac, "o", color=colour, ms=3, mfc="none", mew=0.8)
+    ax.plot(x, frac, ls="", marker=marker, color=colour, ms=3.5 if marker == "o" else 4.5,
+            mfc="none", mew=0.8)
     if fit.status == "ok":
         xs = np.geomspace(x.min(), x.max(), 300) if x.min() > 0 else \
             np.linspace(x.min(), x.max(), 300)
         ax.plot(xs, fit.probability(xs), color=colour, ls=ls, lw=1.0)
-        return Line2D([], [], color=colour, ls=ls, lw=1.0, marker="o", ms=3, mfc="none",
+        return Line2D([], [], color=colour, ls=ls, lw=1.0, marker=marker, ms=3, mfc="none",
                       mew=0.8, label=f"{label}: median {fit.median:.3g}, "
                                      f"$\\beta$ {fit.beta:.2f}")
-    return Line2D([], [], color=colour, ls="", marker="o", ms=3, mfc="none", mew=0.8,
+    return Line2D([], [], color=colour, ls="", marker=marker, ms=3, mfc="none", mew=0.8,
                   label=f"{label}: no fit ({fit.status.replace('_', ' ')})")
 
 
@@ -196,7 +204,8 @@ def fig_fragility(res):
             handles.append(_curve(ax, res.intensity, frac[li, si],
                                   res.fits[law][float(size)]["overturn"], _law_colour(law),
                                   _STYLES[si % len(_STYLES)],
-                                  f"{_LAW_NAMES.get(law, law)}, $R = {size:g}$ m"))
+                                  f"{_LAW_NAMES.get(law, law)}, $R = {size:g}$ m",
+                                  _law_marker(law)))
     ax.set_xlabel(_xlabel(res))
     ax.set_ylabel("P(overturn)")
     ax.set_ylim(-0.03, 1.03)
@@ -221,7 +230,8 @@ def fig_rotation(res):
                 handles.append(_curve(ax, res.intensity, frac[li, si],
                                       res.fits[law][float(size)][f"exceed_{lv:g}"],
                                       _law_colour(law), _STYLES[si % len(_STYLES)],
-                                      f"{_LAW_NAMES.get(law, law)}, $R = {size:g}$ m"))
+                                      f"{_LAW_NAMES.get(law, law)}, $R = {size:g}$ m",
+                                      _law_marker(law)))
         ax.set_xlabel(_xlabel(res))
         ax.set_title(f"$\\max|\\theta| / \\theta_c \\geq {lv:g}$")
         ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncols=1,
