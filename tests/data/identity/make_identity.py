@@ -62,8 +62,14 @@ def main(argv=None):
     wanted = set(args.only or old["cases"])
     with np.load(HERE / "labels.npz") as z:
         small = {k: z[k] for k in z.files if k.split("::")[0] not in wanted}
+    with np.load(HERE / "blas_values.npz") as z:
+        blas = {k: z[k] for k in z.files if k.split("::")[0] not in wanted}
+    core = ti.blas_core()
+    if old.get("blas_core") not in (None, core) and not wanted >= ti.BLAS_CASES:
+        sys.exit(f"the record's BLAS cases were made under {old['blas_core']} kernels and "
+                 f"this machine's are {core}: re-record all of them or none")
     doc = dict(commit=_commit(), numpy=np.__version__, python=sys.version.split()[0],
-               note=old["note"], cases=old["cases"])
+               blas_core=core, note=old["note"], cases=old["cases"])
     t_all = time.perf_counter()
     for name in old["cases"]:
         if name not in wanted:
@@ -71,10 +77,12 @@ def main(argv=None):
         case = doc["cases"][name]
         t0 = time.perf_counter()
         res = _two_state_plane() if name == ti.TWO_STATES else ti._result(name)
-        arrays, scalars, sm = {}, {}, {}
-        ti.walk(res, "", arrays, scalars, sm)
+        arrays, scalars, sm, whole = {}, {}, {}, {}
+        ti.walk(res, "", arrays, scalars, sm, whole)
         case["arrays"], case["scalars"] = arrays, scalars
         small.update({f"{name}::{p}": a for p, a in sm.items()})
+        if name in ti.BLAS_CASES:
+            blas.update({f"{name}::{p}": a for p, a in whole.items()})
         print(f"{name:34s} {time.perf_counter() - t0:7.3f} s  {len(arrays):4d} arrays  "
               f"{len(scalars):4d} scalars", flush=True)
     print(f"{'total':34s} {time.perf_counter() - t_all:7.2f} s", flush=True)
@@ -83,6 +91,7 @@ def main(argv=None):
         f.write("\n")
     # fixed member order and no timestamps: two runs write identical bytes
     _savez(HERE / "labels.npz", small)
+    _savez(HERE / "blas_values.npz", blas)
 
 
 def _commit():
