@@ -3,9 +3,9 @@
 Thousands of seeded runs over hb in [0.75, 20], alpha in [0, 3], omega in [0.05, 20], e in [0, 1]
 (Housner, Mao, constant), N from 8 to 1024, closed and embedded forcing, from initial states near
 0, grazing, near overturning, and over long horizons; and cases beyond those ranges: damping up
-to xi = 500, omega from 1e-3 to 1e3, orbits through rest (rockjit/testing/stress.py says exactly
-which). Every run must end with a known status, within the work bound, with no NaN or
-inf in its output; the impact bound, when hit, is counted and reported. The exact checks ride
+to xi = 500, omega from 1e-3 to 1e3, orbits through rest (tests/stress.py says exactly
+which). Every run must end with a known status, within the work bound, with no NaN or inf in
+its output; the impact bound, when hit, is counted and reported. The exact checks ride
 along: energy conservation (e = 1, xi = 0, no forcing), the mirror symmetry (exact with the
 embedding, to the run's rounding horizon with the closed form) and 1 against 2 threads.
 tests/test_stress.py runs a fast subset of the same generator.
@@ -32,7 +32,9 @@ import _common as H
 
 import rockjit
 from rockjit import Block, Execution, Harmonic, Integration
-from rockjit.testing import stress as S
+
+sys.path.insert(0, str(H.ROOT / "tests"))  # the suite's cases and checks: tests/stress.py
+import stress as S  # noqa: E402
 
 #: n_runs: the stress cases of the study's ranges; n_extreme: the cases beyond them
 FULL = dict(n_runs=3000, n_extreme=3900, max_periods=200, long_periods=20_000, n_energy=300,
@@ -245,7 +247,7 @@ def markdown(m):
         "through the run checks.\n\n",
         "Runs by category and final status:\n\n",
         H.md_table(["category"] + [f"`{s}`" for s in STATUSES] + ["runs"], cat_rows),
-        "\nChecks (rockjit/testing/stress.py defines each):\n\n",
+        "\nChecks (tests/stress.py defines each):\n\n",
         H.md_table(["check", "tried", "failed", "not run"], check_rows),
         "\nReported, not failed:\n\n",
         H.md_table(["outcome", "runs"], obs_rows),

@@ -33,7 +33,7 @@ PUBLIC_MODULES = [
     "rockjit.result", "rockjit.grids.plan", "rockjit.grids.sweep_grid",
     "rockjit.grids.basin_grid", "rockjit.grids.plane_grid", "rockjit.basins.erosion",
     "rockjit.basins.fate", "rockjit.basins.measures", "rockjit.storage.files",
-    "rockjit.testing.stress", "rockjit.orbits.shooting", "rockjit.orbits.arclength",
+    "rockjit.orbits.shooting", "rockjit.orbits.arclength",
     "rockjit.orbits.types", "rockjit.basins.identity", "rockjit.basins.cycles",
     "rockjit.orbits.curves", "rockjit.orbits.plane_chart", "rockjit.ground.pulses",
     "rockjit.ground.records", "rockjit.ground.fema", "rockjit.ground.settings",
@@ -81,7 +81,6 @@ def _public_objects():
     from rockjit.basins import erosion, fate, measures
     from rockjit.single import Prepared
     from rockjit.storage import files
-    from rockjit.testing import stress
     spectrum = sys.modules["rockjit.ground.spectrum"]  # (rockjit.ground.spectrum: the function)
     out = [(f"rockjit.{n}", getattr(rockjit, n)) for n in rockjit.__all__]
     out += [(f"rockjit.ground.{n}", getattr(ground, n)) for n in ground.__all__]
@@ -93,9 +92,6 @@ def _public_objects():
     out += [("rockjit.basins.erosion.ErosionResult", erosion.ErosionResult),
             ("rockjit.basins.fate.FateResult", fate.FateResult),
             ("rockjit.storage.files.OutputDir", files.OutputDir)]
-    out += [(f"rockjit.testing.stress.{n}", getattr(stress, n)) for n in
-            ("cases", "extreme_cases", "case_by_id", "run_case", "check_run", "simulate_flat",
-             "objects", "Case")]
     return [(n, o) for n, o in out if inspect.isclass(o) or inspect.isfunction(o)
             or hasattr(o, "plan")]
 

@@ -15,7 +15,7 @@ import pytest
 
 import rockjit
 from rockjit import Block, Harmonic, Integration, Scipy
-from rockjit.testing.stress import simulate_flat
+from stress import simulate_flat
 
 DOP = Scipy("DOP853", rtol=1e-12, atol=1e-12)
 Z0 = (-0.2254, -0.1597, -0.7778, 0.6284)  # docs/theory/study.md
@@ -23,7 +23,7 @@ Z0 = (-0.2254, -0.1597, -0.7778, 0.6284)  # docs/theory/study.md
 
 def _run(kw, **more):
     """``rockjit.simulate`` of a table's flat keywords (those of
-    :func:`rockjit.testing.stress.simulate_flat`, and ``z0``: the four of the initial state)."""
+    ``stress.simulate_flat`` (tests/stress.py), and ``z0``: the four of the initial state)."""
     kw = dict(kw, **more)
     if "z0" in kw:
         kw.update(zip(("theta0", "dtheta0", "r0", "s0"), kw.pop("z0")))

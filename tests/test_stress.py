@@ -1,6 +1,6 @@
 """The numerical stress suite, fast subset.
 
-The seeded generator and the checks live in ``rockjit/testing/stress.py``, shared with the full
+The seeded generator and the checks live in ``tests/stress.py``, shared with the full
 run ``benchmarks/bench_stress.py``; here a few dozen cases per kind, 50 periods at most, must pass
 every check with no failure. The checks themselves are tested first: each must catch the fault it
 is meant to catch, injected into an otherwise good result. Cases are flat keywords (the form the
@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import rockjit
-from rockjit.testing import stress as S
+import stress as S
 
 SEED = 0
 N_CASES = 60
@@ -372,3 +372,10 @@ def test_bookkeeping_knows_the_default_impact_bound_grows_with_periods():
     assert res.status == "max_impacts" and res.n_impacts == 15 * 10_000  # independent: the rule
     assert S.check_bookkeeping(kw, res) == []
     assert S.check_bookkeeping(dict(kw, max_impacts=100_000), res) != []  # a smaller bound fails
+
+
+def test_the_harness_examples_run():
+    """The examples in the harness's docstrings (tests/stress.py) run as written."""
+    import doctest
+    failed, tried = doctest.testmod(S, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+    assert tried > 0 and failed == 0

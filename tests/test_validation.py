@@ -18,7 +18,7 @@ import pytest
 import rockjit
 from rockjit import (Block, Classification, Execution, Harmonic, Integration, Lattice, Scipy)
 from rockjit.single import MAX_STEP
-from rockjit.testing.stress import simulate_flat
+from stress import simulate_flat
 
 BASE = dict(hb=1.0, alpha=0.6, omega=1.3, periods=1)
 NAN = math.nan

@@ -4,10 +4,10 @@ every run must pass.
 What it is for: finding inputs on which the compiled integrator misbehaves (a NaN, a wrong
 ending, unbounded work, impacts that stop advancing time, broken exact symmetries) by running
 thousands of seeded cases over and beyond the study's ranges, and checking each result against
-properties that must hold whatever the dynamics. It is test infrastructure shipped with the
-package so that both users of it import it the same way: ``tests/test_stress.py`` runs a fast
-subset in the test suite, and ``benchmarks/bench_stress.py`` runs the full suite and tabulates
-the outcome (benchmarks/README.md, "Stress suite"). Everything is a pure function of a seed, so a
+properties that must hold whatever the dynamics. Two users import it as ``stress`` (from
+``tests/``, where it lives): ``tests/test_stress.py`` runs a fast subset in the test suite, and
+``benchmarks/bench_stress.py`` runs the full suite and tabulates the outcome
+(benchmarks/README.md, "Stress suite"). Everything is a pure function of a seed, so a
 failing case can be rerun by its id (``python benchmarks/bench_stress.py --case ID``).
 
 Cases cover hb in [0.75, 20], alpha in [0, 3] (half of them with ``alpha omega^2 hb`` in [0, 4],
@@ -118,11 +118,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 import rockjit
-
-from ..excitation import Harmonic
-from ..model import Block
-from ..settings import Classification, Execution, Integration, Lattice, default_max_impacts
-from ..single import steps_per_period
+from rockjit.excitation import Harmonic
+from rockjit.model import Block
+from rockjit.settings import Classification, Execution, Integration, Lattice, default_max_impacts
+from rockjit.single import steps_per_period
 
 RANGES = dict(hb=(0.75, 20.0), alpha=(0.0, 3.0), omega=(0.05, 20.0), e=(0.0, 1.0))
 CATEGORIES = ("random", "near_zero", "grazing", "near_overturn", "long_horizon",
@@ -187,7 +186,7 @@ def objects(kw):
 
     Examples
     --------
-    >>> from rockjit.testing.stress import objects
+    >>> from stress import objects
     >>> block, forcing, state, integration, rest = objects(
     ...     dict(hb=1.0, alpha=0.6, omega=1.3, theta0=0.1, periods=20, lyapunov=True))
     >>> forcing.start()[1:], state, integration.periods, rest
@@ -220,7 +219,7 @@ def simulate_flat(**kw):
 
     Examples
     --------
-    >>> from rockjit.testing.stress import simulate_flat
+    >>> from stress import simulate_flat
     >>> simulate_flat(hb=1.0, alpha=0.6, omega=1.3, theta0=0.1, periods=20).status
     'done'
     """
@@ -244,7 +243,7 @@ class Case:
 
     Examples
     --------
-    >>> from rockjit.testing.stress import Case, run_case
+    >>> from stress import Case, run_case
     >>> case = Case("demo", "random", dict(hb=1.0, alpha=0.6, omega=1.3, periods=20))
     >>> result, problems, refusal = run_case(case)
     >>> result.status, any(problems.values()), refusal
@@ -466,7 +465,7 @@ def cases(n, seed=0, *, max_periods=200, long_periods=20_000):
 
     Examples
     --------
-    >>> from rockjit.testing.stress import cases
+    >>> from stress import cases
     >>> [(c.id, c.category) for c in cases(3)]
     [('s0-0', 'random'), ('s0-1', 'near_zero'), ('s0-2', 'grazing')]
     """
@@ -571,7 +570,7 @@ def extreme_cases(n, seed=0, *, max_periods=200):
 
     Examples
     --------
-    >>> from rockjit.testing.stress import extreme_cases
+    >>> from stress import extreme_cases
     >>> [(c.id, c.category) for c in extreme_cases(3)]
     [('x0-0', 'stiff_damping'), ('x0-1', 'wide_omega'), ('x0-2', 'through_rest')]
     """
@@ -601,7 +600,7 @@ def case_by_id(case_id, *, max_periods=200, long_periods=20_000):
 
     Examples
     --------
-    >>> from rockjit.testing.stress import case_by_id
+    >>> from stress import case_by_id
     >>> case = case_by_id("s0-1")
     >>> case.category, case.kwargs["periods"], case.kwargs["dtheta0"]
     ('near_zero', 1, -1e-300)
@@ -812,7 +811,7 @@ def check_run(kw, res):
 
     Examples
     --------
-    >>> from rockjit.testing.stress import check_run, simulate_flat
+    >>> from stress import check_run, simulate_flat
     >>> kw = dict(hb=1.0, alpha=0.6, omega=1.3, periods=20)
     >>> problems = check_run(kw, simulate_flat(**kw))
     >>> sorted(problems), any(problems.values())
@@ -860,7 +859,7 @@ def run_case(case):
 
     Examples
     --------
-    >>> from rockjit.testing.stress import Case, run_case
+    >>> from stress import Case, run_case
     >>> coarse = Case("demo", "random", dict(hb=1.0, alpha=0.6, omega=0.05, n_steps=8))
     >>> result, problems, refusal = run_case(coarse)
     >>> result is None, refusal.startswith("n_steps must be >=")

@@ -1,1 +1,0 @@
-"""Tools for testing rockjit itself: the seeded stress suite (:mod:`.stress`)."""
