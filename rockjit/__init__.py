@@ -15,6 +15,8 @@ import importlib
 _HOMES = {
     "explore": "rockjit.explorer",
     "erosion": "rockjit.basins.erosion",
+    "safety": "rockjit.integrity", "SafetyResult": "rockjit.integrity",
+    "fatal_shock": "rockjit.integrity", "edge_state": "rockjit.integrity",
     "fate": "rockjit.basins.fate",
     "Harmonic": "rockjit.excitation",
     "Pulse": "rockjit.ground", "Record": "rockjit.ground", "Transient": "rockjit.ground",

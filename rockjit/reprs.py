@@ -146,6 +146,19 @@ def _erosion(r):
                                "label")))])
 
 
+def _safety(r):
+    na, nw = np.shape(r.safe)
+    g = "×".join(str(np.size(x)) for x in (r.theta0, r.dtheta0))
+    s = np.asarray(r.safe, dtype=float)
+    return _lines(f"SafetyResult: {na}×{nw} forcings × {g} basins", [
+        ("block", _block(r.block)),
+        ("alpha", _span(r.alpha)), ("omega", _span(r.omega)),
+        ("safe", f"{_g(np.nanmin(s), '.3f')} to {_g(np.nanmax(s), '.3f')} of the initial states"
+                 if s.size else None),
+        ("attractors", f"up to {int(np.max(r.n_attractors, initial=0))} per forcing"),
+        ("arrays", _arrays(r, ("safe", "GIM", "IF", "LIM", "n_attractors")))])
+
+
 def _fate(r):
     return _lines(f"FateResult: {np.size(r.outcome)} runs near one initial state", [
         ("block", _block(r.block)), ("forcing", _forcing(r.forcing)),
@@ -256,7 +269,8 @@ def _fragility(r):
 
 
 _BY_TYPE = {"SweepResult": _sweep, "BasinResult": _basin, "PlaneResult": _plane,
-            "ErosionResult": _erosion, "FateResult": _fate, "Attractor": _attractor,
+            "ErosionResult": _erosion, "SafetyResult": _safety,
+            "FateResult": _fate, "Attractor": _attractor,
             "PeriodicOrbit": _orbit, "Branch": _branch, "Bifurcation": _bifurcation,
             "Continuation": _continuation, "ChartResult": _chart,
             "SpectrumResult": _spectrum, "FragilityResult": _fragility}

@@ -142,6 +142,7 @@ OUTPUTS = {
     "basin": ("basin.npz", "basin.*", "attractors.*"),
     "plane": ("plane.npz", "plane.*"),
     "erosion": ("erosion.npz", "erosion.*"),
+    "safety": ("safety.npz", "safety_*"),
     "orbits": ("orbits.npz", "orbits.*"),
     "fate": ("fate.npz", "fate.*"),
     "cor": ("restitution.*", "e_table.csv", "e_table.md"),
@@ -151,8 +152,8 @@ OUTPUTS = {
     "fragility": ("fragility.npz", "fragility.*", "rotation.*"),
 }
 #: The commands whose grids keep their finished chunks in <out>.chunks.
-CHUNKED = ("sweep", "basin", "plane", "erosion", "orbits", "chart", "paper", "spectrum",
-           "fragility")
+CHUNKED = ("sweep", "basin", "plane", "erosion", "safety", "orbits", "chart", "paper",
+           "spectrum", "fragility")
 
 
 def _check_run(args):
@@ -371,6 +372,32 @@ def _erosion_plan(args):
                               integration=integration, classification=_classification(args),
                               execution=execution)
             for law in _laws(args)}
+
+
+def _safety_plan(args):
+    """``rockjit safety``: one :func:`rockjit.safety` plan per law, the contour levels
+    checked."""
+    from ..integrity.chart import safety
+    from ..validate import real
+    for v in args.levels:
+        real("--levels", v, 0.0, 1.0)
+    phase = _forcing(args, alpha=False, omega=False)
+    return {law: safety.plan(_block(args, law), tuple(args.alpha_range),
+                             tuple(args.omega_range), grid=tuple(args.grid),
+                             lattice=args.lattice, forcing=phase,
+                             integration=_integration(args),
+                             classification=_classification(args), execution=_execution(args))
+            for law in _laws(args)}
+
+
+def _safety_run(args, plans, out):
+    from ..integrity.chart import run
+    from ..integrity.figure import write
+    t0 = time.perf_counter()
+    res = {law: _grid(args, run, p, f"safety_{law}") for law, p in plans.items()}
+    wall = time.perf_counter() - t0
+    _say(args, f"{args.command}: computed in {wall:.1f} s")
+    return wall, write(out, res, tuple(args.levels))
 
 
 def _grid_run(writer, name):
@@ -796,6 +823,29 @@ def build_parser():
     _add_block(p, alpha=False, laws="housner, mao, constant or both")
     _add_alphas(p, 0.01)
     p.add_argument("--grid", type=int, default=100, help="cells per side (default 100)")
+    _add_phase(p, "default (r0, s0) = (0, 1)")
+    _add_run(p, grid=True)
+    p.add_argument("--full-length", action="store_true", help="disable early stopping")
+    _add_common(p)
+    _add_scheduler(p)
+
+    p = _command(sub, "safety", _safety_plan, _safety_run,
+                 "integrity charts: the safe basin over the (alpha, omega) plane",
+                 "A basin at every forcing of an (alpha, omega) grid, each reduced to its safe "
+                 "fraction, GIM, IF, LIM and attractors; write safety.npz, safety_<law>.png "
+                 "(the safe fraction with contours at --levels; with --law both also "
+                 "safety_difference.png) and summary.json. Column by column, resumable, on "
+                 "Dask with --scheduler.")
+    _add_block(p, alpha=False, omega=False, laws="housner, mao, constant or both")
+    _add_alphas(p, None)
+    p.add_argument("--omega-range", type=float, nargs=2, required=True,
+                   metavar=("START", "END"), help="frequencies (ends included)")
+    p.add_argument("--grid", type=int, nargs=2, default=(20, 20), metavar=("NA", "NW"),
+                   help="forcings along alpha and omega (default 20 20)")
+    p.add_argument("--lattice", type=int, default=50,
+                   help="initial states per side of every basin, over [-1, 1]^2 (default 50)")
+    p.add_argument("--levels", type=float, nargs="+", default=[0.5, 0.9], metavar="FRACTION",
+                   help="safe fractions drawn as contours (default 0.5 0.9)")
     _add_phase(p, "default (r0, s0) = (0, 1)")
     _add_run(p, grid=True)
     p.add_argument("--full-length", action="store_true", help="disable early stopping")
