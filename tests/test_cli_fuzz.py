@@ -143,7 +143,8 @@ NAMES = {
     "--xi": r"\bxi\b", "--rest-speed": r"rest[-_]speed", "--max-impacts": r"max[-_]impacts",
     "--uncertainty": r"\buncertainty\b", "--erosion-step": r"erosion[-_]step",
     "--ensemble": r"\bensemble\b", "--spread": r"\bspread\b", "--seed": r"\bseed\b",
-    "--erosion-grid": r"erosion[-_]grid", "--max-period": r"max[-_]period",
+    "--erosion-grid": r"erosion[-_]grid", "--lattice": r"\blattice\b", "--levels": r"levels",
+    "--max-period": r"max[-_]period",
     "--scheduler": r"--scheduler\b(?!-)", "--scheduler-timeout": r"scheduler[-_]timeout",
     "--seed-omegas": r"seed[-_]omegas",
     "--pulse": r"--pulse\b", "--ratio-range": r"\bratio", "--amplitude-range": r"\bamplitude",
@@ -862,6 +863,10 @@ BASES = {
               "--omega-range": [("0.8", "3"), ("1", "1.6")], "--grid": [None, ("4", "5")],
               "--law": [None, "housner", "mao", "both"], "--periods": [None, "5", "20"],
               "--max-period": [None, "1", "2"]},
+    "safety": {"--hb": ["1", "2"], "--alpha-range": [("0.5", "0.6"), ("0.1", "0.2")],
+               "--omega-range": [("1.2", "1.3"), ("1", "1.6")], "--grid": [None, ("2", "3")],
+               "--lattice": [None, "4"], "--law": [None, "housner", "both"],
+               "--periods": [None, "5"], "--levels": [None, ("0.5",), ("0.2", "0.8")]},
     "fate": {"--hb": ["1", "2"], "--alpha": ["0.6", "0.969"], "--omega": ["1.3", "1.6"],
              "--ensemble": [None, "8"], "--periods": [None, "5"], "--n-steps": [None, "64"]},
     "spectrum": {"--hb": ["1", "2", "4"], "--law": [None, "housner", "mao", "both"],
@@ -1266,6 +1271,8 @@ EDGE_BASES = {
               "--max-period 1",
     "chart": "--hb 2 --alpha-range 0.1 0.2 --omega-range 1.2 1.3 --grid 2 2 --periods 2 "
              "--max-period 1 --seed-omegas 1.25",
+    "safety": "--hb 2 --alpha-range 0.1 0.2 --omega-range 1.2 1.3 --grid 2 2 --lattice 2 "
+              "--periods 1",
     "fate": "--hb 2 --alpha 0.2 --omega 1.3 --periods 1 --ensemble 2",
     "spectrum": "--hb 4 --ratio-range 1 2 --amplitude-range 1 2 --grid 2 2 --free-time 5",
     "fragility": f"--hb 3 --size 1 --records {RECORD_OK} --intensities 1.5 --free-time 5",
@@ -1279,7 +1286,8 @@ GUARD_ONLY = {"paper", "explore"}
 #: Accepted edge values that ask for much legitimate work (minutes, not years, or a server):
 #: checked as far as the start of the work
 LONG_EDGES = {("fate", "--ensemble", "1000000"), ("spectrum", "--grid", "10000"),
-              ("fragility", "--size", "0.001")}  # a 1 mm block: about a minute
+              ("fragility", "--size", "0.001"),  # a 1 mm block: about a minute
+              ("safety", "--grid", "1000")}
 
 
 def _long(case):

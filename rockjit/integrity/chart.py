@@ -25,7 +25,7 @@ from ..excitation import ALPHA_MAX, OMEGA_RANGE, check_acceleration
 from ..grids import plan as gp
 from ..grids import runner
 from ..grids.basin_grid import lattice as as_lattice
-from ..settings import Execution
+from ..settings import Execution, Lattice
 from ..validate import integer, pair
 
 __all__ = ["MAX_SIDE", "SafetyPlan", "SafetyResult", "run", "safety"]
@@ -240,8 +240,8 @@ def safety(block, alpha_range, omega_range, *, grid=(20, 20), lattice=50, forcin
     grid : pair of int
         Points ``(na, nw)`` along alpha and omega, each in ``[1, 1000]`` (default 20 20).
     lattice : int or Lattice
-        Every basin's initial states (as ``grid`` of :func:`rockjit.basin`, at least 2 per
-        side); default 50 per side over ``[-1, 1]^2``.
+        Every basin's initial states: points per side over ``[-1, 1]^2``, in ``[2, 10^5]``
+        (default 50), or a :class:`rockjit.Lattice` of at least 2 per side.
     forcing : Harmonic, optional
         The forcing's phase (no ``alpha`` or ``omega``: the chart sweeps both); default
         ``(r0, s0) = (0, 1)``, the basins' and erosion profiles'.
@@ -283,7 +283,8 @@ def safety(block, alpha_range, omega_range, *, grid=(20, 20), lattice=50, forcin
     if nw > 1 and not w0 < w1:
         raise ValueError(f"omega_range must have start < end for {nw} frequencies "
                          f"(got ({w0:g}, {w1:g}))")
-    lat = as_lattice(lattice)
+    lat = as_lattice(lattice if isinstance(lattice, Lattice) else
+                     integer("lattice", lattice, 2, 10**5))
     if lat.grid < 2:
         raise ValueError(f"lattice must have >= 2 points per side: the integrity measures need "
                          f"a two-dimensional lattice (got {lat.grid})")
