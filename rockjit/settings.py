@@ -8,8 +8,8 @@ name the field, the allowed range and the value given:
 - :class:`Classification`: how a grid's cells are classified (the period test's tolerances,
   early stopping, attractor identity, the uncertain-cell test);
 - :class:`Lattice`: the initial states of a basin, ``grid x grid`` over ``(theta0, theta0')``;
-- :class:`Execution`: where and how a grid runs (threads, chunks, lanes, a Dask cluster, a chunk
-  store, progress). It never changes a result.
+- :class:`Execution`: where and how a grid runs (the device, threads, chunks, lanes, a Dask
+  cluster, a chunk store, progress). It never changes a result.
 
 The block (:class:`rockjit.Block`) and the excitation (:class:`rockjit.Harmonic`) are the other
 two; every entry point takes these objects plus what is its own alone.
@@ -24,8 +24,9 @@ from typing import Any, Callable
 
 from .validate import boolean, integer, pair, real
 
-__all__ = ["Classification", "Execution", "Integration", "Lattice", "MAX_IMPACTS", "MAX_N",
-           "MAX_PERIODS", "REST_SPEED_RANGE", "default_max_impacts"]
+__all__ = ["DEVICES", "Classification", "Execution", "Integration", "Lattice", "MAX_IMPACTS",
+           "MAX_N", "MAX_PERIODS", "REST_SPEED_RANGE", "cuda_missing", "cuda_refusal",
+           "default_max_impacts"]
 
 #: Largest number of periods, and of steps per period, a run may ask for: bounds that keep the
 #: kernels' step counter in 64 bits. The memory check refuses most large requests first, with
@@ -248,6 +249,38 @@ class Lattice(_Replace):
                 np.linspace(*self.dtheta_range, self.grid))
 
 
+#: Where a grid's cells may run (:class:`Execution`'s ``device``).
+DEVICES = ("cpu", "cuda")
+
+
+def cuda_missing():
+    """What this machine lacks for ``device="cuda"``, as a phrase, or ``None`` where numba's
+    CUDA target sees a GPU (``numba.cuda.is_available()``; imported only when asked)."""
+    import importlib
+    try:
+        cuda = importlib.import_module("numba.cuda")
+    except Exception:  # numba-cuda absent or broken: any failure to import means no device
+        return "numba-cuda is not installed"
+    try:
+        if cuda.is_available():
+            return None
+    except Exception:  # a driver that fails to load is no driver
+        pass
+    return "no CUDA-capable GPU with a working driver was found"
+
+
+def cuda_refusal(what='device="cuda"', instead='device="cpu"'):
+    """The one line that refuses ``what`` (the CUDA device, as the caller names it): what it
+    needs, what is missing here, and ``instead``."""
+    need = (f'{what} needs a CUDA-capable NVIDIA GPU with its driver and numba-cuda '
+            f'(pip install "rockjit[cuda]")')
+    missing = cuda_missing()
+    if missing is not None:
+        return f"{need}; {missing}: use {instead}"
+    return f"{need}, and CUDA kernels, which this version of rockjit does not have yet: " \
+        f"use {instead}"
+
+
 @dataclass(frozen=True)
 class Execution(_Replace):
     """Where and how a grid runs. Nothing here changes a result: every cell is computed the
@@ -255,11 +288,21 @@ class Execution(_Replace):
 
     Parameters
     ----------
+    device : {"cpu", "cuda"}
+        Where the cells run: the CPU's cores (default), or an NVIDIA GPU through numba's CUDA
+        target, which needs a CUDA-capable GPU with its driver and ``numba-cuda``
+        (``pip install "rockjit[cuda]"``). This version has no CUDA kernels yet:
+        ``device="cuda"`` is refused with a ``ValueError`` saying so, or saying what of the GPU,
+        its driver and ``numba-cuda`` this machine lacks.
     threads : int, optional
         numba threads (default: all).
     chunk : int, optional
-        Cells per chunk: the unit of progress, of Dask tasks and of resumption; default about a
-        twentieth of the grid, at least 64.
+        Cells per chunk: the unit of progress, of Dask tasks and of resumption. Default, in
+        this process, 256 cells per thread (the whole grid if smaller), and a rerun on a chunk
+        store keeps the first run's chunks; on Dask, about a twentieth of the grid, at least
+        64. In this process the chunks do not wait for each other: a chunk gets a thread per
+        64 of its cells (at most all of them) and one chunk more than the threads hold runs
+        at once, so that chunks of any size keep every thread busy.
     lanes : int, optional
         Cells per thread in lockstep, 1 to 8 (grids without tangent vectors); default 8.
     client : dask.distributed.Client, optional
@@ -297,6 +340,7 @@ class Execution(_Replace):
     chunk: int | None = None
     lanes: int | None = None
     client: Any = None
+    device: str = "cpu"
     scheduler: str | None = None
     store: Any = None
     progress: bool | Callable = False
@@ -304,6 +348,11 @@ class Execution(_Replace):
     worker_timeout: float | None = None
 
     def __post_init__(self):
+        if not isinstance(self.device, str) or self.device not in DEVICES:
+            raise ValueError(f"device must be one of {', '.join(map(repr, DEVICES))} "
+                             f"(got {self.device!r})")
+        if self.device == "cuda":
+            raise ValueError(cuda_refusal())
         if self.threads is not None:
             import numba
             _set(self, threads=integer("threads", self.threads, 1,

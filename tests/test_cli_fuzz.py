@@ -152,6 +152,7 @@ NAMES = {
     "--records": r"\brecords?\b", "--measure": r"\bmeasure\b",
     "--intensities": r"\bintensit(y|ies)\b",
     "--style": r"--style\b", "--format": r"--format\b", "--port": r"\bport\b",
+    "--device": r"--device\b",
     "--address": r"\baddress\b|cannot listen on", "--allow-host": r"allow[-_]hosts?",
 }
 
@@ -771,6 +772,13 @@ def _figure_options():
             + _values(cmd, "--format", ["", "jpg", "PNG"])]
 
 
+def _device_options():
+    """``--device``: a choice, on every grid command; ``cuda`` refused where it cannot run."""
+    return [c for cmd in _commands_with("--device")
+            for c in _values(cmd, "--device", ["", "gpu", "CUDA"]
+                             + (["cuda"] if cmd in BASES else []))]
+
+
 def _misc():
     return [
         Case("(no command)", "", {}, r"COMMAND|command", base=False),
@@ -878,6 +886,9 @@ BASES = {
                   "--size": [("1",), ("0.5", "2")], "--records": [(RECORD_OK,)],
                   "--intensities": [None, ("1.5", "3")], "--measure": [None, "pga"]},
 }
+
+
+CASES += _device_options()
 
 
 def argv_of(case, out):

@@ -156,6 +156,13 @@ CHUNKED = ("sweep", "basin", "plane", "erosion", "safety", "orbits", "chart", "p
            "spectrum", "fragility")
 
 
+def _check_device(args):
+    """``--device cuda`` is refused in one line, before any work, where it cannot run."""
+    if getattr(args, "device", "cpu") == "cuda":
+        from ..settings import cuda_refusal
+        raise UsageError(cuda_refusal("--device cuda", "--device cpu"))
+
+
 def _check_run(args):
     """``--threads`` fits numba's; the scipy path's tolerances are valid numbers whatever the
     method; ``--scheduler`` needs dask and ``--scheduler-timeout`` is a positive time; ``--out``
@@ -268,6 +275,7 @@ def _execution(args, client=None, name=None):
     from ..settings import Execution
     root = _chunk_root(args)
     return Execution(threads=getattr(args, "threads", None), progress=not args.quiet,
+                     device=getattr(args, "device", "cpu"),
                      client=client, store=root / name if name else root,
                      message=lambda m: _say(args, m))
 
@@ -469,7 +477,8 @@ def _fate_plan(args):
     return fate.plan(_block(args), _forcing(args), _state(args),
                      integration=_integration(args), ensemble=args.ensemble,
                      spread=args.spread, seed=args.seed,
-                     execution=Execution(threads=args.threads, progress=not args.quiet))
+                     execution=Execution(threads=args.threads, device=args.device,
+                                                 progress=not args.quiet))
 
 
 def _fate_run(args, p, out):
@@ -477,7 +486,7 @@ def _fate_run(args, p, out):
     from ..basins.fate import run
     from ..settings import Execution
     t0 = time.perf_counter()
-    fr = run(p, Execution(threads=args.threads, progress=not args.quiet))
+    fr = run(p, Execution(threads=args.threads, device=args.device, progress=not args.quiet))
     wall = time.perf_counter() - t0
     _say(args, "fate: " + ", ".join(f"{k} {v:.3f}" for k, v in fr.probabilities.items()))
     return wall, outputs.fate(out, fr)
@@ -687,7 +696,7 @@ def _add_forcing(p):
                    help="closed-form forcing or the 4-D oscillator embedding")
 
 
-def _add_common(p, threads=True):
+def _add_common(p, threads=True, device=True):
     p.add_argument("--out", required=True, help="output directory (created if missing)")
     p.add_argument("--style", default="default", choices=("default", "paper"),
                    help="figures for the screen (default) or for a journal's columns (paper: "
@@ -697,6 +706,10 @@ def _add_common(p, threads=True):
     if threads:
         p.add_argument("--threads", type=int, default=None,
                        help="numba threads (default all); results do not depend on it")
+    if device:
+        p.add_argument("--device", default="cpu", choices=("cpu", "cuda"),
+                       help="where the cells run: the CPU's cores (default) or an NVIDIA GPU "
+                            "(needs its driver and numba-cuda: pip install 'rockjit[cuda]')")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
 
 
@@ -778,7 +791,7 @@ def build_parser():
     p.add_argument("--lyapunov", action="store_true", help="compute Lyapunov exponents")
     p.add_argument("--max-points", type=int, default=50_000,
                    help="at most this many recorded points (default 50000)")
-    _add_common(p)
+    _add_common(p, device=False)
 
     p = _command(sub, "sweep", _sweep_plan, _grid_run("sweep", "sweep"), "sweep over alpha",
                  "Sweep the forcing amplitude; write sweep.npz, bifurcation.png and "
@@ -964,7 +977,7 @@ def build_parser():
                    help="rows of the table")
     p.add_argument("--hb-max", type=float, default=E_FIGURE_HB_MAX,
                    help="largest h/b in the figure")
-    _add_common(p, threads=False)
+    _add_common(p, threads=False, device=False)
 
     p = _command(sub, "paper", _paper_plan, _paper_run,
                  "every figure and table of the study, with the data of each",
@@ -1138,6 +1151,7 @@ def _main(argv, sig):
     if args.command == "compile":
         return _compile(args)
     try:
+        _check_device(args)
         plan = args.plan(args)
         _check_run(args)
         # --out taken for this run (its lock), refused if it holds files rockjit did not write

@@ -124,12 +124,19 @@ def grid_memory(what, n_cells, settings, execution, n_pts=0, n_imp_pts=0, lyapun
                 copies=1):
     """Refuse a grid whose arrays would not fit (``what`` names the parameter that sized it, in
     the message); returns the bytes it needs. ``copies``: outputs held at once (2 for the
-    uncertain-cell test, whose second run's outputs sit beside the first's)."""
+    uncertain-cell test, whose second run's outputs sit beside the first's). In this process
+    several chunks run at once (:func:`rockjit.grids.runner.local_plan`): their outputs and
+    their threads' scratch are counted together."""
+    n = int(min(n_cells, MAX_CELLS))
+    threads = execution.threads or numba.config.NUMBA_NUM_THREADS
+    if execution.client is None and execution.scheduler is None:
+        chunk = execution.chunk or runner.default_chunk(n, threads)
+        per, at_once = runner.local_plan(chunk, threads, -(-n // chunk), concurrent=True)
+        chunk, threads = chunk * at_once, per * at_once
+    else:
+        chunk = execution.chunk or kernel.default_chunk(n)
     nbytes = copies * kernel.grid_bytes(n_cells, settings["periods"], settings["n_steps"], n_pts,
-                               n_imp_pts, bool(lyapunov),
-                               execution.chunk or kernel.default_chunk(int(min(n_cells,
-                                                                               MAX_CELLS))),
-                               execution.threads or numba.config.NUMBA_NUM_THREADS)
+                                        n_imp_pts, bool(lyapunov), chunk, threads)
     memory(f"{what} ({n_cells:.4g} cells)", nbytes)
     return nbytes
 

@@ -8,6 +8,12 @@ into the full output arrays as chunks arrive; with a store (:class:`rockjit.stor
 ChunkStore`) every finished chunk is saved, and a rerun computes only what is missing. Dask is
 optional and imported only when a client is given.
 
+In this process, the chunks of a grid do not wait for each other (:func:`local_plan`): several
+run at once, each on a share of the threads, so that the next chunk's cells start while the
+last cells of a chunk finish instead of the threads idling at the end of every chunk. The
+default chunk is sized from the thread count (:func:`default_chunk`). A cell's results do not
+depend on its chunk, its thread or what runs beside it.
+
 On Dask, each chunk is a task whose key is unique to the computation (its fingerprint, the
 chunk's bounds and a nonce of the call), so that computations sharing a scheduler never get
 each other's results; each task returns its tag with its arrays, and a result whose tag is not
@@ -19,20 +25,24 @@ or when every worker is lost mid-run).
 from __future__ import annotations
 
 import asyncio
+import concurrent.futures as cf
 import contextlib
 import contextvars
+import itertools
+import json
 import secrets
 import sys
 import time
 
+import numba
 import numpy as np
 
 from .._engine import kernel
 from ..storage import chunkstore as chunks
 from ..storage.chunkstore import DamagedChunk
 
-__all__ = ["NoWorkers", "WORKER_TIMEOUT", "run_chunks", "run_grid", "wait_for_workers",
-           "worker_timeout"]
+__all__ = ["CELLS_PER_THREAD", "NoWorkers", "WORKER_TIMEOUT", "default_chunk", "local_plan",
+           "run_chunks", "run_grid", "wait_for_workers", "worker_timeout"]
 
 #: Seconds a computation on a Dask client waits for a worker before giving up (the default of
 #: ``Execution(worker_timeout=...)``; ``rockjit.grids.runner.worker_timeout(seconds)`` sets
@@ -112,10 +122,71 @@ def _fingerprint(runner, inputs, n, chunk):
     return chunks.fingerprint(arrays, dict(runner=name, rest=rest, n=int(n), chunk=int(chunk)))
 
 
+#: Cells per thread in a default chunk of a grid in this process: enough for four blocks of 64
+#: cells per thread (:func:`rockjit._engine.kernel.lane_block`), so that each thread's lanes
+#: stay full and a chunk's last blocks are short beside the chunk.
+CELLS_PER_THREAD = 256
+#: The fewest cells per thread of one call of the kernel: a chunk smaller than this many cells
+#: per thread runs on fewer threads, with more chunks at once (:func:`local_plan`).
+MIN_CELLS_PER_THREAD = 64
+
+
+def default_chunk(n, threads):
+    """Cells per chunk of a grid of ``n`` cells run in this process on ``threads`` threads
+    when none is given: :data:`CELLS_PER_THREAD` per thread (the whole grid if smaller)."""
+    return max(1, min(int(n), CELLS_PER_THREAD * max(1, int(threads))))
+
+
+def _thread_safe_layer():
+    """Whether numba's threading layer lets two threads of this process launch parallel
+    kernels at once (``tbb`` and ``omp`` do; ``workqueue`` ends the process if it sees it)."""
+    numba.get_num_threads()  # starts the threading layer, if not yet started
+    try:
+        return numba.threading_layer() in ("tbb", "omp")
+    except ValueError:
+        return False
+
+
+def local_plan(chunk, threads, n_chunks, concurrent=None):
+    """How the chunks of a grid run in this process: ``(threads_per_chunk, at_once)``.
+
+    A chunk gets ``chunk // MIN_CELLS_PER_THREAD`` threads (at least one, at most
+    ``threads``), and ``threads // threads_per_chunk + 1`` chunks run at once (at most
+    ``n_chunks``): one more than the threads hold, so that when a chunk is down to its last
+    cells, the next one has already started on the threads it leaves idle. Where the
+    threading layer does not allow parallel kernels from two threads (``concurrent`` false;
+    default: asked of numba), one chunk runs at a time on all the threads."""
+    threads = max(1, int(threads))
+    if concurrent is None:
+        concurrent = _thread_safe_layer()
+    if not concurrent:
+        return threads, 1
+    per = max(1, min(threads, int(chunk) // MIN_CELLS_PER_THREAD))
+    return per, max(1, min(int(n_chunks), -(-threads // per) + 1))
+
+
+def _stored_chunk(store, key, n):
+    """The chunk length of a store already begun for this computation (its manifest), or
+    ``None``: a rerun keeps the chunks of the first run whatever its thread count."""
+    from pathlib import Path
+    try:
+        have = json.loads((Path(store) / chunks.ChunkStore.MANIFEST).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if isinstance(have, dict) and have.get("key") == key and have.get("n") == n and \
+            isinstance(have.get("chunk"), int) and have["chunk"] >= 1:
+        return have["chunk"]
+    return None
+
+
 def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, label, execution):
     """All cells through :func:`rockjit._engine.kernel.run_chunk`, chunk by chunk, as
     ``execution`` (a :class:`rockjit.Execution`) says: threads, chunk size, lanes, in this
     process or on a Dask cluster, with a chunk store, with progress.
+
+    In this process the chunk defaults to :func:`default_chunk` (or the chunk of the store
+    already begun for the same computation) and chunks overlap (:func:`local_plan`); on Dask
+    it defaults to :func:`rockjit._engine.kernel.default_chunk`, a twentieth of the grid.
 
     Returns the outputs by name: ``res`` (the kernels' rows; :func:`rockjit._engine.kernel.
     grid_results` names them), ``pts``, ``imp``, ``n_got``, ``n_imp_got``. With a Dask
@@ -124,18 +195,30 @@ def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, label, executi
     """
     ex = execution
     n = y0s.shape[0]
-    chunk = kernel.default_chunk(n) if ex.chunk is None else ex.chunk
     outputs_ = kernel.grid_outputs(n, n_pts, n_imp_pts)
-    cs = None
+    key = None
     if ex.store is not None:
         key = chunks.fingerprint((y0s, pars, ipar, cpar),
                                  dict(tangent=bool(tangent), n_pts=n_pts, n_imp_pts=n_imp_pts))
-        cs = chunks.ChunkStore(ex.store, key, n, chunk, message=ex.message)
     with _client(ex) as client:
+        threads, at_once = ex.threads, 1
+        if client is None:
+            # the calling thread's count (numba.set_num_threads is per thread)
+            total = numba.get_num_threads() if ex.threads is None else ex.threads
+            chunk = ex.chunk
+            if chunk is None and key is not None:
+                chunk = _stored_chunk(ex.store, key, n)
+            if chunk is None:
+                chunk = default_chunk(n, total)
+            threads, at_once = local_plan(chunk, total, -(-n // chunk))
+        else:
+            chunk = kernel.default_chunk(n) if ex.chunk is None else ex.chunk
+        cs = None if key is None else chunks.ChunkStore(ex.store, key, n, chunk,
+                                                        message=ex.message)
         run_chunks(kernel.run_chunk, (bool(tangent), y0s, pars, ipar, cpar, n_pts, n_imp_pts,
-                                      ex.threads, ex.lanes), n, chunk, outputs_, client=client,
+                                      threads, ex.lanes), n, chunk, outputs_, client=client,
                    store=cs, progress=ex.progress, label=label, message=ex.message,
-                   worker_timeout=ex.worker_timeout)
+                   worker_timeout=ex.worker_timeout, at_once=at_once)
     return outputs_
 
 
@@ -239,7 +322,8 @@ class _Callback:
 
 
 def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, progress=False,
-               label="cells", task_prefix="rockjit", message=None, worker_timeout=None):
+               label="cells", task_prefix="rockjit", message=None, worker_timeout=None,
+               at_once=1):
     """Run ``runner`` over chunks of ``n`` cells and fill ``outputs`` in place.
 
     Parameters
@@ -277,6 +361,13 @@ def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, pr
         Seconds to wait, with a client, for the scheduler to have a worker, at the start or
         after losing them all, before raising :class:`NoWorkers` (default
         :data:`WORKER_TIMEOUT`, or the value :func:`worker_timeout` set).
+    at_once : int
+        In this process, how many chunks run at once, each ``runner`` call in a thread of its
+        own (``runner`` must release the GIL to gain from it, as numba's parallel kernels
+        do); default one at a time, in the calling thread. Chunks are placed as they finish.
+        When a chunk, the progress callback or an interrupt raises, no chunk starts any more;
+        the chunks already running are waited for (and kept in the store) before the
+        exception propagates.
     """
     if message is None and store is not None:
         message = store.message
@@ -284,14 +375,15 @@ def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, pr
         store.acquire()
     try:
         return _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, label,
-                           task_prefix, message, _timeout(worker_timeout))
+                           task_prefix, message, _timeout(worker_timeout),
+                           max(1, int(at_once)))
     finally:
         if store is not None:
             store.close()
 
 
 def _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, label,
-                task_prefix, message, timeout):
+                task_prefix, message, timeout, at_once=1):
     bounds = [(a, min(n, a + chunk)) for a in range(0, n, chunk)]
     todo = []
     for a, b in bounds:
@@ -326,15 +418,50 @@ def _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, labe
         bar.update(b - a)
 
     try:
-        if client is None:
+        if client is None and (at_once == 1 or len(todo) == 1):
             for a, b in todo:
                 place(a, b, runner(*args(a, b)))
+        elif client is None:
+            _at_once(runner, todo, args, place, store, at_once)
         elif todo:
             _on_dask(client, runner, inputs, n, chunk, todo, args, place, task_prefix, message,
                      timeout)
     finally:
         bar.close()
     return outputs
+
+
+def _at_once(runner, todo, args, place, store, at_once):
+    """The chunks ``todo`` in this process, ``at_once`` of them running at a time, each in a
+    thread of its own, placed as they finish (see :func:`run_chunks`)."""
+    queue = iter(todo)
+    pending = {}
+    with cf.ThreadPoolExecutor(max_workers=at_once, thread_name_prefix="rockjit-chunk") as pool:
+        def start(n_more):
+            for a, b in itertools.islice(queue, n_more):
+                pending[pool.submit(runner, *args(a, b))] = (a, b)
+
+        try:
+            start(at_once)
+            while pending:
+                done, _ = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
+                for fut in sorted(done, key=pending.get):
+                    a, b = pending.pop(fut)
+                    out = fut.result()
+                    start(1)  # the next chunk starts before this one is placed and saved
+                    place(a, b, out)
+        finally:
+            # after an error nothing new starts; what runs finishes, and is kept if stored
+            for fut in list(pending):
+                if fut.cancel():
+                    del pending[fut]
+            for fut, (a, b) in pending.items():
+                try:
+                    out = fut.result()
+                except BaseException:  # noqa: BLE001 - the first error is the one raised
+                    continue
+                if store is not None:
+                    store.save(a, b, out)
 
 
 def _on_dask(client, runner, inputs, n, chunk, todo, args, place, task_prefix, message,

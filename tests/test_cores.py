@@ -1,0 +1,201 @@
+"""Grids on every core: chunks that run at once give the same results, bit for bit, and keep
+progress, resumption, cancellation and errors working; the device setting says no clearly.
+
+Checked against: the kernel called once on the whole grid with one thread (no chunks, nothing
+at once); a runner that counts, for a fact, how many of its calls run at once; the store's
+manifest as written; numba's own answer on whether a CUDA device is usable here.
+"""
+
+import threading
+import time
+
+import numba
+import numpy as np
+import pytest
+
+import rockjit
+from rockjit import Block, Classification, Execution, Harmonic, Integration
+from rockjit._engine import kernel
+from rockjit.grids import runner
+from rockjit.settings import cuda_missing
+
+OUTPUTS = ("res", "pts", "imp", "n_got", "n_imp_got")
+
+
+def _plan(grid=9, periods=40, early_stop=True, lyapunov=False):
+    return rockjit.basin.plan(Block(1.0), Harmonic(alpha=0.66, omega=1.3), grid,
+                              integration=Integration(periods=periods, window=20),
+                              classification=Classification(early_stop=early_stop),
+                              lyapunov=lyapunov)
+
+
+def _whole(p):
+    """The kernel once on every cell, one thread: no chunk, nothing at once."""
+    return kernel.run_chunk(p.tangent, p.y0s, p.pars, p.ipar, p.cpar, p.n_pts, p.n_imp_pts, 1)
+
+
+def _chunked(p, **execution):
+    return runner.run_grid(p.y0s, p.pars, p.ipar, p.cpar, tangent=p.tangent, n_pts=p.n_pts,
+                           n_imp_pts=p.n_imp_pts, label="test", execution=Execution(**execution))
+
+
+def _same(a, b):
+    for k in OUTPUTS:
+        assert a[k].shape == b[k].shape and np.array_equal(a[k], b[k], equal_nan=True), k
+
+
+@pytest.mark.parametrize("early_stop", [True, False])
+def test_any_chunking_gives_the_same_cells_bit_for_bit(early_stop):
+    p = _plan(early_stop=early_stop)  # 81 cells
+    ref = _whole(p)
+    threads = numba.config.NUMBA_NUM_THREADS
+    for chunk in (1, 7, 40, 81, None):
+        for t in sorted({1, threads}):
+            _same(_chunked(p, chunk=chunk, threads=t), ref)
+
+
+def test_grids_with_exponents_too():
+    p = _plan(grid=5, periods=30, lyapunov=True)
+    _same(_chunked(p, chunk=3), _whole(p))
+
+
+def test_local_plan_fills_the_threads_and_one_chunk_more():
+    for threads in (1, 2, 3, 8, 16, 64):
+        for chunk in (1, 63, 64, 65, 200, 256 * threads, 10**6):
+            per, at_once = runner.local_plan(chunk, threads, 10**6, concurrent=True)
+            assert 1 <= per <= threads and per <= max(1, chunk // 64)
+            # the threads are all in use, and one chunk more waits on them, never two
+            assert per * (at_once - 1) >= threads > per * (at_once - 2)
+        assert runner.local_plan(10**6, threads, 1, concurrent=True)[1] == 1
+        assert runner.local_plan(64, threads, 10**6, concurrent=False) == (threads, 1)
+    assert runner.default_chunk(10, 16) == 10 and runner.default_chunk(10**6, 3) == 768
+
+
+def _counting(calls, state, lock, delay=0.02, fail_at=None):
+    def run(x):
+        with lock:
+            state["now"] += 1
+            state["most"] = max(state["most"], state["now"])
+            k = len(calls)
+            calls.append((int(x[0]), int(x[-1]) + 1))
+        try:
+            if fail_at is not None and k == fail_at:
+                raise ZeroDivisionError("chunk failed")
+            time.sleep(delay)  # releases the GIL, as the compiled kernels do
+            return {"y": np.sqrt(x) + 1.0}
+        finally:
+            with lock:
+                state["now"] -= 1
+    return run
+
+
+@pytest.mark.parametrize("at_once", [1, 2, 5])
+def test_chunks_run_at_once_and_land_in_place(at_once):
+    n, chunk = 43, 4
+    calls, state, lock = [], dict(now=0, most=0), threading.Lock()
+    out = {"y": np.zeros(n)}
+    seen = []
+    runner.run_chunks(_counting(calls, state, lock), (np.arange(n, dtype=float),), n, chunk,
+                      out, at_once=at_once, progress=lambda d, t: seen.append(d))
+    assert np.array_equal(out["y"], np.sqrt(np.arange(n)) + 1.0)
+    assert sorted(calls) == [(a, min(n, a + chunk)) for a in range(0, n, chunk)]
+    assert state["most"] == at_once
+    assert seen[0] == 0 and seen[-1] == n and seen == sorted(seen) and len(seen) == 12
+
+
+def test_a_cancelled_run_starts_nothing_more_and_stores_what_ran(tmp_path):
+    from rockjit.storage import chunkstore
+    n, chunk, at_once = 40, 4, 3
+    x = np.arange(n, dtype=float)
+    key = chunkstore.fingerprint((x,), {})
+    calls, state, lock = [], dict(now=0, most=0), threading.Lock()
+
+    def cancel(done, total):
+        if done >= 2 * chunk:
+            raise KeyboardInterrupt
+
+    store = chunkstore.ChunkStore(tmp_path / "s", key, n, chunk)
+    with pytest.raises(KeyboardInterrupt):
+        runner.run_chunks(_counting(calls, state, lock), (x,), n, chunk, {"y": np.zeros(n)},
+                          store=store, at_once=at_once, progress=cancel)
+    assert len(calls) <= 2 + at_once  # two placed, then at most the ones already running
+    stored = sorted(tmp_path.joinpath("s").glob("cells-*.npz"))
+    assert len(stored) == len(calls)  # every chunk that ran is kept
+    assert not store.locked and state["now"] == 0
+    # the rerun computes only the rest
+    again = []
+    out = {"y": np.zeros(n)}
+    runner.run_chunks(_counting(again, state, lock), (x,), n, chunk, out,
+                      store=chunkstore.ChunkStore(tmp_path / "s", key, n, chunk),
+                      at_once=at_once)
+    assert sorted(calls + again) == [(a, a + chunk) for a in range(0, n, chunk)]
+    assert np.array_equal(out["y"], np.sqrt(x) + 1.0)
+
+
+def test_a_failing_chunk_raises_after_the_others_finish():
+    n, chunk = 40, 4
+    calls, state, lock = [], dict(now=0, most=0), threading.Lock()
+    with pytest.raises(ZeroDivisionError, match="chunk failed"):
+        runner.run_chunks(_counting(calls, state, lock, fail_at=2), (np.arange(n, dtype=float),),
+                          n, chunk, {"y": np.zeros(n)}, at_once=3)
+    assert state["now"] == 0  # nothing runs on after the error is raised
+    assert len(calls) < n // chunk
+
+
+def test_a_rerun_keeps_the_stores_chunks_whatever_the_threads(tmp_path, monkeypatch):
+    p = _plan(grid=6, periods=30)
+    first = _chunked(p, chunk=5, threads=1, store=tmp_path / "s")
+    manifest = (tmp_path / "s" / "manifest.json").read_text()
+    assert '"chunk": 5' in manifest
+    calls = []
+    monkeypatch.setattr(kernel, "run_chunk", lambda *a: calls.append(a) or None)
+    again = _chunked(p, store=tmp_path / "s")  # default chunk, all threads: loads them all
+    assert calls == []
+    _same(again, first)
+
+
+def test_device_is_cpu_or_cuda():
+    assert Execution().device == "cpu" and Execution(device="cpu").device == "cpu"
+    for bad in ("gpu", "CUDA", "", None, 0):
+        with pytest.raises(ValueError, match=r"device must be one of 'cpu', 'cuda'"):
+            Execution(device=bad)
+
+
+def test_cuda_without_a_gpu_is_one_clear_line(monkeypatch):
+    try:
+        from numba import cuda
+        usable = bool(cuda.is_available())
+    except Exception:
+        usable = False
+    assert (cuda_missing() is None) == usable
+    with pytest.raises(ValueError) as exc:
+        Execution(device="cuda")
+    text = str(exc.value)
+    assert "\n" not in text and "numba-cuda" in text and "GPU" in text and 'device="cpu"' in text
+    # numba-cuda absent: the import fails, and the line says so
+    import sys
+    monkeypatch.setitem(sys.modules, "numba.cuda", None)
+    assert cuda_missing() == "numba-cuda is not installed"
+    with pytest.raises(ValueError, match="numba-cuda is not installed"):
+        Execution(device="cuda")
+
+
+def test_cuda_on_a_gpu_says_the_kernels_are_missing(monkeypatch):
+    import rockjit.settings as st
+    monkeypatch.setattr(st, "cuda_missing", lambda: None)
+    with pytest.raises(ValueError, match="CUDA kernels, which this version"):
+        Execution(device="cuda")
+
+
+def test_cli_device(tmp_path, capsys):
+    from rockjit.cli.main import main
+    args = ["basin", "--hb", "1", "--alpha", "0.66", "--omega", "1.3", "--grid", "3",
+            "--periods", "10", "--quiet"]
+    assert main(args + ["--out", str(tmp_path / "a"), "--device", "cuda"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("rockjit: error: --device cuda needs") and "\n" not in err
+    assert "--device cpu" in err
+    assert not (tmp_path / "a").exists()
+    assert main(args + ["--out", str(tmp_path / "b"), "--device", "cpu"]) == 0
+    assert main(args + ["--out", str(tmp_path / "c"), "--device", "tpu"]) == 2
+    assert "invalid choice" in capsys.readouterr().err
