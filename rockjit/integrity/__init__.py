@@ -6,5 +6,5 @@ from .chart import SafetyResult, safety
 from .edge import EdgeState, edge_state
 from .shock import FatalShock, fatal_shock, fatal_shock_chart, fatal_shocks
 
-__all__ = ["EdgeState", "FatalShock", "edge_state", "SafetyResult", "fatal_shock", "fatal_shock_chart", "fatal_shocks",
-           "safety"]
+__all__ = ["EdgeState", "FatalShock", "SafetyResult", "edge_state", "fatal_shock",
+           "fatal_shock_chart", "fatal_shocks", "safety"]

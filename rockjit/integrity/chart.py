@@ -74,6 +74,15 @@ class SafetyResult:
     theta0, dtheta0 : ndarray
         The lattice of every basin.
     block, forcing, settings
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> from rockjit import Block, Integration
+    >>> ch = rockjit.safety(Block(hb=1), (0.6, 0.7), (1.2, 1.3), grid=(2, 2), lattice=6,
+    ...                     integration=Integration(periods=100))
+    >>> ch.safe.shape, ch.n_attractors.shape
+    ((2, 2), (2, 2))
     """
 
     alpha: np.ndarray

@@ -149,6 +149,18 @@ def edge_state(block, forcing, safe, fatal, *, periods=500, track=300, separatio
         points show no period up to ``max_period`` (an edge state that is not periodic).
     rockjit.orbits.OrbitRefused
         When shooting does not converge from the tracked point.
+
+    Examples
+    --------
+    Between the symmetric cycle of ``h/b = 1`` at ``alpha = 0.66`` and a state its minimal
+    fatal shock away, a period-1 saddle:
+
+    >>> import rockjit
+    >>> from rockjit import Block, Harmonic
+    >>> e = rockjit.edge_state(Block(hb=1), Harmonic(alpha=0.66, omega=1.3), (-0.2825, -0.164),
+    ...                        (0.0709, 0.2243), track=30)
+    >>> e.period, e.residual <= 1e-10, bool(abs(e.multipliers[0]) > 1)
+    (1, True, True)
     """
     from ..orbits import periodic_orbit
     periods = integer("periods", periods, 10, 10**6)

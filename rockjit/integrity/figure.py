@@ -7,7 +7,7 @@ import numpy as np
 
 from ..plotting import style as S
 
-__all__ = ["fig_safety", "fig_safety_difference", "write"]
+__all__ = ["fig_fatal_shock", "fig_safety", "fig_safety_difference", "write"]
 
 #: The default contour levels of the safe fraction.
 LEVELS = (0.5, 0.9)
@@ -89,6 +89,45 @@ def fig_safety_difference(charts):
     _study_line(ax, a, handles)
     _axes_labels(ax)
     ax.set_title(f"{S.law_name(a.block)} minus {S.law_name(b.block)}")
+    _legend(fig, handles)
+    return fig
+
+
+@S.styled
+def fig_fatal_shock(basin_result, shocks, edge=None):
+    """A basin (safe cells shaded, overturning white) with each attractor's minimal fatal shock
+    (``shocks``: ``{id: FatalShock}``, :func:`rockjit.integrity.fatal_shocks`) drawn as an
+    arrow from its point with the circle of that radius, and the edge state (an
+    :class:`~rockjit.integrity.EdgeState`) on the boundary."""
+    from matplotlib.colors import ListedColormap
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Circle, Patch
+    b = basin_result
+    fig = _figure()
+    ax = fig.add_subplot()
+    safe = (np.asarray(b.label) != 0).astype(float)
+    ax.pcolormesh(_edges(b.theta0), _edges(b.dtheta0), safe.T, cmap=ListedColormap(
+        ["white", "#c6dbef"]), vmin=0, vmax=1, shading="flat")
+    handles = [Patch(facecolor="#c6dbef", edgecolor="0.5", label="safe initial states")]
+    for k, (aid, sh) in enumerate(shocks.items()):
+        x, d = sh.point, sh.delta
+        ax.plot(*x, marker="o", ms=4, color="black", ls="none")
+        ax.annotate("", xy=x + d, xytext=x, arrowprops=dict(arrowstyle="->", lw=1.0,
+                                                              color="#d62728"))
+        ax.add_patch(Circle(x, sh.norm, fill=False, ls="--", lw=0.7, color="#d62728"))
+    handles.append(Line2D([], [], color="#d62728", lw=1.0, marker=">", ms=4,
+                          label="minimal fatal shock"))
+    if edge is not None:
+        ax.plot(*edge.state, marker="*", ms=8, color="#ff7f0e", mec="black", mew=0.5,
+                ls="none")
+        handles.append(Line2D([], [], color="#ff7f0e", marker="*", ms=8, mec="black",
+                              mew=0.5, ls="none", label=f"edge state (period {edge.period})"))
+    ax.set_xlim(b.theta0[0], b.theta0[-1])
+    ax.set_ylim(b.dtheta0[0], b.dtheta0[-1])
+    ax.set_aspect("equal")
+    from ..plotting.style import SYMBOLS
+    ax.set_xlabel(SYMBOLS.get("theta0", r"$\theta_0$"))
+    ax.set_ylabel(SYMBOLS.get("dtheta0", r"$\theta'_0$"))
     _legend(fig, handles)
     return fig
 
