@@ -7,7 +7,7 @@ module is all they share:
 - :class:`Bench` parses the common options (``--quick``, ``--out DIR``), records what the numbers
   were measured on, and writes the report: the Markdown table (``.md``, also pasted into its
   marked block of any page that carries one), the ``.csv``, the ``.json`` and the plots, every file
-  through :mod:`rockjit.storage.files`'s atomic writers (so the JSON is strict, with non-finite
+  through :mod:`rockjit.storage.atomic`'s writers (so the JSON is strict, with non-finite
   floats written as the strings ``"nan"``, ``"inf"``, ``"-inf"``, rockjit's one convention);
 - :func:`side_by_side` times cases interleaved in rotating order (medians of repeats, every ratio
   taken within one process: the machine is shared and noisy);
@@ -171,8 +171,8 @@ class Bench:
 
 
 def _io():
-    import rockjit.storage.files
-    return rockjit.storage.files
+    import rockjit.storage.atomic
+    return rockjit.storage.atomic
 
 
 def update_block(path, key: str, text: str) -> bool:

@@ -24,7 +24,7 @@ On the study's case (hb=1, Housner, omega=1.3, alpha in [0.5, 1.0]):
     python benchmarks/bench_orbits.py --quick    # smoke mode (coarser sweep, fewer repeats)
 
 Writes orbits.{md,csv,json,png} and orbits_branches.png to benchmarks/results/
-(benchmarks/results/quick/ with --quick, or --out DIR), through rockjit.storage.files's atomic writers.
+(benchmarks/results/quick/ with --quick, or --out DIR), through rockjit.storage.atomic's writers.
 """
 
 from __future__ import annotations

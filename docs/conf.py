@@ -78,8 +78,8 @@ nitpick_ignore_regex = [
 # names that rockjit.orbits' docstrings mention as they stand (the module is being redesigned)
 nitpick_ignore = [
     ("py:func", "rockjit.grids.grids.sweep"),
-    ("py:func", "rockjit.storage.files.write_json"),
-    ("py:func", "rockjit.storage.files.write_npz"),
+    ("py:func", "rockjit.storage.atomic.write_json"),
+    ("py:func", "rockjit.storage.atomic.write_npz"),
 ]
 
 # -- MyST and myst-nb ------------------------------------------------------------------------

@@ -21,7 +21,7 @@ import pytest
 import rockjit
 from rockjit.cli import outputs
 from rockjit.grids import plan as grid_plan
-from rockjit.storage import files as rio
+from rockjit.storage import atomic as rio
 from rockjit import BEHAVIOURS, Block, Harmonic, Integration
 from rockjit.cli.main import OUTPUTS, main
 

@@ -94,12 +94,12 @@ GUARDED = (
     "rockjit.ground.reference:run_scipy",
     "rockjit.study.paper:write_e_table",  # the work of `cor` (and of `paper`'s first part)
     "rockjit.study.paper:paper",
-    "rockjit.storage.files:atomic_open",       # every file the CLI writes goes through these
-    "rockjit.storage.files:write_json",
-    "rockjit.storage.files:write_npz",
-    "rockjit.storage.files:write_csv",
-    "rockjit.storage.files:write_text",
-    "rockjit.storage.files:save_figure",
+    "rockjit.storage.atomic:atomic_open",       # every file the CLI writes goes through these
+    "rockjit.storage.atomic:write_json",
+    "rockjit.storage.atomic:write_npz",
+    "rockjit.storage.atomic:write_csv",
+    "rockjit.storage.atomic:write_text",
+    "rockjit.storage.atomic:save_figure",
     "rockjit.explorer.server:Explorer",     # `explore`: its server is up (after the checks)
 )
 #: Patched as well where they exist (names of a refactor in progress); absent ones are ignored.

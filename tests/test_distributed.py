@@ -124,7 +124,7 @@ def test_interrupted_run_resumes(tmp_path, local_plane, monkeypatch):
         an.plane(**PLANE, chunk=6, store=store)
     done = sorted(store.glob("cells-*.npz"))
     assert len(done) == 3
-    assert not list(store.glob(".*.tmp"))  # nothing half-written (rockjit.storage.files names)
+    assert not list(store.glob(".*.tmp"))  # nothing half-written (rockjit.storage.atomic names)
     assert not (store / "lock.json").exists()  # the interrupted run released the store
     counted = []
 

@@ -32,7 +32,7 @@ PUBLIC_MODULES = [
     "rockjit.model", "rockjit.excitation", "rockjit.settings", "rockjit.single",
     "rockjit.result", "rockjit.grids.plan", "rockjit.grids.sweep_grid",
     "rockjit.grids.basin_grid", "rockjit.grids.plane_grid", "rockjit.basins.erosion",
-    "rockjit.basins.fate", "rockjit.basins.measures", "rockjit.storage.files",
+    "rockjit.basins.fate", "rockjit.basins.measures", "rockjit.storage.output_dir",
     "rockjit.orbits.shooting", "rockjit.orbits.arclength",
     "rockjit.orbits.types", "rockjit.basins.identity", "rockjit.basins.cycles",
     "rockjit.orbits.curves", "rockjit.orbits.plane_chart", "rockjit.ground.pulses",
@@ -80,7 +80,7 @@ def _public_objects():
     from rockjit import ground, orbits
     from rockjit.basins import erosion, fate, measures
     from rockjit.single import Prepared
-    from rockjit.storage import files
+    from rockjit.storage import output_dir
     spectrum = sys.modules["rockjit.ground.spectrum"]  # (rockjit.ground.spectrum: the function)
     out = [(f"rockjit.{n}", getattr(rockjit, n)) for n in rockjit.__all__]
     out += [(f"rockjit.ground.{n}", getattr(ground, n)) for n in ground.__all__]
@@ -91,7 +91,7 @@ def _public_objects():
     out += [(f"rockjit.basins.measures.{n}", getattr(measures, n)) for n in measures.__all__]
     out += [("rockjit.basins.erosion.ErosionResult", erosion.ErosionResult),
             ("rockjit.basins.fate.FateResult", fate.FateResult),
-            ("rockjit.storage.files.OutputDir", files.OutputDir)]
+            ("rockjit.storage.output_dir.OutputDir", output_dir.OutputDir)]
     return [(n, o) for n, o in out if inspect.isclass(o) or inspect.isfunction(o)
             or hasattr(o, "plan")]
 

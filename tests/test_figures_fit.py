@@ -179,7 +179,7 @@ def test_the_check_catches_text_off_the_canvas():
 def test_formats_and_paper_sizes(tmp_path):
     """``--format`` writes each figure in its format; the paper style's figures are a journal
     column wide."""
-    from rockjit.storage.files import OutputDir
+    from rockjit.storage.output_dir import OutputDir
     out = OutputDir(tmp_path / "o")
     out.figure_format = "svg"
     with style.use("paper"):

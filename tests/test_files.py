@@ -24,7 +24,9 @@ from numba.core.caching import _CacheLocator
 from rockjit import _jit
 from rockjit.grids import runner as grid_runner
 from rockjit.storage import chunkstore as chunks
-from rockjit.storage import files as rio
+from rockjit.storage import atomic
+from rockjit.storage import output_dir as rio
+from rockjit.storage.processes import host_name
 from rockjit.storage.ownership import RECORD
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -111,12 +113,12 @@ def _expect_line(proc, want):
 def test_writers_follow_the_umask(tmp_path, umask):
     f_mode, _ = _plain_modes(tmp_path)
     assert f_mode == 0o666 & ~umask
-    rio.write_json(tmp_path / "a.json", {"x": 1})
-    rio.write_text(tmp_path / "a.txt", "x")
-    rio.write_npz(tmp_path / "a.npz", x=np.arange(3))
-    rio.write_csv(tmp_path / "a.csv", ["a"], [[1.0]])
-    rio.save_figure(_Fig(), tmp_path / "a.png")
-    with rio.atomic_open(tmp_path / "b.bin", "wb") as fh:
+    atomic.write_json(tmp_path / "a.json", {"x": 1})
+    atomic.write_text(tmp_path / "a.txt", "x")
+    atomic.write_npz(tmp_path / "a.npz", x=np.arange(3))
+    atomic.write_csv(tmp_path / "a.csv", ["a"], [[1.0]])
+    atomic.save_figure(_Fig(), tmp_path / "a.png")
+    with atomic.atomic_open(tmp_path / "b.bin", "wb") as fh:
         fh.write(b"x")
     for name in ("a.json", "a.txt", "a.npz", "a.csv", "a.png", "b.bin"):
         assert _mode(tmp_path / name) == f_mode, name
@@ -280,7 +282,7 @@ def test_signal_during_publish_is_deferred(tmp_path, monkeypatch, existing):
 
 CHILD_PUBLISH = """
     import os, signal, sys, time
-    from rockjit.storage import files as rio
+    from rockjit.storage import output_dir as rio
     out = rio.OutputDir(sys.argv[1], command="basin")
     out.text("a.txt", "new a")
     out.text("summary.json", "new summary")
@@ -336,7 +338,7 @@ def test_stale_stages_only_of_dead_runs_on_this_host(tmp_path):
     out = tmp_path / "out"
     dead = subprocess.Popen([sys.executable, "-c", "pass"])
     dead.wait()
-    host = rio.host_name()
+    host = host_name()
     stages = {"dead": tmp_path / f".out.rockjit-stage-{host}-{dead.pid}-00000000",
               "alive": tmp_path / f".out.rockjit-stage-{host}-{os.getppid()}-00000000",
               "elsewhere": tmp_path / f".out.rockjit-stage-otherhost-{dead.pid}-00000000",
@@ -630,7 +632,7 @@ def test_lock_of_another_host_is_refused(tmp_path):
 
 
 def _lock(pid, **kw):
-    return json.dumps(dict(pid=pid, host=rio.host_name(), token="t", **kw))
+    return json.dumps(dict(pid=pid, host=host_name(), token="t", **kw))
 
 
 def _proc(path):
@@ -762,7 +764,7 @@ def test_a_dead_owners_lock_is_taken_over(tmp_path):
     p.kill()
     p.wait(timeout=60)
     lock = json.loads((store / "lock.json").read_text())
-    assert lock["pid"] == p.pid and lock["host"] == rio.host_name()
+    assert lock["pid"] == p.pid and lock["host"] == host_name()
     (store / ".cells-0000000005-0000000010.npz.0badc0de.tmp").write_bytes(b"half")
     msgs = []
     s = _open_like_child(store, msgs.append)
@@ -1002,7 +1004,7 @@ def _published(out, files):
     """An earlier rockjit run's ``files`` (name -> bytes) published into ``out``."""
     with rio.OutputDir(out) as o:
         for name, data in files.items():
-            with rio.atomic_open(o.file(name), "wb") as fh:
+            with atomic.atomic_open(o.file(name), "wb") as fh:
                 fh.write(data)
 
 
@@ -1129,7 +1131,7 @@ def test_one_command_at_a_time_per_output_directory(tmp_path):
 
 CHILD_CLAIM = """
     import sys, time
-    from rockjit.storage import files as rio
+    from rockjit.storage import output_dir as rio
     out = rio.OutputDir(sys.argv[1])
     out.claim(name="--out")
     print("claimed", flush=True)

@@ -386,7 +386,7 @@ def test_summary_and_arrays_round_trip(study, tmp_path):
     import json
 
     import physics as ph  # tests/physics.py
-    from rockjit.storage import files as io
+    from rockjit.storage import atomic as io
     _, cont = study
     summary, arrays = cont.to_summary()
     io.write_json(tmp_path / "summary.json", summary)

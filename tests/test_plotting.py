@@ -16,7 +16,7 @@ from rockjit import Block, Harmonic, Integration  # noqa: E402
 from rockjit.basins.identity import agreement  # noqa: E402
 from rockjit.plotting import figures as P  # noqa: E402
 from rockjit.result import BEHAVIOURS, BasinResult, SweepResult, fractions  # noqa: E402
-from rockjit.storage.files import save_figure  # noqa: E402
+from rockjit.storage.atomic import save_figure  # noqa: E402
 
 # one compiled variant
 RUN = dict(integration=Integration(periods=20, n_steps=64), record_stride=4, lyapunov=True)

@@ -1,11 +1,13 @@
 """One outcome per run: the exit status of a command says whether ``--out`` was published.
 
 Each run is a real process (the console script's entry point ``rockjit.cli.main``, or ``python -m
-rockjit``) sent SIGINT or SIGTERM at a known moment: the environment variable
-``ROCKJIT_TEST_PAUSE`` makes it stop there (``rockjit: paused at <point>`` on stderr) until a
-signal arrives. Before publication a signal leaves ``--out`` as it was and exits 130 (SIGINT) or
-143 (SIGTERM); after it, the run has succeeded (exit status 0, and it says so), and its chunks
-are cleaned up all the same. Never a traceback.
+rockjit``) sent SIGINT or SIGTERM at a known moment: the process is started by a few lines of
+this file (:data:`PAUSING`) that wrap one step of the run so that it stops there (``rockjit:
+paused at <point>`` on stderr) until a signal arrives: the import of the commands (``imports``),
+the summary written after the work (``work``), the publication of ``--out`` (``published``) or
+the command's last line (``wrote``). Before publication a signal leaves ``--out`` as it was and
+exits 130 (SIGINT) or 143 (SIGTERM); after it, the run has succeeded (exit status 0, and it says
+so), and its chunks are cleaned up all the same. Never a traceback.
 """
 
 import os
@@ -19,6 +21,68 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 SCRIPT = "import sys, rockjit.cli; sys.exit(rockjit.cli.main())"  # as the console script
+#: The console script (or ``python -m rockjit``: ``sys.argv[1] == "-m"``) with one step wrapped
+#: to pause at ``sys.argv[1]`` until the command's handler has recorded a signal (at most 60 s);
+#: the handler's state is the one it is marked with (``rockjit_state``, rockjit.cli.signals)
+PAUSING = """
+import runpy, signal, sys, time
+
+import rockjit.cli
+
+entry = rockjit.cli.main  # (importing rockjit.cli.main below rebinds the name to the module)
+point = sys.argv.pop(1)
+how = sys.argv.pop(1)
+
+
+def pause():
+    state = signal.getsignal(signal.SIGINT).rockjit_state
+    n = len(state.received)
+    print(f"rockjit: paused at {point}", file=sys.stderr, flush=True)
+    deadline = time.monotonic() + 60.0
+    while len(state.received) == n and time.monotonic() < deadline:
+        time.sleep(0.01)
+
+
+def after(module, name):
+    real = getattr(module, name)
+
+    def wrapped(*args, **kwargs):
+        value = real(*args, **kwargs)
+        pause()
+        return value
+    setattr(module, name, wrapped)
+
+
+class PauseAtTheImport:  # the import of the commands, after the handler is installed
+    def find_spec(self, name, path=None, target=None):
+        if name == "rockjit.cli.main":
+            sys.meta_path.remove(self)
+            pause()
+        return None
+
+
+if point == "imports":
+    sys.meta_path.insert(0, PauseAtTheImport())
+elif point == "work":
+    from rockjit.cli import outputs
+    after(outputs, "summary")
+elif point == "published":
+    from rockjit.storage.output_dir import OutputDir
+    after(OutputDir, "publish")
+elif point == "wrote":
+    import importlib
+    commands = importlib.import_module("rockjit.cli.main")
+
+    def say(args, message, real=commands._say):
+        real(args, message)
+        if message.startswith(f"{args.command}: wrote"):
+            pause()
+    commands._say = say
+if how == "script":
+    sys.exit(entry())
+sys.argv[0] = "rockjit"
+runpy.run_module("rockjit", run_name="__main__", alter_sys=True)
+"""
 BASIN = ["basin", "--hb", "1", "--alpha", "0.66", "--omega", "1.3", "--grid", "6", "--periods",
          "20", "--n-steps", "64"]
 COR = ["cor", "--quiet"]
@@ -31,13 +95,9 @@ def _default_sigint():
     signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
-def _start(argv, cwd, pause=None, how="script"):
+def _start(argv, cwd, pause, how="script"):
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    env.pop("ROCKJIT_TEST_PAUSE", None)
-    if pause:
-        env["ROCKJIT_TEST_PAUSE"] = pause
-    head = [sys.executable, "-c", SCRIPT] if how == "script" else [sys.executable, "-m",
-                                                                   "rockjit"]
+    head = [sys.executable, "-c", PAUSING, pause, "script" if how == "script" else "-m"]
     return subprocess.Popen(head + argv, cwd=cwd, env=env, stdin=subprocess.DEVNULL,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             preexec_fn=_default_sigint)
@@ -86,7 +146,7 @@ def test_a_signal_during_the_imports(tmp_path, name):
 def test_a_signal_during_the_work_leaves_out_as_it_was(tmp_path, name, how):
     signum, status = SIGNALS[name]
     out = tmp_path / "o"
-    from rockjit.storage.files import OutputDir
+    from rockjit.storage.output_dir import OutputDir
     with OutputDir(out) as earlier:  # an earlier run's (rockjit replaces only its own files)
         earlier.text("summary.json", "an earlier run's")
     rc, err = _signalled(COR + ["--out", "o"], tmp_path, "work", signum, how)
@@ -122,7 +182,6 @@ def test_a_signal_at_any_moment_gives_one_outcome(tmp_path, name, delay):
     # unpaused: whenever it comes, the exit status says whether --out was published
     signum, status = SIGNALS[name]
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    env.pop("ROCKJIT_TEST_PAUSE", None)
     proc = subprocess.Popen([sys.executable, "-c", STARTED] + COR + ["--out", "o"], cwd=tmp_path,
                             env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, preexec_fn=_default_sigint)

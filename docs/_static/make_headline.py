@@ -28,7 +28,7 @@ def make(path=HEADLINE, *, periods=None, alpha_step=None):
 
     from rockjit.grids.plan import run
     from rockjit.plotting import style
-    from rockjit.storage.files import save_figure
+    from rockjit.storage.atomic import save_figure
     from rockjit.study import paper
 
     kw = {k: v for k, v in dict(periods=periods, alpha_step=alpha_step).items()

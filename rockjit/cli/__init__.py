@@ -1,64 +1,33 @@
 """The ``rockjit`` command line (:mod:`.main`: the parser and the commands; :mod:`.outputs`: what
-each command leaves on disk), and its entry point :func:`main`, which handles SIGINT and SIGTERM
-from its first instant, the imports of rockjit's modules included.
+each command leaves on disk; :mod:`.signals`: SIGINT and SIGTERM), and its entry point
+:func:`main`, which handles SIGINT and SIGTERM from its first instant, the imports of rockjit's
+modules included.
 
 Importing the numerical modules (numpy, numba) takes a noticeable time, and Ctrl-C during it
 would end in a ``KeyboardInterrupt`` traceback. The package ``rockjit`` loads its public names
-lazily, so this module is reached with only the standard library imported; it installs the
-command line's signal handler first, written here again because nothing of rockjit may be
-imported before it (the protocol of
-:func:`rockjit.storage.files.interrupt_handler`: the state's ``received``, ``final`` and
-``out``; the handler marked with ``rockjit_state``). :func:`rockjit.cli.main.main` then finds
-that handler and uses it; once it has returned, the two signals are ignored for the rest of the
-process's life, so that a signal after the run cannot change its exit status. A signal during the imports ends the program with
-one line and exit status 130 (SIGINT) or 143 (SIGTERM), nothing written.
+lazily, and :mod:`.signals` imports only the standard library, so this module installs the
+command's signal handler (:func:`~.signals.interrupt_handler`) before anything numerical loads.
+:func:`rockjit.cli.main.main` then finds that handler and uses it; once it has returned, the
+two signals are ignored for the rest of the process's life, so that a signal after the run
+cannot change its exit status. A signal during the imports ends the program with one line and
+exit status 130 (SIGINT) or 143 (SIGTERM), nothing written.
 """
 
-import os
 import signal
 import sys
-import time
 import types
 
-
-def _handler(state):
-    def handler(signum, frame):
-        state.received.append(signum)
-        if state.final or getattr(state.out, "published", False):
-            return
-        exc = KeyboardInterrupt()
-        exc.signum = signum
-        raise exc
-    handler.rockjit_state = state
-    return handler
-
-
-def _pause(point, state):  # rockjit.storage.files.pause_for_tests, for the imports
-    if os.environ.get("ROCKJIT_TEST_PAUSE") != point:
-        return
-    n = len(state.received)
-    print(f"rockjit: paused at {point}", file=sys.stderr, flush=True)
-    deadline = time.monotonic() + 60.0
-    while len(state.received) == n and time.monotonic() < deadline:
-        time.sleep(0.01)
+from .signals import interrupt_handler, quiet_lost_interrupts
 
 
 def main():
     """Run ``rockjit`` with the arguments of the command line; returns the exit status."""
     state = types.SimpleNamespace(received=[], final=False, out=None)
-    handler = _handler(state)
+    handler = interrupt_handler(state)
     for s in (signal.SIGINT, signal.SIGTERM):
         signal.signal(s, handler)
-    previous = sys.unraisablehook
-
-    def hook(unraisable):  # rockjit.storage.files.quiet_lost_interrupts, for the imports
-        if issubclass(unraisable.exc_type, KeyboardInterrupt) and state.received:
-            return
-        previous(unraisable)
-
-    sys.unraisablehook = hook
+    sys.unraisablehook = quiet_lost_interrupts(state, sys.unraisablehook)
     try:
-        _pause("imports", state)
         from .main import main as run
         if state.received:  # a signal whose KeyboardInterrupt was swallowed while importing
             raise KeyboardInterrupt

@@ -5,12 +5,12 @@ Every command parses its options into the library's own plan (:func:`rockjit.sin
 a bad value ends the command with one line ``rockjit: error: ...`` on stderr and exit status 2,
 having written nothing. Then it computes and writes its data, its figure(s) and
 ``summary.json`` into a hidden staging directory, published into ``--out`` as one unit at the
-end (:class:`rockjit.storage.files.OutputDir`). Every problem with ``--out`` itself (a file, a
-dangling or looping link, a name too long, a directory named like an output file, a place that
-cannot be written, a file rockjit did not write where it would write one, another rockjit run
-writing into it) is found before any work, with the rest of the input; ``--out`` stays this
-run's until it is published (:mod:`rockjit.storage.ownership`). A figure that cannot be drawn
-does not lose the data: they are published without it, a line says so, exit status 3.
+end (:class:`rockjit.storage.output_dir.OutputDir`). Every problem with ``--out`` itself (a
+file, a dangling or looping link, a name too long, a directory named like an output file, a
+place that cannot be written, a file rockjit did not write where it would write one, another
+rockjit run writing into it) is found before any work, with the rest of the input; ``--out``
+stays this run's until it is published (:mod:`rockjit.storage.ownership`). A figure that cannot
+be drawn does not lose the data: they are published without it, a line says so, exit status 3.
 
 One outcome per run: the exit status says whether ``--out`` was published. A command
 interrupted before that (SIGINT, Ctrl-C: exit status 130; SIGTERM: 143) leaves ``--out`` as it
@@ -21,7 +21,7 @@ line ``rockjit: error: ...`` or ``rockjit: internal error: ...`` on stderr with 
 report file, exit status 1, ``--out`` as it was.
 
 JSON files write non-finite numbers as the strings ``"nan"``, ``"inf"``, ``"-inf"``
-(:mod:`rockjit.storage.files`).
+(:mod:`rockjit.storage.atomic`).
 """
 
 from __future__ import annotations
@@ -166,7 +166,7 @@ def _check_device(args):
 def _check_run(args):
     """``--threads`` fits numba's; the scipy path's tolerances are valid numbers whatever the
     method; ``--scheduler`` needs dask and ``--scheduler-timeout`` is a positive time; ``--out``
-    can be written (:func:`rockjit.storage.files.check_out`)."""
+    can be written (:func:`rockjit.storage.output_dir.check_out`)."""
     from ..validate import integer, real
     if getattr(args, "threads", None) is not None:
         import numba
@@ -181,13 +181,13 @@ def _check_run(args):
             import dask.distributed  # noqa: F401
         except ImportError:
             raise UsageError("--scheduler needs dask: pip install 'rockjit[dask]'") from None
-    from ..storage.files import check_out
+    from ..storage.output_dir import check_out
     check_out(args.out, name="--out", files=OUTPUTS.get(args.command, ()),
               chunks=args.command in CHUNKED)
 
 
 def _chunk_root(args):
-    from ..storage.files import chunk_root
+    from ..storage.output_dir import chunk_root
     return chunk_root(args.out)
 
 
@@ -1102,7 +1102,7 @@ def main(argv=None):
     did not write in the way, another run writing it), 3 published but a figure could not be
     drawn (one line says which; its data are written), 130 / 143 interrupted by SIGINT /
     SIGTERM before ``--out`` was published (``--out`` as it was)."""
-    from ..storage.files import command_interrupts
+    from .signals import command_interrupts
     with command_interrupts() as sig:
         try:
             return _main(argv, sig)
@@ -1121,7 +1121,8 @@ def main(argv=None):
 def _interrupted(exc, sig):
     """A SIGINT or SIGTERM (``exc.signum``) that interrupted the run: 128 + the signal, unless
     ``--out`` was published already (0)."""
-    from ..storage.files import chunk_root, signal_name
+    from ..storage.output_dir import chunk_root
+    from .signals import signal_name
     signum = getattr(exc, "signum", None) or (sig.received[-1] if sig.received else 2)
     out = sig.out
     if out is not None and out.published:
@@ -1141,7 +1142,8 @@ def _interrupted(exc, sig):
 
 def _main(argv, sig):
     from . import outputs
-    from ..storage.files import OutputDir, interrupted, pause_for_tests, signal_name
+    from ..storage.output_dir import OutputDir
+    from .signals import interrupted, signal_name
     try:
         args = build_parser().parse_args(argv)
     except UsageError as exc:
@@ -1187,7 +1189,6 @@ def _main(argv, sig):
                 (worker_timeout(timeout) if timeout else contextlib.nullcontext()):
             if args.quiet:
                 warnings.simplefilter("ignore")
-            pause_for_tests("work", sig)
             wall, results = args.run(args, plan, out)
             inputs = {k: v for k, v in vars(args).items() if not callable(v)}
             out.json("summary.json", outputs.summary(out, args.command, inputs, wall, **results))
@@ -1215,7 +1216,6 @@ def _main(argv, sig):
         out.discard()
         raise
     sig.final = True  # published: from here on a signal changes nothing
-    pause_for_tests("published", sig)
     try:
         if note:
             _warn(note)
@@ -1229,7 +1229,6 @@ def _main(argv, sig):
     except Exception as exc:  # the outputs are published: the command has succeeded
         _warn(f"{args.out} was written; cleaning up after it failed ({type(exc).__name__}: "
               f"{exc})")
-    pause_for_tests("wrote", sig)
     status = 3 if out.figure_errors else 0  # published, a figure missing
     late = ([out.interrupted] if out.interrupted else []) + sig.received[n:]
     if late:

@@ -1,7 +1,7 @@
 """What each command leaves on disk: its data (``.npz``), its figures and its summary.
 
 One function per kind of result writes it into an output directory object
-(:class:`rockjit.storage.files.OutputDir`, or anything with its ``npz``, ``figure`` and
+(:class:`rockjit.storage.output_dir.OutputDir`, or anything with its ``npz``, ``figure`` and
 ``describe`` methods) and returns the JSON-ready part of ``summary.json`` that describes it.
 The command line and the paper (:func:`rockjit.study.paper`) both write through these, so a
 sweep or a basin has the same files wherever it was computed. Every file is described

@@ -485,8 +485,8 @@ class Continuation:
     :func:`rockjit.orbits.continue_branches`.
 
     ``to_summary()`` gives ``(summary, arrays)``: JSON-ready dicts (write them with
-    :func:`rockjit.storage.files.write_json`, which handles non-finite floats) and arrays for
-    :func:`rockjit.storage.files.write_npz`.
+    :func:`rockjit.storage.atomic.write_json`, which handles non-finite floats) and arrays for
+    :func:`rockjit.storage.atomic.write_npz`.
 
     Attributes
     ----------

@@ -5,7 +5,7 @@ Every function takes result objects (:class:`rockjit.result.Result`,
 computed about them (a run's behaviour, an ensemble's outcomes, a basin's measures), and returns
 a :class:`matplotlib.figure.Figure` built without :mod:`matplotlib.pyplot`, so no GUI backend is
 needed and nothing is kept in pyplot's figure registry; save it with
-:func:`rockjit.storage.files.save_figure` or ``fig.savefig``. Nothing here computes a result:
+:func:`rockjit.storage.atomic.save_figure` or ``fig.savefig``. Nothing here computes a result:
 behaviours are passed in (``rockjit.classify_result`` gives a run's) or read from a grid's
 labels.
 

@@ -1,26 +1,28 @@
 """The store of finished grid chunks: resumable grid computations, one run at a time.
 
-A grid (the cells of a sweep, a basin, a parameter plane, a spectrum) is cut into chunks of consecutive
-cells (:mod:`rockjit.grids.runner`). With a store directory (:class:`ChunkStore`), every finished chunk is written there atomically
-(:func:`rockjit.storage.files.atomic_open`, with the user's umask) beside a manifest holding a fingerprint
-of the whole computation (inputs, settings, chunking, rockjit's version). Running the same
-computation again with the same directory loads the finished chunks and computes only the
-missing ones, so an interrupted run, or one that lost workers, resumes; the result equals an
-uninterrupted run's bit for bit, because each cell is computed independently of the chunking
-and of where it runs. A directory that holds another computation's chunks is refused rather
-than mixed in. A chunk that cannot be read back whole (truncated, not a zip archive, arrays
-missing or of the wrong shape or type) is discarded and computed again, and the run says so.
+A grid (the cells of a sweep, a basin, a parameter plane, a spectrum) is cut into chunks of
+consecutive cells (:mod:`rockjit.grids.runner`). With a store directory (:class:`ChunkStore`),
+every finished chunk is written there atomically (:func:`rockjit.storage.atomic.atomic_open`,
+with the user's umask) beside a manifest holding a fingerprint of the whole computation (inputs,
+settings, chunking, rockjit's version). Running the same computation again with the same
+directory loads the finished chunks and computes only the missing ones, so an interrupted run,
+or one that lost workers, resumes; the result equals an uninterrupted run's bit for bit, because
+each cell is computed independently of the chunking and of where it runs. A directory that holds
+another computation's chunks is refused rather than mixed in. A chunk that cannot be read back
+whole (truncated, not a zip archive, arrays missing or of the wrong shape or type) is discarded
+and computed again, and the run says so.
 
-A store is used by one run at a time: a lock file (``lock.json``: the owner's pid and host,
-and where the system tells them, that process's start time and the boot id) makes a second run
-on the same store refuse with a ``ValueError`` naming the owner while it is alive, and saying
-how to take the store over when it is not. A lock is stale, taken over (and the run says so),
-when its process no longer exists on this host, or when its pid now belongs to another process:
-one that started at another time, or that runs under another boot (pids are reused after a
-reboot, and from one container's life to the next). A lock without a start time (rockjit
-0.1.0's) is stale when its pid's process started after the lock was written. :func:`rockjit.grids.runner.run_chunks` releases the lock when it returns or raises; :func:`remove_stores`
-deletes a store only when it can hold the lock, and only the files rockjit wrote there.
-
+A store is used by one run at a time: a lock file (``lock.json``: the owner's pid and host, and
+where the system tells them, that process's start time and the boot id) makes a second run on
+the same store refuse with a ``ValueError`` naming the owner while it is alive, and saying how
+to take the store over when it is not. A lock is stale, taken over (and the run says so), when
+its process no longer exists on this host, or when its pid now belongs to another process: one
+that started at another time, or that runs under another boot (pids are reused after a reboot,
+and from one container's life to the next). A lock without a start time (rockjit 0.1.0's) is
+stale when its pid's process started after the lock was written.
+:func:`rockjit.grids.runner.run_chunks` releases the lock when it returns or raises;
+:func:`remove_stores` deletes a store only when it can hold the lock, and only the files rockjit
+wrote there.
 """
 
 from __future__ import annotations
@@ -41,8 +43,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .files import (atomic_open, boot_id, create_temp, host_name, pid_alive, process_start,
-                    process_start_time, write_text)
+from .atomic import atomic_open, create_temp, write_text
+from .processes import boot_id, host_name, pid_alive, process_start, process_start_time
 
 __all__ = ["ChunkStore", "DamagedChunk", "fingerprint", "fingerprint_of", "remove_stores"]
 
@@ -432,7 +434,7 @@ class ChunkStore:
         return out
 
     def save(self, a, b, out):
-        """Write chunk ``a:b`` atomically (:func:`rockjit.storage.files.atomic_open`)."""
+        """Write chunk ``a:b`` atomically (:func:`rockjit.storage.atomic.atomic_open`)."""
         with atomic_open(self._path(a, b), "wb") as fh:
             np.savez(fh, **out)
 

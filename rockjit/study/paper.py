@@ -5,7 +5,7 @@ The constants are the study's parameters: the slenderness ratios with their forc
 and amplitude ranges, the sweeps' step, the zoom, the initial states of the single runs, the
 gallery, the basins. :func:`plan_paper` validates a paper's settings (nothing computed) and
 :func:`paper` computes every figure and table and writes them into an output directory object
-(:class:`rockjit.storage.files.OutputDir` on the command line): figures 1-6 of the study, and beyond it
+(:class:`rockjit.storage.output_dir.OutputDir` on the command line): figures 1-6 of the study, and beyond it
 the branches of periodic orbits over its bifurcation diagrams with their located bifurcations
 (figure 5's ``fig5_branches_*``, ``bifurcation_table``), the attractor maps of its basins with
 their entropy and integrity (figure 7) and the erosion profiles of both laws (figure 8). Its
@@ -391,7 +391,7 @@ def paper(out, plan=None, *, execution=None, say=None):
 
     Parameters
     ----------
-    out : rockjit.storage.files.OutputDir
+    out : rockjit.storage.output_dir.OutputDir
         Where the files go (``json``, ``npz``, ``figure``, ``table``, ``text`` methods); the
         caller publishes it.
     plan : PaperPlan, optional

@@ -1,303 +1,31 @@
-"""Writing files safely: atomic writers and a command's output directory.
+"""A command's output directory: its files staged in a hidden directory and published together.
 
-Every writer here writes a hidden temporary file next to its target
-(``.<name>.<random>.tmp``, same directory so the rename stays on one file system), flushes and
-``fsync``s it, then moves it over the target with :func:`os.replace`, which is atomic on POSIX
-and Windows. If anything goes wrong before the rename, including ``KeyboardInterrupt``, the
-temporary file is removed and the target is left as it was (absent, or its previous complete
-version).
-
-Permissions: files are created with mode ``0o666`` and directories with ``0o777``, and the
-operating system applies the process's umask (and a directory's default ACL, where there is
-one), so everything rockjit writes gets the permissions a plain ``open()`` or ``mkdir`` would
-give: ``-rw-r--r--`` and ``drwxr-xr-x`` under umask ``022``. (:func:`tempfile.mkstemp` and
-:func:`tempfile.mkdtemp` would leave ``-rw-------`` and ``drwx------``.)
-
-A command's outputs (:class:`OutputDir`) are staged in a hidden directory and published
-together: a failure or an interrupt before :meth:`OutputDir.publish` leaves ``--out`` exactly as
-it was, and files rockjit did not write are never deleted or replaced.
-
-JSON conventions (:func:`write_json`, :func:`to_jsonable`):
-
-- numpy scalars become Python numbers, numpy arrays nested lists, tuples lists, paths strings;
-- non-finite floats, which strict JSON cannot hold, are written as the **strings**
-  ``"nan"``, ``"inf"`` and ``"-inf"``, everywhere (also inside arrays). ``float(value)`` reads
-  both forms back, so a reader can always do ``float(summary["lambda_max"])``. (``-inf`` is
-  meaningful here: the Lyapunov exponent of a block at rest.)
+A failure or an interrupt before :meth:`OutputDir.publish` leaves ``--out`` exactly as it was,
+and files rockjit did not write are never deleted or replaced (:mod:`.ownership`). Each file is
+written atomically (:mod:`.atomic`); what a dead run left behind is told from a live run's by
+its host and process (:mod:`.processes`).
 """
 
 from __future__ import annotations
 
 import contextlib
-import csv
-import dataclasses
 import errno
 import fnmatch
 import hashlib
-import io as _io
 import json
-import math
 import os
 import secrets
 import shutil
 import signal
-import socket
-import sys
 import threading
-import time
-import types
 from pathlib import Path
 
-import numpy as np
-
+from . import atomic  # its writers looked up at each call: a test may replace one
 from .ownership import (RECORD, RECORD_HOLDS, PublishLock, Record, digest, lock_path, refusal,
                         unproven)
+from .processes import host_name, pid_alive
 
-__all__ = ["OutputDir", "atomic_open", "boot_id", "boot_time", "check_out",
-           "command_interrupts", "create_temp", "defer_signals", "host_name",
-           "installed_interrupts", "interrupt_handler", "interrupted", "markdown_table",
-           "pause_for_tests", "pid_alive", "process_start", "process_start_time",
-           "quiet_lost_interrupts", "save_figure", "signal_name",
-           "sigterm_interrupts", "to_jsonable", "write_csv", "write_json", "write_npz",
-           "write_text"]
-
-TMP_SUFFIX = ".tmp"
-_O_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
-
-
-def create_temp(directory, prefix, suffix=TMP_SUFFIX):
-    """Create a new empty file ``<directory>/<prefix><random><suffix>`` for writing.
-
-    The file is created with mode ``0o666`` less the umask, as :func:`open` would create it.
-
-    Returns
-    -------
-    fd : int
-        An open file descriptor, write-only.
-    path : Path
-        The file's path.
-    """
-    directory = Path(directory) if str(directory) else Path(".")
-    for _ in range(100):
-        path = directory / f"{prefix}{secrets.token_hex(4)}{suffix}"
-        try:
-            fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | _O_CLOEXEC, 0o666)
-        except FileExistsError:
-            continue
-        return fd, path
-    raise FileExistsError(errno.EEXIST, "no unused temporary file name", str(directory))
-
-
-@contextlib.contextmanager
-def atomic_open(path, mode="w", **kwargs):
-    """Open a temporary file beside ``path``; on a clean exit, rename it to ``path``.
-
-    Parameters
-    ----------
-    path : str or Path
-        The target. Its directory must exist.
-    mode : {"w", "wb"}
-        Text or binary.
-    **kwargs
-        Passed to :func:`open` (e.g. ``newline=""`` for CSV, ``encoding``).
-
-    Yields
-    ------
-    file
-        The open temporary file (permissions: ``0o666`` less the umask).
-    """
-    path = Path(path)
-    if mode not in ("w", "wb"):
-        raise ValueError(f"mode must be 'w' or 'wb' (got {mode!r})")
-    if "b" not in mode:
-        kwargs.setdefault("encoding", "utf-8")
-    fd, tmp = create_temp(path.parent, f".{path.name}.")
-    try:
-        with os.fdopen(fd, mode, **kwargs) as fh:
-            yield fh
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
-        raise
-
-
-def _float(x):
-    x = float(x)
-    if math.isfinite(x):
-        return x
-    return "nan" if math.isnan(x) else ("inf" if x > 0 else "-inf")
-
-
-def to_jsonable(obj):
-    """``obj`` with numpy types, tuples, paths and non-finite floats made JSON-safe.
-
-    See the module docstring for the conventions.
-    """
-    if isinstance(obj, dict):
-        return {str(k): to_jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [to_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return to_jsonable(obj.tolist())
-    if isinstance(obj, (bool, np.bool_)):
-        return bool(obj)
-    if isinstance(obj, (int, np.integer)):
-        return int(obj)
-    if isinstance(obj, (float, np.floating)):
-        return _float(obj)
-    if isinstance(obj, (str, type(None))):
-        return obj
-    if isinstance(obj, os.PathLike):
-        return os.fspath(obj)
-    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
-        return to_jsonable(dataclasses.asdict(obj))
-    raise TypeError(f"cannot write {type(obj).__name__} to JSON")
-
-
-def write_json(path, obj, *, indent=2):
-    """Write ``obj`` as strict JSON (``allow_nan=False``), atomically."""
-    text = json.dumps(to_jsonable(obj), indent=indent, allow_nan=False) + "\n"
-    write_text(path, text)
-
-
-def write_text(path, text):
-    """Write a string, atomically."""
-    with atomic_open(path, "w") as fh:
-        fh.write(text)
-
-
-def write_npz(path, **arrays):
-    """Write arrays to an uncompressed ``.npz`` archive, atomically.
-
-    Arrays are stored without pickling (string arrays as numpy unicode), so
-    ``np.load(path)`` reads them with the default ``allow_pickle=False``.
-    """
-    buf = {k: np.asarray(v) for k, v in arrays.items()}
-    for k, v in buf.items():
-        if v.dtype == object:
-            raise TypeError(f"array {k!r} has dtype object; store plain numbers or strings")
-    with atomic_open(path, "wb") as fh:
-        np.savez(fh, **buf)
-
-
-def write_csv(path, header, rows):
-    """Write a CSV table (``header``: column names; ``rows``: sequences), atomically.
-
-    Floats are written with ``repr`` precision; non-finite ones as ``nan``, ``inf``, ``-inf``.
-    """
-    with atomic_open(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(list(header))
-        for row in rows:
-            w.writerow([_cell(v) for v in row])
-
-
-def _cell(v):
-    if isinstance(v, (float, np.floating)):
-        v = float(v)
-        return repr(v) if math.isfinite(v) else _float(v)
-    if isinstance(v, np.integer):
-        return int(v)
-    return v
-
-
-def save_figure(fig, path, *, dpi=150):
-    """Save a matplotlib figure, atomically; the format follows ``path``'s suffix."""
-    path = Path(path)
-    fmt = path.suffix.lstrip(".").lower() or "png"
-    buf = _io.BytesIO()  # render fully first: a failing render never opens the target
-    fig.savefig(buf, format=fmt, dpi=dpi)
-    with atomic_open(path, "wb") as fh:
-        fh.write(buf.getvalue())
-
-
-def markdown_table(header, rows, fmt=None):
-    """A Markdown table; floats formatted with ``fmt[column]`` (default ``".4g"``)."""
-    fmt = fmt or {}
-
-    def cell(i, v):
-        if isinstance(v, (float, np.floating)):
-            return format(float(v), fmt.get(header[i], ".4g"))
-        return str(v)
-
-    lines = ["| " + " | ".join(header) + " |",
-             "|" + "|".join("---" for _ in header) + "|"]
-    lines += ["| " + " | ".join(cell(i, v) for i, v in enumerate(r)) + " |" for r in rows]
-    return "\n".join(lines) + "\n"
-
-
-# ---- owners of hidden directories and lock files -----------------------------------------------
-
-def host_name():
-    """This machine's name, reduced to letters, digits, ``.``, ``-`` and ``_``."""
-    name = "".join(c if c.isalnum() or c in ".-_" else "_" for c in socket.gethostname())
-    return name or "localhost"
-
-
-def pid_alive(pid):
-    """Whether process ``pid`` exists on this machine (a zombie counts as alive)."""
-    if pid <= 0:
-        return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:  # another user's process
-        return True
-    except OSError:
-        return True  # cannot tell: assume alive, which never deletes anything
-    return True
-
-
-def process_start(pid):
-    """When process ``pid`` started, in clock ticks since boot (``/proc/<pid>/stat``, field
-    22), or ``None`` where that cannot be read (no such process, no ``/proc``). Together with
-    the pid it names one process: a pid reused by a later process has a later start."""
-    try:
-        with open(f"/proc/{int(pid)}/stat", "rb") as fh:
-            stat_line = fh.read()
-        # the command name (field 2) is in parentheses and may hold spaces or ')'
-        return int(stat_line[stat_line.rindex(b")") + 2:].split()[19])
-    except (OSError, ValueError, IndexError):
-        return None
-
-
-def boot_id():
-    """This boot's identifier (``/proc/sys/kernel/random/boot_id``), or ``None`` where there is
-    none: a pid recorded under another boot id names a process of an earlier boot."""
-    try:
-        with open("/proc/sys/kernel/random/boot_id", encoding="ascii") as fh:
-            return fh.read().strip() or None
-    except (OSError, ValueError):
-        return None
-
-
-def boot_time():
-    """When this machine booted (seconds since the epoch; ``btime`` of ``/proc/stat``), or
-    ``None`` where that cannot be read."""
-    try:
-        with open("/proc/stat", encoding="ascii") as fh:
-            for line in fh:
-                if line.startswith("btime "):
-                    return float(line.split()[1])
-    except (OSError, ValueError, IndexError):
-        pass
-    return None
-
-
-def process_start_time(pid):
-    """When process ``pid`` started, in seconds since the epoch, or ``None`` (see
-    :func:`process_start`)."""
-    ticks, booted = process_start(pid), boot_time()
-    if ticks is None or booted is None:
-        return None
-    try:
-        return booted + ticks / os.sysconf("SC_CLK_TCK")
-    except (AttributeError, ValueError, OSError):
-        return None
+__all__ = ["SUMMARY", "OutputDir", "check_out", "chunk_root", "defer_signals"]
 
 
 @contextlib.contextmanager
@@ -327,126 +55,6 @@ def defer_signals(signums=(signal.SIGINT, signal.SIGTERM)):
         for s, h in old.items():
             signal.signal(s, signal.SIG_DFL if h is None else h)
 
-
-# ---- the signals of a command: one outcome per run -------------------------------------------
-#
-# A command's state is a namespace with ``received`` (the signals that arrived, in order),
-# ``final`` (once true, signals are only recorded) and ``out`` (its OutputDir, or None). Its
-# handler (interrupt_handler) records each SIGINT or SIGTERM and, until ``final`` is set or
-# ``out`` is published, raises KeyboardInterrupt carrying the signal in ``signum``: before
-# publication a signal interrupts the run (exit status 128 + signum, --out as it was); after
-# it, the run has succeeded and the signal changes nothing. The console script's entry point
-# (:func:`rockjit.cli.main`) installs the same handler before rockjit's numerical modules load,
-# so that Ctrl-C during the imports is handled too; it marks it with ``rockjit_state``.
-
-def interrupt_handler(state):
-    """The SIGINT and SIGTERM handler of a command's ``state`` (see the comment above)."""
-    def handler(signum, frame):
-        state.received.append(signum)
-        if state.final or getattr(state.out, "published", False):
-            return
-        exc = KeyboardInterrupt()
-        exc.signum = signum
-        raise exc
-    handler.rockjit_state = state
-    return handler
-
-
-def installed_interrupts():
-    """The state of the command handler installed for both SIGINT and SIGTERM, or ``None``."""
-    state = getattr(signal.getsignal(signal.SIGINT), "rockjit_state", None)
-    if state is not None and getattr(signal.getsignal(signal.SIGTERM), "rockjit_state",
-                                     None) is state:
-        return state
-    return None
-
-
-@contextlib.contextmanager
-def command_interrupts(keep=False):
-    """SIGINT and SIGTERM handled for one command (:func:`interrupt_handler`).
-
-    Reuses the handler already installed by the program's entry point, if there is one, and
-    leaves it in place; otherwise installs one for the block and puts the previous handlers
-    back on exit, unless ``keep`` (the program's own entry point: a signal after the run has
-    ended must not change its exit status). Outside the main thread nothing is installed.
-
-    Yields
-    ------
-    namespace
-        The state: ``received``, ``final``, ``out``.
-    """
-    state = installed_interrupts()
-    if state is not None:
-        yield state
-        return
-    state = types.SimpleNamespace(received=[], final=False, out=None)
-    old = {}
-    hook = sys.unraisablehook
-    if threading.current_thread() is threading.main_thread():
-        handler = interrupt_handler(state)
-        for s in (signal.SIGINT, signal.SIGTERM):
-            try:
-                old[s] = signal.signal(s, handler)
-            except (ValueError, OSError):
-                pass
-        sys.unraisablehook = quiet_lost_interrupts(state, hook)
-    try:
-        yield state
-    finally:
-        if not keep:
-            for s, h in old.items():
-                signal.signal(s, signal.SIG_DFL if h is None else h)
-            sys.unraisablehook = hook
-
-
-def quiet_lost_interrupts(state, previous):
-    """A ``sys.unraisablehook`` that drops the KeyboardInterrupt of a signal raised where it
-    cannot propagate (in a finalizer: Python would print "Exception ignored in ..." and a
-    traceback, and go on). The signal is in ``state.received``, and the command acts on it
-    before publishing (see :func:`interrupted`). Anything else goes to ``previous``."""
-    def hook(unraisable):
-        if issubclass(unraisable.exc_type, KeyboardInterrupt) and state.received:
-            return
-        previous(unraisable)
-    return hook
-
-
-def interrupted(state):
-    """Raise the KeyboardInterrupt of a signal that arrived (``state.received``) but whose
-    KeyboardInterrupt did not reach the command: swallowed by a finalizer, or by a library's
-    ``except BaseException``. Called before work and before publishing, so that a signal
-    before publication always interrupts."""
-    if state.received and not state.final:
-        exc = KeyboardInterrupt()
-        exc.signum = state.received[-1]
-        raise exc
-
-
-def signal_name(signum):
-    """``"SIGINT"``, ``"SIGTERM"``, ..."""
-    try:
-        return signal.Signals(signum).name
-    except ValueError:
-        return f"signal {signum}"
-
-
-PAUSE_VARIABLE = "ROCKJIT_TEST_PAUSE"
-
-
-def pause_for_tests(point, state):
-    """Where the environment variable ``ROCKJIT_TEST_PAUSE`` names ``point``: say so on stderr
-    (``rockjit: paused at <point>``) and wait, at most 60 s, for a signal, so that a test can
-    send one at a known moment of a run. Otherwise nothing."""
-    if os.environ.get(PAUSE_VARIABLE) != point:
-        return
-    n = len(state.received)
-    print(f"rockjit: paused at {point}", file=sys.stderr, flush=True)
-    deadline = time.monotonic() + 60.0
-    while len(state.received) == n and time.monotonic() < deadline:
-        time.sleep(0.01)
-
-
-# ---- a command's output directory ------------------------------------------------------------
 
 _STAGE = "rockjit-stage"
 SUMMARY = "summary.json"
@@ -756,7 +364,7 @@ class OutputDir:
     >>> import tempfile
     >>> from pathlib import Path
     >>> import numpy as np
-    >>> from rockjit.storage.files import OutputDir
+    >>> from rockjit.storage.output_dir import OutputDir
     >>> out = OutputDir(Path(tempfile.mkdtemp()) / "basin")
     >>> try:
     ...     out.npz("basin.npz", label=np.zeros((2, 2), dtype=int))
@@ -885,7 +493,8 @@ class OutputDir:
     def file(self, name):
         """The staged path of ``name``, for a writer of its own; ``name`` is listed as written.
 
-        Write it completely (e.g. with ``atomic_open``) before :meth:`publish`.
+        Write it completely (e.g. with :func:`rockjit.storage.atomic.atomic_open`) before
+        :meth:`publish`.
         """
         _check_name(name)
         path = self._stage_dir() / name
@@ -902,12 +511,12 @@ class OutputDir:
 
     def json(self, name, obj):
         """Stage ``obj`` as strict JSON (``write_json``)."""
-        write_json(self._target(name), obj)
+        atomic.write_json(self._target(name), obj)
         self._add(name)
 
     def npz(self, name, **arrays):
         """Stage arrays as an ``.npz`` archive (``write_npz``)."""
-        write_npz(self._target(name), **arrays)
+        atomic.write_npz(self._target(name), **arrays)
         self._add(name)
 
     def figure(self, name, fig, *, dpi=None):
@@ -916,7 +525,7 @@ class OutputDir:
         (its suffix the format's)."""
         if self.figure_format:
             name = f"{Path(name).stem}.{self.figure_format}"
-        save_figure(fig, self._target(name), dpi=dpi or self.dpi)
+        atomic.save_figure(fig, self._target(name), dpi=dpi or self.dpi)
         self._add(name)
         fig.clear()
         return name
@@ -935,18 +544,18 @@ class OutputDir:
 
     def csv(self, name, header, rows):
         """Stage a CSV table (``write_csv``)."""
-        write_csv(self._target(name), header, rows)
+        atomic.write_csv(self._target(name), header, rows)
         self._add(name)
 
     def text(self, name, text):
         """Stage a text file (``write_text``)."""
-        write_text(self._target(name), text)
+        atomic.write_text(self._target(name), text)
         self._add(name)
 
     def table(self, stem, header, rows, fmt=None):
         """Stage CSV and Markdown versions of one table: ``<stem>.csv``, ``<stem>.md``."""
         self.csv(stem + ".csv", header, rows)
-        self.text(stem + ".md", markdown_table(header, rows, fmt))
+        self.text(stem + ".md", atomic.markdown_table(header, rows, fmt))
 
     # -- publishing -----------------------------------------------------------------------------
 
@@ -1086,7 +695,7 @@ class OutputDir:
         if theirs:
             raise ValueError(refusal(self.path, theirs, rec, self.name)
                              + "; nothing of this run was published")
-        write_json(self._stage / RECORD, Record.write_data(files, self.command, __version__))
+        atomic.write_json(self._stage / RECORD, Record.write_data(files, self.command, __version__))
 
     def _check_targets(self, names):
         if not self.path.is_dir():
@@ -1119,22 +728,3 @@ class OutputDir:
         else:
             self.discard()
         return False
-
-
-@contextlib.contextmanager
-def sigterm_interrupts():
-    """Within the block, SIGTERM interrupts like Ctrl-C (``KeyboardInterrupt``), so that a
-    command's staged outputs are removed on the way out (:meth:`OutputDir.discard`). Only in
-    the main thread, where signals can be handled; elsewhere it does nothing."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def interrupt(signum, frame):
-        raise KeyboardInterrupt
-
-    old = signal.signal(signal.SIGTERM, interrupt)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, old)
