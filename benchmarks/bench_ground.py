@@ -37,7 +37,7 @@ import rockjit
 from rockjit import Block, Pulse, Record
 from rockjit.ground.batch import Batch, scipy_kernel
 from rockjit.ground.compiled import compiled_kernel
-from rockjit.ground.methods import transient_scipy
+from rockjit.ground.batch import transient_scipy
 from rockjit.ground.plan import grid_settings
 
 FULL = dict(grid=(200, 200), records=44, intensities=50, repeats=3, scipy_spectrum=60,

@@ -23,7 +23,7 @@ import pytest
 import rockjit
 from rockjit import Block, Integration, Pulse, Scipy, Transient
 from rockjit.ground import batch as B
-from rockjit.ground.methods import transient_scipy
+from rockjit.ground.batch import transient_scipy
 from rockjit.ground.closed_forms import cosine_no_impact, sine_no_impact, sine_phi
 from rockjit.ground.response import OVERTURN_IMPACT, OVERTURN_NO_IMPACT, SAFE
 

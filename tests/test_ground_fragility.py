@@ -28,7 +28,7 @@ from scipy.stats import binom, chi2, norm
 import rockjit
 from rockjit import Block, Record, Transient
 from rockjit.ground import fit_capacities, fit_lognormal
-from rockjit.ground.methods import transient_scipy
+from rockjit.ground.batch import transient_scipy
 from rockjit.ground.response import SAFE, UNRESOLVED
 
 MEDIAN, BETA = 2.0, 0.35

@@ -541,7 +541,7 @@ def _explore_plan(args):
 def _transient_method(args):
     """The method of ``--method --rtol --atol`` for pulses and records: ``"rockjit"`` (the
     compiled path), or the scipy path at the tolerances given."""
-    from ..ground.methods import check_method
+    from ..ground.batch import check_method
     from ..single import Scipy
     method = check_method(args.method)
     name = "DOP853" if method == "rockjit" or args.method == "scipy" else method.method

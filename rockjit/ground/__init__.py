@@ -12,8 +12,8 @@ One concept per module:
 - :mod:`~rockjit.ground.reference`: one run on the scipy reference path;
 - :mod:`~rockjit.ground.compiled`: the compiled path: a batch's cells in parallel, or one run;
 - :mod:`~rockjit.ground.plan`: a single run's plan (what :func:`rockjit.simulate` builds);
-- :mod:`~rockjit.ground.methods`: the compiled path or which scipy path;
-- :mod:`~rockjit.ground.batch`: a batch of cells and the kernels that compute their outcomes;
+- :mod:`~rockjit.ground.batch`: a batch of cells, the kernels that compute their outcomes and
+  the method (the compiled path or which scipy path);
 - :mod:`~rockjit.ground.spectrum`: overturning spectra of pulses;
 - :mod:`~rockjit.ground.fitting`: lognormal fragility fits by maximum likelihood;
 - :mod:`~rockjit.ground.fragility`: incremental dynamic analysis over a record set;

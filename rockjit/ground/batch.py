@@ -1,4 +1,5 @@
-"""A batch of cells under transient excitations, and the kernels that compute their outcomes.
+"""A batch of cells under transient excitations, the kernels that compute their outcomes, and the
+method they run on (the compiled path or which scipy path).
 
 Every grid of this package (a pulse's overturning spectrum, each step of its bisections, an
 incremental dynamic analysis) is a :class:`Batch`: cell ``i`` is the block
@@ -42,8 +43,8 @@ import numpy as np
 
 from .response import OUTPUTS, STATUS_CODES, empty_outputs
 
-__all__ = ["Batch", "KERNELS", "OUTPUTS", "STATUS_CODES", "grid_method", "kernel_for",
-           "run_batch", "scipy_kernel"]
+__all__ = ["Batch", "KERNELS", "OUTPUTS", "STATUS_CODES", "check_method", "grid_method",
+           "kernel_for", "run_batch", "scipy_kernel", "transient_scipy"]
 
 @dataclass(frozen=True, eq=False)
 class Batch:
@@ -109,11 +110,25 @@ def kernel_for(method):
     return KERNELS[name]
 
 
+def transient_scipy():
+    """The scipy path the spectra and fragility curves use by default: DOP853 at
+    ``rtol = 1e-10, atol = 1e-12`` (an explicit method suits the non-stiff block; the tight
+    tolerances keep the bisections' outcomes a property of the model, not of the solver)."""
+    from ..single import Scipy
+    return Scipy("DOP853", rtol=1e-10, atol=1e-12)
+
+
+def check_method(method):
+    """``"rockjit"`` (the compiled path), or the :class:`rockjit.Scipy` of ``method``
+    (``"scipy"``, ``"scipy:<M>"`` or a Scipy)."""
+    from ..single import _method
+    return _method(method)
+
+
 def grid_method(method):
     """The method of a grid: ``"rockjit"`` (the compiled kernel, the default), else the
-    :class:`rockjit.Scipy` of ``method`` (:func:`rockjit.ground.methods.transient_scipy` is
-    the one the checks use: DOP853 at ``rtol = 1e-10, atol = 1e-12``)."""
-    from .methods import check_method
+    :class:`rockjit.Scipy` of ``method`` (:func:`transient_scipy` is the one the checks use:
+    DOP853 at ``rtol = 1e-10, atol = 1e-12``)."""
     if method is None or method == "rockjit":
         kernel_for("rockjit")
         return "rockjit"
