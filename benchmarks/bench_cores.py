@@ -6,9 +6,12 @@ beside the *yardstick*'s, measured in the same run at the same thread counts: a 
 parallel kernel in which every cell does the same work in registers (a damped linear oscillator
 stepped by RK4, no memory traffic), whose speed-up is what this host's threads can give. The
 study's 100 x 100 Housner basin (h/b = 1, alpha = 0.66, omega = 1.3, 500 periods) runs at
-each thread count full length and early-stopped, with the default chunks, with one chunk for
-the whole grid, and (full length) with chunks of 64 cells. Every case's labels must equal the
-one-thread run's. Compile time is excluded (a warm-up call first).
+each thread count full length and early-stopped: with the default chunks, with one chunk for
+the whole grid, and (full length) with chunks of 64 cells, each run as pieces on one thread
+each, as many at once as threads (rockjit.grids.runner); and, for comparison, as one call of
+the parallel kernel on every cell with all the threads (the way a chunk used to run, each call
+waiting for its slowest block). Every case's labels must equal the one-thread run's. Compile
+time is excluded (a warm-up call first).
 
     python benchmarks/bench_cores.py            # full: 1, 2, 4, ... threads up to all
     python benchmarks/bench_cores.py --quick    # smoke: 20 x 20, 60 periods, 1 repeat
@@ -33,10 +36,12 @@ from rockjit.grids import runner
 
 FULL = dict(grid=100, periods=500, repeats=3, yardstick_s=1.0)
 QUICK = dict(grid=20, periods=60, repeats=1, yardstick_s=0.05)
-#: The basin's cases: (key, early stopping, chunk: "default", "one" (the whole grid) or cells).
+#: The basin's cases: (key, early stopping, chunk: "default", "one" (the whole grid), cells,
+#: or "call": one call of the parallel kernel on every cell, all the threads).
 CASES = (("full, default chunks", False, "default"), ("full, one chunk", False, "one"),
-         ("full, 64-cell chunks", False, 64), ("early-stopped, default chunks", True, "default"),
-         ("early-stopped, one chunk", True, "one"))
+         ("full, 64-cell chunks", False, 64), ("full, one kernel call", False, "call"),
+         ("early-stopped, default chunks", True, "default"),
+         ("early-stopped, one kernel call", True, "call"))
 HEADERS = ("threads", "case", "median s", "speed-up", "yardstick speed-up",
            "share of the yardstick's", "labels as 1 thread")
 
@@ -84,12 +89,20 @@ def calibrate(n_cells, seconds):
 
 
 def basin(cfg, early_stop, threads, chunk):
+    """The basin's labels, flat."""
+    from rockjit._engine import kernel
     n = cfg["grid"] ** 2
+    args = (Block(1.0), Harmonic(alpha=0.66, omega=1.3), cfg["grid"])
+    kw = dict(integration=Integration(periods=cfg["periods"]),
+              classification=Classification(early_stop=early_stop))
+    if chunk == "call":
+        p = rockjit.basin.plan(*args, **kw)
+        out = kernel.run_chunk(p.tangent, p.y0s, p.pars, p.ipar, p.cpar, p.n_pts, p.n_imp_pts,
+                               threads)
+        return kernel.grid_results(out)["label"]
     size = None if chunk == "default" else n if chunk == "one" else chunk
-    return rockjit.basin(Block(1.0), Harmonic(alpha=0.66, omega=1.3), cfg["grid"],
-                         integration=Integration(periods=cfg["periods"]),
-                         classification=Classification(early_stop=early_stop),
-                         execution=Execution(threads=threads, chunk=size))
+    ex = Execution(threads=threads, chunk=size)
+    return rockjit.basin(*args, **kw, execution=ex).label.ravel()
 
 
 def measure(cfg):
@@ -109,7 +122,7 @@ def measure(cfg):
                 numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
         cases = {"yardstick": yard}
         for key, early, chunk in CASES:
-            cases[key] = lambda early=early, chunk=chunk, t=t: basin(cfg, early, t, chunk).label
+            cases[key] = lambda early=early, chunk=chunk, t=t: basin(cfg, early, t, chunk)
         got = H.side_by_side(cases, cfg["repeats"])
         for k, times in got.wall.items():
             wall[(t, k)] = times
@@ -162,9 +175,9 @@ def main(argv=None):
     table = rows(wall, labels)
     top = max(r[0] for r in table)
     n = cfg["grid"] ** 2
-    per, at_once = runner.local_plan(runner.default_chunk(n, top), top,
-                                     -(-n // runner.default_chunk(n, top)))
-    worst = min((r[5] for r in table if r[1] != "yardstick" and r[0] > 1), default=math.nan)
+    per, at_once = runner.local_plan(top)
+    worst = min((r[5] for r in table if r[0] > 1 and r[1] != "yardstick"
+                 and "kernel call" not in r[1]), default=math.nan)
     md = (f"### Threads and chunks{H.quick_note(b.quick)}\n\n"
           + H.md_table(HEADERS, table) + "\n"
           + f"The study's {cfg['grid']} x {cfg['grid']} Housner basin (h/b = 1, alpha = 0.66, "
@@ -173,8 +186,9 @@ def main(argv=None):
             f"over this one, of the same case. The yardstick: {n} cells of {steps} RK4 steps "
             f"each in registers (every cell the same work), its speed-up what this host's "
             f"threads give. The lowest share of the yardstick's speed-up, over every case "
-            f"above one thread: {worst:.0%}. Default chunks at {top} threads: "
-            f"{runner.default_chunk(n, top)} cells, each on {per} threads, {at_once} at once. "
+            f"of the grid runner above one thread: {worst:.0%}. At {top} threads the cells "
+            f"ran as pieces of {runner.PIECE_MIN} to {runner.PIECE_MAX} cells on {per} thread "
+            f"each, {at_once} at once. "
             f"Threading layer: {numba.threading_layer()}. {H.env_line(b.env)}\n")
     data = dict(rows=[dict(zip(HEADERS, r)) for r in table], env=b.env, config=cfg,
                 yardstick_steps=steps, threading_layer=numba.threading_layer(),

@@ -59,16 +59,31 @@ def test_grids_with_exponents_too():
     _same(_chunked(p, chunk=3), _whole(p))
 
 
-def test_local_plan_fills_the_threads_and_one_chunk_more():
-    for threads in (1, 2, 3, 8, 16, 64):
-        for chunk in (1, 63, 64, 65, 200, 256 * threads, 10**6):
-            per, at_once = runner.local_plan(chunk, threads, 10**6, concurrent=True)
-            assert 1 <= per <= threads and per <= max(1, chunk // 64)
-            # the threads are all in use, and one chunk more waits on them, never two
-            assert per * (at_once - 1) >= threads > per * (at_once - 2)
-        assert runner.local_plan(10**6, threads, 1, concurrent=True)[1] == 1
-        assert runner.local_plan(64, threads, 10**6, concurrent=False) == (threads, 1)
-    assert runner.default_chunk(10, 16) == 10 and runner.default_chunk(10**6, 3) == 768
+def test_local_plan_never_asks_for_more_threads_than_given():
+    for threads in (1, 2, 3, 16, 64):
+        assert runner.local_plan(threads, concurrent=True) == (1, threads)
+        assert runner.local_plan(threads, concurrent=False) == (threads, 1)
+
+
+@pytest.mark.parametrize("bounds, at_once", [([(0, 10000)], 16), ([(0, 500), (500, 1000),
+                                              (1000, 1003)], 2), ([(0, 5), (5, 10)], 4),
+                                             ([(3, 900), (1200, 5000)], 8)])
+def test_pieces_cover_each_chunk_in_order_and_shrink_to_the_end(bounds, at_once):
+    got = list(runner.pieces(bounds, at_once, smallest=32, largest=4096))
+    for k, (a, b) in enumerate(bounds):
+        mine = [(p, q) for p, q, kk in got if kk == k]
+        assert mine[0][0] == a and mine[-1][1] == b
+        assert all(q0 == p1 for (_, q0), (p1, _) in zip(mine, mine[1:]))
+        # every piece but a chunk's last is within the bounds
+        assert all(32 <= q - p <= 4096 for p, q in mine[:-1])
+    sizes = [q - p for p, q, _ in got]
+    total = sum(b - a for a, b in bounds)
+    # guided: a piece never holds more than the cells left over twice the callers
+    left = total
+    for size in sizes:
+        assert size <= max(32, left // (2 * at_once))
+        left -= size
+    assert sizes[-1] <= 32
 
 
 def _counting(calls, state, lock, delay=0.02, fail_at=None):
@@ -89,18 +104,60 @@ def _counting(calls, state, lock, delay=0.02, fail_at=None):
     return run
 
 
-@pytest.mark.parametrize("at_once", [1, 2, 5])
-def test_chunks_run_at_once_and_land_in_place(at_once):
-    n, chunk = 43, 4
+@pytest.mark.parametrize("at_once, split", [(1, False), (2, False), (5, False), (3, True)])
+def test_chunks_run_at_once_and_land_in_place(at_once, split):
+    n, chunk = 430, 40
     calls, state, lock = [], dict(now=0, most=0), threading.Lock()
-    out = {"y": np.zeros(n)}
+    out = {"y": np.zeros(n), "pair": np.zeros((n, 2))}
     seen = []
-    runner.run_chunks(_counting(calls, state, lock), (np.arange(n, dtype=float),), n, chunk,
-                      out, at_once=at_once, progress=lambda d, t: seen.append(d))
-    assert np.array_equal(out["y"], np.sqrt(np.arange(n)) + 1.0)
-    assert sorted(calls) == [(a, min(n, a + chunk)) for a in range(0, n, chunk)]
+
+    def run(x):
+        got = _counting(calls, state, lock, delay=0.005)(x)
+        return dict(got, pair=np.stack([x, -x], axis=1))
+
+    x = np.arange(n, dtype=float)
+    runner.run_chunks(run, (x,), n, chunk, out, at_once=at_once, split=split,
+                      progress=lambda d, t: seen.append(d))
+    assert np.array_equal(out["y"], np.sqrt(x) + 1.0)
+    assert np.array_equal(out["pair"], np.stack([x, -x], axis=1))
+    spans = sorted(calls)
+    assert spans[0][0] == 0 and spans[-1][1] == n
+    assert all(q0 == p1 for (_, q0), (p1, _) in zip(spans, spans[1:]))
+    if not split:
+        assert spans == [(a, min(n, a + chunk)) for a in range(0, n, chunk)]
+    else:
+        assert len(spans) > n // chunk  # the chunks were cut into pieces
     assert state["most"] == at_once
+    # progress is told once at the start, then once per chunk, in whole chunks
     assert seen[0] == 0 and seen[-1] == n and seen == sorted(seen) and len(seen) == 12
+    assert all(d % chunk == 0 for d in seen[:-1])
+
+
+def test_a_grid_keeps_to_its_threads(monkeypatch):
+    p = _plan(grid=10, periods=30)
+    ref = _whole(p)
+    real = kernel.run_chunk
+    state, lock, per_call = dict(now=0, most=0), threading.Lock(), []
+
+    def counted(*args):
+        with lock:
+            state["now"] += 1
+            state["most"] = max(state["most"], state["now"])
+            per_call.append(args[7])
+        try:
+            time.sleep(0.01)
+            return real(*args)
+        finally:
+            with lock:
+                state["now"] -= 1
+
+    monkeypatch.setattr(kernel, "run_chunk", counted)
+    threads = numba.config.NUMBA_NUM_THREADS
+    _same(_chunked(p, threads=threads, chunk=50), ref)
+    if numba.threading_layer() in ("omp", "tbb"):
+        assert set(per_call) == {1} and state["most"] == threads
+    else:
+        assert set(per_call) == {threads} and state["most"] == 1
 
 
 def test_a_cancelled_run_starts_nothing_more_and_stores_what_ran(tmp_path):

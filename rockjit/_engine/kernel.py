@@ -392,8 +392,11 @@ DEFAULT_LANES = 8
 
 def lane_block(n, threads):
     """Cells per block of lanes (one task of the parallel loop): 256, or fewer so that every
-    thread gets four blocks. Results do not depend on it."""
-    return max(1, min(256, -(-n // (4 * max(1, threads)))))
+    thread gets four blocks (on one thread, nothing to balance: up to 256 in one block).
+    Results do not depend on it."""
+    if threads <= 1:
+        return max(1, min(256, n))
+    return max(1, min(256, -(-n // (4 * threads))))
 
 
 def default_chunk(n):

@@ -125,16 +125,13 @@ def grid_memory(what, n_cells, settings, execution, n_pts=0, n_imp_pts=0, lyapun
     """Refuse a grid whose arrays would not fit (``what`` names the parameter that sized it, in
     the message); returns the bytes it needs. ``copies``: outputs held at once (2 for the
     uncertain-cell test, whose second run's outputs sit beside the first's). In this process
-    several chunks run at once (:func:`rockjit.grids.runner.local_plan`): their outputs and
-    their threads' scratch are counted together."""
+    a chunk's pieces are held until the chunk is complete, beside the pieces running
+    (:func:`rockjit.grids.runner.pieces`): both are counted."""
     n = int(min(n_cells, MAX_CELLS))
     threads = execution.threads or numba.config.NUMBA_NUM_THREADS
+    chunk = execution.chunk or kernel.default_chunk(n)
     if execution.client is None and execution.scheduler is None:
-        chunk = execution.chunk or runner.default_chunk(n, threads)
-        per, at_once = runner.local_plan(chunk, threads, -(-n // chunk), concurrent=True)
-        chunk, threads = chunk * at_once, per * at_once
-    else:
-        chunk = execution.chunk or kernel.default_chunk(n)
+        chunk = chunk + threads * runner.PIECE_MAX
     nbytes = copies * kernel.grid_bytes(n_cells, settings["periods"], settings["n_steps"], n_pts,
                                         n_imp_pts, bool(lyapunov), chunk, threads)
     memory(f"{what} ({n_cells:.4g} cells)", nbytes)

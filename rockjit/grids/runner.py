@@ -8,11 +8,14 @@ into the full output arrays as chunks arrive; with a store (:class:`rockjit.stor
 ChunkStore`) every finished chunk is saved, and a rerun computes only what is missing. Dask is
 optional and imported only when a client is given.
 
-In this process, the chunks of a grid do not wait for each other (:func:`local_plan`): several
-run at once, each on a share of the threads, so that the next chunk's cells start while the
-last cells of a chunk finish instead of the threads idling at the end of every chunk. The
-default chunk is sized from the thread count (:func:`default_chunk`). A cell's results do not
-depend on its chunk, its thread or what runs beside it.
+In this process, a grid's cells run as *pieces*: calls of the kernel on one thread each, as
+many at once as there are threads, each thread taking the next piece as soon as its last one
+is done (:func:`local_plan`, :func:`pieces`). No thread waits for another at the end of a
+chunk, and the pieces shrink as the grid nears its end (guided scheduling: a piece holds the
+cells left over twice the threads, between :data:`PIECE_MIN` and :data:`PIECE_MAX` cells, and
+never crosses a chunk's end), so that the last pieces are short. A chunk (the unit of progress,
+of resumption and of Dask tasks) is placed once all its pieces are done. A cell's results do
+not depend on its chunk, its piece, its thread or what runs beside it.
 
 On Dask, each chunk is a task whose key is unique to the computation (its fingerprint, the
 chunk's bounds and a nonce of the call), so that computations sharing a scheduler never get
@@ -41,7 +44,7 @@ from .._engine import kernel
 from ..storage import chunkstore as chunks
 from ..storage.chunkstore import DamagedChunk
 
-__all__ = ["CELLS_PER_THREAD", "NoWorkers", "WORKER_TIMEOUT", "default_chunk", "local_plan",
+__all__ = ["NoWorkers", "PIECE_MAX", "PIECE_MIN", "WORKER_TIMEOUT", "local_plan", "pieces",
            "run_chunks", "run_grid", "wait_for_workers", "worker_timeout"]
 
 #: Seconds a computation on a Dask client waits for a worker before giving up (the default of
@@ -122,19 +125,12 @@ def _fingerprint(runner, inputs, n, chunk):
     return chunks.fingerprint(arrays, dict(runner=name, rest=rest, n=int(n), chunk=int(chunk)))
 
 
-#: Cells per thread in a default chunk of a grid in this process: enough for four blocks of 64
-#: cells per thread (:func:`rockjit._engine.kernel.lane_block`), so that each thread's lanes
-#: stay full and a chunk's last blocks are short beside the chunk.
-CELLS_PER_THREAD = 256
-#: The fewest cells per thread of one call of the kernel: a chunk smaller than this many cells
-#: per thread runs on fewer threads, with more chunks at once (:func:`local_plan`).
-MIN_CELLS_PER_THREAD = 64
-
-
-def default_chunk(n, threads):
-    """Cells per chunk of a grid of ``n`` cells run in this process on ``threads`` threads
-    when none is given: :data:`CELLS_PER_THREAD` per thread (the whole grid if smaller)."""
-    return max(1, min(int(n), CELLS_PER_THREAD * max(1, int(threads))))
+#: The fewest cells of a piece (the last pieces of a grid; a chunk smaller than this is one
+#: piece): eight lanes' worth of cells four times over, so that a piece's lanes stay busy.
+PIECE_MIN = 32
+#: The most cells of a piece (the first pieces of a large grid): bounds the outputs held by
+#: the pieces running at once.
+PIECE_MAX = 4096
 
 
 def _thread_safe_layer():
@@ -147,22 +143,35 @@ def _thread_safe_layer():
         return False
 
 
-def local_plan(chunk, threads, n_chunks, concurrent=None):
-    """How the chunks of a grid run in this process: ``(threads_per_chunk, at_once)``.
+def local_plan(threads, concurrent=None):
+    """How a grid runs in this process on ``threads`` threads: ``(threads_per_call, at_once)``.
 
-    A chunk gets ``chunk // MIN_CELLS_PER_THREAD`` threads (at least one, at most
-    ``threads``), and ``threads // threads_per_chunk + 1`` chunks run at once (at most
-    ``n_chunks``): one more than the threads hold, so that when a chunk is down to its last
-    cells, the next one has already started on the threads it leaves idle. Where the
-    threading layer does not allow parallel kernels from two threads (``concurrent`` false;
-    default: asked of numba), one chunk runs at a time on all the threads."""
+    Where the threading layer lets several threads launch kernels at once (``concurrent``;
+    default: asked of numba), ``(1, threads)``: pieces of one thread each, ``threads`` at once
+    (never more threads busy than asked for). Otherwise ``(threads, 1)``: one chunk at a time
+    on all the threads."""
     threads = max(1, int(threads))
     if concurrent is None:
         concurrent = _thread_safe_layer()
-    if not concurrent:
-        return threads, 1
-    per = max(1, min(threads, int(chunk) // MIN_CELLS_PER_THREAD))
-    return per, max(1, min(int(n_chunks), -(-threads // per) + 1))
+    return (1, threads) if concurrent else (threads, 1)
+
+
+def pieces(bounds, at_once, smallest=PIECE_MIN, largest=PIECE_MAX):
+    """The pieces ``(a, b, k)`` of the chunks ``bounds`` (``[(a, b), ...]``; ``k`` the chunk's
+    index), in order: each holds the cells not yet given out over ``2 * at_once``, at least
+    ``smallest`` and at most ``largest``, and never crosses its chunk's end.
+
+    >>> [p[:2] for p in pieces([(0, 60), (60, 75)], 2, smallest=8, largest=20)]
+    [(0, 18), (18, 32), (32, 42), (42, 50), (50, 58), (58, 60), (60, 68), (68, 75)]
+    """
+    left = sum(b - a for a, b in bounds)
+    for k, (a, b) in enumerate(bounds):
+        while a < b:
+            size = max(smallest, min(largest, left // (2 * max(1, at_once))))
+            end = min(b, a + size)
+            yield a, end, k
+            left -= end - a
+            a = end
 
 
 def _stored_chunk(store, key, n):
@@ -184,9 +193,10 @@ def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, label, executi
     ``execution`` (a :class:`rockjit.Execution`) says: threads, chunk size, lanes, in this
     process or on a Dask cluster, with a chunk store, with progress.
 
-    In this process the chunk defaults to :func:`default_chunk` (or the chunk of the store
-    already begun for the same computation) and chunks overlap (:func:`local_plan`); on Dask
-    it defaults to :func:`rockjit._engine.kernel.default_chunk`, a twentieth of the grid.
+    The chunk defaults to :func:`rockjit._engine.kernel.default_chunk` (a twentieth of the
+    grid), or to the chunk of the store already begun for the same computation. In this
+    process the cells run as pieces on one thread each, as many at once as threads
+    (:func:`local_plan`, :func:`pieces`).
 
     Returns the outputs by name: ``res`` (the kernels' rows; :func:`rockjit._engine.kernel.
     grid_results` names them), ``pts``, ``imp``, ``n_got``, ``n_imp_got``. With a Dask
@@ -200,25 +210,23 @@ def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, label, executi
     if ex.store is not None:
         key = chunks.fingerprint((y0s, pars, ipar, cpar),
                                  dict(tangent=bool(tangent), n_pts=n_pts, n_imp_pts=n_imp_pts))
+    chunk = ex.chunk
+    if chunk is None and key is not None:
+        chunk = _stored_chunk(ex.store, key, n)
+    if chunk is None:
+        chunk = kernel.default_chunk(n)
     with _client(ex) as client:
         threads, at_once = ex.threads, 1
         if client is None:
             # the calling thread's count (numba.set_num_threads is per thread)
             total = numba.get_num_threads() if ex.threads is None else ex.threads
-            chunk = ex.chunk
-            if chunk is None and key is not None:
-                chunk = _stored_chunk(ex.store, key, n)
-            if chunk is None:
-                chunk = default_chunk(n, total)
-            threads, at_once = local_plan(chunk, total, -(-n // chunk))
-        else:
-            chunk = kernel.default_chunk(n) if ex.chunk is None else ex.chunk
+            threads, at_once = local_plan(total)
         cs = None if key is None else chunks.ChunkStore(ex.store, key, n, chunk,
                                                         message=ex.message)
         run_chunks(kernel.run_chunk, (bool(tangent), y0s, pars, ipar, cpar, n_pts, n_imp_pts,
                                       threads, ex.lanes), n, chunk, outputs_, client=client,
                    store=cs, progress=ex.progress, label=label, message=ex.message,
-                   worker_timeout=ex.worker_timeout, at_once=at_once)
+                   worker_timeout=ex.worker_timeout, at_once=at_once, split=at_once > 1)
     return outputs_
 
 
@@ -323,7 +331,7 @@ class _Callback:
 
 def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, progress=False,
                label="cells", task_prefix="rockjit", message=None, worker_timeout=None,
-               at_once=1):
+               at_once=1, split=False):
     """Run ``runner`` over chunks of ``n`` cells and fill ``outputs`` in place.
 
     Parameters
@@ -362,12 +370,16 @@ def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, pr
         after losing them all, before raising :class:`NoWorkers` (default
         :data:`WORKER_TIMEOUT`, or the value :func:`worker_timeout` set).
     at_once : int
-        In this process, how many chunks run at once, each ``runner`` call in a thread of its
-        own (``runner`` must release the GIL to gain from it, as numba's parallel kernels
-        do); default one at a time, in the calling thread. Chunks are placed as they finish.
-        When a chunk, the progress callback or an interrupt raises, no chunk starts any more;
-        the chunks already running are waited for (and kept in the store) before the
+        In this process, how many calls of ``runner`` run at once, each in a thread of its own
+        (``runner`` must release the GIL to gain from it, as numba's kernels do); default one
+        at a time, in the calling thread. Chunks are placed as they finish. When a call, the
+        progress callback or an interrupt raises, no call starts any more; the calls already
+        running are waited for (and their finished chunks kept in the store) before the
         exception propagates.
+    split : bool
+        With ``at_once > 1``, call ``runner`` on pieces of the chunks (:func:`pieces`; a
+        chunk's outputs are the concatenation of its pieces', so every output must have the
+        cells on its first axis) instead of whole chunks.
     """
     if message is None and store is not None:
         message = store.message
@@ -376,14 +388,14 @@ def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, pr
     try:
         return _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, label,
                            task_prefix, message, _timeout(worker_timeout),
-                           max(1, int(at_once)))
+                           max(1, int(at_once)), bool(split))
     finally:
         if store is not None:
             store.close()
 
 
 def _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, label,
-                task_prefix, message, timeout, at_once=1):
+                task_prefix, message, timeout, at_once=1, split=False):
     bounds = [(a, min(n, a + chunk)) for a in range(0, n, chunk)]
     todo = []
     for a, b in bounds:
@@ -418,11 +430,11 @@ def _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, labe
         bar.update(b - a)
 
     try:
-        if client is None and (at_once == 1 or len(todo) == 1):
+        if client is None and at_once == 1:
             for a, b in todo:
                 place(a, b, runner(*args(a, b)))
         elif client is None:
-            _at_once(runner, todo, args, place, store, at_once)
+            _at_once(runner, todo, args, place, store, at_once, split)
         elif todo:
             _on_dask(client, runner, inputs, n, chunk, todo, args, place, task_prefix, message,
                      timeout)
@@ -431,37 +443,56 @@ def _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, labe
     return outputs
 
 
-def _at_once(runner, todo, args, place, store, at_once):
-    """The chunks ``todo`` in this process, ``at_once`` of them running at a time, each in a
-    thread of its own, placed as they finish (see :func:`run_chunks`)."""
-    queue = iter(todo)
+def _at_once(runner, todo, args, place, store, at_once, split):
+    """The chunks ``todo`` in this process, ``at_once`` calls running at a time, each in a
+    thread of its own, on whole chunks or (``split``) on their :func:`pieces`; each chunk
+    placed once all its calls are done (see :func:`run_chunks`)."""
+    work = pieces(todo, at_once) if split else ((a, b, k) for k, (a, b) in enumerate(todo))
+    parts = [{} for _ in todo]  # per chunk: its finished pieces' outputs by their start
+    left = [b - a for a, b in todo]  # per chunk: cells not yet finished
     pending = {}
-    with cf.ThreadPoolExecutor(max_workers=at_once, thread_name_prefix="rockjit-chunk") as pool:
+
+    def whole(k):
+        got = parts[k]
+        if len(got) == 1:
+            return next(iter(got.values()))
+        starts = sorted(got)
+        return {name: np.concatenate([got[a][name] for a in starts]) for name in got[starts[0]]}
+
+    with cf.ThreadPoolExecutor(max_workers=at_once, thread_name_prefix="rockjit-cells") as pool:
         def start(n_more):
-            for a, b in itertools.islice(queue, n_more):
-                pending[pool.submit(runner, *args(a, b))] = (a, b)
+            for a, b, k in itertools.islice(work, n_more):
+                pending[pool.submit(runner, *args(a, b))] = (a, b, k)
+
+        def finish(fut):
+            a, b, k = pending.pop(fut)
+            parts[k][a] = fut.result()
+            left[k] -= b - a
+            return k
 
         try:
             start(at_once)
             while pending:
                 done, _ = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
                 for fut in sorted(done, key=pending.get):
-                    a, b = pending.pop(fut)
-                    out = fut.result()
-                    start(1)  # the next chunk starts before this one is placed and saved
-                    place(a, b, out)
+                    k = finish(fut)
+                    start(1)  # the next call starts before this chunk is placed and saved
+                    if not left[k]:
+                        out, parts[k] = whole(k), None
+                        place(*todo[k], out)
         finally:
-            # after an error nothing new starts; what runs finishes, and is kept if stored
+            # after an error nothing new starts; what runs finishes, and the chunks it
+            # completes are kept if stored
             for fut in list(pending):
                 if fut.cancel():
                     del pending[fut]
-            for fut, (a, b) in pending.items():
+            for fut in list(pending):
                 try:
-                    out = fut.result()
+                    k = finish(fut)
                 except BaseException:  # noqa: BLE001 - the first error is the one raised
                     continue
-                if store is not None:
-                    store.save(a, b, out)
+                if not left[k] and store is not None:
+                    store.save(*todo[k], whole(k))
 
 
 def _on_dask(client, runner, inputs, n, chunk, todo, args, place, task_prefix, message,
