@@ -69,6 +69,8 @@ SCRIPTS = {
     "bench_attractors.py": (["hb", "alpha", "omega", "law", "grid", "without_s", "with_s",
                              "overhead", "measures_s", "n_attractors", "labels_equal"],
                             ["attractors.png"]),
+    "bench_safety.py": (["law", "chart", "lattice", "periods", "threads", "wall_s",
+                         "s_per_basin", "60x60_s", "60x60", "mean_safe"], ["safety.png"]),
     "bench_orbits.py": (["measurement", "value", "unit", "target"],
                         ["orbits.png", "orbits_branches.png"]),
     "bench_versions.py": (["case", "base_s", "this_s", "ratio", "cpu_ratio", "pair_min",
@@ -277,6 +279,13 @@ VALUES = {
              measures_s=nonneg, n_attractors=count(1), labels_equal=one_of("True")),
         [("overhead = with / without - 1", lambda r: abs(
             num(r, "with_s") / num(r, "without_s") - 1 - num(r, "overhead")) < 1e-9)]),
+    "bench_safety.py": (
+        {"law": one_of(*LAWS), "chart": text, "lattice": count(2), "periods": count(1),
+         "threads": count(1), "wall_s": positive, "s_per_basin": positive,
+         "60x60_s": positive, "60x60": one_of("measured", "extrapolated"),
+         "mean_safe": between(0, 1)},
+        [("the 60x60 time is 3600 basins at the time per basin", lambda r: abs(
+            num(r, "60x60_s") - 3600 * num(r, "s_per_basin")) <= 1e-2 * num(r, "60x60_s"))]),
     "bench_orbits.py": ({}, []),  # its values are checked where its conversion is
     "bench_versions.py": (
         dict(case=one_of("run", "run+lyapunov", "basin", "sweep"), base_s=positive,

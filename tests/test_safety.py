@@ -9,7 +9,7 @@ import pytest
 
 import rockjit
 from rockjit import Block, Harmonic, Integration, Lattice
-from rockjit.basins import measures as M
+from rockjit import measures as M
 from rockjit.result import OVERTURN
 
 BLOCK = Block(hb=1.0)
@@ -188,3 +188,17 @@ def test_cli_safety_refuses_bad_ranges(tmp_path, capsys, argv):
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1 and err[0].startswith("rockjit: error:")
     assert not (tmp_path / "o").exists()
+
+
+def test_shock_chart_is_bounded_by_each_basins_nearest_fatal_cell():
+    from rockjit.integrity import fatal_shock_chart
+    ch = rockjit.safety(BLOCK, (0.62, 0.66), (1.3, 1.3), grid=(2, 1), lattice=41,
+                        integration=SHORT)
+    norms = fatal_shock_chart(ch, rtol=1e-3, radius=1.0)
+    TH, DTH = np.meshgrid(ch.theta0, ch.dtheta0, indexing="ij")
+    for i, a in enumerate(ch.alpha):
+        b = rockjit.basin(BLOCK, Harmonic(alpha=float(a), omega=1.3), 41, integration=SHORT)
+        x = np.asarray(ch.attractors[i][0][0]["points"]).reshape(-1, 2)
+        fatal = b.label == OVERTURN
+        nearest = min(np.min(np.hypot(TH - p[0], DTH - p[1])[fatal]) for p in x)
+        assert 0 < norms[i, 0] <= nearest
