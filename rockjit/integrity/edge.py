@@ -4,11 +4,12 @@ Edge tracking (Skufca, Yorke and Eckhardt 2006): two initial states at the forci
 safe and one fatal, are bisected along their segment until they are ``bisect_tol`` apart; both
 are then carried along by the stroboscopic map, and whenever they drift more than
 ``separation`` apart they are bisected again between their images (an image of a safe state is
-safe, of a fatal one fatal). The pair stays on the boundary and is drawn to the attracting set
-*within* it, the edge state. Its period is read off the tracked points (the smallest ``p`` whose
-points recur), and the orbit is handed to rockjit's shooting
-(:func:`rockjit.orbits.periodic_orbit`), which converges it and gives its Floquet multipliers:
-one outside the unit circle (the direction across the boundary), the rest inside.
+safe, of a fatal one fatal), until the tracked points recur with a period. The pair stays on
+the boundary and is drawn to the attracting set *within* it, the edge state. Its period is read
+off the tracked points (the smallest ``p`` whose points recur), and the orbit is handed to
+rockjit's shooting (:func:`rockjit.orbits.periodic_orbit`), which converges it and gives its
+Floquet multipliers: one outside the unit circle (the direction across the boundary), the rest
+inside.
 
 The tracking runs the compiled path at ``n_steps`` steps per period, both the map's periods
 and the fates of the bisection (:class:`.outcome.Outcomes`, ``periods`` long).
@@ -33,6 +34,8 @@ __all__ = ["EdgeState", "edge_state"]
 
 #: States run at once in one round of the bisection (each round shrinks the segment 16 times).
 K = 15
+#: Periods tracked at least before the tracked points are looked at for a period.
+MIN_TRACK = 20
 
 
 @dataclass
@@ -124,7 +127,9 @@ def edge_state(block, forcing, safe, fatal, *, periods=500, track=300, separatio
     periods : int
         Horizon of a run deciding a state's fate, ``>= 10``.
     track : int
-        Periods the pair is tracked, ``>= 10``.
+        Periods the pair is tracked at most, ``>= 10``; the tracking stops earlier, after at
+        least 20 periods, once its last points recur with a period up to ``max_period``
+        (within ten times ``separation``).
     separation : float
         Distance at which the pair is bisected again, in ``(bisect_tol, 0.1]``.
     bisect_tol : float
@@ -203,6 +208,10 @@ def edge_state(block, forcing, safe, fatal, *, periods=500, track=300, separatio
             a, b = _bisect(oc, a, b, bisect_tol)
             rebisections += 1
         tracked.append(0.5 * (a + b))
+        # settled: the last points recur with a period (checked every few periods)
+        if len(tracked) >= MIN_TRACK and len(tracked) % 5 == 0 and \
+                _period(np.asarray(tracked), max_period, 10 * separation) is not None:
+            break
     tracked = np.asarray(tracked)
     p = _period(tracked, max_period, 10 * separation)
     if p is None:
