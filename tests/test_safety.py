@@ -202,3 +202,19 @@ def test_shock_chart_is_bounded_by_each_basins_nearest_fatal_cell():
         fatal = b.label == OVERTURN
         nearest = min(np.min(np.hypot(TH - p[0], DTH - p[1])[fatal]) for p in x)
         assert 0 < norms[i, 0] <= nearest
+
+
+def test_chart_on_a_dask_cluster_is_the_chart_in_process(chart):
+    distributed = pytest.importorskip("dask.distributed")
+    from rockjit import Execution
+    cluster = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                       dashboard_address=":0")
+    try:
+        with distributed.Client(cluster) as client:
+            on = rockjit.safety(BLOCK, (0.6, 0.7), (1.2, 1.3), grid=(3, 2), lattice=8,
+                                integration=SHORT,
+                                execution=Execution(client=client, chunk=40))
+    finally:
+        cluster.close()
+    for name in ("safe", "GIM", "IF", "LIM", "n_attractors"):
+        np.testing.assert_array_equal(getattr(on, name), getattr(chart, name), err_msg=name)
