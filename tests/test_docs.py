@@ -410,3 +410,29 @@ def test_the_gallery_index_shows_a_thumbnail_per_page():
     grid = re.search(r"```\{rockjit-gallery\}\n(.*?)```", index, re.S).group(1).split()
     assert grid == _toctree(index)
     assert _ext("rockjit_gallery").ENV_KEY
+
+
+# ------------------------------------------------------------------------------- one symbol
+
+def test_alpha_is_the_forcing_amplitude_only_in_what_a_user_reads():
+    """The uplift threshold is written ``g cot theta_c`` (= g b/h) and the tipping angle
+    ``pi/2 - theta_c``: the command line's help, a pulse's line, the fragility measure's name,
+    the ground figures' labels and the pages on ground motions never call them alpha."""
+    from rockjit import Pulse
+    from rockjit.cli.main import build_parser
+    from rockjit.ground import figures as GF
+    from rockjit.ground.fragility import MEASURES
+    parser = build_parser()
+    sub = next(a for a in parser._actions if hasattr(a, "choices") and a.choices)
+    for command in ("spectrum", "fragility"):
+        helps = " ".join(str(a.help) for a in sub.choices[command]._actions)
+        assert "cot theta_c" in helps and "tan alpha" not in helps, command
+    line = Pulse("sine", ratio=2.0, amplitude=3.0).describe()
+    assert "a_p/(g cot theta_c) = 3" in line and "alpha" not in line
+    assert MEASURES["pga"] == "PGA / (g cot theta_c)"
+    assert GF.AMPLITUDE == r"$a_p / (g \cot\theta_c)$"
+    source = Path(GF.__file__).read_text()
+    assert r"\tan\theta_c" not in source and r"/ \theta_c" not in source
+    for page in ("guide/earthquakes.md", "theory/ground-motions.md"):
+        text = (DOCS / page).read_text()
+        assert r"\tan\alpha_s" not in text, page

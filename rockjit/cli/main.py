@@ -935,7 +935,7 @@ def build_parser():
                    metavar=("START", "END"), help="frequency ratios omega_p/p (ends included)")
     p.add_argument("--amplitude-range", type=float, nargs=2, required=True,
                    metavar=("START", "END"),
-                   help="amplitude ratios a_p/(g tan alpha) (ends included; 1 is uplift)")
+                   help="amplitude ratios a_p/(g cot theta_c) (ends included; 1 is uplift)")
     p.add_argument("--grid", type=int, nargs=2, default=(100, 100), metavar=("NR", "NK"),
                    help="points along the ratios and the amplitudes (default 100 100)")
     p.add_argument("--tol", type=float, default=1e-6,
@@ -957,7 +957,7 @@ def build_parser():
                    help="farfield, nearfield, nearfield-pulse, nearfield-no-pulse (FEMA P695: "
                         "pip install 'rockjit[records]') or .AT2 / two-column (s, g) files")
     p.add_argument("--measure", default="pga", choices=("pga", "pgv"),
-                   help="intensity measure: PGA/(g tan alpha) (default) or PGV in m/s")
+                   help="intensity measure: PGA/(g cot theta_c) (default) or PGV in m/s")
     p.add_argument("--intensities", type=float, nargs="+", default=None, metavar="X",
                    help="the intensities every record is scaled to (default 1.25 to 6 by "
                         "0.25 for pga, 0.05 to 1 m/s by 0.05 for pgv)")

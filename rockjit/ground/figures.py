@@ -34,7 +34,7 @@ def _figure(width, aspect):
 
 #: The axes' quantities, in the study's symbols (theta_c the block's critical angle).
 RATIO = r"$\omega_p / p$"
-AMPLITUDE = r"$a_p / (g \tan\theta_c)$"
+AMPLITUDE = r"$a_p / (g \cot\theta_c)$"
 
 
 def _law_colour(law):
@@ -97,7 +97,7 @@ def _closed_form(ax, sp):
 @_styled
 def fig_spectrum(results, comparison=None):
     """Overturning spectra: per law, the outcome of every cell over
-    ``(omega_p / p, a_p / (g tan theta_c))`` with the located boundaries; with two laws, a
+    ``(omega_p / p, a_p / (g cot theta_c))`` with the located boundaries; with two laws, a
     third panel of the cells where they differ and both laws' minimum overturning amplitude.
     ``results``: a :class:`~rockjit.ground.spectrum.SpectrumResult` or a dict law -> one. The
     legends sit below the panels, off the data."""
@@ -186,7 +186,7 @@ def _curve(ax, x, frac, fit, colour, ls, label, marker="o"):
 
 
 def _xlabel(res):
-    return r"PGA / $(g \tan\theta_c)$" if res.measure == "pga" else "PGV [m/s]"
+    return r"PGA / $(g \cot\theta_c)$" if res.measure == "pga" else "PGV [m/s]"
 
 
 @_styled
@@ -217,8 +217,8 @@ def fig_fragility(res):
 
 @_styled
 def fig_rotation(res):
-    """Rotation exceedance: ``P(max |theta| / theta_c >= level)`` for each fitted level, one
-    panel each, laws and sizes as in :func:`fig_fragility`."""
+    """Rotation exceedance: ``P(max |theta| / (pi/2 - theta_c) >= level)`` for each fitted
+    level, one panel each, laws and sizes as in :func:`fig_fragility`."""
     from .fragility import EXCEEDANCE
     fig = _figure("double", 0.55)
     axes = fig.subplots(1, len(EXCEEDANCE), sharey=True, squeeze=False)[0]
@@ -233,7 +233,7 @@ def fig_rotation(res):
                                       f"{_LAW_NAMES.get(law, law)}, $R = {size:g}$ m",
                                       _law_marker(law)))
         ax.set_xlabel(_xlabel(res))
-        ax.set_title(f"$\\max|\\theta| / \\theta_c \\geq {lv:g}$")
+        ax.set_title(f"$\\max|\\theta| / (\\pi/2 - \\theta_c) \\geq {lv:g}$")
         ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncols=1,
                   handlelength=3.0)
     axes[0].set_ylabel("P(exceeded)")
@@ -243,8 +243,8 @@ def fig_rotation(res):
 
 @_styled
 def fig_transient(result):
-    """One transient run: ``theta / theta_c`` and the base acceleration ``f / tan theta_c``
-    against time, the impacts marked."""
+    """One transient run: ``theta / (pi/2 - theta_c)`` and the base acceleration
+    ``f / cot theta_c`` against time, the impacts marked."""
     fig = _figure("double", 0.5)
     ax, axf = fig.subplots(2, 1, sharex=True, height_ratios=(2, 1))
     a = result.alpha_s
@@ -255,15 +255,15 @@ def fig_transient(result):
         ax.axvline(t, color="0.7", lw=0.5)
     ax.axhline(1.0, color="0.5", ls=":", lw=0.8)
     ax.axhline(-1.0, color="0.5", ls=":", lw=0.8)
-    ax.set_ylabel(r"$\theta / \theta_c$")
+    ax.set_ylabel(r"$\theta / (\pi/2 - \theta_c)$")
     t_end = max(result.t, 1e-9)
     ts = np.linspace(0.0, t_end, 4000)
     axf.plot(ts, result.excitation.f(ts) * result.block.hb, color="#1f77b4", lw=0.7)
     axf.axhline(1.0, color="0.5", ls=":", lw=0.8)
     axf.axhline(-1.0, color="0.5", ls=":", lw=0.8)
-    axf.set_ylabel(r"$f / \tan\theta_c$")
+    axf.set_ylabel(r"$f / \cot\theta_c$")
     axf.set_xlabel(r"$t$ [units of $\sqrt{R/g}$]")
     mode = f", {result.mode}" if result.mode else ""
-    ax.set_title(f"{result.status}{mode}; $\\max|\\theta| / \\theta_c = "
+    ax.set_title(f"{result.status}{mode}; $\\max|\\theta| / (\\pi/2 - \\theta_c) = "
                  f"{result.max_rotation:.3g}$")
     return fig

@@ -9,7 +9,7 @@ do not identify is reported as such, without an estimate) to:
 - the probability that ``max |theta| / alpha_s`` reaches 0.5 and 1 (rotation exceedance; an
   overturned run exceeds every level).
 
-The intensity measure is ``PGA / (g tan alpha_s)`` (``measure="pga"``, the default: the
+The intensity measure is ``PGA / (g cot theta_c)`` (``measure="pga"``, the default: the
 record's peak ground acceleration over the uplift threshold, dimensionless, 1 at uplift) or
 the peak ground velocity in m/s (``measure="pgv"``). Both are measured on the record itself,
 independent of the block's size, so the curves of blocks of several sizes (``sizes``) are
@@ -40,7 +40,7 @@ from .response import OVERTURN_IMPACT, OVERTURN_NO_IMPACT, UNRESOLVED
 __all__ = ["EXCEEDANCE", "FragilityPlan", "FragilityResult", "MEASURES", "fragility", "run"]
 
 #: Intensity measures: name -> what it is.
-MEASURES = {"pga": "PGA / (g tan alpha_s)", "pgv": "PGV (m/s)"}
+MEASURES = {"pga": "PGA / (g cot theta_c)", "pgv": "PGV (m/s)"}
 #: The rotation levels ``max |theta| / alpha_s`` whose exceedance is fitted.
 EXCEEDANCE = (0.5, 1.0)
 #: Most runs one analysis may ask for.
@@ -297,7 +297,7 @@ def fragility(block, records, sizes, intensities, *, measure="pga", laws=None,
     intensities : sequence of float
         The intensities every record is scaled to, increasing and positive.
     measure : {"pga", "pgv"}
-        ``PGA / (g tan alpha_s)`` (default) or PGV in m/s.
+        ``PGA / (g cot theta_c)`` (default) or PGV in m/s.
     laws : sequence of str, optional
         Restitution laws to run, e.g. ``("housner", "mao")``; default the block's.
     integration : Transient, optional

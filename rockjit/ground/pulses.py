@@ -3,7 +3,7 @@
 A pulse is given, as in the rocking literature (Zhang & Makris 2001; Dimitrakopoulos & DeJong
 2012), by two dimensionless ratios: its frequency against the block's frequency parameter,
 ``ratio = omega_p / p``, and its peak acceleration against the uplift threshold,
-``amplitude = a_p / (g tan alpha_s)`` with ``tan alpha_s = b/h``. In model units
+``amplitude = a_p / (g cot theta_c)`` with ``cot theta_c = b/h``. In model units
 (docs/theory/model.md), ``p = sqrt(3/4)``, so ``omega_p = ratio * sqrt(3/4)`` and the peak base
 acceleration in ``g`` is ``a_p / g = amplitude / hb``: the pulse needs the block's slenderness to
 become a base acceleration. :meth:`Pulse.bind` gives it the block's; the forms of
@@ -51,7 +51,7 @@ class Pulse(Excitation):
     ratio : float, optional
         ``omega_p / p`` in ``[1e-3, 1e3]``. Left out where a spectrum sweeps it.
     amplitude : float, optional
-        ``a_p / (g tan alpha_s)`` in ``[0, 1e6]``: above 1 the pulse can lift the block. Left
+        ``a_p / (g cot theta_c)`` in ``[0, 1e6]``: above 1 the pulse can lift the block. Left
         out where a spectrum sweeps it.
     hb : float, optional
         The slenderness ``h/b`` the amplitude refers to; :func:`rockjit.simulate` binds the
@@ -226,4 +226,4 @@ class Pulse(Excitation):
     def describe(self) -> str:
         """One line: the pulse and its ratios."""
         return (f"one-{self.kind} pulse" if self.kind != "ricker" else "Ricker wavelet") + \
-            f", omega_p/p = {self.ratio:g}, a_p/(g tan alpha) = {self.amplitude:g}"
+            f", omega_p/p = {self.ratio:g}, a_p/(g cot theta_c) = {self.amplitude:g}"

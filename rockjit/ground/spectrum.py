@@ -1,7 +1,7 @@
 """Overturning spectra of pulses: outcome and demand over the plane of the two ratios.
 
 :func:`spectrum` runs a block, from rest, under a pulse at every ``(omega_p / p,
-a_p / (g tan alpha_s))`` of a grid and records each cell's outcome (safe, overturned after an
+a_p / (g cot theta_c))`` of a grid and records each cell's outcome (safe, overturned after an
 impact, overturned without one: Zhang & Makris 2001's two modes) and ``max |theta| / alpha_s``.
 At every frequency ratio it then locates, by bisection to a relative ``tol`` (default
 ``1e-6``), two boundaries:
@@ -93,7 +93,7 @@ class SpectrumResult:
     ratio : ndarray, shape (nr,)
         The frequency ratios ``omega_p / p``.
     amplitude : ndarray, shape (nk,)
-        The amplitude ratios ``a_p / (g tan alpha_s)``.
+        The amplitude ratios ``a_p / (g cot theta_c)``.
     outcome : ndarray of int8, shape (nr, nk)
         Each cell's outcome code (:data:`rockjit.ground.OUTCOMES`).
     max_rotation, t_overturn : ndarray, shape (nr, nk)
@@ -281,7 +281,7 @@ def spectrum(block, pulse, ratios, amplitudes, *, integration=None, method=None,
     ratios : array of float
         Frequency ratios ``omega_p / p``, increasing, in ``[1e-3, 1e3]``.
     amplitudes : array of float
-        Amplitude ratios ``a_p / (g tan alpha_s)``, increasing, in ``[0, 1e6]``.
+        Amplitude ratios ``a_p / (g cot theta_c)``, increasing, in ``[0, 1e6]``.
     integration : Transient, optional
         Free rocking time, Zeno cut-off, overturning threshold; every run stops once its
         outcome is decided (``stop_when_decided``) and keeps no trajectory.
