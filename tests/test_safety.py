@@ -218,3 +218,20 @@ def test_chart_on_a_dask_cluster_is_the_chart_in_process(chart):
         cluster.close()
     for name in ("safe", "GIM", "IF", "LIM", "n_attractors"):
         np.testing.assert_array_equal(getattr(on, name), getattr(chart, name), err_msg=name)
+
+
+def test_figures_read_in_a_journal(chart):
+    import matplotlib
+    matplotlib.use("Agg")
+    from rockjit.integrity.figure import fig_fatal_shock, fig_safety, fig_safety_difference
+    from rockjit.plotting import legibility as L
+    mao = rockjit.safety(Block(hb=1, law="mao"), (0.6, 0.7), (1.2, 1.3), grid=(3, 2),
+                         lattice=8, integration=SHORT)
+    b = rockjit.basin(BLOCK, FORCING, 12, integration=SHORT)
+    shock = rockjit.fatal_shock(BLOCK, FORCING, POINT, integration=SHORT, rtol=1e-2,
+                                directions=16, radii=8, angle_tol=0.05)
+    figs = [fig_safety(chart, (0.5, 0.53)), fig_safety(mao),
+            fig_safety_difference({"housner": chart, "mao": mao}),
+            fig_fatal_shock(b, {0: shock})]
+    for fig in figs:
+        assert L.problems(fig) == []
