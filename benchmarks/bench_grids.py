@@ -42,7 +42,7 @@ import _common as H
 import rockjit
 from rockjit import BEHAVIOURS, Block, Classification, Execution, Harmonic, Integration
 from rockjit.grids.plan import GRID_N
-from rockjit.basins.identity import agreement
+from rockjit.grids.identity import agreement
 
 #: The study's four basins (docs/theory/study.md, figure 6): (block, forcing), every cell at
 #: the forcing phase (r0, s0) = (0, 1) (a basin's default)

@@ -125,7 +125,7 @@ class BasinEntropy:
     Examples
     --------
     >>> import numpy as np
-    >>> from rockjit.basins.measures import basin_entropy
+    >>> from rockjit.measures import basin_entropy
     >>> ids = np.zeros((10, 10), dtype=int)
     >>> ids[:, 4:] = 1
     >>> Sb, Sbb = basin_entropy(ids)
@@ -191,7 +191,7 @@ def basin_entropy(ids, box=5):
     Two outcomes split by a straight boundary inside the first column of boxes:
 
     >>> import numpy as np
-    >>> from rockjit.basins.measures import basin_entropy
+    >>> from rockjit.measures import basin_entropy
     >>> ids = np.zeros((10, 10), dtype=int)
     >>> ids[:, 4:] = 1
     >>> e = basin_entropy(ids, box=5)
@@ -282,7 +282,7 @@ def uncertain_fraction(ids, eps_cells, margin=None):
     Examples
     --------
     >>> import numpy as np
-    >>> from rockjit.basins.measures import uncertain_fraction
+    >>> from rockjit.measures import uncertain_fraction
     >>> ids = np.zeros((10, 10), dtype=int)
     >>> ids[:, 4:] = 1
     >>> uncertain_fraction(ids, [1, 2])
@@ -328,7 +328,7 @@ class UncertaintyExponent:
 
     Examples
     --------
-    >>> from rockjit.basins.measures import uncertainty_exponent
+    >>> from rockjit.measures import uncertainty_exponent
     >>> alpha, stderr, dimension = uncertainty_exponent([1, 2, 4], [0.1, 0.2, 0.4])
     >>> round(alpha, 12), round(dimension, 12)
     (1.0, 1.0)
@@ -382,7 +382,7 @@ def uncertainty_exponent(eps, f, dim=2):
     --------
     A smooth boundary (the fraction grows like ``eps``) has ``alpha = 1``, dimension 1:
 
-    >>> from rockjit.basins.measures import uncertainty_exponent
+    >>> from rockjit.measures import uncertainty_exponent
     >>> u = uncertainty_exponent([1, 2, 4], [0.1, 0.2, 0.4])
     >>> round(u.alpha, 12), round(u.stderr, 12), round(u.dimension, 12)
     (1.0, 0.0, 1.0)
@@ -431,7 +431,7 @@ class SampledUncertainty:
 
     Examples
     --------
-    >>> from rockjit.basins.measures import uncertain_fraction_sampled
+    >>> from rockjit.measures import uncertain_fraction_sampled
     >>> half_plane = lambda points: (points[:, 0] > 0).astype(int)
     >>> s = uncertain_fraction_sampled(half_plane, (-1, -1), (1, 1), [0.01, 0.02, 0.04],
     ...                                n=2000)
@@ -494,7 +494,7 @@ def uncertain_fraction_sampled(outcome, lo, hi, eps, n=10_000, seed=0):
     --------
     The outcome of a half-plane: its boundary is a straight line, its exponent 1:
 
-    >>> from rockjit.basins.measures import uncertain_fraction_sampled
+    >>> from rockjit.measures import uncertain_fraction_sampled
     >>> half_plane = lambda points: (points[:, 0] > 0).astype(int)
     >>> s = uncertain_fraction_sampled(half_plane, (-1, -1), (1, 1), [0.01, 0.02, 0.04],
     ...                                n=2000, seed=0)
@@ -572,7 +572,7 @@ class Integrity:
     Examples
     --------
     >>> import numpy as np
-    >>> from rockjit.basins.measures import integrity
+    >>> from rockjit.measures import integrity
     >>> axis = np.linspace(-1, 1, 21)
     >>> ids = np.zeros((21, 21), dtype=int)
     >>> ids[:5] = -1
@@ -687,7 +687,7 @@ def integrity(ids, theta, dtheta, points=None, lim_basin="safe"):
     attractor at ``(0.5, 0)``:
 
     >>> import numpy as np
-    >>> from rockjit.basins.measures import integrity
+    >>> from rockjit.measures import integrity
     >>> axis = np.linspace(-1, 1, 21)
     >>> ids = np.zeros((21, 21), dtype=int)
     >>> ids[:5] = -1

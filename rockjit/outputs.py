@@ -3,9 +3,9 @@
 One function per kind of result writes it into an output directory object
 (:class:`rockjit.storage.output_dir.OutputDir`, or anything with its ``npz``, ``figure`` and
 ``describe`` methods) and returns the JSON-ready part of ``summary.json`` that describes it.
-The command line and the paper (:func:`rockjit.study.paper`) both write through these, so a
-sweep or a basin has the same files wherever it was computed. Every file is described
-(``out.describe``): ``summary.json`` lists each with what it holds.
+The command line (:mod:`rockjit.cli`) and the paper (:func:`rockjit.study.paper.paper`) both
+write through these, so a sweep or a basin has the same files wherever it was computed. Every
+file is described (``out.describe``): ``summary.json`` lists each with what it holds.
 
 The data come first and never depend on a figure: a figure that cannot be drawn or written is
 left out and noted (``out.figure_failed``; ``summary.json``'s ``figures_failed``), and the
@@ -35,8 +35,8 @@ def summary(out, command, inputs, wall, **results):
     """``summary.json``'s content: the command and its inputs, rockjit's version, the wall
     time, the behaviour names, every file written with what it holds (``files``), the figures
     that could not be drawn (``figures_failed``, only if any) and the command's ``results``."""
-    from .. import __version__
-    from ..result import BEHAVIOURS
+    from . import __version__
+    from .result import BEHAVIOURS
     failed = list(getattr(out, "figure_errors", []))
     extra = dict(figures_failed=failed) if failed else {}
     return dict(command=command, rockjit_version=__version__, inputs=inputs, wall_s=wall,
@@ -73,8 +73,8 @@ def _npz(out, name, holds, **arrays):
 def trajectory(out, res, *, npz="trajectory.npz", png="trajectory.png"):
     """One run: its arrays (``Result.arrays``) and
     :func:`rockjit.plotting.figures.fig_trajectory`."""
-    from ..single import classify_result
-    from ..plotting.figures import fig_trajectory
+    from .single import classify_result
+    from .plotting.figures import fig_trajectory
     name, period = classify_result(res)
     _npz(out, npz, "the run's arrays: t, theta, dtheta, r, s (recorded trajectory), strobe, "
                    "strobe_half, impacts (t, dtheta-, dtheta+), lyapunov_running", **res.arrays())
@@ -86,7 +86,7 @@ def trajectory(out, res, *, npz="trajectory.npz", png="trajectory.png"):
 
 def sweep(out, sw, *, npz="sweep.npz", png="bifurcation.png"):
     """A sweep: its arrays and its bifurcation diagram."""
-    from ..plotting.figures import fig_bifurcation
+    from .plotting.figures import fig_bifurcation
     _npz(out, npz, "the sweep: alpha, label (behaviour codes, names), period, lambda_max "
                    "(exact where periodic), lambda_window (finite-window estimate), strobe "
                    "(theta, theta' at kT), impact_section, t_end, attractor", **sw.arrays())
@@ -105,8 +105,8 @@ def basins(out, res, *, npz="basin.npz", png="basin.png", attractors_png="attrac
     """One basin, or two laws' (a dict ``law: BasinResult``): the labels, attractor maps and
     (when computed) exponents and uncertain cells, per law when there are two; the behaviour
     map (with the two laws' agreement) and the attractor map with its measures."""
-    from ..basins.identity import agreement, attractor_agreement
-    from ..plotting.figures import fig_attractors, fig_basin, fig_basin_compare
+    from .grids.identity import agreement, attractor_agreement
+    from .plotting.figures import fig_attractors, fig_basin, fig_basin_compare
     if not isinstance(res, dict):
         res = {res.block.law: res}
     first = next(iter(res.values()))
@@ -155,7 +155,7 @@ def basins(out, res, *, npz="basin.npz", png="basin.png", attractors_png="attrac
 
 def plane(out, pl, *, npz="plane.npz", png="plane.png"):
     """A plane from its first initial state: its arrays and its map."""
-    from ..plotting.figures import fig_plane
+    from .plotting.figures import fig_plane
     arrays = dict(alpha=pl.alpha, omega=pl.omega, z0=pl.z0, label=pl.label[0],
                   period=pl.period[0], lambda_max=pl.lambda_max[0], t_end=pl.t_end[0],
                   names=np.asarray(pl.names, dtype=str))
@@ -179,7 +179,7 @@ def plane(out, pl, *, npz="plane.npz", png="plane.png"):
 def erosion(out, res, *, npz="erosion.npz", png="erosion.png"):
     """Erosion profiles (a dict ``law: ErosionResult``): per law, the profile's arrays, and the
     profile figure."""
-    from ..plotting.figures import fig_erosion
+    from .plotting.figures import fig_erosion
     first = next(iter(res.values()))
     _npz(out, npz, "alpha, theta0, dtheta0 and per law (suffix _<law>): GIM, IF, fractions "
                    "(each attractor's percent at each alpha), overturn, basin_entropy, the "
@@ -195,7 +195,7 @@ def erosion(out, res, *, npz="erosion.npz", png="erosion.png"):
 def fate(out, fr, *, npz="fate.npz", png="fate.png"):
     """An ensemble's outcomes: the members' initial states, outcomes and end times, and a
     figure of the outcome probabilities and the end times against the horizon."""
-    from ..plotting.figures import fig_fate
+    from .plotting.figures import fig_fate
     _npz(out, npz, "the members' initial states, outcome ids (-1 overturn, -2 unresolved, "
                    "attractors from 0) and end times", initial=fr.initial, outcome=fr.outcome,
          t_end=fr.t_end)
@@ -209,7 +209,7 @@ def orbits(out, res, *, npz="orbits.npz", png="orbits.png", caption="orbits.md")
     bifurcations' arrays, the diagram with the branches over the sweep's dots, its caption
     (every bifurcation and where each branch stops) and the summary (``"bifurcations"``: type,
     alpha, period, multipliers, state)."""
-    from ..plotting.figures import branch_caption, fig_branches
+    from .plotting.figures import branch_caption, fig_branches
     cont, sw = res
     summary, arrays = cont.to_summary()
     _npz(out, npz, "per branch i: branch{i}_value, _cycle, _multipliers, _stable, ...; the "
@@ -232,7 +232,7 @@ def chart(out, res, *, npz="chart.npz", png="chart.png"):
     (:func:`rockjit.plotting.chart.fig_chart`), and the summary: ``"curves"`` (type, period,
     law, points ``[[alpha, omega], ...]``, ends, codimension-two points, residuals) and, per
     law, the chart's fractions, seeds, refusals and timing."""
-    from ..plotting.chart import fig_chart
+    from .plotting.chart import fig_chart
     arrays, charts, curves = {}, {}, []
     two = len(res) > 1
     for law, r in res.items():
@@ -258,9 +258,9 @@ def spectrum(out, res, *, npz="spectrum.npz", png="spectrum.png"):
     """Overturning spectra (a dict ``law: SpectrumResult``): the grid and, per law (suffixed
     ``_<law>`` with two laws), the outcomes, demands and located boundaries; the figure; the
     summary (``min_overturn`` per law, and where two laws differ)."""
-    from ..ground.figures import fig_spectrum
-    from ..ground.response import OUTCOMES
-    from ..ground.spectrum import compare
+    from .ground.figures import fig_spectrum
+    from .ground.response import OUTCOMES
+    from .ground.spectrum import compare
     first = next(iter(res.values()))
     arrays = dict(ratio=first.ratio, amplitude=first.amplitude,
                   outcomes=np.asarray(OUTCOMES, dtype=str))
@@ -287,8 +287,8 @@ def spectrum(out, res, *, npz="spectrum.npz", png="spectrum.png"):
 def fragility(out, fr, *, npz="fragility.npz", png="fragility.png", rotation_png="rotation.png"):
     """An incremental dynamic analysis: every run's outcome and demand, the fitted curves'
     figures and their summary."""
-    from ..ground.figures import fig_fragility, fig_rotation
-    from ..ground.response import OUTCOMES
+    from .ground.figures import fig_fragility, fig_rotation
+    from .ground.response import OUTCOMES
     _npz(out, npz, "every run of the incremental dynamic analysis: record, size, intensity, "
                    "law, outcome (index into outcomes), max rotation; the fitted fragility "
                    "curves' medians and dispersions", outcomes=np.asarray(OUTCOMES, dtype=str),

@@ -273,10 +273,10 @@ class GridResult:
     settings: dict = field(default_factory=dict)
     names: np.ndarray = field(default_factory=_names_array)
     #: Outcome id of each cell (same shape as ``label``): ``>= 0`` the attractor it reaches,
-    #: ``-1`` overturn, ``-2`` unresolved (rockjit.basins.identity); None when not identified.
+    #: ``-1`` overturn, ``-2`` unresolved (rockjit.grids.identity); None when not identified.
     attractor: np.ndarray | None = None
     #: The attractors, by id: each one's behaviour, period, cycle points, basin fraction and
-    #: Floquet multipliers (``rockjit.basins.identity.Attractor``).
+    #: Floquet multipliers (``rockjit.grids.identity.Attractor``).
     attractors: list = field(default_factory=list)
     #: Cells whose outcome changes when their initial state moves by ``settings["uncertainty"]``
     #: (``Classification(uncertainty=...)``); None when not asked for.
@@ -492,11 +492,11 @@ class BasinResult(GridResult):
         return basin_dataset(self)
 
     def measures(self, box=5, eps_cells=(1, 2, 3, 4, 6, 8)):
-        """Measures of the attractor map (rockjit.basins.measures): basin entropy ``Sb`` and
+        """Measures of the attractor map (rockjit.measures): basin entropy ``Sb`` and
         boundary basin entropy ``Sbb`` on ``box x box`` boxes, the uncertainty exponent of the
         boundary from the fraction of cells whose outcome differs ``eps`` cells away, and the
         dynamical integrity (GIM, IF, and LIM of each bounded attractor). JSON-ready."""
-        from .basins import measures as M
+        from . import measures as M
         ids = self.attractor
         if min(ids.shape) >= 2:
             out = M.basin_entropy(ids, box=min(box, *ids.shape)).to_dict()

@@ -15,7 +15,7 @@ import pytest
 
 import rockjit
 from rockjit import Block, Classification, Harmonic, Integration, Scipy
-from rockjit.basins.identity import cycle_distance, identify, match_attractors
+from rockjit.grids.identity import cycle_distance, identify, match_attractors
 
 BLOCK = Block(hb=1.0, law="housner")  # the study's hb=1 basin
 FORCING = Harmonic(alpha=0.66, omega=1.3)

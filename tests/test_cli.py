@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 import rockjit
-from rockjit.cli import outputs
+from rockjit import outputs
 from rockjit.grids import plan as grid_plan
 from rockjit.storage import atomic as rio
 from rockjit import BEHAVIOURS, Block, Harmonic, Integration

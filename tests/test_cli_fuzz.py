@@ -950,8 +950,8 @@ def reached():
     # import every module the CLI may import lazily first: one imported while the patches are
     # in place would keep a sentinel under its own name for the rest of the test run
     for name in ("grids.plan", "ground.batch", "ground.spectrum", "ground.fragility",
-                 "ground.reference", "basins.identity", "basins.erosion", "basins.fate",
-                 "orbits.arclength", "orbits.plane_chart", "cli.outputs", "plotting.figures",
+                 "ground.reference", "grids.identity", "basins.erosion", "basins.fate",
+                 "orbits.arclength", "orbits.plane_chart", "outputs", "plotting.figures",
                  "study.paper"):
         importlib.import_module(f"rockjit.{name}")
     _GUARDS["calls"] = calls

@@ -1,4 +1,4 @@
-"""The one cycle matcher (rockjit.basins.cycles) against a plain-Python brute force: every cyclic
+"""The one cycle matcher (rockjit.grids.cycles) against a plain-Python brute force: every cyclic
 shift, stacks broadcast, symmetric bit for bit; and the distance of two attractors built on it."""
 
 import math
@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from rockjit.basins.cycles import cycle_distance, cycle_size
-from rockjit.basins.identity import Attractor, attractor_distance, match_attractors
+from rockjit.grids.cycles import cycle_distance, cycle_size
+from rockjit.grids.identity import Attractor, attractor_distance, match_attractors
 
 
 def brute(a, b):

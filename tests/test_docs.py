@@ -32,9 +32,9 @@ PUBLIC_MODULES = [
     "rockjit.model", "rockjit.excitation", "rockjit.settings", "rockjit.single",
     "rockjit.result", "rockjit.grids.plan", "rockjit.grids.sweep_grid",
     "rockjit.grids.basin_grid", "rockjit.grids.plane_grid", "rockjit.basins.erosion",
-    "rockjit.basins.fate", "rockjit.basins.measures", "rockjit.storage.output_dir",
+    "rockjit.basins.fate", "rockjit.measures", "rockjit.storage.output_dir",
     "rockjit.orbits.shooting", "rockjit.orbits.arclength",
-    "rockjit.orbits.types", "rockjit.basins.identity", "rockjit.basins.cycles",
+    "rockjit.orbits.types", "rockjit.grids.identity", "rockjit.grids.cycles",
     "rockjit.orbits.curves", "rockjit.orbits.plane_chart", "rockjit.ground.pulses",
     "rockjit.ground.records", "rockjit.ground.fema", "rockjit.ground.settings",
     "rockjit.ground.response", "rockjit.ground.spectrum", "rockjit.ground.fitting",
@@ -78,7 +78,8 @@ def test_docstring_example(test):
 def _public_objects():
     """``(qualified name, object)`` of everything the API reference documents."""
     from rockjit import ground, orbits
-    from rockjit.basins import erosion, fate, measures
+    from rockjit import measures
+    from rockjit.basins import erosion, fate
     from rockjit.single import Prepared
     from rockjit.storage import output_dir
     spectrum = sys.modules["rockjit.ground.spectrum"]  # (rockjit.ground.spectrum: the function)
@@ -88,7 +89,7 @@ def _public_objects():
             ("rockjit.single.Prepared", Prepared),
             ("rockjit.orbits.ChartResult", orbits.ChartResult),
             ("rockjit.orbits.BifurcationCurve", orbits.BifurcationCurve)]
-    out += [(f"rockjit.basins.measures.{n}", getattr(measures, n)) for n in measures.__all__]
+    out += [(f"rockjit.measures.{n}", getattr(measures, n)) for n in measures.__all__]
     out += [("rockjit.basins.erosion.ErosionResult", erosion.ErosionResult),
             ("rockjit.basins.fate.FateResult", fate.FateResult),
             ("rockjit.storage.output_dir.OutputDir", output_dir.OutputDir)]

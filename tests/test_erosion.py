@@ -1,5 +1,5 @@
 """Erosion profiles: the stacked computation against separate basins, the measures against
-rockjit.basins.measures on each basin, and the continued branches' bookkeeping."""
+rockjit.measures on each basin, and the continued branches' bookkeeping."""
 
 import math
 
@@ -11,7 +11,7 @@ import physics as ph  # tests/physics.py: the independent statement of the physi
 import rockjit
 from rockjit import Block, Harmonic, Integration
 from rockjit.basins import erosion as er
-from rockjit.basins import measures as M
+from rockjit import measures as M
 
 BLOCK = Block(hb=1.0, law="housner")
 FORCING = Harmonic(omega=1.3)

@@ -22,7 +22,7 @@ import pytest
 
 import rockjit
 from rockjit import Block, Harmonic, Integration, Scipy
-from rockjit.basins.identity import floquet
+from rockjit.grids.identity import floquet
 from rockjit.result import BEHAVIOURS
 
 MAO = Block(hb=1.0, law="mao")

@@ -106,7 +106,7 @@ def test_each_member_of_an_ensemble_is_its_own_plain_run():
 
 
 def test_outcome_keys_name_attractors_by_what_they_are_not_by_their_ids():
-    from rockjit.basins.identity import Attractor
+    from rockjit.grids.identity import Attractor
 
     def att(i, behaviour, period, x):
         return Attractor(id=i, behaviour=behaviour, period=period, points=np.array([[x, 0.1]]),

@@ -17,7 +17,7 @@ matplotlib.use("Agg")
 
 import rockjit  # noqa: E402
 from rockjit import Block, Harmonic, Integration  # noqa: E402
-from rockjit.cli import outputs  # noqa: E402
+from rockjit import outputs  # noqa: E402
 from rockjit.plotting import legibility, style  # noqa: E402
 from rockjit.study import paper as study  # noqa: E402
 

@@ -1,6 +1,8 @@
 """The house rules a reader relies on: no import cycle between the package's modules (lazy
-imports inside functions included), the compiled engine below storage and scheduling, and every
-file opening with a line on what it is for."""
+imports inside functions included), none between its rooms either (a subpackage, or a module
+of the package's top level: no import runs back up the house), the compiled engine below
+storage and scheduling, the command line above everything it runs, no module of the package
+for testing rockjit itself, and every file opening with a line on what it is for."""
 
 import ast
 from importlib.util import resolve_name
@@ -79,6 +81,53 @@ def test_the_import_reader_resolves_relative_imports():
 def test_no_import_cycle_in_the_package():
     cycles = _cycles(_graph())
     assert not cycles, [sorted(c) for c in cycles]
+
+
+def _room(module):
+    """``rockjit.grids.plan`` -> ``rockjit.grids``; ``rockjit.result`` stays itself."""
+    parts = module.split(".")
+    return ".".join(parts[:2])
+
+
+def _rooms(graph):
+    """The arrows between rooms, each with the module imports that draw it."""
+    arrows = {}
+    for m, deps in graph.items():
+        for d in deps:
+            if _room(m) != _room(d):
+                arrows.setdefault(_room(m), {}).setdefault(_room(d), []).append(f"{m} -> {d}")
+    return arrows
+
+
+def test_the_room_reader_joins_a_subpackage():
+    graph = {"rockjit.a.x": {"rockjit.b"}, "rockjit.a.y": {"rockjit.a.x"},
+             "rockjit.b": {"rockjit.a.y"}}
+    arrows = _rooms(graph)
+    assert set(arrows) == {"rockjit.a", "rockjit.b"}
+    assert _cycles({k: set(v) for k, v in arrows.items()}) == {frozenset({"rockjit.a",
+                                                                          "rockjit.b"})}
+
+
+def test_no_import_runs_back_up_the_house():
+    # e.g. grids -> basins while basins -> grids, result -> basins while basins -> result,
+    # study -> cli while cli -> study
+    arrows = _rooms(_graph())
+    cycles = _cycles({k: set(v) for k, v in arrows.items()})
+    ties = {tuple(sorted(c)): sorted(w for a in c for b, why in arrows[a].items() if b in c
+                                     for w in why) for c in cycles}
+    assert not ties, ties
+
+
+def test_only_the_entry_points_import_the_command_line():
+    graph = _graph()
+    users = {m for m, deps in graph.items() for d in deps
+             if d.startswith("rockjit.cli") and not m.startswith("rockjit.cli")}
+    assert users == set(), users  # (rockjit/__main__.py, the entry point, is no module here)
+
+
+def test_the_package_holds_no_test_tools():
+    assert not (PKG / "testing").exists()
+    assert not [m for m in MODULES if "test" in m.rpartition(".")[2]]
 
 
 def test_the_engine_imports_neither_storage_nor_scheduling():

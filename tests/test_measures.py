@@ -1,4 +1,4 @@
-"""Tests of rockjit.basins.measures against hand-computed values, closed forms and slow references.
+"""Tests of rockjit.measures against hand-computed values, closed forms and slow references.
 
 The maps are synthetic (half-planes, checkerboards, discs, strips, seeded noise), so every
 expected value is worked out here by hand or by a readable loop that shares no code with the
@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from rockjit.basins.measures import (
+from rockjit.measures import (
     basin_entropy, integrity, uncertain_fraction, uncertain_fraction_sampled,
     uncertainty_exponent,
 )

@@ -10,7 +10,7 @@ again from the papers (Housner 1963; Mao et al. 2024; Müller 1995) and never im
 - the saltation matrix against Müller's formula; the uplift instant against a brute-force scan;
 - whole runs, compiled and scipy, against a slow event-driven ``solve_ivp`` integration with
   its own jump, rest and uplift (impact times and speeds, the stroboscopic samples);
-- Floquet multipliers (:func:`rockjit.basins.identity.floquet`, :func:`rockjit.orbits.
+- Floquet multipliers (:func:`rockjit.grids.identity.floquet`, :func:`rockjit.orbits.
   periodic_orbit`) of period-1, 2 and 3 orbits against the eigenvalues of a finite-difference
   Jacobian of ``P^p`` computed from that slow integrator.
 
@@ -27,7 +27,7 @@ import pytest
 import physics as ph  # tests/physics.py: the independent statement
 import rockjit
 from rockjit import Block, Harmonic, Integration, Scipy, model
-from rockjit.basins.identity import floquet
+from rockjit.grids.identity import floquet
 from rockjit.orbits import periodic_orbit
 
 #: The study's initial state (theta, theta', r, s) of its single runs and sweeps.

@@ -13,7 +13,7 @@ from matplotlib.colors import to_hex  # noqa: E402
 
 import rockjit  # noqa: E402
 from rockjit import Block, Harmonic, Integration  # noqa: E402
-from rockjit.basins.identity import agreement  # noqa: E402
+from rockjit.grids.identity import agreement  # noqa: E402
 from rockjit.plotting import figures as P  # noqa: E402
 from rockjit.result import BEHAVIOURS, BasinResult, SweepResult, fractions  # noqa: E402
 from rockjit.storage.atomic import save_figure  # noqa: E402

@@ -353,7 +353,7 @@ def test_the_study_pages_basin_measures_are_todays():
         assert f"{m['uncertainty_exponent']['alpha']:.2f}" == unc, (case, law)
         assert (f"{m['integrity']['GIM']:.3f}", f"{m['integrity']['IF']:.3f}") == (gim, if_)
     # the two laws' agreement on the behaviour and on the attractor, h/b = 1 and 2
-    from rockjit.basins.identity import agreement, attractor_agreement
+    from rockjit.grids.identity import agreement, attractor_agreement
     quoted = _number(r"agree on the behaviour of ([\d.]+) % \(\$h/b = 1\$\) and ([\d.]+) % "
                      r"\(\$h/b = 2\$\) of the cells and on the attractor \(matched by kind\) of "
                      r"([\d.]+) % and ([\d.]+) %", text).groups()

@@ -64,7 +64,7 @@ class PauseAtTheImport:  # the import of the commands, after the handler is inst
 if point == "imports":
     sys.meta_path.insert(0, PauseAtTheImport())
 elif point == "work":
-    from rockjit.cli import outputs
+    from rockjit import outputs
     after(outputs, "summary")
 elif point == "published":
     from rockjit.storage.output_dir import OutputDir
@@ -205,7 +205,7 @@ COR_IN_PROCESS = ["cor", "--hb-values", "1", "--quiet"]
 
 
 def test_a_signal_that_a_library_swallowed_still_interrupts(tmp_path, monkeypatch, capsys):
-    from rockjit.cli import outputs
+    from rockjit import outputs
     from rockjit.cli.main import main
     real = outputs.summary
 
@@ -232,7 +232,7 @@ class _SignalsWhenCollected:
 
 
 def test_a_signal_during_a_finalizer_still_interrupts_quietly(tmp_path, monkeypatch, capsys):
-    from rockjit.cli import outputs
+    from rockjit import outputs
     from rockjit.cli.main import main
     real = outputs.summary
 

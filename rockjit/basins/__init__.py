@@ -1,3 +1,3 @@
-"""Basins and what lives in them: attractor identity (:mod:`.identity`), basin entropy,
-uncertainty and integrity (:mod:`.measures`), erosion profiles (:mod:`.erosion`) and fates
-decided by round-off (:mod:`.fate`)."""
+"""Basins over a parameter and under round-off: erosion profiles (:mod:`.erosion`) and fates
+decided by round-off (:mod:`.fate`); the attractors they name are the grids'
+(:mod:`rockjit.grids.identity`), and each map's measures are :mod:`rockjit.measures`'."""

@@ -4,8 +4,8 @@ continued from one amplitude to the next (global continuation, as in Attractors.
 :func:`erosion` plans one grid of every basin's cells (``n_alpha`` stacked basins, each on
 the same ``(theta0, theta0')`` lattice at the same forcing phase), so the whole profile runs as
 one computation: chunk by chunk with progress, resumable from a chunk store, on Dask when asked.
-and then, at each amplitude, identifies the attractors (:func:`rockjit.basins.identity.identify`)
-and measures the basin (:mod:`rockjit.basins.measures`: GIM, IF, basin entropy), and links each
+and then, at each amplitude, identifies the attractors (:func:`rockjit.grids.identity.identify`)
+and measures the basin (:mod:`rockjit.measures`: GIM, IF, basin entropy), and links each
 amplitude's attractors to the previous amplitude's (same behaviour and period, cycles within
 ``cont_tol`` of the orbit's size, the nearest one): a *branch* is an attractor followed across
 amplitudes, and its basin fraction against the amplitude is the stacked panel of the profile.
@@ -29,8 +29,8 @@ from ..entry import entry_point
 from ..grids import runner
 from ..settings import Integration
 from ..validate import real
-from . import measures as M
-from .identity import FloquetRuns, attractor_distance, identify
+from .. import measures as M
+from ..grids.identity import FloquetRuns, attractor_distance, identify
 
 __all__ = ["LINK_TOL", "ErosionResult", "erosion"]
 
@@ -60,7 +60,7 @@ class ErosionResult:
     ----------
     alpha : ndarray, shape (na,)
     GIM, IF : ndarray, shape (na,)
-        Global integrity measure and integrity factor of each basin (rockjit.basins.measures).
+        Global integrity measure and integrity factor of each basin (rockjit.measures).
     basin_entropy, boundary_basin_entropy : ndarray, shape (na,)
     overturn : ndarray, shape (na,)
         Percent of cells that overturn.
@@ -167,11 +167,11 @@ class ErosionResult:
 def _link(prev, cur, tol, floor):
     """``{id_cur: id_prev}``: each current attractor, largest basin first, to the nearest
     previous one not yet taken of the same behaviour and period whose
-    :func:`~rockjit.basins.identity.attractor_distance` is within ``tol`` (rest to rest; clouds
+    :func:`~rockjit.grids.identity.attractor_distance` is within ``tol`` (rest to rest; clouds
     by their centroids); the size is at least ``floor`` (a small orbit moves by more than its
     own size from one amplitude to the next, while staying far from any other).
 
-    Not :func:`~rockjit.basins.identity.match_attractors`, which pairs the nearest candidates
+    Not :func:`~rockjit.grids.identity.match_attractors`, which pairs the nearest candidates
     first over all pairs and leaves clouds unmatched: along a profile the largest basin claims
     its predecessor first, and a chaotic attractor is followed too."""
     links = {}

@@ -10,11 +10,11 @@ to ``1e-10``) and reports each outcome's probability, the finite-time exponent o
 and the horizon. The ensemble is one grid of the compiled kernels (closed-form forcing) or
 ``K`` single runs (the embedding), so it is independent of the number of threads.
 
-Grids can flag their *uncertain* cells (:func:`rockjit.grids.grids.uncertain_cells`, the
+Grids can flag their *uncertain* cells (:func:`rockjit.grids.plan.uncertain_cells`, the
 ``uncertainty`` setting of the grids): those whose outcome changes when the initial state is
 perturbed by ``eps``; the fraction of uncertain cells against ``eps`` gives the boundary's
 uncertainty exponent (Grebogi, McDonald, Ott & Yorke 1983,
-:func:`rockjit.basins.measures.uncertainty_exponent`).
+:func:`rockjit.measures.uncertainty_exponent`).
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ from ..entry import entry_point
 from ..grids import runner
 
 from .._engine import kernel
-from .identity import identify
+from ..grids.identity import identify
 from ..result import BEHAVIOURS, HORIZON_TOL, ROUNDING, horizon
 from ..settings import Classification, Execution
 from ..single import classify_result
@@ -74,7 +74,7 @@ def outcome_keys(attractors):
     Parameters
     ----------
     attractors : list of Attractor
-        As :func:`rockjit.basins.identity.identify` returns them.
+        As :func:`rockjit.grids.identity.identify` returns them.
 
     Returns
     -------
@@ -83,7 +83,7 @@ def outcome_keys(attractors):
     Examples
     --------
     >>> import numpy as np
-    >>> from rockjit.basins.identity import Attractor
+    >>> from rockjit.grids.identity import Attractor
     >>> a = [Attractor(id=k, behaviour="asymmetric", period=1, points=np.array([[x, 0.0]]),
     ...                fraction=50.0, n_cells=1, lam=np.zeros(2)) for k, x in enumerate((0.1, -0.1))]
     >>> outcome_keys(a)

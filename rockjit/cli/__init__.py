@@ -1,7 +1,7 @@
-"""The ``rockjit`` command line (:mod:`.main`: the parser and the commands; :mod:`.outputs`: what
-each command leaves on disk; :mod:`.signals`: SIGINT and SIGTERM), and its entry point
-:func:`main`, which handles SIGINT and SIGTERM from its first instant, the imports of rockjit's
-modules included.
+"""The ``rockjit`` command line (:mod:`.main`: the parser and the commands, which write through
+:mod:`rockjit.outputs`; :mod:`.signals`: SIGINT and SIGTERM), and its entry point :func:`main`,
+which handles SIGINT and SIGTERM from its first instant, the imports of rockjit's modules
+included.
 
 Importing the numerical modules (numpy, numba) takes a noticeable time, and Ctrl-C during it
 would end in a ``KeyboardInterrupt`` traceback. The package ``rockjit`` loads its public names

@@ -1,9 +1,9 @@
 """The ``rockjit`` command line: argparse and file output over the library's plans and runs.
 
-Every command parses its options into the library's own plan (:func:`rockjit.single.plan`,
-:func:`rockjit.grids.grids.plan_sweep` and the others), which validates everything before any work:
-a bad value ends the command with one line ``rockjit: error: ...`` on stderr and exit status 2,
-having written nothing. Then it computes and writes its data, its figure(s) and
+Every command parses its options into the library's own plan (``rockjit.simulate.plan``,
+``rockjit.sweep.plan`` and the others: :mod:`rockjit.entry`), which validates everything before
+any work: a bad value ends the command with one line ``rockjit: error: ...`` on stderr and exit
+status 2, having written nothing. Then it computes and writes its data, its figure(s) and
 ``summary.json`` into a hidden staging directory, published into ``--out`` as one unit at the
 end (:class:`rockjit.storage.output_dir.OutputDir`). Every problem with ``--out`` itself (a
 file, a dangling or looping link, a name too long, a directory named like an output file, a
@@ -171,7 +171,7 @@ def _check_run(args):
     if getattr(args, "threads", None) is not None:
         import numba
         integer("threads", args.threads, 1, numba.config.NUMBA_NUM_THREADS)
-    if getattr(args, "rtol", None) is not None:  # as rockjit.single.plan checks them for scipy
+    if getattr(args, "rtol", None) is not None:  # as rockjit.simulate.plan checks them for scipy
         real("rtol", args.rtol, 0.0, 1.0, lo_open=True, hi_open=True)
         real("atol", args.atol, 0.0, None, lo_open=True)
     if getattr(args, "scheduler_timeout", None) is not None:
@@ -312,7 +312,7 @@ def _trajectory_plan(args):
 
 
 def _trajectory_run(args, p, out):
-    from . import outputs
+    from .. import outputs
     from ..single import run
     name = p.method if p.method == "rockjit" else p.method.name
     _say(args, f"trajectory: {p.periods} periods, {name}")
@@ -412,7 +412,7 @@ def _grid_run(writer, name):
     """The run of a grid command: its plan (or one plan per law) computed with the command
     line's progress, Dask client and chunk store, then written by ``outputs.<writer>``."""
     def run_it(args, plans, out):
-        from . import outputs
+        from .. import outputs
         if writer == "erosion":
             from ..basins.erosion import run
         elif writer == "orbits":
@@ -456,7 +456,7 @@ def _chart_plan(args):
 
 
 def _chart_run(args, plans, out):
-    from . import outputs
+    from .. import outputs
     from ..orbits.plane_chart import run
     t0 = time.perf_counter()
     res = {}
@@ -482,7 +482,7 @@ def _fate_plan(args):
 
 
 def _fate_run(args, p, out):
-    from . import outputs
+    from .. import outputs
     from ..basins.fate import run
     from ..settings import Execution
     t0 = time.perf_counter()
@@ -574,7 +574,7 @@ def _spectrum_plan(args):
 
 
 def _spectrum_run(args, plans, out):
-    from . import outputs
+    from .. import outputs
     from ..ground.spectrum import run
     t0 = time.perf_counter()
     res = {law: _grid(args, run, p, f"spectrum-{law}") for law, p in plans.items()}
@@ -617,7 +617,7 @@ def _fragility_plan(args):
 
 
 def _fragility_run(args, p, out):
-    from . import outputs
+    from .. import outputs
     from ..ground.fragility import run
     path = "compiled path" if p.method == "rockjit" else f"scipy path ({p.method.method})"
     _say(args, f"fragility: {p.runs} runs ({len(p.records)} records x "
@@ -1141,7 +1141,7 @@ def _interrupted(exc, sig):
 
 
 def _main(argv, sig):
-    from . import outputs
+    from .. import outputs
     from ..storage.output_dir import OutputDir
     from .signals import interrupted, signal_name
     try:

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..excitation import Harmonic
 from ..model import XI_STUDY, Block
-from ..settings import Execution, Integration, Lattice
+from ..settings import Execution, Integration
 
 __all__ = ["BasinView", "CompareView", "LAWS", "MAX_CELL_STEPS", "MAX_PERIODS", "Params",
            "REFINE", "RunView", "SweepView", "basin_stages", "chunk_for", "clean_number",
@@ -244,7 +244,7 @@ def compare_call(params, grid):
     """Python that reproduces the two laws side by side and their agreement."""
     p = params
     extra = ("Integration",) if p.integration_source() else ()
-    text = _header(*extra) + "from rockjit.basins.identity import agreement\n"
+    text = _header(*extra) + "from rockjit.grids.identity import agreement\n"
     for name, law in (("housner", "housner"), ("mao", "mao")):
         text += (f"{name} = rockjit.basin({p.block_source(law)}, {p.forcing_source()}, "
                  f"grid={grid}{p.integration_source()})\n")
@@ -404,9 +404,3 @@ def nearest_cell(result, theta0, dtheta0):
         return k if 0 <= k < n else None
     i, j = index(th, theta0), index(dth, dtheta0)
     return None if i is None or j is None else (i, j)
-
-
-def lattice_of(result):
-    """The :class:`rockjit.Lattice` a basin was computed on."""
-    return Lattice(int(result.settings["grid"]), tuple(result.settings["theta_range"]),
-                   tuple(result.settings["dtheta_range"]))

@@ -2,7 +2,7 @@
 
 A period-``p`` cycle is ``p`` points ``(theta, theta')`` at ``t = kT``; which of them comes first
 depends only on when sampling began, so two cycles are compared under every cyclic shift. The
-attractor identity of the grids (:mod:`rockjit.basins.identity`), the erosion profiles'
+attractor identity of the grids (:mod:`rockjit.grids.identity`), the erosion profiles'
 continuation (:mod:`rockjit.basins.erosion`) and the branches of periodic orbits
 (:mod:`rockjit.orbits`) all measure cycles with :func:`cycle_distance`.
 """
@@ -31,7 +31,7 @@ def cycle_distance(a, b):
 
     Examples
     --------
-    >>> from rockjit.basins.cycles import cycle_distance
+    >>> from rockjit.grids.cycles import cycle_distance
     >>> cycle_distance([[0.1, 0.0], [-0.1, 0.0]], [[-0.1, 0.0], [0.1, 0.0]])
     0.0
     >>> cycle_distance([[0.1, 0.0]], [[[0.1, 0.0]], [[0.3, 0.0]]]).round(12).tolist()
@@ -50,7 +50,7 @@ def cycle_size(c):
 
     Examples
     --------
-    >>> from rockjit.basins.cycles import cycle_size
+    >>> from rockjit.grids.cycles import cycle_size
     >>> float(cycle_size([[0.1, -0.4], [-0.1, 0.4]]))
     0.4
     """

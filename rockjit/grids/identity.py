@@ -358,7 +358,7 @@ def attractor_distance(x, y, floor=1e-12):
     """How far apart two attractors are, relative to their size; ``None`` when they are not of
     one kind (behaviour and period).
 
-    Rest and rest are 0 apart; two cycles, :func:`~rockjit.basins.cycles.cycle_distance`; two
+    Rest and rest are 0 apart; two cycles, :func:`~rockjit.grids.cycles.cycle_distance`; two
     clouds (chaotic, aperiodic), the largest difference of their samples' centroids. Sizes are
     the larger attractor's largest ``|theta|, |theta'|``, at least ``floor``. The distance is
     symmetric in ``x`` and ``y``, bit for bit.
@@ -366,7 +366,7 @@ def attractor_distance(x, y, floor=1e-12):
     Examples
     --------
     >>> import numpy as np
-    >>> from rockjit.basins.identity import Attractor, attractor_distance
+    >>> from rockjit.grids.identity import Attractor, attractor_distance
     >>> def cycle(*pts):
     ...     return Attractor(id=0, behaviour="symmetric", period=len(pts), points=np.array(pts),
     ...                      fraction=100.0, n_cells=1, lam=np.zeros(2))
@@ -429,7 +429,7 @@ def agreement(label_a, label_b):
 
     Examples
     --------
-    >>> from rockjit.basins.identity import agreement
+    >>> from rockjit.grids.identity import agreement
     >>> print(agreement([[0, 2], [2, 5]], [[0, 2], [3, 5]]))
     75.0
     """

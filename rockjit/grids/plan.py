@@ -22,8 +22,6 @@ import numba
 import numpy as np
 
 from .._engine import kernel
-from ..basins.identity import (FloquetRuns, cycles_differ, identify, identify_along,
-                               match_attractors)
 from ..excitation import ALPHA_MAX, Harmonic
 from ..model import Block
 from ..result import BasinResult, PlaneResult, SweepResult
@@ -32,6 +30,8 @@ from ..single import check_step, settings_for
 
 from ..validate import integer, memory, pair, real
 from . import runner
+from .identity import (FloquetRuns, cycles_differ, identify, identify_along,
+                       match_attractors)
 
 __all__ = ["GRID_N", "MAX_CELLS", "GridPlan", "alpha_count", "alpha_grid", "common",
            "exponents", "grid_memory", "progress_label", "run", "uncertain_cells"]
@@ -65,7 +65,7 @@ class GridPlan:
     shape: tuple              # the result arrays' shape
     settings: dict = field(default_factory=dict)
     memory_bytes: float = 0.0
-    attractors: bool = False  # identify the attractors (rockjit.basins.identity)
+    attractors: bool = False  # identify the attractors (rockjit.grids.identity)
     phi: float = 0.0          # the forcing phase (basins: of every cell)
     uncertainty: float | None = None  # flag the cells whose outcome moves with eps
 
@@ -276,7 +276,7 @@ def uncertain_cells(plan, result, eps, *, seed=0, execution=None):
     Each cell's ``(theta0, theta0')`` is moved by ``eps`` times its size (absolute where 0) in
     a seeded random direction and run again with the same plan; a cell is uncertain when the
     moved run reaches another outcome: another behaviour or period, or another attractor (the
-    two maps' attractors matched by their cycles, :mod:`rockjit.basins.identity`). Returns a
+    two maps' attractors matched by their cycles, :mod:`rockjit.grids.identity`). Returns a
     boolean array shaped like the labels.
     """
     rng = np.random.default_rng(seed)
@@ -314,7 +314,7 @@ def _cell_forcing(p, cell):
 
 
 def _floquet_of(runs, alpha, omega, phi, point, period, exact):
-    """The multipliers of one cycle (``runs``: a :class:`~rockjit.basins.identity.FloquetRuns`
+    """The multipliers of one cycle (``runs``: a :class:`~rockjit.grids.identity.FloquetRuns`
     of the plan's block), kept in ``exact`` under its exact inputs: a cycle met again with
     bit-identical inputs reuses them, any other is computed anew."""
     point = np.asarray(point, dtype=float)
@@ -341,7 +341,7 @@ def exponents(p, r, pts, n_got, exact=None):
     ``p`` and it kept at least ``p`` samples at ``t = kT``: its cycle point
     ``pts[cell, n_got - p]`` (the first of its last ``p``) starts a run of ``p`` periods with
     tangent vectors and no renormalisation, saltation at every impact
-    (:func:`rockjit.basins.identity.floquet`), whose tangent is the monodromy; through a rest
+    (:func:`rockjit.grids.identity.floquet`), whose tangent is the monodromy; through a rest
     phase the monodromy is zero and the exponent ``-inf``. On a periodic orbit the window's
     QR average converges to this value only as the window grows, slowly and oscillating where
     the multipliers are a complex pair (docs/theory/exponents.md); the exact value does not
@@ -367,7 +367,7 @@ def exponents(p, r, pts, n_got, exact=None):
 
 def _identify(p, r, pts, n_got, exact=None):
     """Attractor ids (shaped like the labels) and attractors of a plan's cells, with the
-    Floquet multipliers of the periodic ones (:mod:`rockjit.basins.identity`; those of a
+    Floquet multipliers of the periodic ones (:mod:`rockjit.grids.identity`; those of a
     cycle already computed by :func:`exponents` with bit-identical inputs are reused)."""
     exact = {} if exact is None else exact
     label, period = r["label"], r["period"]

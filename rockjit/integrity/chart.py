@@ -3,9 +3,9 @@
 Each column of the chart (one frequency, every amplitude) is exactly an erosion profile's grid
 (:func:`rockjit.erosion`'s plan: the same cells, the same packed settings), run through the grid
 runner chunk by chunk, resumable from a chunk store (one sub-store per column) and on Dask like
-every grid; each basin is then reduced at once to its measures (:mod:`rockjit.basins.measures`):
+every grid; each basin is then reduced at once to its measures (:mod:`rockjit.measures`):
 the safe fraction (cells that do not overturn), GIM, IF and the LIM of its largest safe
-attractor, and its attractors (:func:`rockjit.basins.identity.identify`). Only those numbers are
+attractor, and its attractors (:func:`rockjit.grids.identity.identify`). Only those numbers are
 kept, so a chart of thousands of basins needs the memory of one column.
 """
 
@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 
 from .._engine import kernel
-from ..basins import measures as M
+from .. import measures as M
 from ..basins.erosion import erosion
-from ..basins.identity import identify
+from ..grids.identity import identify
 from ..entry import entry_point
 from ..excitation import ALPHA_MAX, OMEGA_RANGE, check_acceleration
 from ..grids import plan as gp
@@ -60,7 +60,7 @@ class SafetyResult:
         Fraction of the lattice's initial states that do not overturn (basin stability).
     GIM, IF : ndarray, shape (na, nw)
         Global integrity measure and integrity factor of the safe basin
-        (:func:`rockjit.basins.measures.integrity`: unresolved cells are not safe).
+        (:func:`rockjit.measures.integrity`: unresolved cells are not safe).
     LIM : ndarray, shape (na, nw)
         Local integrity measure of the safe attractor with the largest basin (``nan`` where
         there is none).
@@ -169,7 +169,7 @@ class SafetyResult:
 def basin_measures(ids, found, theta0, dtheta0):
     """One basin's entries of a chart: ``(safe, GIM, IF, LIM, attractors)`` from its outcome
     ids (``-1`` overturn, ``-2`` unresolved) and its attractors
-    (:func:`rockjit.basins.identity.identify`)."""
+    (:func:`rockjit.grids.identity.identify`)."""
     points = {a.id: np.asarray(a.points, dtype=float).reshape(-1, 2) for a in found}
     integ = M.integrity(ids, theta0, dtheta0, points=points or None)
     rows = []

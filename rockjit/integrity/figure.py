@@ -1,5 +1,5 @@
 """Integrity charts on paper and on disk: a figure per law, the two laws' difference, and the
-``rockjit safety`` command's files (through :mod:`rockjit.cli.outputs`' publishing)."""
+``rockjit safety`` command's files (through :mod:`rockjit.outputs`' publishing)."""
 
 from __future__ import annotations
 
@@ -136,7 +136,7 @@ def write(out, charts, levels=LEVELS, *, npz="safety.npz"):
     """The files of ``rockjit safety`` (``charts``: ``{law: SafetyResult}``): the arrays of
     every law, a figure per law and, with two laws, their difference; returns the JSON-ready
     summary."""
-    from ..cli.outputs import _figure as publish, _npz
+    from ..outputs import _figure as publish, _npz
     first = next(iter(charts.values()))
     _npz(out, npz, "alpha, omega, theta0, dtheta0 and per law (suffix _<law>): safe (fraction "
                    "of initial states that do not overturn), GIM, IF, LIM (of the largest "

@@ -42,7 +42,7 @@ What lives where
 
 The imports go one way: ``types`` <- ``shooting`` <- ``grazing`` <- ``bifurcations`` <-
 ``arclength`` <- ``curves`` <- ``plane_chart``. Cycles are compared with
-``rockjit.basins.cycles.cycle_distance``, as the attractors of the grids.
+``rockjit.grids.cycles.cycle_distance``, as the attractors of the grids.
 
 Examples
 --------

@@ -17,7 +17,7 @@ Continuation
     existing. Overturning and rest end a branch likewise. A branch also ends at the range's
     end, at a branch point (a doubled or asymmetric branch folding back onto the orbit it was
     born from, which is then seeded too), on joining a branch already computed (or its mirror
-    image: cycles compared by :func:`rockjit.basins.cycles.cycle_distance`), or on closing a
+    image: cycles compared by :func:`rockjit.grids.cycles.cycle_distance`), or on closing a
     loop. A bifurcation met again on a stretch that retraces a branch already followed (a seed
     next to a fold of that branch, before it joins it) is reported once.
 Seeds
@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..basins.cycles import cycle_distance
+from ..grids.cycles import cycle_distance
 from ..entry import entry_point
 from ..grids import plan as gp
 from ..grids import sweep_grid

@@ -26,9 +26,7 @@ Grazing
     by bisection on the count (to ``param_tol``). Near a grazing from the side without the extra
     impact the map's derivative blows up (di Bernardo et al. 2008, ch. 6) and the corrector
     fails before the count changes: the orbit is then followed by damped Newton at fixed
-    parameter values to where it stops existing, by bisection (measured on the hb=1 Housner
-    case: within ``3e-10`` of where the turning point's depth, from dense plain runs,
-    extrapolates to zero). Overturning and rest end a branch likewise, located the same way and
+    parameter values to where it stops existing, by bisection. Overturning and rest end a branch likewise, located the same way and
     reported as a grazing (of ``theta_over``, of rest).
 """
 
@@ -214,9 +212,8 @@ class Locator:
         Near a grazing the corrector's undamped steps fail some ``1e-8`` short of it; the
         damped Newton that keeps the orbit's impact count, from the branch's tangent predictor,
         gets within ``1e-9`` (a start from the last orbit itself, without the predictor, can
-        already have crossed, and Newton then finds the other orbit that meets it there:
-        measured ``2e-8`` short on the hb=2 Mao case). Returns ``(point, bracket width)``;
-        ``(P, inf)`` if no end is found within ``1e-3``.
+        already have crossed, and Newton then finds the other orbit that meets it there).
+        Returns ``(point, bracket width)``; ``(P, inf)`` if no end is found within ``1e-3``.
         """
         s = self.s
         if direction == 0:

@@ -36,8 +36,7 @@ Jacobian
     the bordered system ``[G_y; t^T]`` starts from the last point's Jacobian, updates its
     differenced part by Broyden's rank-one formula and its exact part ``M - I`` at every
     iterate, and takes a new one where the residual falls by less than a factor 20: an
-    iteration costs one run over ``p`` periods, a new Jacobian five (measured on the h/b = 1
-    Housner curves: about ten runs per point).
+    iteration costs one run over ``p`` periods, a new Jacobian five.
 Continuation
     Pseudo-arclength in ``y`` (Keller 1977), secant predictor, step grown by 1.3 after at most
     six iterations and halved after a failure, between ``ds_min`` and ``ds_max``; the
@@ -385,7 +384,7 @@ class BifurcationCurve:
         """Whether the curve crosses ``omega`` within ``tol`` (relative) of ``alpha``, with an
         orbit there within 5 % of its size of ``cycle`` (or of its mirror image): the same
         curve, found again."""
-        from ..basins.cycles import cycle_distance
+        from ..grids.cycles import cycle_distance
         w = self.omega - omega
         for k in np.nonzero(w[:-1] * w[1:] <= 0)[0]:
             dw = self.omega[k + 1] - self.omega[k]

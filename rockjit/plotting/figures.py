@@ -1083,15 +1083,6 @@ def _branch_group(br):
     return f"period $\\geq {GROUPED_PERIOD}$", S.tint(green, 0.4), "h"
 
 
-def _branch_colour(br):
-    """A branch's colour (:func:`_branch_group`)."""
-    return _branch_group(br)[1]
-
-
-def _branch_kind(br):
-    return _branch_group(br)[0]
-
-
 def _branch_runs(value, y, stable, t_next, period, mu=None):
     """Pieces ``(x, y, stable)`` of one branch line: broken where an impact crosses the
     sampling instant (the time to the next impact jumps by more than a quarter period, and the

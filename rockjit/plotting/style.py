@@ -282,7 +282,7 @@ def attractor_colours(attractors):
     """One colour per attractor (in order): the first attractor of a behaviour that rocks gets
     its behaviour's colour, the next ones darker shades; an orbit through rest (Floquet
     multipliers zero) gets a light tint. ``attractors`` are
-    :class:`rockjit.basins.identity.Attractor` or erosion branches (dicts)."""
+    :class:`rockjit.grids.identity.Attractor` or erosion branches (dicts)."""
     seen = {}
     out = []
     for a in attractors:

@@ -238,7 +238,7 @@ def after_the_fall(sw):
     """What a sweep integrated past overturning plots where the block fell: the share of its
     amplitudes whose points and exponent come from motion after the fall, and that motion's
     behaviours, exponent signs and distinct attractors (continued along the amplitudes)."""
-    from ..basins.identity import identify_along
+    from ..grids.identity import identify_along
     fell = np.isfinite(sw.t_overturn)
     plotted = fell & np.isin(sw.motion, [BEHAVIOURS.index(b) for b in
                                          ("symmetric", "asymmetric", "multiperiodic",
@@ -304,7 +304,7 @@ def _phase_of(res):
 def floquet_of_run(res, behaviour):
     """The Floquet exponent ``ln|mu1| / (pT)`` of the periodic orbit a run settled on (its
     last cycle point), or ``nan`` when it did not settle on one."""
-    from ..basins.identity import floquet
+    from ..grids.identity import floquet
     name, p = behaviour
     if name not in ("symmetric", "asymmetric", "multiperiodic") or p < 1 or \
             res.strobe.shape[0] <= p:
@@ -350,7 +350,7 @@ def _outcome_words(probabilities):
 def _same_orbit(a, b, behaviour_a, behaviour_b, tol=1e-4):
     """Two runs of one system that settled on the same periodic orbit (cycles within ``tol``
     of their size, any shift)."""
-    from ..basins.cycles import cycle_distance, cycle_size
+    from ..grids.cycles import cycle_distance, cycle_size
     if behaviour_a != behaviour_b or behaviour_a[0] not in ("symmetric", "asymmetric",
                                                             "multiperiodic"):
         return False
@@ -403,7 +403,7 @@ def paper(out, plan=None, *, execution=None, say=None):
     say : callable, optional
         ``say(message)`` for one line of progress per part.
     """
-    from ..basins.identity import agreement, attractor_agreement
+    from ..grids.identity import agreement, attractor_agreement
     from ..orbits import continue_branches
     from ..plotting.figures import (branch_caption, fig_attractors, fig_basin_compare,
                                     fig_bifurcation, fig_branches, fig_erosion, fig_gallery,
@@ -767,7 +767,7 @@ def _fig9_charts(out, integration, within, say):
     overlaid; returns the curves (type, period, law, points) per slenderness."""
     from ..orbits.plane_chart import ChartCurves, chart
     from ..plotting.chart import fig_chart
-    from ..cli.outputs import chart as write_chart
+    from ..outputs import chart as write_chart
     found, names = {}, []
     for hb in STUDY:
         res = {}
