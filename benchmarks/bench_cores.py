@@ -9,9 +9,9 @@ study's 100 x 100 Housner basin (h/b = 1, alpha = 0.66, omega = 1.3, 500 periods
 each thread count full length and early-stopped: with the default chunks, with one chunk for
 the whole grid, and (full length) with chunks of 64 cells, each run as pieces on one thread
 each, as many at once as threads (rockjit.grids.runner); and, for comparison, as one call of
-the parallel kernel on every cell with all the threads (the way a chunk used to run, each call
-waiting for its slowest block). Every case's labels must equal the one-thread run's. Compile
-time is excluded (a warm-up call first).
+the parallel kernel on every cell with all the threads, which waits for its slowest block of
+cells. Every case does the same work (the grid, then its attractors) and its labels must equal
+the one-thread run's. Compile time is excluded (a warm-up call first).
 
     python benchmarks/bench_cores.py            # full: 1, 2, 4, ... threads up to all
     python benchmarks/bench_cores.py --quick    # smoke: 20 x 20, 60 periods, 1 repeat
@@ -22,6 +22,7 @@ or --out DIR).
 
 from __future__ import annotations
 
+import contextlib
 import math
 import sys
 
@@ -88,21 +89,28 @@ def calibrate(n_cells, seconds):
         numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
 
 
+@contextlib.contextmanager
+def one_call_per_chunk():
+    """Within the block, each chunk runs as one call of the parallel kernel on all the threads
+    (no pieces): with one chunk, the whole grid in one call."""
+    real = runner.local_plan
+    runner.local_plan = lambda threads, concurrent=None: (max(1, int(threads)), 1)
+    try:
+        yield
+    finally:
+        runner.local_plan = real
+
+
 def basin(cfg, early_stop, threads, chunk):
-    """The basin's labels, flat."""
-    from rockjit._engine import kernel
+    """The basin's labels, flat (the same work in every case: the grid, then its attractors)."""
     n = cfg["grid"] ** 2
-    args = (Block(1.0), Harmonic(alpha=0.66, omega=1.3), cfg["grid"])
     kw = dict(integration=Integration(periods=cfg["periods"]),
               classification=Classification(early_stop=early_stop))
-    if chunk == "call":
-        p = rockjit.basin.plan(*args, **kw)
-        out = kernel.run_chunk(p.tangent, p.y0s, p.pars, p.ipar, p.cpar, p.n_pts, p.n_imp_pts,
-                               threads)
-        return kernel.grid_results(out)["label"]
-    size = None if chunk == "default" else n if chunk == "one" else chunk
+    size = None if chunk == "default" else chunk if isinstance(chunk, int) else n
     ex = Execution(threads=threads, chunk=size)
-    return rockjit.basin(*args, **kw, execution=ex).label.ravel()
+    with one_call_per_chunk() if chunk == "call" else contextlib.nullcontext():
+        return rockjit.basin(Block(1.0), Harmonic(alpha=0.66, omega=1.3), cfg["grid"], **kw,
+                             execution=ex).label.ravel()
 
 
 def measure(cfg):
@@ -171,6 +179,7 @@ def plot(table, cfg):
 def main(argv=None):
     b = H.Bench(__doc__, argv)
     cfg = QUICK if b.quick else FULL
+    load0 = H.load_text()
     wall, labels, steps = measure(cfg)
     table = rows(wall, labels)
     top = max(r[0] for r in table)
@@ -189,7 +198,10 @@ def main(argv=None):
             f"of the grid runner above one thread: {worst:.0%}. At {top} threads the cells "
             f"ran as pieces of {runner.PIECE_MIN} to {runner.PIECE_MAX} cells on {per} thread "
             f"each, {at_once} at once. "
-            f"Threading layer: {numba.threading_layer()}. {H.env_line(b.env)}\n")
+            f"Threading layer: {numba.threading_layer()}. Load average (1, 5, 15 min) at "
+            f"the start {load0}, at the end {H.load_text()}: a yardstick that gains little "
+            f"from more threads means the host's cores were busy with other work. "
+            f"{H.env_line(b.env)}\n")
     data = dict(rows=[dict(zip(HEADERS, r)) for r in table], env=b.env, config=cfg,
                 yardstick_steps=steps, threading_layer=numba.threading_layer(),
                 raw_wall_s={f"{t}|{k}": v for (t, k), v in wall.items()})

@@ -297,12 +297,12 @@ class Execution(_Replace):
     threads : int, optional
         numba threads (default: all).
     chunk : int, optional
-        Cells per chunk: the unit of progress, of Dask tasks and of resumption. Default, in
-        this process, 256 cells per thread (the whole grid if smaller), and a rerun on a chunk
-        store keeps the first run's chunks; on Dask, about a twentieth of the grid, at least
-        64. In this process the chunks do not wait for each other: a chunk gets a thread per
-        64 of its cells (at most all of them) and one chunk more than the threads hold runs
-        at once, so that chunks of any size keep every thread busy.
+        Cells per chunk: the unit of progress, of Dask tasks and of resumption; default about
+        a twentieth of the grid, at least 64 (a rerun on a chunk store keeps the chunks it
+        began with). In this process the cells run as pieces of a chunk on one thread each,
+        as many at once as ``threads``, each thread taking the next piece when its last is
+        done, so that no thread waits at a chunk's end whatever the chunk's size
+        (:mod:`rockjit.grids.runner`).
     lanes : int, optional
         Cells per thread in lockstep, 1 to 8 (grids without tangent vectors); default 8.
     client : dask.distributed.Client, optional
