@@ -3,7 +3,7 @@ a journal, in both styles; every figure has its data file; every file is describ
 
 The figures are caught as they are written (an output directory that keeps them instead of
 saving them) and each visible text artist's drawn extent is compared with the figure's
-(:func:`rockjit.plotting.style.texts_outside`): a clipped legend entry ("verturn"), a title
+(:func:`rockjit.plotting.legibility.texts_outside`): a clipped legend entry ("verturn"), a title
 cut at the right edge or a label below the canvas fails here, naming the figure and the text.
 """
 
@@ -37,7 +37,7 @@ class CaughtOut:
             self.written.append(name)
 
     def figure(self, name, fig, *, dpi=None):
-        self.outside[name] = style.texts_outside(fig)
+        self.outside[name] = legibility.texts_outside(fig)
         self.problems[name] = legibility.problems(fig)
         self.figures.append(name)
         self._add(name)
@@ -168,12 +168,12 @@ def test_the_check_catches_text_off_the_canvas():
     ax = fig.add_subplot()
     ax.legend(handles=[matplotlib.lines.Line2D([], [], label="overturn")],
               loc="center left", bbox_to_anchor=(0.95, 0.5))
-    bad = style.texts_outside(fig)
+    bad = legibility.texts_outside(fig)
     assert [t for t, _ in bad] == ["overturn"]
     fig = Figure(figsize=(3, 2), layout="constrained")
     ax = fig.add_subplot()
     ax.set_title("a title that fits")
-    assert style.texts_outside(fig) == []
+    assert legibility.texts_outside(fig) == []
 
 
 def test_formats_and_paper_sizes(tmp_path):
