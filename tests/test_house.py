@@ -10,7 +10,8 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent
+#: The repository (wherever in tests/ this file lies)
+ROOT = next(p for p in Path(__file__).resolve().parents if (p / "pyproject.toml").is_file())
 PKG = ROOT / "rockjit"
 
 
@@ -142,7 +143,7 @@ def test_the_engine_imports_neither_storage_nor_scheduling():
 
 
 @pytest.mark.parametrize("path", sorted(PKG.rglob("*.py")) + sorted(ROOT.glob("benchmarks/*.py"))
-                         + sorted(ROOT.glob("tests/*.py")), ids=lambda p: str(p.relative_to(ROOT)))
+                         + sorted(ROOT.glob("tests/**/*.py")), ids=lambda p: str(p.relative_to(ROOT)))
 def test_every_file_opens_with_what_it_is_for(path):
     doc = ast.get_docstring(ast.parse(path.read_text(encoding="utf-8")))
     assert doc and len(doc.splitlines()[0].split()) >= 3, f"{path.name}: no opening line"
