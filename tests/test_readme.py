@@ -168,15 +168,13 @@ def test_the_integrity_of_both_laws_is_as_quoted():
 
 @pytest.mark.slow
 def test_the_mean_integrity_at_the_studys_resolution_is_as_quoted():
-    import numpy as np
-
     import rockjit
     from rockjit import Block, Harmonic
-    pages = {"study.md": r"\(mean ([\d.]+) against ([\d.]+)\)",
-             "theory/study.md": r"the mean GIM over \$\\alpha = 0.3\$–\$0.9\$ is ([\d.]+) "
-                                r"against Housner's ([\d.]+)",
-             "guide/erosion.md": r"the mean GIM over \$\\alpha \\in \[0.3, 0.9\]\$ is ([\d.]+) "
-                                 r"under Housner's law and ([\d.]+) under Mao's"}
+    pages = {"study.md": r"\(mean (\d\.\d+) against (\d\.\d+)\)",
+             "theory/study.md": r"the mean GIM over \$\\alpha = 0.3\$–\$0.9\$ is (\d\.\d+) "
+                                r"against Housner's (\d\.\d+)",
+             "guide/erosion.md": r"the mean GIM over \$\\alpha \\in \[0.3, 0.9\]\$ is (\d\.\d+) "
+                                 r"under Housner's law and (\d\.\d+) under Mao's"}
     mean = {law: rockjit.erosion(Block(hb=1, law=law), Harmonic(omega=1.3),
                                  rockjit.alpha_grid((0.3, 0.9), 0.01), 100).GIM.mean()
             for law in ("housner", "mao")}
