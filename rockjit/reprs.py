@@ -49,7 +49,7 @@ def _block(b):
     return f"h/b = {_g(b.hb)}, {b.law} law" + (f" (e = {_g(e, '.3f')})" if e is not None else "")
 
 
-def _shares(percent, limit=5):
+def _shares(percent, limit=4):
     """``{name: percent}`` as "name 52.0 %, ...", largest first, zeros left out."""
     items = sorted(((k, float(v)) for k, v in percent.items() if float(v) > 0),
                    key=lambda kv: -kv[1])
@@ -69,9 +69,24 @@ def _arrays(obj, names):
     return "; ".join(f"{', '.join(ns)} {shape}" for shape, ns in groups.items())
 
 
+def _wrap(key, value):
+    """One row, its value carried on to further lines at "; " or ", " where it is too long."""
+    lines, head = [], f"  {key:<11} "
+    while len(head) + len(value) > MAX_WIDTH:
+        room = MAX_WIDTH - len(head)
+        cut = max(value.rfind("; ", 0, room), value.rfind(", ", 0, room))
+        if cut <= 0:
+            break
+        lines.append(head + value[:cut + 1])
+        value, head = value[cut + 2:], " " * len(head)
+    return lines + [head + value]
+
+
 def _lines(title, rows):
     out = [f"<rockjit.{title}>"]
-    out += [f"  {k:<11} {v}" for k, v in rows if v is not None]
+    for k, v in rows:
+        if v is not None:
+            out += _wrap(k, v)
     out = [_one(ln) for ln in out]
     return "\n".join(out[:MAX_LINES])
 
