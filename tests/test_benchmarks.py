@@ -71,6 +71,8 @@ SCRIPTS = {
                             ["attractors.png"]),
     "bench_safety.py": (["law", "chart", "lattice", "periods", "threads", "wall_s",
                          "s_per_basin", "60x60_s", "60x60", "mean_safe"], ["safety.png"]),
+    "bench_cores.py": (["threads", "case", "median s", "speed-up", "yardstick speed-up",
+                        "share of the yardstick's", "labels as 1 thread"], ["cores.png"]),
     "bench_orbits.py": (["measurement", "value", "unit", "target"],
                         ["orbits.png", "orbits_branches.png"]),
     "bench_versions.py": (["case", "base_s", "this_s", "ratio", "cpu_ratio", "pair_min",
@@ -286,6 +288,17 @@ VALUES = {
          "mean_safe": between(0, 1)},
         [("the 60x60 time is 3600 basins at the time per basin", lambda r: abs(
             num(r, "60x60_s") - 3600 * num(r, "s_per_basin")) <= 1e-2 * num(r, "60x60_s"))]),
+    "bench_cores.py": (
+        {"threads": count(1), "case": text, "median s": positive, "speed-up": positive,
+         "yardstick speed-up": positive, "share of the yardstick's": positive,
+         "labels as 1 thread": one_of("yes", "—")},
+        [("the share is the speed-up over the yardstick's", lambda r: abs(
+            num(r, "speed-up") / num(r, "yardstick speed-up")
+            - num(r, "share of the yardstick's")) <= 1e-9),
+         ("one thread is the unit", lambda r: r["threads"] != "1"
+          or num(r, "speed-up") == 1.0),
+         ("the yardstick has no labels, every basin the one-thread labels", lambda r:
+          (r["labels as 1 thread"] == "—") == (r["case"] == "yardstick"))]),
     "bench_orbits.py": ({}, []),  # its values are checked where its conversion is
     "bench_versions.py": (
         dict(case=one_of("run", "run+lyapunov", "basin", "sweep"), base_s=positive,
