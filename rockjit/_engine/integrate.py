@@ -56,7 +56,6 @@ from __future__ import annotations
 import functools
 import math
 from collections import namedtuple
-from fractions import Fraction
 
 import numpy as np
 
@@ -66,31 +65,10 @@ from ..result import STATUSES
 from ..model import (NEAR_RANGE, SINCOS_RANGE, accel_near, accel_pq, corner, forcing_closed, jump,
                     near_poly, oscillator, rotate, saltation, sincos, sincos_poly, slope_pq,
                     uplift_time)
-
-# ---- Dormand–Prince 5(4), scipy's names --------------------------------------------------------
-C = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0])
-A = np.array([
-    [0.0, 0.0, 0.0, 0.0, 0.0],
-    [1 / 5, 0.0, 0.0, 0.0, 0.0],
-    [3 / 40, 9 / 40, 0.0, 0.0, 0.0],
-    [44 / 45, -56 / 15, 32 / 9, 0.0, 0.0],
-    [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0.0],
-    [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656],
-])
-B = np.array([35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84])
-E = np.array([-71 / 57600, 0.0, 71 / 16695, -71 / 1920, 17253 / 339200, -22 / 525, 1 / 40])
-P = np.array([
-    [1.0, -8048581381 / 2820520608, 8663915743 / 2820520608, -12715105075 / 11282082432],
-    [0.0, 0.0, 0.0, 0.0],
-    [0.0, 131558114200 / 32700410799, -68118460800 / 10900136933,
-     87487479700 / 32700410799],
-    [0.0, -1754552775 / 470086768, 14199869525 / 1410260304, -10690763975 / 1880347072],
-    [0.0, 127303824393 / 49829197408, -318862633887 / 49829197408,
-     701980252875 / 199316789632],
-    [0.0, -282668133 / 205662961, 2019193451 / 616988883, -1453857185 / 822651844],
-    [0.0, 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423],
-])
-N_STAGES = 6
+from .stages import chain, compile_step
+# the tableau (scipy's names) and the step's table: data of their own module, named here too
+from .tableau import (A, B, C, E, N_STAGES, N_TAB, P, T_HAA, T_HB, T_HBA, T_HC,  # noqa: F401
+                      T_ROTC, T_ROTS, _AA, _BA, step_table, tab_entry)
 
 # ---- status codes (kernels return these; the Python layer explains them) ----------------------
 RUNNING = -1
@@ -215,65 +193,6 @@ def settled_period(strobe, half, per_imp, k, reps, pmax, tol):
     return 0
 
 
-# ---- layout of the per-step-length table ``tab`` (:func:`step_table`) --------------------------
-# rows 0..5: h A[i, :]; row 6: h B; rows 7 and 8: cos and sin of the forcing's phase advance
-# omega c_i h to stage i (c_6 = 1, the step's end); rows 9..14: h^2 (A A)[i, :]; row 15:
-# h^2 (B A); row 16: h c_i.
-T_HB, T_ROTC, T_ROTS, T_HAA, T_HBA, T_HC = 6, 7, 8, 9, 15, 16
-N_TAB = 17
-
-
-def _nystrom():
-    """``A A`` and ``B A``, exactly (in rationals) and then rounded: a stage's angle straight
-    from the accelerations is ``x_i = x0 + h c_i v0 + h^2 (A A k)_i``, and the step's end
-    ``x0 + h v0 + h^2 (B A k)``."""
-    a = [[Fraction(0)] * N_STAGES for _ in range(N_STAGES)]
-    rows = [(), ((1, 5),), ((3, 40), (9, 40)), ((44, 45), (-56, 15), (32, 9)),
-            ((19372, 6561), (-25360, 2187), (64448, 6561), (-212, 729)),
-            ((9017, 3168), (-355, 33), (46732, 5247), (49, 176), (-5103, 18656))]
-    for i, row in enumerate(rows):
-        for j, (n, d) in enumerate(row):
-            a[i][j] = Fraction(n, d)
-    b = [Fraction(35, 384), Fraction(0), Fraction(500, 1113), Fraction(125, 192),
-         Fraction(-2187, 6784), Fraction(11, 84)]
-    aa = [[sum(a[i][m] * a[m][j] for m in range(N_STAGES)) for j in range(N_STAGES)]
-          for i in range(N_STAGES)]
-    ba = [sum(b[m] * a[m][j] for m in range(N_STAGES)) for j in range(N_STAGES)]
-    assert np.array_equal(np.array(a, dtype=float)[:, :N_STAGES - 1], A)
-    return np.array(aa, dtype=float), np.array(ba, dtype=float)
-
-
-_AA, _BA = _nystrom()
-
-
-@jit(nrt=False, inline=True)
-def step_table(omega, h, tab):
-    """Fill ``tab`` for a step of length ``h`` (layout above). Only the lower triangles are
-    written (an event costs two of these): the entries above are zero from allocation on."""
-    h2 = h * h
-    for i in range(N_STAGES):
-        for j in range(i):
-            tab[i, j] = h * A[i, j]
-        for j in range(i - 1):
-            tab[T_HAA + i, j] = h2 * _AA[i, j]
-        tab[T_HB, i] = h * B[i]
-        tab[T_HBA, i] = h2 * _BA[i]
-    # the phase advances: within NEAR_RANGE (omega h = 2 pi / N < 0.3 from N = 21 on) the short
-    # polynomial of a small angle, else the sine's
-    near = abs(omega * h) <= NEAR_RANGE
-    for i in range(N_STAGES + 1):
-        c = C[i] if i < N_STAGES else 1.0
-        tab[T_HC, i] = h * c
-        u = omega * c * h
-        if near:
-            sn, cs = near_poly(u)
-            sn = sn * u
-        else:
-            sn, cs = sincos(u)
-        tab[T_ROTC, i] = cs
-        tab[T_ROTS, i] = sn
-
-
 @jit(nrt=False)
 def block_stage(FAST, SLOPE, x0, d, v, f, side, par, s0, c0):
     """Acceleration and its slope ``d theta''/d theta`` at angle ``x0 + d`` (:mod:`rockjit.model`).
@@ -318,74 +237,41 @@ def rhs(EMBED4, r, y, side, par, K, jac, trig):
                                       0.0, 0.0)
 
 
-@jit(nrt=False, inline=True)
-def block_step(FAST, SLOPE, x0, v0, fr, tab, side, par, K, jac, trig):
-    """The block's ``(theta, theta')`` over one Dormand–Prince step, written out stage by stage.
+def _tab_coef(kind, i, j):
+    """A coefficient of the chain (:func:`rockjit._engine.stages.chain`) in the step's table."""
+    row, col = tab_entry(kind, i, j)
+    return f"tab[{row}, {col}]"
+
+
+#: :func:`block_step`'s source, rendered from the one stage chain
+_BLOCK_STEP = (
+    ["k0 = K[0, 1]", "s0 = trig[0]", "c0 = trig[1]"]
+    + chain(lambda i: f"k{i}, j{i} = block_stage(FAST, SLOPE, x0, x{i}, v{i}, fr[{i}], side, "
+                      f"par, s0, c0)", _tab_coef, arith="fma", form="nystrom")
+    + ["x6e = x0 + x6",
+       "trig[2], trig[3] = sincos_poly(x6e) if FAST else sincos(x6e)",
+       "far = max(max(max(abs(x1), abs(x2)), max(abs(x3), abs(x4))), max(abs(x5), abs(x6)))",
+       "far = max(far * (1.0 / NEAR_RANGE), abs(x6e) * (1.0 / SINCOS_RANGE))"]
+    + [f"K[{i}, 0] = v{i}" for i in range(1, N_STAGES + 1)]
+    + [f"K[{i}, 1] = k{i}" for i in range(1, N_STAGES + 1)]
+    + ["if SLOPE is not None:"] + [f"    jac[{i}] = j{i}" for i in range(1, N_STAGES + 1)]
+    + ["return x6e, v6, far"])
+
+block_step = compile_step(
+    "block_step", "FAST, SLOPE, x0, v0, fr, tab, side, par, K, jac, trig", _BLOCK_STEP, globals(),
+    jit(nrt=False, inline=True), doc="""The block's ``(theta, theta')`` over one Dormand–Prince step.
 
     ``K[0, 1]`` holds the acceleration at the start, ``trig[0:2]`` the sine and cosine of
     ``x0``; ``fr[i]`` the forcing acceleration at stage ``i``; ``tab`` the step's table. Fills
     ``K[1:, :2]``, ``jac[1:]`` and ``trig[2:4]`` (at the step's end) and returns
     ``(theta, theta', far)`` at the step's end.
 
-    This is the integrator's critical path. The stage values stay in registers; a sum reads the
-    newest stage last, so the rest of it is ready early; the stages' angles are kept as offsets
-    ``d`` from ``x0`` (:func:`block_stage`). With ``FAST``, ``far > 1`` says an offset exceeded
-    ``NEAR_RANGE`` or the end angle ``SINCOS_RANGE``: the caller must redo the step without.
-    """
-    k0 = K[0, 1]
-    s0 = trig[0]
-    c0 = trig[1]
-    # offsets of the stages' angles straight from the accelerations (Nystrom's form of the same
-    # tableau), so that each waits for the acceleration two stages back, not for a velocity
-    d1 = tab[T_HC, 1] * v0
-    v1 = fma(tab[1, 0], k0, v0)
-    k1, j1 = block_stage(FAST, SLOPE, x0, d1, v1, fr[1], side, par, s0, c0)
-    d2 = fma(tab[T_HAA + 2, 0], k0, tab[T_HC, 2] * v0)
-    v2 = fma(tab[2, 1], k1, fma(tab[2, 0], k0, v0))
-    k2, j2 = block_stage(FAST, SLOPE, x0, d2, v2, fr[2], side, par, s0, c0)
-    d3 = fma(tab[T_HAA + 3, 1], k1, fma(tab[T_HAA + 3, 0], k0, tab[T_HC, 3] * v0))
-    v3 = fma(tab[3, 2], k2, fma(tab[3, 1], k1, fma(tab[3, 0], k0, v0)))
-    k3, j3 = block_stage(FAST, SLOPE, x0, d3, v3, fr[3], side, par, s0, c0)
-    d4 = fma(tab[T_HAA + 4, 2], k2, fma(tab[T_HAA + 4, 1], k1,
-             fma(tab[T_HAA + 4, 0], k0, tab[T_HC, 4] * v0)))
-    v4 = fma(tab[4, 3], k3, fma(tab[4, 2], k2, fma(tab[4, 1], k1, fma(tab[4, 0], k0, v0))))
-    k4, j4 = block_stage(FAST, SLOPE, x0, d4, v4, fr[4], side, par, s0, c0)
-    d5 = fma(tab[T_HAA + 5, 3], k3, fma(tab[T_HAA + 5, 2], k2, fma(tab[T_HAA + 5, 1], k1,
-             fma(tab[T_HAA + 5, 0], k0, tab[T_HC, 5] * v0))))
-    v5 = fma(tab[5, 4], k4, fma(tab[5, 3], k3, fma(tab[5, 2], k2,
-             fma(tab[5, 1], k1, fma(tab[5, 0], k0, v0)))))
-    k5, j5 = block_stage(FAST, SLOPE, x0, d5, v5, fr[5], side, par, s0, c0)
-    # B[1] = 0, and (B A)[1] = (B A)[5] = 0
-    d6 = fma(tab[T_HBA, 4], k4, fma(tab[T_HBA, 3], k3, fma(tab[T_HBA, 2], k2,
-             fma(tab[T_HBA, 0], k0, tab[T_HC, 6] * v0))))
-    v6 = fma(tab[T_HB, 5], k5, fma(tab[T_HB, 4], k4, fma(tab[T_HB, 3], k3,
-             fma(tab[T_HB, 2], k2, fma(tab[T_HB, 0], k0, v0)))))
-    k6, j6 = block_stage(FAST, SLOPE, x0, d6, v6, fr[N_STAGES], side, par, s0, c0)
-    x6 = x0 + d6
-    # the next step's base angle, afresh (off the chain: its first use is the next step's rotate)
-    trig[2], trig[3] = sincos_poly(x6) if FAST else sincos(x6)
-    far = max(max(max(abs(d1), abs(d2)), max(abs(d3), abs(d4))), max(abs(d5), abs(d6)))
-    far = max(far * (1.0 / NEAR_RANGE), abs(x6) * (1.0 / SINCOS_RANGE))
-    K[1, 0] = v1
-    K[2, 0] = v2
-    K[3, 0] = v3
-    K[4, 0] = v4
-    K[5, 0] = v5
-    K[6, 0] = v6
-    K[1, 1] = k1
-    K[2, 1] = k2
-    K[3, 1] = k3
-    K[4, 1] = k4
-    K[5, 1] = k5
-    K[6, 1] = k6
-    if SLOPE is not None:
-        jac[1] = j1
-        jac[2] = j2
-        jac[3] = j3
-        jac[4] = j4
-        jac[5] = j5
-        jac[6] = j6
-    return x6, v6, far
+    This is the integrator's critical path: the stage chain in Nystrom's form
+    (:mod:`rockjit._engine.stages`), whose stage values stay in registers; the stages' angles
+    are offsets ``x_i`` from ``x0`` (:func:`block_stage`). The sine and cosine of the end angle
+    (the next step's base) are off the chain. With ``FAST``, ``far > 1`` says an offset
+    exceeded ``NEAR_RANGE`` or the end angle ``SINCOS_RANGE``: the caller must redo the step
+    without.""")
 
 
 @jit(nrt=False)
@@ -408,36 +294,17 @@ def osc_step(y, K, ytmp, ynew, tab, par, fr):
     ynew[3] = ytmp[3]
 
 
-@jit(nrt=False, inline=True)
-def tangent_column(p0, q0, tab, jac, jb):
-    """One column ``(p, q)`` of the tangent matrix over one step, ``p' = q``,
-    ``q' = jac_i p + jb q`` at stage ``i``, written out like :func:`block_step` (its stages are
-    independent of the state's chain, so this is throughput, not latency). Returns the column at
-    the step's end and its derivative there."""
-    k0 = fma(jac[0], p0, jb * q0)
-    p1 = fma(tab[1, 0], q0, p0)
-    q1 = fma(tab[1, 0], k0, q0)
-    k1 = fma(jac[1], p1, jb * q1)
-    p2 = fma(tab[2, 1], q1, fma(tab[2, 0], q0, p0))
-    q2 = fma(tab[2, 1], k1, fma(tab[2, 0], k0, q0))
-    k2 = fma(jac[2], p2, jb * q2)
-    p3 = fma(tab[3, 2], q2, fma(tab[3, 1], q1, fma(tab[3, 0], q0, p0)))
-    q3 = fma(tab[3, 2], k2, fma(tab[3, 1], k1, fma(tab[3, 0], k0, q0)))
-    k3 = fma(jac[3], p3, jb * q3)
-    p4 = fma(tab[4, 3], q3, fma(tab[4, 2], q2, fma(tab[4, 1], q1, fma(tab[4, 0], q0, p0))))
-    q4 = fma(tab[4, 3], k3, fma(tab[4, 2], k2, fma(tab[4, 1], k1, fma(tab[4, 0], k0, q0))))
-    k4 = fma(jac[4], p4, jb * q4)
-    p5 = fma(tab[5, 4], q4, fma(tab[5, 3], q3, fma(tab[5, 2], q2,
-             fma(tab[5, 1], q1, fma(tab[5, 0], q0, p0)))))
-    q5 = fma(tab[5, 4], k4, fma(tab[5, 3], k3, fma(tab[5, 2], k2,
-             fma(tab[5, 1], k1, fma(tab[5, 0], k0, q0)))))
-    k5 = fma(jac[5], p5, jb * q5)
-    # B[1] = 0
-    p6 = fma(tab[T_HB, 5], q5, fma(tab[T_HB, 4], q4, fma(tab[T_HB, 3], q3,
-             fma(tab[T_HB, 2], q2, fma(tab[T_HB, 0], q0, p0)))))
-    q6 = fma(tab[T_HB, 5], k5, fma(tab[T_HB, 4], k4, fma(tab[T_HB, 3], k3,
-             fma(tab[T_HB, 2], k2, fma(tab[T_HB, 0], k0, q0)))))
-    return p6, q6, fma(jac[N_STAGES], p6, jb * q6), k0
+tangent_column = compile_step(
+    "tangent_column", "x0, v0, tab, jac, jb",
+    ["k0 = fma(jac[0], x0, jb * v0)"]
+    + chain(lambda i: f"k{i} = fma(jac[{i}], x{i}, jb * v{i})", _tab_coef, arith="fma",
+            form="first")
+    + ["return x6, v6, k6, k0"],
+    globals(), jit(nrt=False, inline=True), doc="""One column ``(p, q)`` of the tangent matrix
+    over one step, ``p' = q``, ``q' = jac_i p + jb q`` at stage ``i``: the stage chain in its
+    first-order form (its stages are independent of the state's chain, so this is throughput,
+    not latency). Returns the column at the step's end and its derivative there and at the
+    start.""")
 
 
 @jit(nrt=False, inline=True)
