@@ -7,7 +7,7 @@ each waiting for the last (its cost is latency, not arithmetic); ``L`` independe
 by side let the core overlap them, and written as one loop over lanes with no branch in it,
 LLVM turns the lanes into SIMD vectors.
 
-:func:`block_step_lanes` is :func:`rockjit._engine.integrate.block_step` (fast path, no slopes) for
+:func:`block_step_lanes` is :func:`rockjit._engine.step.block_step` (fast path, no slopes) for
 ``L`` lanes with the lane as the innermost, contiguous index of every array: the same
 operations in the same order, fused multiply-adds included, so each lane's result is bit for
 bit the single-lane step's (a vector FMA rounds once, as the scalar one).
@@ -144,11 +144,11 @@ block_step_lanes = compile_step("block_step_lanes", "n, j, lin, lout, ftl", _STE
         A lane whose step is *fast* (below) has its state advanced to the step's end here.
     lout : ndarray, (N_LOUT * W,)
         Receives the stages' velocities and accelerations (``O_KV + i``, ``O_KA + i``, rows
-        ``i = 1..6``: ``K[i, 0]`` and ``K[i, 1]`` of :func:`rockjit._engine.integrate.block_step`), the
+        ``i = 1..6``: ``K[i, 0]`` and ``K[i, 1]`` of :func:`rockjit._engine.step.block_step`), the
         angle and velocity at the step's end, the sine and cosine of that angle, ``far``
         (``> 1``: the step left the polynomials' range) and ``O_FAST``: 1 when the step is
         accepted as it is (in flight, in range, and none of the events that
-        :func:`rockjit._engine.integrate.detect` looks for), else 0 (the lane's state is left as it was,
+        :func:`rockjit._engine.events.detect` looks for), else 0 (the lane's state is left as it was,
         for the single-lane code to take the step).
     ftl : ndarray, (N * 7 * W,)
         Each lane's forcing acceleration at stage ``i`` of step ``j`` at ``(7 j + i) W + l``.
@@ -375,7 +375,7 @@ def _sync(l, b):
 @jit(nrt=False, inline=True)
 def _stages(l, b):
     """The vector step's stages and end into the lane's work arrays, as
-    :func:`rockjit._engine.integrate.rk_step` would leave them (no tangent)."""
+    :func:`rockjit._engine.step.rk_step` would leave them (no tangent)."""
     K = b.K[l]
     for i in range(1, ig.N_STAGES + 1):
         K[i, 0] = b.lout[(O_KV + i) * W + l]
