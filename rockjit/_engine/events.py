@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from .._jit import fma, jit
-from ..model import corner, oscillator, slope_pq
+from ..model import jerk_snap, oscillator
 from .layout import (BISECT_ITERS, DELTA_EULER, EV_IMPACT, EV_NONE, EV_OVERTURN, EV_UPLIFT,
                      LOCATE_TOL, NEWTON_ITERS, OFF_GRID, O_RESTEP, O_RHS, O_UNCONVERGED, P_AW2,
                      P_COT, P_CTHC, P_OMEGA, P_STHC, P_THOVER, P_XI)
@@ -105,32 +105,11 @@ def dense_event_slope(kind, y0m, h, q0, q1, q2, q3, side, par, x):
 
 @jit(nrt=False, inline=True)
 def end_derivs(f, df, side, s, c, v, a, par):
-    """The third and fourth derivatives of theta in time (jerk and snap) at a point of a step
-    on corner ``side``.
-
-    From the forcing acceleration ``f`` there and its time derivative ``df``, the sine and
-    cosine ``s, c`` of theta, ``v = theta'`` and ``a = theta''``. With
-    ``theta'' = P cos(theta) + Q sin(theta) - k theta'`` (:func:`rockjit.model.corner`,
-    ``k = 3/4 xi``), ``P`` and ``Q`` affine in ``f`` (``dP/df = a1 = 3/4 sin(thc)``,
-    ``dQ/df = a2 = 3/4 side cos(thc)``) and ``f'' = -omega^2 f`` (the closed form)::
-
-        jerk = (a1 c + a2 s) f' + (Q c - P s) v - k a
-        snap = 2 (a2 c - a1 s) f' v + (a1 c + a2 s) f'' - (a + k v) v^2 + (Q c - P s) a - k jerk
-
-    (``P c + Q s = a + k v``; ``Q c - P s`` is :func:`rockjit.model.slope_pq`).
-    """
-    a1 = 0.75 * par[P_STHC]
-    a2 = 0.75 * (side * par[P_CTHC])
-    k = 0.75 * par[P_XI]
-    P, Q = corner(f, side, par[P_STHC], par[P_CTHC])
-    dadf = fma(a1, c, a2 * s)
-    dadf_th = fma(a2, c, -(a1 * s))
-    sl = slope_pq(P, Q, s, c)
-    j = fma(dadf, df, fma(sl, v, -(k * a)))
+    """The jerk and snap of theta (:func:`rockjit.model.jerk_snap`) at a point of a step on
+    corner ``side``, under the closed-form forcing: ``f`` and its time derivative ``df`` there,
+    and ``f'' = -omega^2 f``."""
     ddf = -(par[P_OMEGA] * par[P_OMEGA]) * f
-    sn = fma(2.0 * dadf_th * df, v,
-             fma(dadf, ddf, fma(sl, a, fma(-fma(k, v, a) * v, v, -(k * j)))))
-    return j, sn
+    return jerk_snap(f, df, ddf, side, par[P_STHC], par[P_CTHC], par[P_XI], s, c, v, a)
 
 
 @jit(nrt=False, inline=True)

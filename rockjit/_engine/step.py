@@ -8,8 +8,9 @@ for a tangent column); the tableau and the step's table, :mod:`rockjit._engine.t
 from __future__ import annotations
 
 from .._jit import fma, jit
-from ..model import (NEAR_RANGE, SINCOS_RANGE, accel_near, accel_pq, corner, forcing_closed,
-                     near_poly, oscillator, rotate, sincos, sincos_poly, slope_pq)
+from ..model import (NEAR_RANGE, SINCOS_RANGE, accel_near, accel_pq, corner, damping_rate,
+                     forcing_closed, near_poly, oscillator, rotate, sincos, sincos_poly,
+                     slope_pq)
 from .layout import FT_COS, FT_SIN, P_AW2, P_CTHC, P_OMEGA, P_PHI, P_STHC, P_XI
 from .stages import chain, compile_step
 from .tableau import A, N_STAGES, P, T_HB, T_ROTC, T_ROTS, tab_entry
@@ -136,7 +137,7 @@ def tangent_step(NS, y, K, ynew, tab, par, jac):
     ``jac``). The tangent never feeds back into the state. ``K[0]`` and ``K[-1]`` receive the
     tangent's derivative at the step's ends (the end's is used to carry an event's state the
     last Newton correction, :func:`locate`)."""
-    jb = -0.75 * par[P_XI]
+    jb = -damping_rate(par[P_XI])
     for c in range(2):
         a = NS + 2 * c
         p, q, k6, k0 = tangent_column(y[a], y[a + 1], tab, jac, jb)
