@@ -409,6 +409,41 @@ def slope_pq(P, Q, s, c):
     return fma(Q, c, -(P * s))
 
 
+@jit(nrt=False, inline=True)
+def damping_rate(xi):
+    """``k`` of the damping term ``-k theta'`` in ``theta''``: ``k = 3/4 xi``."""
+    return 0.75 * xi
+
+
+@jit(nrt=False, inline=True)
+def jerk_snap(f, df, ddf, side, sthc, cthc, xi, s, c, v, a):
+    """The third and fourth derivatives of theta in time (jerk and snap) on corner ``side``.
+
+    From the forcing acceleration ``f`` and its first two time derivatives ``df, ddf``, the
+    sine and cosine ``s, c`` of theta, ``v = theta'`` and ``a = theta''``. With
+    ``theta'' = P cos(theta) + Q sin(theta) - k theta'`` (:func:`corner`,
+    :func:`damping_rate`), ``P`` and ``Q`` affine in ``f`` (``dP/df = a1 = 3/4 sin(thc)``,
+    ``dQ/df = a2 = 3/4 side cos(thc)``)::
+
+        jerk = (a1 c + a2 s) f' + (Q c - P s) v - k a
+        snap = 2 (a2 c - a1 s) f' v + (a1 c + a2 s) f'' - (a + k v) v^2 + (Q c - P s) a - k jerk
+
+    (``P c + Q s = a + k v``; ``Q c - P s`` is :func:`slope_pq`). ``sthc, cthc`` are
+    ``sin(thc), cos(thc)``.
+    """
+    a1 = 0.75 * sthc
+    a2 = 0.75 * (side * cthc)
+    k = damping_rate(xi)
+    P, Q = corner(f, side, sthc, cthc)
+    dadf = fma(a1, c, a2 * s)
+    dadf_th = fma(a2, c, -(a1 * s))
+    sl = slope_pq(P, Q, s, c)
+    j = fma(dadf, df, fma(sl, v, -(k * a)))
+    sn = fma(2.0 * dadf_th * df, v,
+             fma(dadf, ddf, fma(sl, a, fma(-fma(k, v, a) * v, v, -(k * j)))))
+    return j, sn
+
+
 @jit
 def accel(theta, dtheta, f, side, thc, xi):
     """Angular acceleration ``theta''`` while rocking on corner ``side`` (+1 or -1).

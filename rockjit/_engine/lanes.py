@@ -7,7 +7,7 @@ each waiting for the last (its cost is latency, not arithmetic); ``L`` independe
 by side let the core overlap them, and written as one loop over lanes with no branch in it,
 LLVM turns the lanes into SIMD vectors.
 
-:func:`block_step_lanes` is :func:`rockjit._engine.integrate.block_step` (fast path, no slopes) for
+:func:`block_step_lanes` is :func:`rockjit._engine.step.block_step` (fast path, no slopes) for
 ``L`` lanes with the lane as the innermost, contiguous index of every array: the same
 operations in the same order, fused multiply-adds included, so each lane's result is bit for
 bit the single-lane step's (a vector FMA rounds once, as the scalar one).
@@ -24,31 +24,29 @@ from numba import prange
 from . import integrate as ig
 from . import cell
 from .._jit import cycles, fma, jit
+from .stages import chain, compile_step
+from .tableau import COLS
 from ..model import (NEAR_RANGE, SINCOS_RANGE, accel_near, corner, initial_side, rotate,
                     sincos_poly, uplift_time)
 
 __all__ = ["W", "bank", "block_step_lanes", "lane_tables", "run_lanes", "scalar_step"]
 
-# rows of the lane-major step table ``tabl`` (:func:`lane_tables`): the entries of
-# integrate's table that the block's step reads, lane innermost
-(L_A10, L_A20, L_A21, L_A30, L_A31, L_A32, L_A40, L_A41, L_A42, L_A43, L_A50, L_A51, L_A52,
- L_A53, L_A54, L_B0, L_B2, L_B3, L_B4, L_B5, L_AA20, L_AA30, L_AA31, L_AA40, L_AA41, L_AA42,
- L_AA50, L_AA51, L_AA52, L_AA53, L_BA0, L_BA2, L_BA3, L_BA4, L_C1, L_C2, L_C3, L_C4, L_C5,
- L_C6) = range(40)
-N_LTAB = 40
+# rows of the lane-major step table (:func:`lane_tables`): the entries of integrate's table that
+# the block's step reads (the chain's coefficients not exactly zero, :data:`tableau.COLS`), lane
+# innermost; ``LANE_ROW[kind, i, j]`` is the row of coefficient ``j`` of chain row ``i``
+LANE_ROW = {}
+for _kind in ("A", "AA"):
+    for _i in range(1, ig.N_STAGES + 1):
+        for _j in COLS[_kind][_i]:
+            LANE_ROW[_kind, _i, _j] = len(LANE_ROW)
+for _i in range(1, ig.N_STAGES + 1):
+    LANE_ROW["C", _i, 0] = len(LANE_ROW)
+N_LTAB = len(LANE_ROW)
 
 
 def _lane_rows():
     """``(row, column)`` of integrate's step table for each row of the lane table."""
-    rows = [(1, 0), (2, 0), (2, 1), (3, 0), (3, 1), (3, 2), (4, 0), (4, 1), (4, 2), (4, 3),
-            (5, 0), (5, 1), (5, 2), (5, 3), (5, 4)]
-    rows += [(ig.T_HB, j) for j in (0, 2, 3, 4, 5)]
-    rows += [(ig.T_HAA + 2, 0), (ig.T_HAA + 3, 0), (ig.T_HAA + 3, 1), (ig.T_HAA + 4, 0),
-             (ig.T_HAA + 4, 1), (ig.T_HAA + 4, 2), (ig.T_HAA + 5, 0), (ig.T_HAA + 5, 1),
-             (ig.T_HAA + 5, 2), (ig.T_HAA + 5, 3)]
-    rows += [(ig.T_HBA, j) for j in (0, 2, 3, 4)]
-    rows += [(ig.T_HC, i) for i in range(1, 7)]
-    assert len(rows) == N_LTAB
+    rows = [ig.tab_entry(*key) for key in LANE_ROW]
     return np.array(rows, dtype=np.int64)
 
 
@@ -79,9 +77,58 @@ O_KA = O_KV + ig.N_STAGES       # rows O_KA + 1 .. O_KA + 6
 O_FAST = O_KA + ig.N_STAGES + 1
 N_LOUT = O_FAST + 1
 
-@jit(nrt=False)
-def block_step_lanes(n, j, lin, lout, ftl):
-    """One Dormand–Prince step of the block in ``n`` lanes at once (fast path, no slopes).
+
+def _lane_coef(kind, i, j):
+    """A coefficient of the chain (:func:`rockjit._engine.stages.chain`) in the lane's table."""
+    return f"lin[tb + {LANE_ROW[kind, i, j]} * W]"
+
+
+def _lane_stage(i):
+    """Stage ``i``'s acceleration on the fast path: the corner rotated to the step's start."""
+    return (f"P, Q = corner(ftl[(j * 7 + {i}) * W + l], side, st, ct)\n"
+            f"Pr, Qr = rotate(P, Q, sl, cl)\n"
+            f"k{i} = accel_near(Pr, Qr, x{i}, v{i}, dmp)")
+
+
+_STEP_LANES = (
+    ["for l in range(n):"]
+    + ["    " + ln for ln in (
+        ["x0 = lin[I_X * W + l]",
+         "v0 = lin[I_V * W + l]",
+         "k0 = lin[I_K * W + l]",
+         "sl = lin[I_S * W + l]",
+         "cl = lin[I_C * W + l]",
+         "side = lin[I_SG * W + l]",
+         "st = lin[I_STHC * W + l]",
+         "ct = lin[I_CTHC * W + l]",
+         "dmp = lin[I_XI * W + l]",
+         "tb = I_TAB * W + l  # the lane's step table: row r at tb + r W"]
+        + chain(_lane_stage, _lane_coef, arith="fma", form="nystrom")
+        + ["xe = x0 + x6",
+           "s6, c6 = sincos_poly(xe)",
+           "f = max(max(max(abs(x1), abs(x2)), max(abs(x3), abs(x4))), max(abs(x5), abs(x6)))",
+           "far = max(f * (1.0 / NEAR_RANGE), abs(xe) * (1.0 / SINCOS_RANGE))",
+           "lout[O_FAR * W + l] = far"]
+        + [f"lout[(O_KV + {i}) * W + l] = v{i}" for i in range(1, ig.N_STAGES + 1)]
+        + [f"lout[(O_KA + {i}) * W + l] = k{i}" for i in range(1, ig.N_STAGES + 1)]
+        + ["lout[O_X * W + l] = xe",
+           "lout[O_V * W + l] = v6",
+           "lout[O_S * W + l] = s6",
+           "lout[O_C * W + l] = c6",
+           "g0 = side * x0",
+           "g1 = side * xe",
+           "graze = (g0 > 0.0) & (side * v0 < 0.0) & (side * v6 > 0.0)",
+           "fast = ((side != 0.0) & (far <= 1.0) & (g1 < lin[I_THOVER * W + l]) & (g1 >= 0.0)"
+           " & (not graze))",
+           "lout[O_FAST * W + l] = 1.0 if fast else 0.0",
+           "lin[I_X * W + l] = xe if fast else x0",
+           "lin[I_V * W + l] = v6 if fast else v0",
+           "lin[I_K * W + l] = k6 if fast else k0",
+           "lin[I_S * W + l] = s6 if fast else sl",
+           "lin[I_C * W + l] = c6 if fast else cl"])])
+
+block_step_lanes = compile_step("block_step_lanes", "n, j, lin, lout, ftl", _STEP_LANES,
+                                globals(), jit(nrt=False), doc="""One Dormand–Prince step of the block in ``n`` lanes at once (fast path, no slopes).
 
     Parameters
     ----------
@@ -97,104 +144,25 @@ def block_step_lanes(n, j, lin, lout, ftl):
         A lane whose step is *fast* (below) has its state advanced to the step's end here.
     lout : ndarray, (N_LOUT * W,)
         Receives the stages' velocities and accelerations (``O_KV + i``, ``O_KA + i``, rows
-        ``i = 1..6``: ``K[i, 0]`` and ``K[i, 1]`` of :func:`rockjit._engine.integrate.block_step`), the
+        ``i = 1..6``: ``K[i, 0]`` and ``K[i, 1]`` of :func:`rockjit._engine.step.block_step`), the
         angle and velocity at the step's end, the sine and cosine of that angle, ``far``
         (``> 1``: the step left the polynomials' range) and ``O_FAST``: 1 when the step is
         accepted as it is (in flight, in range, and none of the events that
-        :func:`rockjit._engine.integrate.detect` looks for), else 0 (the lane's state is left as it was,
+        :func:`rockjit._engine.events.detect` looks for), else 0 (the lane's state is left as it was,
         for the single-lane code to take the step).
     ftl : ndarray, (N * 7 * W,)
         Each lane's forcing acceleration at stage ``i`` of step ``j`` at ``(7 j + i) W + l``.
 
     Notes
     -----
+    The stage chain is :mod:`rockjit._engine.stages`' (Nystrom's form), the lane as the loop
+    index.
     Three flat arrays whose rows lie a compile-time stride ``W`` apart: LLVM's loop vectoriser
     then needs three overlap checks (with one array per quantity it gives up: "too many memory
     checks"). The state is written back here, as a vector, so that the next step's vector loads
     never wait on single-lane stores (a failed store-to-load forwarding cost three times the
     step).
-    """
-    for l in range(n):
-        xl = lin[(I_X) * W + l]
-        vl = lin[(I_V) * W + l]
-        kl = lin[(I_K) * W + l]
-        sl = lin[(I_S) * W + l]
-        cl = lin[(I_C) * W + l]
-        side = lin[(I_SG) * W + l]
-        st = lin[(I_STHC) * W + l]
-        ct = lin[(I_CTHC) * W + l]
-        dmp = lin[(I_XI) * W + l]
-        tb = I_TAB * W + l  # the lane's step table: row r at tb + r W
-        d1 = lin[tb + L_C1 * W] * vl
-        v1 = fma(lin[tb + L_A10 * W], kl, vl)
-        P, Q = corner(ftl[(j * 7 + 1) * W + l], side, st, ct)
-        Pr, Qr = rotate(P, Q, sl, cl)
-        k1 = accel_near(Pr, Qr, d1, v1, dmp)
-        d2 = fma(lin[tb + L_AA20 * W], kl, lin[tb + L_C2 * W] * vl)
-        v2 = fma(lin[tb + L_A21 * W], k1, fma(lin[tb + L_A20 * W], kl, vl))
-        P, Q = corner(ftl[(j * 7 + 2) * W + l], side, st, ct)
-        Pr, Qr = rotate(P, Q, sl, cl)
-        k2 = accel_near(Pr, Qr, d2, v2, dmp)
-        d3 = fma(lin[tb + L_AA31 * W], k1, fma(lin[tb + L_AA30 * W], kl, lin[tb + L_C3 * W] * vl))
-        v3 = fma(lin[tb + L_A32 * W], k2,
-                 fma(lin[tb + L_A31 * W], k1, fma(lin[tb + L_A30 * W], kl, vl)))
-        P, Q = corner(ftl[(j * 7 + 3) * W + l], side, st, ct)
-        Pr, Qr = rotate(P, Q, sl, cl)
-        k3 = accel_near(Pr, Qr, d3, v3, dmp)
-        d4 = fma(lin[tb + L_AA42 * W], k2, fma(lin[tb + L_AA41 * W], k1,
-                 fma(lin[tb + L_AA40 * W], kl, lin[tb + L_C4 * W] * vl)))
-        v4 = fma(lin[tb + L_A43 * W], k3, fma(lin[tb + L_A42 * W], k2, fma(lin[tb + L_A41 * W], k1,
-                 fma(lin[tb + L_A40 * W], kl, vl))))
-        P, Q = corner(ftl[(j * 7 + 4) * W + l], side, st, ct)
-        Pr, Qr = rotate(P, Q, sl, cl)
-        k4 = accel_near(Pr, Qr, d4, v4, dmp)
-        d5 = fma(lin[tb + L_AA53 * W], k3,
-                 fma(lin[tb + L_AA52 * W], k2, fma(lin[tb + L_AA51 * W], k1,
-                 fma(lin[tb + L_AA50 * W], kl, lin[tb + L_C5 * W] * vl))))
-        v5 = fma(lin[tb + L_A54 * W], k4, fma(lin[tb + L_A53 * W], k3, fma(lin[tb + L_A52 * W], k2,
-                 fma(lin[tb + L_A51 * W], k1, fma(lin[tb + L_A50 * W], kl, vl)))))
-        P, Q = corner(ftl[(j * 7 + 5) * W + l], side, st, ct)
-        Pr, Qr = rotate(P, Q, sl, cl)
-        k5 = accel_near(Pr, Qr, d5, v5, dmp)
-        d6 = fma(lin[tb + L_BA4 * W], k4, fma(lin[tb + L_BA3 * W], k3, fma(lin[tb + L_BA2 * W], k2,
-                 fma(lin[tb + L_BA0 * W], kl, lin[tb + L_C6 * W] * vl))))
-        v6 = fma(lin[tb + L_B5 * W], k5, fma(lin[tb + L_B4 * W], k4, fma(lin[tb + L_B3 * W], k3,
-                 fma(lin[tb + L_B2 * W], k2, fma(lin[tb + L_B0 * W], kl, vl)))))
-        P, Q = corner(ftl[(j * 7 + 6) * W + l], side, st, ct)
-        Pr, Qr = rotate(P, Q, sl, cl)
-        k6 = accel_near(Pr, Qr, d6, v6, dmp)
-        x6 = xl + d6
-        s6, c6 = sincos_poly(x6)
-        f = max(max(max(abs(d1), abs(d2)), max(abs(d3), abs(d4))), max(abs(d5), abs(d6)))
-        far = max(f * (1.0 / NEAR_RANGE), abs(x6) * (1.0 / SINCOS_RANGE))
-        lout[(O_FAR) * W + l] = far
-        lout[(O_KV + 1) * W + l] = v1
-        lout[(O_KV + 2) * W + l] = v2
-        lout[(O_KV + 3) * W + l] = v3
-        lout[(O_KV + 4) * W + l] = v4
-        lout[(O_KV + 5) * W + l] = v5
-        lout[(O_KV + 6) * W + l] = v6
-        lout[(O_KA + 1) * W + l] = k1
-        lout[(O_KA + 2) * W + l] = k2
-        lout[(O_KA + 3) * W + l] = k3
-        lout[(O_KA + 4) * W + l] = k4
-        lout[(O_KA + 5) * W + l] = k5
-        lout[(O_KA + 6) * W + l] = k6
-        lout[(O_X) * W + l] = x6
-        lout[(O_V) * W + l] = v6
-        lout[(O_S) * W + l] = s6
-        lout[(O_C) * W + l] = c6
-        g0 = side * xl
-        g1 = side * x6
-        graze = (g0 > 0.0) & (side * vl < 0.0) & (side * v6 > 0.0)
-        fast = ((side != 0.0) & (far <= 1.0) & (g1 < lin[I_THOVER * W + l]) & (g1 >= 0.0)
-                & (not graze))
-        lout[O_FAST * W + l] = 1.0 if fast else 0.0
-        lin[I_X * W + l] = x6 if fast else xl
-        lin[I_V * W + l] = v6 if fast else vl
-        lin[I_K * W + l] = k6 if fast else kl
-        lin[I_S * W + l] = s6 if fast else sl
-        lin[I_C * W + l] = c6 if fast else cl
+    """)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -407,7 +375,7 @@ def _sync(l, b):
 @jit(nrt=False, inline=True)
 def _stages(l, b):
     """The vector step's stages and end into the lane's work arrays, as
-    :func:`rockjit._engine.integrate.rk_step` would leave them (no tangent)."""
+    :func:`rockjit._engine.step.rk_step` would leave them (no tangent)."""
     K = b.K[l]
     for i in range(1, ig.N_STAGES + 1):
         K[i, 0] = b.lout[(O_KV + i) * W + l]

@@ -53,17 +53,7 @@ from numba import prange
 
 from .._jit import jit
 from ..model import accel, accel_pq, corner, free_rocking_decided, jump, sincos
-from .integrate import A as _A, B as _B, C as _C
-
-# ---- the tableau, as scalars (numba freezes module floats into the code) ------------------------
-C2, C3, C4, C5 = float(_C[1]), float(_C[2]), float(_C[3]), float(_C[4])
-A21 = float(_A[1, 0])
-A31, A32 = float(_A[2, 0]), float(_A[2, 1])
-A41, A42, A43 = float(_A[3, 0]), float(_A[3, 1]), float(_A[3, 2])
-A51, A52, A53, A54 = float(_A[4, 0]), float(_A[4, 1]), float(_A[4, 2]), float(_A[4, 3])
-A61, A62, A63, A64, A65 = (float(_A[5, 0]), float(_A[5, 1]), float(_A[5, 2]), float(_A[5, 3]),
-                           float(_A[5, 4]))
-B1, B3, B4, B5, B6 = float(_B[0]), float(_B[2]), float(_B[3]), float(_B[4]), float(_B[5])
+from .stages import chain, compile_step, node
 
 # ---- codes --------------------------------------------------------------------------------------
 K_SINE, K_COSINE, K_RICKER, K_RECORD = 0, 1, 2, 3
@@ -136,33 +126,22 @@ def acc_free(th, v, side, sthc, cthc, xi):
     return accel_pq(P, Q, s, c, v, xi)
 
 
-@jit(nrt=False, inline=True)
-def dp_step(t, th, v, a0, hh, cap, side, sthc, cthc, xi, x, rec):
-    """One Dormand–Prince step of length ``hh`` from ``(t, th, v)`` (``a0``: ``theta''``
-    there): ``(theta, theta', theta'')`` at ``t + hh``. The stages' instants are kept at or
-    below ``cap``, the grid instant that ends the step: a step that ends on the excitation's
-    end sees the forcing's value there even where ``t + hh`` rounds beyond it (the one-cosine
-    pulse ends on ``a_p``)."""
-    k1 = a0
-    th2 = th + hh * (A21 * v)
-    v2 = v + hh * (A21 * k1)
-    k2 = acc(th2, v2, min(t + C2 * hh, cap), side, sthc, cthc, xi, x, rec)
-    th3 = th + hh * (A31 * v + A32 * v2)
-    v3 = v + hh * (A31 * k1 + A32 * k2)
-    k3 = acc(th3, v3, min(t + C3 * hh, cap), side, sthc, cthc, xi, x, rec)
-    th4 = th + hh * (A41 * v + A42 * v2 + A43 * v3)
-    v4 = v + hh * (A41 * k1 + A42 * k2 + A43 * k3)
-    k4 = acc(th4, v4, min(t + C4 * hh, cap), side, sthc, cthc, xi, x, rec)
-    th5 = th + hh * (A51 * v + A52 * v2 + A53 * v3 + A54 * v4)
-    v5 = v + hh * (A51 * k1 + A52 * k2 + A53 * k3 + A54 * k4)
-    k5 = acc(th5, v5, min(t + C5 * hh, cap), side, sthc, cthc, xi, x, rec)
-    th6 = th + hh * (A61 * v + A62 * v2 + A63 * v3 + A64 * v4 + A65 * v5)
-    v6 = v + hh * (A61 * k1 + A62 * k2 + A63 * k3 + A64 * k4 + A65 * k5)
-    k6 = acc(th6, v6, min(t + hh, cap), side, sthc, cthc, xi, x, rec)
-    th1 = th + hh * (B1 * v + B3 * v3 + B4 * v4 + B5 * v5 + B6 * v6)
-    v1 = v + hh * (B1 * k1 + B3 * k3 + B4 * k4 + B5 * k5 + B6 * k6)
-    a1 = acc(th1, v1, min(t + hh, cap), side, sthc, cthc, xi, x, rec)
-    return th1, v1, a1
+def _stage(i):
+    """Stage ``i``'s ``theta''``, its instant kept at or below ``cap``."""
+    c = node(i)
+    at = "t + hh" if c == "1.0" else f"t + {c} * hh"
+    return f"k{i} = acc(x{i}, v{i}, min({at}, cap), side, sthc, cthc, xi, x, rec)"
+
+
+dp_step = compile_step(
+    "dp_step", "t, x0, v0, k0, hh, cap, side, sthc, cthc, xi, x, rec",
+    chain(_stage, arith="plain", form="first", h="hh") + ["return x6, v6, k6"],
+    globals(), jit(nrt=False, inline=True), doc="""One Dormand–Prince step of length ``hh``
+    from ``(t, theta, theta')`` (``k0``: ``theta''`` there): ``(theta, theta', theta'')`` at
+    ``t + hh``, the stage chain of :mod:`rockjit._engine.stages` in its first-order form with
+    literal coefficients. The stages' instants are kept at or below ``cap``, the grid instant
+    that ends the step: a step that ends on the excitation's end sees the forcing's value there
+    even where ``t + hh`` rounds beyond it (the one-cosine pulse ends on ``a_p``).""")
 
 
 @jit(nrt=False)
