@@ -236,10 +236,9 @@ class RunPlan:
 
 def run(p: RunPlan, execution=None) -> Result:
     """Execute a :class:`RunPlan` on its path (compiled or scipy); a plan under a pulse or a
-    record (:class:`rockjit.ground.plan.TransientPlan`) runs on the transient path."""
+    record (:class:`rockjit.ground.plan.TransientPlan`) runs itself on the transient path."""
     if not isinstance(p, RunPlan):
-        from .ground.plan import run_transient
-        return run_transient(p)
+        return p.run()
     if p.method != "rockjit":
         from .reference import simulate_scipy  # scipy.integrate only when asked for
         return simulate_scipy(p)
@@ -307,9 +306,8 @@ def simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
     if not isinstance(block, Block):
         raise ValueError(f"block must be a rockjit.Block (got {type(block).__name__})")
     if getattr(forcing, "transient", False) and not isinstance(forcing, Harmonic):
-        from .ground.plan import plan_transient
-        return plan_transient(block, forcing, state, integration, lyapunov, record_stride,
-                              _method(method))
+        return forcing.plan_run(block, state, integration, lyapunov, record_stride,
+                                _method(method))
     if not isinstance(forcing, Harmonic):
         raise ValueError(f"forcing must be a rockjit excitation: Harmonic, Pulse or Record "
                          f"(got {type(forcing).__name__})")

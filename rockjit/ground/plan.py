@@ -15,7 +15,7 @@ from ..model import Block
 from ..validate import real, real_array
 from .settings import Transient
 
-__all__ = ["TransientPlan", "grid_settings", "plan_transient", "run_transient"]
+__all__ = ["TransientPlan", "grid_settings", "plan_run", "plan_transient", "run_transient"]
 
 
 @dataclass(frozen=True)
@@ -27,6 +27,10 @@ class TransientPlan:
     state: tuple         # (theta0, theta0')
     settings: Transient
     method: object       # "rockjit" or a Scipy
+
+    def run(self):
+        """Run the plan (:func:`run_transient`)."""
+        return run_transient(self)
 
 
 def grid_settings(integration):
@@ -89,6 +93,12 @@ def plan_transient(block, forcing, state, integration, lyapunov, record_stride, 
     return TransientPlan(block=block, excitation=excitation,
                          state=initial_state(state, integration), settings=integration,
                          method=method)
+
+
+def plan_run(excitation, block, state, integration, lyapunov, record_stride, method):
+    """:meth:`rockjit.excitation.Excitation.plan_run` of the transient excitations."""
+    return plan_transient(block, excitation, state, integration, lyapunov, record_stride,
+                          method)
 
 
 def run_transient(p: TransientPlan):
