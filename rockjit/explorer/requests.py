@@ -145,13 +145,13 @@ class Params:
         raises its ``ValueError`` (with its message) if not. Plans only: nothing is run."""
         from .. import basin, sweep
         block, integration = self.block(), self.integration()
+        self.check_limits()  # before the plans: their memory checks would speak for it
         basin.plan(block, self.forcing(), REFINE[0], integration=integration)
         a0, a1 = self.alpha_range
         if not a1 > a0:
             raise ValueError(f"alpha_range must run from a smaller to a larger amplitude "
                              f"(got {a0!r}, {a1!r})")
         sweep.plan(block, self.sweep_forcing(), self.alphas(), integration=integration)
-        self.check_limits()
         return self
 
     def grid_n_steps(self):

@@ -395,7 +395,12 @@ class Solver:
                 dx = -np.linalg.solve(ev.M - np.eye(2), ev.F)
             except np.linalg.LinAlgError:
                 break
-            et = self.full(ev.x + dx, lam, p, j)
+            x = ev.x + dx
+            # near a fold M - I is nearly singular and the step can leave the bounded region,
+            # where no run starts: the orbit stays as converged
+            if not (np.all(np.isfinite(x)) and abs(x[0]) < self.flow.theta_over):
+                break
+            et = self.full(x, lam, p, j)
             if not et.ok or et.nimp != ev.nimp:
                 break
             rt = float(np.abs(et.F).max())
