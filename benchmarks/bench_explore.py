@@ -1,6 +1,6 @@
 """rockjit explore: how long a change of alpha takes to reach the screen.
 
-Runs the browser test's scenario (tests/test_explore.py::test_the_app_in_a_browser: the app in a
+Runs the browser test's scenario (tests/explorer/test_explore.py::test_the_app_in_a_browser: the app in a
 headless system Chromium, driven by Playwright) with its timing log on, and reports the medians
 over its changes of alpha: until the 50² basin of the new alpha is on the page, and until the
 refined 100² one is (target: 1.5 s warm). Beside them, in the same run, the same stages computed
@@ -79,7 +79,7 @@ def browser_scenario():
         t0 = time.perf_counter()
         proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-rs", "-p",
                                "no:cacheprovider",
-                               "tests/test_explore.py::test_the_app_in_a_browser"],
+                               "tests/explorer/test_explore.py::test_the_app_in_a_browser"],
                               cwd=H.ROOT, env=env, capture_output=True, text=True, timeout=900)
         wall = time.perf_counter() - t0
         if proc.returncode != 0:

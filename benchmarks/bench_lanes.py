@@ -11,7 +11,7 @@ put back to its start, rarely):
   loop over lanes, vectorised (it always computes all ``W`` = 8 lanes, one AVX-512 vector; L of them
   count), which also accepts the step.
 
-(That the vector step equals the scalar one bit for bit is tests/test_lanes.py's.) The arithmetic
+(That the vector step equals the scalar one bit for bit is tests/_engine/test_lanes.py's.) The arithmetic
 bound drawn in the plot is :data:`FLOPS_PER_STEP` floating-point instructions (counted from the
 source, below) at :data:`FP_PER_CYCLE` per cycle (two FMA/multiply pipes), scalar and at the
 vector width.

@@ -9,7 +9,7 @@ bifurcations, the basin measures, the explorer). For each, the package and its t
 copied to a fresh temporary folder, the mutation is applied there (the working tree is never
 touched), and a chosen subset of the tests that check rockjit against something independent
 of it (``tests/physics.py``, the ``spec`` fixture of ``tests/conftest.py``, the slow
-classifier of ``tests/test_grids.py``, closed forms, libm, the order conditions, the scipy
+classifier of ``tests/grids/test_grids.py``, closed forms, libm, the order conditions, the scipy
 path, brute-force references, Monte-Carlo calibration) runs in a fresh process with its own
 numba cache (``NUMBA_CACHE_DIR`` inside the copy: rockjit caches compiled code with
 ``cache=True``, so a shared cache could serve the unmutated kernels). A mutant is *caught* when
@@ -59,7 +59,7 @@ UPLIFT = [PI + "test_uplift_time_matches_a_brute_force_scan"]
 RUNS = [PI + "test_run_matches_the_independent_integrator"]
 RUN_SYMMETRIC = [RUNS[0] + "[symmetric-compiled]"]  # one compiled run: the cheapest check
 FLOQUET = [PI + "test_floquet_multipliers_match_the_finite_difference_monodromy[p1-symmetric]"]
-TI = "tests/test_integrate.py::"
+TI = "tests/_engine/test_integrate.py::"
 
 
 @dataclass(frozen=True)
@@ -189,17 +189,17 @@ MUTANTS = [
     _m("qr-log", "exponents", INTEG,
        "lam_sum[1] += l2", "lam_sum[1] += l1",
        "the second exponent accumulates the first one's stretch",
-       ["tests/test_lyapunov.py::test_running_exponents_satisfy_the_identity_at_every_period"]),
+       ["tests/_engine/test_lyapunov.py::test_running_exponents_satisfy_the_identity_at_every_period"]),
     # ---- classification
     _m("period-tolerance", "classification", CLASSIFY,
        "lim = tol * orbit_scale(strobe, half, k0, k1) + 1e-300",
        "lim = 1e5 * tol * orbit_scale(strobe, half, k0, k1) + 1e-300",
        "the period test's tolerance 1e5 times too loose",
-       ["tests/test_grids.py::test_a_period_two_orbit_just_past_its_doubling"]),
+       ["tests/grids/test_grids.py::test_a_period_two_orbit_just_past_its_doubling"]),
     _m("symmetry-test", "classification", CLASSIFY,
        "if abs(half[j, c] + strobe[j, c]) > lim:", "if abs(half[j, c] - strobe[j, c]) > lim:",
        "the mirror symmetry x(T/2) = -x(0) tested as x(T/2) = x(0)",
-       ["tests/test_grids.py::test_gallery_labels[symmetric]"]),
+       ["tests/grids/test_grids.py::test_gallery_labels[symmetric]"]),
 ]
 
 FITTING = "rockjit/ground/fitting.py"
@@ -209,9 +209,9 @@ ARCLENGTH = "rockjit/orbits/arclength.py"
 BIFURCATIONS = "rockjit/orbits/bifurcations.py"
 MEASURES = "rockjit/measures.py"
 EXPLORER = "rockjit/explorer/requests.py"
-TO = "tests/test_orbits.py::"
+TO = "tests/orbits/test_orbits.py::"
 TM = "tests/test_measures.py::"
-TF = "tests/test_ground_fragility.py::"
+TF = "tests/ground/test_ground_fragility.py::"
 
 MUTANTS += [
     # ---- ground motions: fits, capacities, the compiled path's stopping rule
@@ -232,7 +232,7 @@ MUTANTS += [
        "free_rocking_decided(th, v, max_th, thc, th_top)",
        "free_rocking_decided(max(th, 0.0), v, max_th, thc, th_top)",
        "the compiled path's stopping rule takes a block on the theta < 0 side for upright",
-       ["tests/test_ground_stopping.py::test_the_compiled_path_decides_as_the_full_run_ends"]),
+       ["tests/ground/test_ground_stopping.py::test_the_compiled_path_decides_as_the_full_run_ends"]),
     # ---- periodic orbits: continuation and bifurcations
     _m("arclength-step-bound", "continuation", ARCLENGTH,
        "ds = min(1.3 * ds, self.ds_max)", "ds = min(1.3 * ds, 1.1 * self.ds_max)",
@@ -277,7 +277,7 @@ MUTANTS += [
     _m("explorer-nearest-cell", "explorer", EXPLORER,
        "k = int(round((v - axis[0]) / step))", "k = int((v - axis[0]) / step)",
        "a click picks the lattice point below it, not the nearest",
-       ["tests/test_explore.py::test_nearest_cell"]),
+       ["tests/explorer/test_explore.py::test_nearest_cell"]),
 ]
 
 QUICK_NAMES = ("housner-restitution", "saltation-entry", "uplift-time")

@@ -106,7 +106,7 @@ numpydoc_show_class_members = False
 numpydoc_xref_param_type = False
 numpydoc_attributes_as_param_list = True
 # every public function and class: a docstring, every parameter documented (and none that is
-# not one), an Examples section. Methods and properties need a docstring (tests/test_docs.py);
+# not one), an Examples section. Methods and properties need a docstring (tests/docs/test_docs.py);
 # rockjit.orbits is being redesigned and is documented from its docstrings as they stand.
 numpydoc_validation_checks = {"GL08", "PR01", "PR02", "EX01"}
 # results and other records document their fields as Attributes, not as Parameters

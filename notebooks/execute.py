@@ -4,7 +4,7 @@ so that a reader sees every result on GitHub or in Jupyter without running anyth
     python notebooks/execute.py              # both notebooks
     python notebooks/execute.py tour.ipynb   # one
 
-``tests/test_notebook.py`` runs them again and checks that what is stored is what the code now
+``tests/docs/test_notebook.py`` runs them again and checks that what is stored is what the code now
 draws and prints.
 """
 

@@ -4,7 +4,7 @@
 ``nnan``/``ninf``) so event tests and non-finite guards behave, and it leaves out ``contract`` and
 ``reassoc``: with them LLVM fuses or reorders the same arithmetic differently in two compilations
 (tangent vectors on or off, say), and the state's trajectory then differs in the last bit. The
-switch-independence of trajectories is a promise (tests/test_lyapunov.py); measured on the
+switch-independence of trajectories is a promise (tests/_engine/test_lyapunov.py); measured on the
 reference run, contraction bought no speed distinguishable from the noise of this machine.
 """
 

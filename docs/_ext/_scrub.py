@@ -6,7 +6,7 @@ items and specification file. Until each script runs again (the scripts no longe
 notes), those references are taken out here, a Python process is called a process, and a
 sentence reporting a missed target is dropped (the figures themselves stay). Nothing else goes
 through this: the help strings and the docstrings say what the code does at their source, which
-``tests/test_docs.py`` checks.
+``tests/docs/test_docs.py`` checks.
 """
 
 from __future__ import annotations

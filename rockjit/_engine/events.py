@@ -260,7 +260,7 @@ def locate_interp(kind, y, ynew, hh, lo, hi, K, side, par, trig, f0, df0, f1, df
     on the study's basin at N = 64 all but 2 in 100 000 events pass, and every event of the
     event-accuracy orbits from N = 32 on; at N = 16 most of them fail, and so do the events
     early in a coarse step with a slow crossing, where a genuine step of the event's own (short)
-    length is the more accurate (tests/test_integrate.py: the dips through 0 at N = 16).
+    length is the more accurate (tests/_engine/test_integrate.py: the dips through 0 at N = 16).
 
     Returns ``(ok, x, theta, theta')``: ``x = tau / hh`` and the state there; ``ok`` is 1 when
     trusted, 0 when not (``x`` then starts the genuine steps' Newton iteration,

@@ -37,7 +37,7 @@ uplift in closed form gives the boundary of overturning *without impact* (mode 2
 These are the literature's mode-2 boundaries of the linearised block (Zhang & Makris 2001
 found them by the same route; Dimitrakopoulos & DeJong 2012 give the similarity argument).
 The nonlinear block of slenderness ``h/b`` approaches them as ``alpha_s -> 0``, with an error of
-order ``alpha_s^2`` (tests/test_ground.py measures it).
+order ``alpha_s^2`` (tests/ground/test_ground.py measures it).
 """
 
 from __future__ import annotations

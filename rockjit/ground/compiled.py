@@ -8,7 +8,7 @@ it. :func:`run_compiled` is a single run (:func:`rockjit.simulate`) on the same 
 cells follow the scipy reference path (:mod:`rockjit.ground.reference`) phase by phase; at the
 step lengths below they agree with scipy's DOP853 at ``rtol = 1e-13`` to about 1e-11 in
 ``max |theta| / alpha_s`` and 4e-11 in the overturning time of a pulse run
-(tests/test_ground_compiled.py, benchmarks/bench_ground.py).
+(tests/ground/test_ground_compiled.py, benchmarks/bench_ground.py).
 
 Step lengths, in model time (``1/sqrt(g/R)``, about 0.32 s for a 1 m block): a pulse is cut
 into equal steps of at most :data:`H_PULSE` and at least :data:`MIN_PULSE_STEPS` of them; a

@@ -7,7 +7,7 @@ without motion, chosen so that every pair stays apart for readers with a colour-
 deficiency: simulated with ``colorspacious`` (Machado et al. 2009, severity 100) and measured in
 CAM02-UCS, the closest pair is 25.8 apart with normal vision, 17.3 under deuteranopia, 17.2
 under protanopia and 17.7 under tritanopia (:func:`cvd_distances` recomputes it;
-``tests/test_style.py`` keeps it above 15). The palette they replace put green (asymmetric) and
+``tests/plotting/test_style.py`` keeps it above 15). The palette they replace put green (asymmetric) and
 red (chaotic) 5.2 apart under deuteranopia, and green and orange (multiperiodic) 1.6 apart under
 protanopia.
 

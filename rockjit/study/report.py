@@ -75,7 +75,7 @@ FATES_NOTE = (
     "members leave the nominal path.")
 
 #: Mean global integrity over alpha = 0.3-0.9, hb = 1, from 100 x 100 basins every 0.01 at 500
-#: periods (the documentation quotes it; tests/test_readme.py recomputes it).
+#: periods (the documentation quotes it; tests/docs/test_readme.py recomputes it).
 GIM_PUBLISHED = {"housner": 0.56, "mao": 0.30}
 
 #: The study's diagrams integrated on past overturning: the percent of amplitudes plotted from

@@ -415,7 +415,7 @@ def test_the_headline_image_is_drawn_by_figure_5s_function(monkeypatch, tmp_path
     from pathlib import Path
 
     from rockjit.study import paper
-    script = Path(__file__).resolve().parents[1] / "docs" / "_static" / "make_headline.py"
+    script = Path(__file__).resolve().parents[2] / "docs" / "_static" / "make_headline.py"
     spec = importlib.util.spec_from_file_location("make_headline", script)
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)

@@ -29,7 +29,7 @@ from rockjit.storage import output_dir as rio
 from rockjit.storage.processes import host_name
 from rockjit.storage.ownership import RECORD
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 # ---------------------------------------------------------------------------------------------

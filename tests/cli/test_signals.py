@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SCRIPT = "import sys, rockjit.cli; sys.exit(rockjit.cli.main())"  # as the console script
 #: The console script (or ``python -m rockjit``: ``sys.argv[1] == "-m"``) with one step wrapped
 #: to pause at ``sys.argv[1]`` until the command's handler has recorded a signal (at most 60 s);

@@ -20,7 +20,7 @@ from rockjit.basins import fate as F
 from rockjit.single import Z0_STUDY
 
 BLOCK = Block(hb=1.0, law="housner")
-CHAOTIC = Harmonic(alpha=0.955, omega=1.3)  # tests/test_lyapunov.py
+CHAOTIC = Harmonic(alpha=0.955, omega=1.3)  # tests/_engine/test_lyapunov.py
 TRANSIENT = Harmonic(alpha=0.969, omega=1.3)  # transient chaos ending in overturning
 
 

@@ -24,7 +24,7 @@ import pytest
 
 import rockjit
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 
 #: The modules whose docstrings the site renders: their examples are the doctests.

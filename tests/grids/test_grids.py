@@ -130,7 +130,7 @@ def test_sweep_matches_single_runs():
     sw = rockjit.sweep(Block(1), Harmonic(omega=1.3), alphas, integration=integration,
                        classification=Classification(early_stop=False))
     # lambda_window is the finite-window estimate a single run averages (lambda_max is the
-    # exact Floquet exponent where a cell is periodic: tests/test_exact_exponents.py)
+    # exact Floquet exponent where a cell is periodic: tests/grids/test_exact_exponents.py)
     for a, lab, lam, pts in zip(alphas, sw.label, sw.lambda_window, sw.strobe):
         res = rockjit.simulate(Block(1), Harmonic(alpha=a, omega=1.3), integration=integration,
                                lyapunov=True)

@@ -34,7 +34,7 @@ from rockjit import Block, Harmonic
 from rockjit.explorer import requests as R
 from rockjit.explorer.worker import Cancelled, Computer
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 # ---------------------------------------------------------------------------------------------

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SMALL = ["--grid", "6", "--periods", "40", "--alpha-step", "0.05", "--zoom-step", "0.02",
          "--erosion-step", "0.2", "--quiet"]
 
