@@ -52,8 +52,8 @@ class Excitation:
     def plan_run(self, block, state, integration, lyapunov, record_stride, method):
         """The plan of a single run under this excitation, for an excitation whose runs take
         a path of their own (:func:`rockjit.simulate` asks it): a pulse or a record plans its
-        transient run (:mod:`rockjit.ground.plan`); the harmonic forcing plans in
-        :mod:`rockjit.single` itself. The plan's ``run()`` executes it."""
+        transient run (``rockjit.ground.plan``); the harmonic forcing plans in
+        ``rockjit.single`` itself. The plan's ``run()`` executes it."""
         raise NotImplementedError(f"{type(self).__name__} plans no run of its own")
 
     def replace(self, **changes):

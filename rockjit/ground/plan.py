@@ -96,7 +96,8 @@ def plan_transient(block, forcing, state, integration, lyapunov, record_stride, 
 
 
 def plan_run(excitation, block, state, integration, lyapunov, record_stride, method):
-    """:meth:`rockjit.excitation.Excitation.plan_run` of the transient excitations."""
+    """The plan of a single run under a pulse or a record (``Excitation.plan_run`` of the
+    transient excitations, which :func:`rockjit.simulate` asks)."""
     return plan_transient(block, excitation, state, integration, lyapunov, record_stride,
                           method)
 
