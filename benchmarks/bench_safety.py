@@ -102,12 +102,14 @@ def plot(charts, rows):
     for ax, (law, ch) in zip(np.atleast_1d(axes), charts.items()):
         m = ax.pcolormesh(ch.omega, ch.alpha, ch.safe, vmin=0, vmax=1, shading="nearest")
         if ch.alpha.size > 1 and ch.omega.size > 1:
-            ax.contour(ch.omega, ch.alpha, ch.safe, levels=[0.5, 0.9], colors="white")
+            cs = ax.contour(ch.omega, ch.alpha, ch.safe, levels=[0.5, 0.9], colors="white",
+                            linestyles=["solid", "dashed"])
+            ax.clabel(cs, fmt=lambda v: f"{v:.0%} safe", fontsize=7)
         wall = next(r[5] for r in rows if r[0] == law)
         ax.set_title(f"{law}: safe fraction ({wall:.0f} s)", fontsize=9)
-        ax.set_xlabel("omega")
-        ax.set_ylabel("alpha")
-    fig.colorbar(m, ax=axes, label="safe fraction")
+        ax.set_xlabel(r"$\omega$")
+        ax.set_ylabel(r"$\alpha$")
+    fig.colorbar(m, ax=axes, label="safe fraction (initial states that never overturn)")
     return fig
 
 
