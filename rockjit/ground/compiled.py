@@ -26,6 +26,7 @@ import numpy as np
 
 from .._engine import transient as T
 from ..model import initial_side
+from ..validate import memory
 from .pulses import KINDS, Pulse
 from .response import STATUS_CODES, TransientResult, alpha_s, empty_outputs
 
@@ -152,6 +153,8 @@ def run_compiled(block, excitation, state, settings) -> TransientResult:
         steps = rows[0, T.X_STEPS] * (excitation.n - 1 if rows[0, T.X_KIND] == T.K_RECORD
                                       else 1)
         n_traj = int(steps + (t_lim - min(end, t_lim)) / (shrink * H_FREE)) + 2 * n_imp + 16
+    memory(f"a run recorded over {t_lim:.4g} time units (the Transient's free_time or "
+           f"duration)", 24.0 * (float(n_traj) + float(n_imp)))
     out_f = np.empty(T.N_F)
     out_i = np.zeros(T.N_I, dtype=np.int64)
     for _ in range(2):

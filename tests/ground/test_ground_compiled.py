@@ -199,3 +199,12 @@ def test_a_single_compiled_run_keeps_its_impacts_and_trajectory():
     assert r.status == s.status == "time_limit" and r.t == 30.0 and r.n_impacts == s.n_impacts
     np.testing.assert_allclose(r.impacts, s.impacts, rtol=0, atol=1e-9)
     assert r.max_theta == 0.2
+
+
+def test_a_recorded_run_too_long_for_memory_is_refused_naming_its_settings():
+    """A legal but enormous free-rocking time is refused by the memory its trajectory would
+    take, before any allocation (it ended in a MemoryError for 2 TiB)."""
+    from rockjit import Block, Pulse, Transient, simulate
+    with pytest.raises(ValueError, match=r"free_time or duration\) would need .* fits"):
+        simulate(Block(hb=4), Pulse("sine", ratio=1, amplitude=2),
+                 integration=Transient(free_time=1e9))
