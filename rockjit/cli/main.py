@@ -699,8 +699,9 @@ def _add_forcing(p):
 def _add_common(p, threads=True, device=True):
     p.add_argument("--out", required=True, help="output directory (created if missing)")
     p.add_argument("--style", default="default", choices=("default", "paper"),
-                   help="figures for the screen (default) or for a journal's columns (paper: "
-                        "no figure titles, 3.5 and 7.2 inches wide, 8-point type)")
+                   help="figures with titles (default, 200 dpi) or for a journal's captions "
+                        "(paper: no figure titles, 300 dpi); both 3.5 or 7.2 inches wide with "
+                        "7-9 point type")
     p.add_argument("--format", default="png", choices=("png", "pdf", "svg"),
                    help="format of the figures (default png)")
     if threads:
@@ -922,12 +923,14 @@ def build_parser():
 
     p = _command(sub, "spectrum", _spectrum_plan, _spectrum_run,
                  "overturning spectrum of a pulse",
-                 "Run the block from rest under a pulse at every (omega_p/p, a_p/(g tan "
-                 "alpha)) of a grid: each cell's outcome (safe, overturned after an impact, "
-                 "overturned without one) and max|theta|/alpha; at every ratio the minimum "
-                 "overturning amplitude and the boundary of overturning without impact, "
+                 "Run the block from rest under a pulse at every (omega_p/p, a_p/(g cot "
+                 "theta_c)) of a grid: each cell's outcome (safe, overturned after an impact, "
+                 "overturned without one) and max|theta|/(pi/2 - theta_c); at every ratio "
+                 "the minimum overturning amplitude and the boundary of overturning without "
+                 "impact, "
                  "located by bisection to --tol. Writes spectrum.npz, spectrum.png and "
-                 "summary.json (\"min_overturn\", per law with --law both). Scipy path.")
+                 "summary.json (\"min_overturn\", per law with --law both). Compiled path; "
+                 "--method scipy for the reference path.")
     _add_block(p, alpha=False, omega=False, laws="housner, mao, constant or both")
     p.add_argument("--pulse", default="sine", choices=("sine", "cosine", "ricker"),
                    help="the pulse (default sine)")
@@ -948,8 +951,8 @@ def build_parser():
                  "fragility curves by incremental dynamic analysis",
                  "Scale every record to each intensity, run the block from rest for each "
                  "size and law, and fit lognormal fragility curves (median and dispersion by "
-                 "maximum likelihood) to overturning and to max|theta|/alpha >= 0.5, 1. Writes "
-                 "fragility.npz, fragility.png, rotation.png and summary.json.")
+                 "maximum likelihood) to overturning and to max|theta|/(pi/2 - theta_c) >= "
+                 "0.5, 1. Writes fragility.npz, fragility.png, rotation.png and summary.json.")
     _add_block(p, alpha=False, omega=False, laws="housner, mao, constant or both")
     p.add_argument("--size", type=float, nargs="+", required=True, metavar="R",
                    help="the block's half-diagonal R in metres (several: the size effect)")
