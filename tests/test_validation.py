@@ -444,7 +444,7 @@ def test_default_impact_bound_fits_the_kernels_counter_for_every_period_count():
 def test_the_largest_period_counts_are_refused_by_their_memory_not_an_overflow(periods):
     with pytest.raises(ValueError, match=r"would need .* fits"):
         simulate(**{**BASE, "periods": periods})
-    with pytest.raises(ValueError, match=r"would need .* fits"):
+    with pytest.raises(ValueError, match=r"over periods = .* would need .* fits"):
         rockjit.basin(Block(1.0), Harmonic(alpha=0.66, omega=1.3), Lattice(2),
                       integration=Integration(periods=periods))
 

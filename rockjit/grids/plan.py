@@ -134,7 +134,7 @@ def grid_memory(what, n_cells, settings, execution, n_pts=0, n_imp_pts=0, lyapun
         chunk = chunk + threads * runner.PIECE_MAX
     nbytes = copies * kernel.grid_bytes(n_cells, settings["periods"], settings["n_steps"], n_pts,
                                         n_imp_pts, bool(lyapunov), chunk, threads)
-    memory(f"{what} ({n_cells:.4g} cells)", nbytes)
+    memory(f"{what} ({n_cells:.4g} cells) over periods = {settings['periods']:.4g}", nbytes)
     return nbytes
 
 
