@@ -302,7 +302,7 @@ class Execution(_Replace):
         began with). In this process the cells run as pieces of a chunk on one thread each,
         as many at once as ``threads``, each thread taking the next piece when its last is
         done, so that no thread waits at a chunk's end whatever the chunk's size
-        (:mod:`rockjit.grids.runner`).
+        (``rockjit.grids.runner``).
     lanes : int, optional
         Cells per thread in lockstep, 1 to 8 (grids without tangent vectors); default 8.
     client : dask.distributed.Client, optional

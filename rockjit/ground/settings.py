@@ -42,7 +42,7 @@ class Transient:
         Stop as soon as the outcome and ``max |theta|`` can no longer change: after the
         excitation, once the block is at rest, or its energy, which free rocking only loses,
         is below the tipping energy and no more than the potential energy at the largest
-        ``|theta|`` so far (:func:`rockjit.model.free_rocking_decided`). Default
+        ``|theta|`` so far (``rockjit.model.free_rocking_decided``). Default
         ``False`` (rock on to the time limit); the spectra and fragility curves set it.
     max_impacts : int, optional
         Bound on the number of impacts (default 100,000); reaching it ends the run unresolved.

@@ -57,6 +57,17 @@ class EdgeState:
         The midpoints of the tracked pair, one per period.
     rebisections : int
         Times the pair was bisected again along the way.
+
+    Examples
+    --------
+    What :func:`rockjit.edge_state` returns:
+
+    >>> import rockjit
+    >>> from rockjit import Block, Harmonic
+    >>> e = rockjit.edge_state(Block(hb=1), Harmonic(alpha=0.66, omega=1.3), (-0.2825, -0.164),
+    ...                        (0.0709, 0.2243), track=30)
+    >>> e.state.shape, e.orbit.period == e.period
+    ((2,), True)
     """
 
     state: np.ndarray

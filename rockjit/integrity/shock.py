@@ -59,6 +59,17 @@ class FatalShock:
         The last step of the direction's search, in radians.
     runs : int
         Runs made.
+
+    Examples
+    --------
+    What :func:`rockjit.fatal_shock` returns:
+
+    >>> import rockjit
+    >>> from rockjit import Block, Harmonic, Integration
+    >>> s = rockjit.fatal_shock(Block(hb=1), Harmonic(alpha=0.66, omega=1.3), (0.0, 0.0),
+    ...                         integration=Integration(periods=100), rtol=1e-3)
+    >>> s.delta.shape, bool(abs(s.norm - float((s.delta ** 2).sum()) ** 0.5) < 1e-12)
+    ((2,), True)
     """
 
     norm: float

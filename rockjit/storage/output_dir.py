@@ -322,14 +322,14 @@ class OutputDir:
     is exactly as before. Staging directories of runs that died (their pid no longer exists on
     this host) are removed when the next run on the same ``path`` starts writing.
 
-    Only rockjit's own files are ever replaced (:mod:`rockjit.storage.ownership`): ``path``
+    Only rockjit's own files are ever replaced (``rockjit.storage.ownership``): ``path``
     holds rockjit's record of the files it wrote there (``.rockjit-files.json``, published
     with the outputs and listed in ``written``), and a file the record does not prove
     rockjit's (the user's, one changed since, one of a directory written before rockjit kept
     a record) is never replaced: :meth:`claim` refuses it before any work, and
     :meth:`publish` refuses the whole set (``ValueError``, nothing published) rather than
     replace it. One command at a time: :meth:`claim` (or the first write) takes the lock of
-    ``path`` (:class:`rockjit.storage.ownership.PublishLock`), held until :meth:`publish`
+    ``path`` (``rockjit.storage.ownership.PublishLock``), held until :meth:`publish`
     or :meth:`discard`; a second :class:`OutputDir` on the same ``path`` is refused while it
     is held, and :meth:`publish` refuses if another run published into ``path`` meanwhile.
 
@@ -493,7 +493,7 @@ class OutputDir:
     def file(self, name):
         """The staged path of ``name``, for a writer of its own; ``name`` is listed as written.
 
-        Write it completely (e.g. with :func:`rockjit.storage.atomic.atomic_open`) before
+        Write it completely (e.g. with ``rockjit.storage.atomic.atomic_open``) before
         :meth:`publish`.
         """
         _check_name(name)
