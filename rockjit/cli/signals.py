@@ -45,13 +45,12 @@ def installed_interrupts():
 
 
 @contextlib.contextmanager
-def command_interrupts(keep=False):
+def command_interrupts():
     """SIGINT and SIGTERM handled for one command (:func:`interrupt_handler`).
 
     Reuses the handler already installed by the program's entry point, if there is one, and
     leaves it in place; otherwise installs one for the block and puts the previous handlers
-    back on exit, unless ``keep`` (the program's own entry point: a signal after the run has
-    ended must not change its exit status). Outside the main thread nothing is installed.
+    back on exit. Outside the main thread nothing is installed.
 
     Yields
     ------
@@ -76,10 +75,9 @@ def command_interrupts(keep=False):
     try:
         yield state
     finally:
-        if not keep:
-            for s, h in old.items():
-                signal.signal(s, signal.SIG_DFL if h is None else h)
-            sys.unraisablehook = hook
+        for s, h in old.items():
+            signal.signal(s, signal.SIG_DFL if h is None else h)
+        sys.unraisablehook = hook
 
 
 def quiet_lost_interrupts(state, previous):
