@@ -90,8 +90,7 @@ def outcome_keys(attractors):
     {-1: 'overturn', -2: 'unresolved', 1: 'asymmetric p=1 (a)', 0: 'asymmetric p=1 (b)'}
     """
     names = {-1: "overturn", -2: "unresolved"}
-    base = {a.id: (a.behaviour if a.behaviour == "rest" or not a.period
-                   else f"{a.behaviour} p={a.period}") for a in attractors}
+    base = {a.id: a.name for a in attractors}
 
     def position(a):
         pts = np.asarray(a.points, dtype=float).reshape(-1, 2)

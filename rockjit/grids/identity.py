@@ -104,6 +104,13 @@ class Attractor:
     cell: int = -1
     extent: tuple | None = None
 
+    @property
+    def name(self):
+        """Its name: the behaviour, with the period for a periodic one (``"symmetric p=1"``;
+        ``"rest"``, ``"chaotic"``)."""
+        return self.behaviour if self.behaviour == "rest" or not self.period else \
+            f"{self.behaviour} p={self.period}"
+
     def __repr__(self):
         from ..reprs import text
         return text(self)
