@@ -99,8 +99,7 @@ def _attractors(res):
     atts = getattr(res, "attractors", None) or []
     if not atts:
         return None
-    names = [a.behaviour if a.behaviour == "rest" or not a.period else
-             f"{a.behaviour} p={a.period}" for a in atts]
+    names = [a.name for a in atts]
     shown = ", ".join(names[:4]) + (f", … {len(names) - 4} more" if len(names) > 4 else "")
     return f"{len(atts)}: {shown}"
 
@@ -185,12 +184,10 @@ def _fate(r):
 
 
 def _attractor(a):
-    name = a.behaviour if a.behaviour == "rest" or not a.period else \
-        f"{a.behaviour} p={a.period}"
     lam = np.asarray(a.lam, dtype=float)
     mu = "" if a.multipliers is None else \
         ", |mu| = " + ", ".join(_g(abs(m), ".3g") for m in np.asarray(a.multipliers))
-    return _one(f"Attractor({a.id}: {name}, {a.fraction:.1f} % of the cells, "
+    return _one(f"Attractor({a.id}: {a.name}, {a.fraction:.1f} % of the cells, "
                 f"lambda1 = {_g(lam[0], '.3g')}{mu})")
 
 
