@@ -171,8 +171,10 @@ def _drawn(fig):
     for ax in fig.get_axes():
         if not ax.get_visible():
             continue
+        spines = set(ax.spines.values())
         for a in ax.get_children():
-            if not a.get_visible() or a is ax.patch or a is ax.get_legend():
+            # the axes' frame (its background and spines) is drawn whatever the data
+            if not a.get_visible() or a is ax.patch or a is ax.get_legend() or a in spines:
                 continue
             if isinstance(a, Line2D):
                 x, y = a.get_data()

@@ -84,6 +84,16 @@ def test_legend_entries_must_name_something_drawn():
                    "legend entry 'all nan' names nothing drawn",
                    "legend entry 'outside' names nothing drawn",
                    "legend entry 'near white' is not seen on the legend's background"]
+    # a black entry (a law's line, style.LAW_LINES) names nothing when only the axes' black
+    # frame is drawn in black
+    fig = _fig()
+    ax = fig.add_subplot()
+    ax.plot([0, 1], [0, 1], color="#228833", label="drawn")
+    ax.plot([], [], label="law", lw=0.8, **dict(style.LAW_LINES["mao"], marker=None))
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), handlelength=4.0)
+    assert L.legend_handle_problems(fig) == ["legend entry 'law' names nothing drawn"]
+    ax.get_lines()[1].set_data([0, 1], [1, 0])
+    assert L.legend_handle_problems(fig) == []
 
 
 def test_a_dashed_entry_shows_its_dashes():
