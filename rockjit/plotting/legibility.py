@@ -424,25 +424,11 @@ def legend_over_data(fig):
 def texts_outside(fig, tol=1.0):
     """The visible, non-empty text artists of ``fig`` whose drawn extent leaves the figure's
     canvas (by more than ``tol`` pixels): ``[(text, extent)]``; empty when all fit. Tick labels
-    count only where a tick is drawn (within the axis' view)."""
-    from matplotlib.axis import Axis
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.text import Text
-    canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
-    canvas.draw()
-    renderer = canvas.get_renderer()
+    count only where a tick is drawn (within the axis' view). The figure is drawn anew."""
+    renderer = _renderer(fig, again=True)
     W, H = fig.bbox.width, fig.bbox.height
-    stale = set()
-    for axis in fig.findobj(Axis):
-        shown = axis.get_visible() and (axis.axes is None or axis.axes.axison)
-        drawn = set(axis._update_ticks()) if shown else set()
-        for tick in axis.majorTicks + axis.minorTicks:
-            if tick not in drawn:
-                stale.update((id(tick.label1), id(tick.label2)))
     bad = []
-    for t in fig.findobj(Text):
-        if id(t) in stale or not t.get_visible() or not t.get_text().strip():
-            continue
+    for t in _texts(fig, renderer):
         bb = t.get_window_extent(renderer)
         if bb.x0 < -tol or bb.y0 < -tol or bb.x1 > W + tol or bb.y1 > H + tol:
             bad.append((t.get_text(), tuple(round(v, 1) for v in bb.extents)))
