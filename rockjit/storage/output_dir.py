@@ -21,8 +21,8 @@ import threading
 from pathlib import Path
 
 from . import atomic  # its writers looked up at each call: a test may replace one
-from .ownership import (RECORD, RECORD_HOLDS, PublishLock, Record, digest, lock_path, refusal,
-                        unproven)
+from .ownership import (RECORD, RECORD_HOLDS, PublishLock, Record, _name_max, _nearest, digest,
+                        lock_path, refusal, unproven)
 from .processes import host_name, pid_alive
 
 __all__ = ["SUMMARY", "OutputDir", "check_out", "chunk_root", "defer_signals"]
@@ -126,28 +126,12 @@ def chunk_root(out):
     return Path(str(Path(out)) + ".chunks")
 
 
-def _name_max(directory):
-    """The longest file name (bytes) the file system of ``directory`` takes (255 if unknown)."""
-    try:
-        return int(os.pathconf(directory, "PC_NAME_MAX"))
-    except (OSError, ValueError, AttributeError, TypeError):
-        return 255
-
-
 def _path_max(directory):
     """The longest path (bytes) the system takes (4096 if unknown)."""
     try:
         return int(os.pathconf(directory, "PC_PATH_MAX"))
     except (OSError, ValueError, AttributeError, TypeError):
         return 4096
-
-
-def _nearest(path):
-    """``path`` (absolute) or its nearest ancestor that exists (as a link, file or directory)."""
-    q = Path(path).absolute()
-    while not os.path.lexists(q) and q != q.parent:
-        q = q.parent
-    return q
 
 
 def _link_problem(path):

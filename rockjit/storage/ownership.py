@@ -216,20 +216,31 @@ def _older_version(out):
 
 # ---- the lock ----------------------------------------------------------------------------------
 
+def _name_max(directory):
+    """The longest file name (bytes) the file system of ``directory`` takes (255 if unknown)."""
+    try:
+        return int(os.pathconf(directory, "PC_NAME_MAX"))
+    except (OSError, ValueError, AttributeError, TypeError):
+        return 255
+
+
+def _nearest(path):
+    """``path`` (absolute) or its nearest ancestor that exists (as a link, file or directory)."""
+    q = Path(path).absolute()
+    while not os.path.lexists(q) and q != q.parent:
+        q = q.parent
+    return q
+
+
 def lock_path(out):
     """Where the lock of a command publishing into ``out`` is (see the module docstring)."""
     out = Path(os.path.abspath(out))
     if os.path.isdir(out):
         return out / LOCK
-    first = out
-    while not os.path.lexists(first.parent) and first.parent != first:
-        first = first.parent
+    parent = _nearest(out.parent)
+    first = parent / out.relative_to(parent).parts[0]  # the first part that does not exist
     name = f".{first.name}.rockjit-lock"
-    try:
-        limit = int(os.pathconf(first.parent, "PC_NAME_MAX"))
-    except (OSError, ValueError, AttributeError):
-        limit = 255
-    if len(os.fsencode(name)) > limit:
+    if len(os.fsencode(name)) > _name_max(parent):
         name = f".{hashlib.sha256(os.fsencode(first.name)).hexdigest()[:16]}.rockjit-lock"
     return first.parent / name
 
