@@ -159,7 +159,7 @@ NAMES = {
 NARGS = {"--alpha-range": 2, "--omega-range": 2, "--theta-range": 2, "--dtheta-range": 2,
          "--zoom": 2, "--hb-values": "+", "--spread": 2, "--seed-omegas": "+",
          "--ratio-range": 2, "--amplitude-range": 2, "--size": "+", "--records": "+",
-         "--intensities": "+"}
+         "--intensities": "+", "--levels": "+"}
 FLAGS = {"--quiet", "--lyapunov", "--no-lyapunov", "--full-length", "--no-browser"}
 
 NONFINITE = ["nan", "inf", "-inf"]
@@ -661,6 +661,40 @@ def _chart():
     return c
 
 
+def _safety():
+    """``rockjit safety``: the plane's forcing ranges and grid (at most 1000 a side), every
+    basin's lattice (at least 2 a side), the contour levels (fractions in [0, 1])."""
+    cmd = "safety"
+    c = _block_cases(cmd, alpha=False, omega=False,
+                     laws_ok=("housner", "mao", "constant", "both"))
+    c.append(Case("safety --law both --e 0.5", cmd, {"--law": ["both"], "--e": ["0.5"]},
+                  NAMES["--e"]))
+    c += _state_cases(cmd, theta=False) + _run_cases(cmd)
+    c += _pairs(cmd, "--alpha-range", [
+        ["0.5"], ["0.5", "0.6", "0.7"], ["0.6", "0.5"], ["0.5", "0.5"], ["-0.1", "0.5"],
+        ["nan", "0.5"], ["0.5", "inf"], ["-inf", "0.5"], ["0.5", "1e308"], ["abc", "0.5"],
+        ["", "0.5"], ["0.5", "1,5"], ["0x10", "0.5"]])
+    c += _pairs(cmd, "--omega-range", [
+        ["1"], ["1", "1.5", "2"], ["2", "1"], ["1.3", "1.3"], ["0", "1"], ["-1", "1"],
+        ["nan", "1"], ["1", "inf"], ["-inf", "1"], ["5e-324", "1"], ["1", "1e308"],
+        ["abc", "1"], ["1", ""], ["1,5", "2"]])
+    for vals in [["5"], ["5", "5", "5"], ["0", "5"], ["5", "0"], ["-1", "5"], ["1001", "2"],
+                 ["2", "1001"], [HUGE_INT, "2"], ["abc", "5"], ["5", "2.5"], ["nan", "5"],
+                 ["1e308", "5"], ["", "5"]]:
+        extra = len(vals) > 2
+        c.append(Case(_id(cmd, "--grid", vals), cmd, {"--grid": vals},
+                      NAMES["--grid"] if not extra else re.escape(vals[-1]),
+                      nargs_ok=len(vals) != 2, extra_ok=extra))
+    # one point a side is no two-dimensional lattice: the integrity measures need one
+    c += _int_opt(cmd, "--lattice", ["1", "0", "-1", "100001", HUGE_INT])
+    c += _pairs(cmd, "--levels", [
+        [], ["abc"], [""], ["nan"], ["inf"], ["-inf"], ["1.5"], ["-0.1"], ["1,5"], ["0x10"],
+        ["0.5", "nan"], ["0.5", "1.5"]])
+    c += _missing(cmd, ["--hb", "--alpha-range", "--omega-range", "--out"])
+    c += _out_cases(cmd) + _chunks_case(cmd)
+    return c
+
+
 def _fate():
     cmd = "fate"
     c = _block_cases(cmd) + _state_cases(cmd) + _run_cases(cmd)
@@ -754,6 +788,13 @@ def _explore():
     # not a host address, or not one of this machine's (the OS's choice of port)
     c += _values(cmd, "--address", ["", " ", "a b", "999.1.1.1", "8.8.8.8"], quiet)
     c += _values(cmd, "--allow-host", ["", "a b", "*.lab", "x" * 300], quiet)
+    # a port, a scheme, an empty label, an unclosed bracket, a name of 257 characters made of
+    # valid labels (a host name has at most 253), and a bad name after a good one
+    c += _values(cmd, "--allow-host", ["host:8000", "http://lab", "a..b", ".lab", "[::1",
+                                       ("a" * 63 + ".") * 4 + "a"], quiet)
+    c.append(Case(f"{cmd} --allow-host lab --allow-host 'a b'", cmd,
+                  {**quiet, "--allow-host=lab": True, "--allow-host": ["a b"]},
+                  NAMES["--allow-host"]))
     return c
 
 
@@ -826,12 +867,12 @@ def _numbers():
 
 
 CASES = (_refusals() + _trajectory() + _sweep() + _basin() + _plane() + _cor() + _paper()
-         + _erosion() + _fate() + _orbits() + _chart() + _grid_extras("sweep")
+         + _erosion() + _safety() + _fate() + _orbits() + _chart() + _grid_extras("sweep")
          + _grid_extras("basin")
          + _grid_extras("plane") + _real_opt("paper", "--erosion-step", ["0", "-0.01", "5e-324"])
          + _int_opt("paper", "--erosion-grid", ["0", "-1", HUGE_INT])
          + [c for cmd in ("sweep", "basin", "plane", "erosion", "orbits", "paper", "chart",
-                          "spectrum", "fragility")
+                          "safety", "spectrum", "fragility")
             for c in _scheduler_cases(cmd)]
          + [c for cmd in ("chart", "erosion", "orbits", "fate")
             for c in _real_opt(cmd, "--xi", ["-1", "-1e-3", "1e5"])]
