@@ -124,12 +124,6 @@ class LognormalFit:
                     log_likelihood=self.log_likelihood)
 
 
-def _nll(mu, beta, lx, k, n):
-    """Negative binomial log-likelihood (without the binomial coefficients)."""
-    z = (lx - mu) / beta
-    return -float(np.sum(k * log_ndtr(z) + (n - k) * log_ndtr(-z)))
-
-
 class _Probit:
     """The binomial log-likelihood of ``z_j = s (l_j - m)`` (``l`` the centred log-intensities),
     with its derivatives in ``z``."""
@@ -149,8 +143,11 @@ class _Probit:
               + self.f * np.minimum(np.maximum(lam_m * (lam_m - z), 0.0), 1.0))
         return float(ll.sum()), d, w
 
-    def ll(self, z):
-        return self.at(z)[0]
+    def hessian(self, w):
+        """The Hessian in ``(a, s)`` of the log-likelihood at ``z = s l - a``, from ``w``
+        (:meth:`at`'s second derivatives in ``z``)."""
+        l = self.l
+        return np.array([[w.sum(), -(w * l).sum()], [-(w * l).sum(), (w * l * l).sum()]])
 
     def fit(self, a, s):
         """Newton's method in ``(a, s)``, ``z = s l - a`` (concave): the maximum."""
@@ -158,7 +155,7 @@ class _Probit:
         v, d, w = self.at(s * l - a)
         for _ in range(200):
             g = np.array([-d.sum(), (d * l).sum()])
-            H = np.array([[w.sum(), -(w * l).sum()], [-(w * l).sum(), (w * l * l).sum()]])
+            H = self.hessian(w)
             try:
                 step = np.linalg.solve(-H, g)
             except np.linalg.LinAlgError:
@@ -400,8 +397,7 @@ def fit_lognormal(x, overturned, runs, *, confidence=CONFIDENCE) -> LognormalFit
             f"fits about as well (likelihood ratio {2 * (ll - ll_flat):.3g} < {q:.3g}), so "
             f"the data set no upper end to beta", ll, m, s)
     # observed information in (a, s), then in (ln theta_m, beta) by the change of variables
-    l = pr.l
-    H = np.array([[w.sum(), -(w * l).sum()], [-(w * l).sum(), (w * l * l).sum()]])
+    H = pr.hessian(w)
     J = np.array([[1.0 / s, -a / s ** 2], [0.0, -1.0 / s ** 2]])   # d(m, beta)/d(a, s)
     try:
         cov = J @ np.linalg.inv(-H) @ J.T
