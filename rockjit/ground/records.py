@@ -426,18 +426,17 @@ def _lines(path):
 
 #: A number in a record file: ASCII decimal digits only (no ``_`` separators, no other
 #: scripts' digits), or ``nan`` / ``inf`` (refused as not finite, by name).
-_NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?"
-                     r"|[-+]?(?:nan|inf|infinity)", re.IGNORECASE)
+_DECIMAL = r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[{exponent}][-+]?[0-9]+)?"
+_NOT_FINITE = r"[-+]?(?:nan|inf|infinity)"
+_NUMBER = re.compile(_DECIMAL.format(exponent="eE") + "|" + _NOT_FINITE, re.IGNORECASE)
 #: The same with Fortran's ``D`` exponents (``.AT2`` files).
-_NUMBER_D = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eEdD][-+]?[0-9]+)?"
-                       r"|[-+]?(?:nan|inf|infinity)", re.IGNORECASE)
+_NUMBER_D = re.compile(_DECIMAL.format(exponent="eEdD") + "|" + _NOT_FINITE, re.IGNORECASE)
 
 
 _SEPARATORS = re.compile(r"[,;\s]+")
 #: A row of a table that is two plain numbers (and nothing else but separators).
-_ROW = re.compile(r"[ \t]*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)"
-                  r"[ \t]*[,; \t][ \t]*"
-                  r"([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)[ \t]*\r?\n?")
+_ROW = re.compile(r"[ \t]*({0})[ \t]*[,; \t][ \t]*({0})[ \t]*\r?\n?".format(
+    _DECIMAL.format(exponent="eE")))
 
 
 def _number(token, pattern=_NUMBER):
@@ -557,14 +556,6 @@ def _named(src, name, make):
         raise ValueError(msg) from None
 
 
-def _is_float(x):
-    try:
-        float(x)
-        return True
-    except ValueError:
-        return False
-
-
 _UNIT = re.compile(r"[\(\[]\s*([^\)\]]*?)\s*[\)\]]")
 _ACCEL_UNITS = {"g", "g0", "gs"}
 _TIME_UNITS = {"s", "sec", "second", "seconds"}
@@ -655,7 +646,11 @@ def read_table(path, *, size=None, p=None, name=None) -> Record:
         if not line:
             continue
         fields = [x for x in _SEPARATORS.split(line) if x]
-        if not times and header is None and not all(_is_float(x) for x in fields[:2]):
+        # a header names its columns: words, no number; a first line of numbers, one of them
+        # written in a way refused here ('1_0', other scripts' digits), is a row, refused
+        # below, not a header to skip
+        if not times and header is None and any(c.isalpha() for c in line) and \
+                not any(_number(x) is not None for x in fields[:2]):
             header = line
             cols = _header_units(src, header)
             for k, col in enumerate(cols):

@@ -347,13 +347,17 @@ def test_a_utf8_byte_order_mark_is_read_as_text(tmp_path):
 
 
 @pytest.mark.parametrize("value", ["1_0", "1_000.5", "\u0661", "\uff11", "0.1e1_0"])
-@pytest.mark.parametrize("kind", ["table", "at2"])
+@pytest.mark.parametrize("kind", ["table", "first row", "at2"])
 def test_numbers_only_in_ascii_decimals(tmp_path, value, kind):
     # Python's float() reads '1_0' as 10 and other scripts' digits as digits; the command
-    # line refuses them, and so does a record file
+    # line refuses them, and so does a record file, on its first row too (not skipped as a
+    # header)
     if kind == "table":
         p = tmp_path / "motion.csv"
         p.write_text(f"0,0\n0.01,{value}\n0.02,0\n", encoding="utf-8")
+    elif kind == "first row":
+        p = tmp_path / "motion.csv"
+        p.write_text(f"0,{value}\n0.01,0\n0.02,0\n", encoding="utf-8")
     else:
         p = _at2(tmp_path, f"0.0 {value} 0.0")
     msg = _refusal(p)
