@@ -14,6 +14,11 @@ import math
 
 import numpy as np
 
+from ..plotting.style import LAW_NAMES
+from ..settings import Integration
+from .paper import (BASIN_CASES, CHART, E_FIGURE_HB_MAX, FIRST_PERIODS, GALLERY, LAST_PERIODS,
+                    LAWS_RUN, REFERENCE_RUN)
+
 __all__ = ["E_TABLE_PUBLISHED", "FATES_NOTE", "FATES_PUBLISHED", "GIM_PUBLISHED", "SHARES_PUBLISHED",
            "TRANSITIONS", "published_beside", "write_index"]
 
@@ -82,8 +87,6 @@ GIM_PUBLISHED = {"housner": 0.56, "mao": 0.30}
 #: motion after the fall, (hb, law) -> percent.
 SHARES_PUBLISHED = {(1, "housner"): 7.0, (1, "mao"): 47.1, (2, "housner"): 10.5,
                     (2, "mao"): 45.1}
-
-_LAW = {"housner": "Housner", "mao": "Mao et al."}
 
 
 def _num(v, fmt):
@@ -211,32 +214,42 @@ def _captions(results, plan):
     caps4 = " ".join(f"{'abc'[i]}) {html.escape(r.get('caption', ''))}"
                      for i, r in enumerate(results.get("fig4", [])))
     g, eg, es = plan.grid, plan.erosion_grid, plan.erosion_step
+    first, last = FIRST_PERIODS, LAST_PERIODS
+    w0, w1 = Integration(periods=plan.periods).window_start(), plan.periods
+    ref, laws = REFERENCE_RUN, LAWS_RUN
+    (hb1, a1, o1), (hb2, a2, o2) = BASIN_CASES
+    tilt = GALLERY["rest after damped rocking"][3][0]
+    seeds = " and ".join(f"{w:g}" for w in CHART["curves"]["seed_omegas"])
     return {
         1: "The restitution laws. Housner's <i>e</i><sub>H</sub> (solid) and Mao et al.'s "
            "<i>e</i><sub>M</sub> (dashed) against the block's angle &theta;<sub>c</sub>, for "
-           "<i>h/b</i> from 1/&radic;2 to 6, with their symmetric difference &Delta;<i>e</i> "
+           f"<i>h/b</i> from 1/&radic;2 to {E_FIGURE_HB_MAX:g}, with their symmetric difference "
+           "&Delta;<i>e</i> "
            "(dotted, right axis). The boxes give the values at <i>h/b</i> = 1 and 2 (the "
            "e-table below).",
-        2: "The reference symmetric run: &alpha; = 0.6, &omega; = 1.3, <i>h/b</i> = 1, "
-           "Housner, from the study's <i>z</i><sub>0</sub>. a) &theta;(<i>t</i>) over the "
-           "first 8 periods (the transient) and b) over the last 4; c) the running largest "
-           "Lyapunov exponent from <i>t</i> = 0, its average over the asymptotic window "
-           f"[400<i>T</i>, 500<i>T</i>] ({lam}, dashed) and the Floquet exponent of the "
+        2: f"The reference symmetric run: &alpha; = {ref['alpha']:g}, &omega; = "
+           f"{ref['omega']:g}, <i>h/b</i> = {ref['hb']:g}, {ref['law'].capitalize()}, from the "
+           "study's <i>z</i><sub>0</sub>. a) &theta;(<i>t</i>) over the "
+           f"first {first} periods (the transient) and b) over the last {last}; c) the running "
+           "largest Lyapunov exponent from <i>t</i> = 0, its average over the asymptotic window "
+           f"[{w0}<i>T</i>, {w1}<i>T</i>] ({lam}, dashed) and the Floquet exponent of the "
            f"orbit ({flo}, dotted); d) the phase portrait over the window. Impacts are the "
            "vertical jumps at &theta; = 0, circles the stroboscopic points <i>t</i> = "
            "<i>kT</i>.",
         3: "The behaviour gallery (Housner), one row per case: &theta;(<i>t</i>) over the "
-           "first 8 and the last 4 periods (the whole run when it is short), and the phase "
-           "portrait of the asymptotic window (the whole run when it ended before). a) rest "
-           "after damped rocking, from a tilt &theta;<sub>0</sub> = 0.7 (the study's 0.05 "
-           "rests within 0.73 time units); b) asymmetric; c) a robust period-2 orbit of the "
+           f"first {first} and the last {last} periods (the whole run when it is short), and "
+           "the phase portrait of the asymptotic window (the whole run when it ended before). "
+           f"a) rest after damped rocking, from a tilt &theta;<sub>0</sub> = {tilt:g} (the "
+           "study's smaller tilt comes to rest too soon to show the decay); b) asymmetric; "
+           "c) a robust period-2 orbit of the "
            "multiperiodic family; d) the study's 'multiperiodic' example, transient chaos "
            f"that overturns (over {n_fate} runs within 10<sup>-10</sup> of <i>z</i><sub>0</sub>: "
            f"{html.escape(fw)}); e) overturn.",
-        4: "Housner against Mao et al. in time: <i>h/b</i> = 2, &alpha; = 0.2, &omega; = 1.6, "
+        4: f"Housner against Mao et al. in time: <i>h/b</i> = {laws['hb']:g}, &alpha; = "
+           f"{laws['alpha']:g}, &omega; = {laws['omega']:g}, "
            "(<i>r</i><sub>0</sub>, <i>s</i><sub>0</sub>) = (0, 1), from three initial states. "
-           "Each row: each law's &theta;(<i>t</i>) over the last 8 periods of its run, where "
-           "it has settled (the whole run when it overturns or rests sooner), and its phase "
+           f"Each row: each law's &theta;(<i>t</i>) over the last {first} periods of its run, "
+           "where it has settled (the whole run when it overturns or rests sooner), and its phase "
            f"portrait, in its behaviour's colour. {caps4}",
         5: "Bifurcation diagrams: &theta;'(<i>kT</i>) over the classified stretch against "
            "&alpha;, coloured by behaviour, the behaviour of every amplitude in the strip, "
@@ -261,8 +274,9 @@ def _captions(results, plan):
               "and of branches with where they stop, is its <code>.md</code> file.",
         6: f"Basins of attraction of both laws ({g} &times; {g} initial states "
            "(&theta;<sub>0</sub>, &theta;'<sub>0</sub>) at (<i>r</i><sub>0</sub>, "
-           "<i>s</i><sub>0</sub>) = (0, 1)) at <i>h/b</i> = 1 (&alpha; = 0.66, &omega; = 1.3) "
-           "and 2 (&alpha; = 0.2, &omega; = 1.6), with the percentage of each behaviour, and "
+           f"<i>s</i><sub>0</sub>) = (0, 1)) at <i>h/b</i> = {hb1:g} (&alpha; = {a1:g}, "
+           f"&omega; = {o1:g}) and {hb2:g} (&alpha; = {a2:g}, &omega; = {o2:g}), with the "
+           "percentage of each behaviour, and "
            "c) the cells where the laws give the same behaviour (white) or not (black).",
         7: "Beyond the study: the attractor each initial state of figure 6 reaches, each in a "
            "tint of its behaviour's colour and named by what it is (the study's single "
@@ -282,7 +296,7 @@ def _captions(results, plan):
            "= 1 and 2, from the study's <i>z</i><sub>0</sub>, a coarse brute-force chart of "
            "behaviours with the bifurcation curves of the period-1 orbits followed across it "
            "by two-parameter continuation (fold solid, symmetry breaking dashed, period "
-           "doubling dash-dotted, grazing dotted), seeded on the lines &omega; = 1.3 and 2.4; "
+           f"doubling dash-dotted, grazing dotted), seeded on the lines &omega; = {seeds}; "
            "a) and b) each law alone, c) both laws' curves overlaid (hatched: the laws' "
            "behaviours differ). Cells are drawn six times finer, each behaviour's share "
            "interpolated linearly between the computed cells. "
@@ -315,7 +329,7 @@ def _published_html(pub):
                  "step may miss a window).</p>")
     parts.append(_table(["h/b", "law", "transition", "α reference", "α this run",
                          "difference"],
-                        [[r["hb"], _LAW.get(r["law"], r["law"]), r["transition"],
+                        [[r["hb"], LAW_NAMES.get(r["law"], r["law"]), r["transition"],
                           _num(r["alpha_published"], ".7f"), _num(r["alpha"], ".7f"),
                           _num(r["difference"], ".1e")] for r in pub["transitions"]],
                         left=(1, 2)))
@@ -329,13 +343,13 @@ def _published_html(pub):
                  "0.3&ndash;0.9; the reference from 100 &times; 100 basins every 0.01, this "
                  "run from its erosion profiles' grid.</p>")
     parts.append(_table(["law", "reference", "this run"],
-                        [[_LAW.get(r["law"], r["law"]), _num(r["published"], ".2f"),
+                        [[LAW_NAMES.get(r["law"], r["law"]), _num(r["published"], ".2f"),
                           _num(r["rockjit"], ".2f")] for r in pub["gim"]], left=(0,)))
     if "as_published" in pub:
         parts.append("<h3>The study's diagrams integrated past overturning</h3>")
         parts.append(_table(["h/b", "law", "share plotted after the fall, reference",
                              "this run"],
-                            [[r["hb"], _LAW.get(r["law"], r["law"]),
+                            [[r["hb"], LAW_NAMES.get(r["law"], r["law"]),
                               _num(r["published"], ".1f") + " %",
                               _num(r["rockjit"], ".1f") + " %"] for r in pub["as_published"]],
                             left=(1,)))
@@ -369,7 +383,7 @@ def _results_tables(results):
             for law in ("housner", "mao"):
                 fr = e[law]["fractions"]
                 rows.append([_num(e["hb"], "g"), _num(e["alpha"], "g"), _num(e["omega"], "g"),
-                             _LAW[law]] + [_num(fr[n], ".1f") for n in BEHAVIOURS]
+                             LAW_NAMES[law]] + [_num(fr[n], ".1f") for n in BEHAVIOURS]
                             + [_num(e["agreement"], ".1f")])
         parts.append(_table(["h/b", "α", "ω", "law"] + list(BEHAVIOURS) + ["agreement %"],
                             rows, left=(3,)))
@@ -381,7 +395,7 @@ def _results_tables(results):
         for e in a7:
             for law in ("housner", "mao"):
                 m = e[law]
-                rows.append([_num(e["hb"], "g"), _LAW[law], len(m["attractors"]),
+                rows.append([_num(e["hb"], "g"), LAW_NAMES[law], len(m["attractors"]),
                              "; ".join(f"{a['name'].replace('$', '')} {a['fraction']:.1f} %"
                                        for a in m["attractors"]),
                              _num(m["basin_entropy"], ".3f"),
@@ -398,7 +412,7 @@ def _results_tables(results):
         parts.append("<h3 id='bifurcation_table'>bifurcation_table: every located "
                      "bifurcation</h3>")
         parts.append(_table(["h/b", "law", "type", "α", "period", "|μ1|", "|μ2|"],
-                            [[_num(r["hb"], "g"), _LAW.get(r["law"], r["law"]),
+                            [[_num(r["hb"], "g"), LAW_NAMES.get(r["law"], r["law"]),
                               r["type"].replace("_", " "), _num(r["alpha"], ".9f"), r["period"],
                               _num(r["abs_mu1"], ".4g"), _num(r["abs_mu2"], ".4g")]
                              for r in bif], left=(1, 2)))

@@ -121,7 +121,39 @@ def test_the_gallery_caption_counts_the_runs_it_was_given():
 
     from rockjit.study import report
     plan = SimpleNamespace(grid=6, erosion_grid=6, erosion_step=0.2, zoom=(0.9, 0.95),
-                           zoom_step=0.01, published=False)
+                           zoom_step=0.01, published=False, periods=40)
     fates = {"closed": dict(settings=dict(ensemble=48), probabilities={"overturn": 0.75})}
     caption = report._captions({"fig3_fates": fates}, plan)[3]
     assert "over 48 runs within" in caption and "overturn 75%" in caption
+
+
+def test_the_small_papers_reference_caption_states_its_own_window(paper_dir):
+    # the small paper runs 40 periods: its asymptotic window is the last fifth, [32T, 40T],
+    # not the study's [400T, 500T]
+    page = (paper_dir / "index.html").read_text()
+    assert "asymptotic window [32<i>T</i>, 40<i>T</i>]" in page
+    assert "400<i>T</i>" not in page and "500<i>T</i>" not in page
+
+
+def test_the_captions_take_their_settings_from_the_papers_constants():
+    from types import SimpleNamespace
+
+    from rockjit.study import paper, report
+    plan = SimpleNamespace(grid=6, erosion_grid=6, erosion_step=0.2, zoom=(0.9, 0.95),
+                           zoom_step=0.01, published=False, periods=paper.PERIODS)
+    caps = report._captions({}, plan)
+    ref = paper.REFERENCE_RUN
+    assert (f"&alpha; = {ref['alpha']:g}, &omega; = {ref['omega']:g}, <i>h/b</i> = "
+            f"{ref['hb']:g}, Housner") in caps[2]
+    # the study's run and its window's start, as the paper defines them
+    assert f"[{paper.WINDOW}<i>T</i>, {paper.PERIODS}<i>T</i>]" in caps[2]
+    assert f"first {paper.FIRST_PERIODS} periods" in caps[2]
+    assert f"over the last {paper.LAST_PERIODS};" in caps[2]
+    laws = paper.LAWS_RUN
+    assert (f"<i>h/b</i> = {laws['hb']:g}, &alpha; = {laws['alpha']:g}, &omega; = "
+            f"{laws['omega']:g}") in caps[4]
+    for hb, alpha, omega in paper.BASIN_CASES:
+        assert f" {hb:g} (&alpha; = {alpha:g}, &omega; = {omega:g})" in caps[6]
+    tilt = paper.GALLERY["rest after damped rocking"][3][0]
+    assert f"&theta;<sub>0</sub> = {tilt:g}" in caps[3]
+    assert "time units" not in caps[3]
