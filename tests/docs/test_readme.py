@@ -312,6 +312,22 @@ def test_the_sites_front_page_quotes_the_readmes_figures():
     assert f"**{paper} s**" in _row("`rockjit paper`, every figure and table")
 
 
+def test_the_earthquake_guide_quotes_the_readmes_ground_figures():
+    # docs/guide/earthquakes.md repeats the speed table's two ground rows (held to
+    # benchmarks/results/ground.md above)
+    page = " ".join((ROOT / "docs" / "guide" / "earthquakes.md").read_text(
+        encoding="utf-8").split())
+    spectrum, ida, spectrum_min, ida_min = re.search(
+        r"A 200 × 200 spectrum with its boundaries located takes about (\d+) s, an incremental "
+        r"dynamic analysis of the 44 far-field records at 50 intensities and both laws about "
+        r"(\d+) s, on two cores; the scipy path would take about (\d+) min for the one and "
+        r"about (\d+) min for the other", page).groups()
+    rows = ("a 200 × 200 overturning spectrum of a one-sine pulse, every boundary located",
+            "fragility over the FEMA P695 far-field set, 50 intensities, both laws")
+    for what, fast, slow in zip(rows, (spectrum, ida), (spectrum_min, ida_min)):
+        assert f"**{fast} s** (the scipy path: about {slow} min)" in _row(what), what
+
+
 def test_the_multiperiodic_examples_accurate_overturning_time_is_as_quoted():
     import rockjit
     from rockjit import Block, Harmonic, Integration
@@ -325,6 +341,11 @@ def test_the_multiperiodic_examples_accurate_overturning_time_is_as_quoted():
     assert f"{ends[1].t:.{len(t.split('.')[1])}f}" == t
     short = _number(r"overturns at \$t = ([\d.]+)\$; the outcome", CLAIMS["study.md"]).group(1)
     assert f"{ends[1].t:.{len(short.split('.')[1])}f}" == short
+    # how long it wanders, in forcing periods T = 2 pi / omega
+    import math
+    wanders = _every(r"the block wanders for about (\d+) periods", ("study.md", "theory/study.md"))
+    for m in wanders.values():
+        assert int(m.group(1)) == round(ends[1].t * 1.3 / (2 * math.pi))
 
 
 def test_the_study_pages_basin_measures_are_todays():
@@ -383,3 +404,91 @@ def test_the_share_plotted_after_the_fall_is_todays():
     short = _number(r"(\d+) % of that diagram's amplitudes plot what followed an overturn",
                     CLAIMS["study.md"]).group(1)
     assert short == f"{float(rows[1][2]):.0f}"
+
+
+# ---- the study's numbers, typed once in the theory page and once in rockjit.study.report ----
+
+def test_the_theory_pages_transitions_are_the_reports():
+    # the table between the transitions markers, per (hb, law), in order, against the
+    # reference values index.html prints beside each run's
+    from rockjit.study.report import TRANSITIONS
+    text = CLAIMS["theory/study.md"]
+    table = text[text.index("<!-- transitions:begin -->"):text.index("<!-- transitions:end -->")]
+    quoted, key = {}, None
+    for line in table.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) != 3 or not re.search(r"\d\.\d{5}", cells[2]):
+            continue
+        if cells[0]:
+            hb, law = cells[0].split(", ")
+            key = (int(hb), law.split()[0].lower())
+        quoted.setdefault(key, []).extend(float(v) for v in re.findall(r"\d\.\d+", cells[2]))
+    reported = {}
+    for hb, law, _, _, _, alpha in TRANSITIONS:
+        reported.setdefault((hb, law), []).append(alpha)
+    assert quoted == reported
+
+
+def test_the_theory_pages_shares_after_the_fall_are_the_reports():
+    from rockjit.study.report import SHARES_PUBLISHED
+    rows = re.findall(r"^\s*\| (\d) \| (Housner|Mao) \| ([\d.]+) % \|", CLAIMS["theory/study.md"],
+                      re.M)
+    assert {(int(hb), law.lower()): float(share) for hb, law, share in rows} == SHARES_PUBLISHED
+
+
+def test_the_restitution_tables_are_the_reports_and_the_laws():
+    from rockjit.model import delta_e_percent, e_housner, e_mao, thc_from_hb
+    from rockjit.study.report import E_TABLE_PUBLISHED
+    # the Settings table of the theory page: e_H and e_M at each slenderness
+    settings = re.findall(r"([\d.]+) and ([\d.]+) at \$h/b = (\d)\$",
+                          _number(r"\| restitution \|[^\n]*", CLAIMS["theory/study.md"]).group(0))
+    assert {float(hb): (float(eh), float(em)) for eh, em, hb in settings} == \
+        {hb: (eh, em) for hb, (eh, em, _) in E_TABLE_PUBLISHED.items()}
+    # the impact laws' page: e_H, e_M and delta e at each slenderness
+    page = (ROOT / "docs" / "theory" / "impacts.md").read_text(encoding="utf-8")
+    page = page[page.index("The study's two blocks:"):page.index("The wider table")]
+    rows = re.findall(r"^\| (\d) \| [\d.]+[^|]*\| ([\d.]+) \| ([\d.]+) \| ([\d.]+) % \|$", page,
+                      re.M)
+    assert {float(hb): tuple(float(v) for v in rest) for hb, *rest in rows} == E_TABLE_PUBLISHED
+    # and the laws themselves, to the digits quoted
+    for hb, (eh, em, de) in E_TABLE_PUBLISHED.items():
+        thc = thc_from_hb(hb)
+        h, m = e_housner(thc), e_mao(thc)
+        assert (f"{h:.3f}", f"{m:.3f}", f"{delta_e_percent(h, m):.2f}") == \
+            (f"{eh:.3f}", f"{em:.3f}", f"{de:.2f}")
+
+
+def test_the_theory_pages_reference_fates_are_the_reports():
+    from rockjit.study.report import FATES_PUBLISHED, GIM_PUBLISHED
+    text = CLAIMS["theory/study.md"]
+    over, p7 = _number(r"rockjit 0\.1\.0,[^%]*?drew (\d+) % and (\d+) %", text).groups()
+    assert (int(over), int(p7)) == tuple(round(100 * FATES_PUBLISHED["closed"][k])
+                                         for k in ("overturn", "period-7"))
+    emb = _every(r"embedded forcing[^.]*?(\d+) % overturn and (\d+) % period 7",
+                 ("study.md", "theory/study.md"))
+    for m in emb.values():
+        assert tuple(int(v) for v in m.groups()) == tuple(
+            round(100 * FATES_PUBLISHED["embedded"][k]) for k in ("overturn", "period-7"))
+    mao, housner = _number(r"the mean GIM over \$\\alpha = 0\.3\$–\$0\.9\$ is ([\d.]+) against "
+                           r"Housner's (\d\.\d+)", text).groups()
+    assert (float(housner), float(mao)) == (GIM_PUBLISHED["housner"], GIM_PUBLISHED["mao"])
+
+
+def test_the_performance_pages_count_of_deliberate_bugs_is_the_benchmarks():
+    # docs/performance.md counts the bugs benchmarks/results/mutants.md lists, one row each
+    page = " ".join((ROOT / "docs" / "performance.md").read_text(encoding="utf-8").split())
+    quoted = int(_number(r"Mutation testing: (\d+) small bugs", page).group(1))
+    text = (RESULTS / "mutants.md").read_text(encoding="utf-8")
+    table = text[text.index("| mutant |"):]
+    rows = [line for line in table.splitlines()[2:] if line.startswith("| ")]
+    assert rows and all(line.count("|") == 8 for line in rows), rows
+    assert quoted == len(rows)
+
+
+def test_the_explorer_guide_quotes_the_servers_session_lifetime():
+    # docs/guide/explore.md: a page's placeholder session is dropped when Bokeh's unused-session
+    # lifetime runs out
+    from rockjit.explorer.server import UNUSED_SESSION_MS
+    page = " ".join((ROOT / "docs" / "guide" / "explore.md").read_text(encoding="utf-8").split())
+    seconds = int(_number(r"its placeholder is dropped about (\d+) s later", page).group(1))
+    assert seconds == round(UNUSED_SESSION_MS / 1000)
