@@ -29,6 +29,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import functools
+import importlib
 import math
 import os
 import re
@@ -398,34 +399,37 @@ def _safety_plan(args):
             for law in _laws(args)}
 
 
-def _safety_run(args, plans, out):
-    from ..integrity.chart import run
+def _write_safety(out, res, args):
     from ..integrity.figure import write
-    t0 = time.perf_counter()
-    res = {law: _grid(args, run, p, f"safety_{law}") for law, p in plans.items()}
-    wall = time.perf_counter() - t0
-    _say(args, f"{args.command}: computed in {wall:.1f} s")
-    return wall, write(out, res, tuple(args.levels))
+    return write(out, res, tuple(args.levels))
 
 
-def _grid_run(writer, name):
+#: The module whose ``run`` computes a grid command's plans (``rockjit.grids.plan`` where the
+#: command is not listed); looked up when the command runs.
+_GRID_RUNS = {"erosion": "rockjit.basins.erosion", "orbits": "rockjit.orbits.arclength",
+              "safety": "rockjit.integrity.chart", "spectrum": "rockjit.ground.spectrum"}
+
+
+def _grid_run(writer, name, store=None, write=None):
     """The run of a grid command: its plan (or one plan per law) computed with the command
-    line's progress, Dask client and chunk store, then written by ``outputs.<writer>``."""
+    line's progress, Dask client and chunk store, then written.
+
+    ``writer``: the name of the writer in :mod:`rockjit.outputs`, called ``(out, results)``;
+    ``write``, where given, is called ``(out, results, args)`` instead. ``name``: the chunk
+    store of a single plan; ``store(law)``: that of each law's plan (default the law)."""
     def run_it(args, plans, out):
         from .. import outputs
-        if writer == "erosion":
-            from ..basins.erosion import run
-        elif writer == "orbits":
-            from ..orbits.arclength import run
-        else:
-            from ..grids.plan import run
+        run = importlib.import_module(_GRID_RUNS.get(args.command, "rockjit.grids.plan")).run
         t0 = time.perf_counter()
         if isinstance(plans, dict):
-            res = {law: _grid(args, run, p, law) for law, p in plans.items()}
+            res = {law: _grid(args, run, p, store(law) if store else law)
+                   for law, p in plans.items()}
         else:
             res = _grid(args, run, plans, name)
         wall = time.perf_counter() - t0
         _say(args, f"{args.command}: computed in {wall:.1f} s")
+        if write is not None:
+            return wall, write(out, res, args)
         return wall, getattr(outputs, writer)(out, res)
     return run_it
 
@@ -571,16 +575,6 @@ def _spectrum_plan(args):
                                integration=integration, method=method, tol=args.tol,
                                execution=_execution(args))
             for law in _laws(args)}
-
-
-def _spectrum_run(args, plans, out):
-    from .. import outputs
-    from ..ground.spectrum import run
-    t0 = time.perf_counter()
-    res = {law: _grid(args, run, p, f"spectrum-{law}") for law, p in plans.items()}
-    wall = time.perf_counter() - t0
-    _say(args, f"spectrum: computed in {wall:.1f} s")
-    return wall, outputs.spectrum(out, res)
 
 
 def _records_of(args):
@@ -843,7 +837,8 @@ def build_parser():
     _add_common(p)
     _add_scheduler(p)
 
-    p = _command(sub, "safety", _safety_plan, _safety_run,
+    p = _command(sub, "safety", _safety_plan,
+                 _grid_run("safety", "safety", "safety_{}".format, _write_safety),
                  "integrity charts: the safe basin over the (alpha, omega) plane",
                  "A basin at every forcing of an (alpha, omega) grid, each reduced to its safe "
                  "fraction, GIM, IF, LIM and attractors; write safety.npz, safety_<law>.png "
@@ -921,7 +916,8 @@ def build_parser():
     p.add_argument("--seed", type=int, default=0, help="seed of the perturbations")
     _add_common(p)
 
-    p = _command(sub, "spectrum", _spectrum_plan, _spectrum_run,
+    p = _command(sub, "spectrum", _spectrum_plan,
+                 _grid_run("spectrum", "spectrum", "spectrum-{}".format),
                  "overturning spectrum of a pulse",
                  "Run the block from rest under a pulse at every (omega_p/p, a_p/(g cot "
                  "theta_c)) of a grid: each cell's outcome (safe, overturned after an impact, "
