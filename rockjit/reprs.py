@@ -259,6 +259,26 @@ def _spectrum(r):
                                "min_overturn")))])
 
 
+def _fit(fit, size):
+    """A lognormal fit's median and beta, or why there are none: its status, with the headline
+    of its reason (what comes before the first ":") where that is short and the median's bound
+    where there is one."""
+    where = f"size {_g(size)}"
+    if fit.status == "ok":
+        return f"median {_g(fit.median, '.3g')}, beta {_g(fit.beta, '.3g')} ({where})"
+    words = fit.status.replace("_", " ")
+    head = fit.reason.split(":", 1)[0].strip()
+    if head and len(head) <= _SHORT_REASON:
+        words += f": {head}"
+    if math.isfinite(fit.bound):
+        where = f"bound {_g(fit.bound, '.3g')}, {where}"
+    return f"{words} ({where})"
+
+
+#: The longest headline of a reason a summary quotes (the whole reason is in ``.reason``).
+_SHORT_REASON = 48
+
+
 def _fragility(r):
     laws = ", ".join(r.laws)
     rows = [("block", _block(r.block)), ("laws", laws),
@@ -266,14 +286,13 @@ def _fragility(r):
             ("records", f"{len(r.records)} records"),
             ("intensity", _span(r.intensity, r.measure))]
     for law in r.laws:
-        try:
-            f = r.fits[law]
-            size = next(iter(f))
-            fit = f[size]["overturn"]
-            rows.append((f"{law}", f"overturn median {_g(fit.median, '.3g')}, "
-                                   f"beta {_g(fit.beta, '.3g')} (size {_g(size)})"))
-        except (KeyError, StopIteration, AttributeError, TypeError):
+        by_size = r.fits.get(law) or {}   # a result may hold no fits
+        if not by_size:
             continue
+        size, fits = next(iter(by_size.items()))
+        fit = fits.get("overturn")
+        if fit is not None:
+            rows.append((law, f"overturn {_fit(fit, size)}"))
     rows.append(("arrays", _arrays(r, ("outcome", "max_rotation", "t_overturn", "scale"))))
     return _lines(f"FragilityResult: {len(r.laws)} law{'s' * (len(r.laws) != 1)} × "
                   f"{np.size(r.sizes)} size{'s' * (np.size(r.sizes) != 1)} × "

@@ -2,6 +2,8 @@
 grid, that state what was computed, its shape and its headline numbers (checked here against
 the result's own arrays, counted independently)."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -151,6 +153,22 @@ def test_fragility():
     text = _short(fr)
     assert "1 law × 1 size × 2 records × 3 intensities" in text
     assert f"{fr.outcome.shape}" in text
+    # a fit the data do not determine is shown by its status and reason, not as median nan
+    from rockjit.ground import fit_lognormal
+    fits = {"ok": fit_lognormal([1, 2, 3, 4], [0, 3, 7, 9], [10, 10, 10, 10]),
+            "survive": fit_lognormal([1, 2], [0, 0], [5, 5]),
+            "one level": fit_lognormal([3.0], [1], [2])}
+    assert [f.status for f in fits.values()] == ["ok", "all_survive", "unidentified"]
+    for key, fit in fits.items():
+        text = _short(dataclasses.replace(fr, fits={"housner": {0.5: {"overturn": fit}}}))
+        row = next(ln for ln in text.splitlines() if ln.startswith("  housner "))
+        assert "nan" not in text, text
+        if key == "ok":
+            assert f"median {fit.median:.3g}, beta {fit.beta:.3g} (size 0.5)" in row, row
+        elif key == "survive":
+            assert "all survive (bound 2, size 0.5)" in row, row
+        else:
+            assert "unidentified: one intensity level (size 0.5)" in row, row
 
 
 def test_the_summary_does_not_grow_with_the_grid():
