@@ -22,7 +22,7 @@ import numba
 import numpy as np
 
 from .._engine import kernel
-from ..excitation import ALPHA_MAX, Harmonic
+from ..excitation import ALPHA_MAX, OMEGA_RANGE, Harmonic, check_acceleration
 from ..model import Block
 from ..result import BasinResult, PlaneResult, SweepResult
 from ..settings import Classification, Execution, Integration
@@ -34,7 +34,7 @@ from .identity import (FloquetRuns, cycles_differ, identify, identify_along,
                        match_attractors)
 
 __all__ = ["GRID_N", "MAX_CELLS", "GridPlan", "alpha_count", "alpha_grid", "common",
-           "exponents", "grid_memory", "progress_label", "run", "uncertain_cells"]
+           "exponents", "forcing_axes", "grid_memory", "progress_label", "run", "uncertain_cells"]
 
 #: Steps per period of sweeps, basins and planes: they need labels and lambda_max, not 1e-10
 #: event times. On the study's four basins and its 501-amplitude sweep, N = 64 gives the labels
@@ -148,6 +148,24 @@ def alpha_count(alpha_range, alpha_step):
         raise ValueError(f"alpha_step = {step:g} over alpha_range ({a0:g}, {a1:g}) would make "
                          f"{count:.3g} amplitudes; give a larger alpha_step")
     return a0, a1, step, math.floor(count) + 1
+
+
+def forcing_axes(alpha_range, omega_range, grid, max_side):
+    """Validated ``(a0, a1, na), (w0, w1, nw)`` of an (alpha, omega) grid: the ranges (ends
+    included, ``0 <= a0 <= a1 <= ALPHA_MAX``, ``w0 <= w1`` in ``OMEGA_RANGE``), the points
+    ``grid = (na, nw)`` along each, in ``[1, max_side]``, and the largest forcing's
+    acceleration (:func:`rockjit.excitation.check_acceleration`). No array is made: the grid
+    may be too large for memory, and is checked by the caller."""
+    a0, a1 = pair("alpha_range", alpha_range, 0.0, ALPHA_MAX)
+    w0, w1 = pair("omega_range", omega_range, *OMEGA_RANGE)
+    try:
+        na, nw = grid
+    except (TypeError, ValueError):
+        raise ValueError(f"grid must be two integers (na, nw) (got {grid!r})") from None
+    na = integer("grid[0]", na, 1, max_side)
+    nw = integer("grid[1]", nw, 1, max_side)
+    check_acceleration(a1, w1)
+    return (a0, a1, na), (w0, w1, nw)
 
 
 def alpha_grid(alpha_range, alpha_step):

@@ -6,10 +6,9 @@ from __future__ import annotations
 import numpy as np
 
 from .._engine import kernel
-from ..excitation import ALPHA_MAX, OMEGA_RANGE, check_acceleration
 from ..result import PlaneResult
 from ..single import initial_state
-from ..validate import boolean, integer, pair, real_array
+from ..validate import boolean, real_array
 from . import plan as gp
 from ..entry import entry_point
 
@@ -66,15 +65,7 @@ def plane(block, alpha_range, omega_range, *, grid=(50, 50), state=None, forcing
     integration, classification, execution = gp.objects(block, integration, classification,
                                                         execution)
     forcing = gp.harmonic(forcing, "-alpha", "-omega", why="a plane")
-    a0, a1 = pair("alpha_range", alpha_range, 0.0, ALPHA_MAX)
-    w0, w1 = pair("omega_range", omega_range, *OMEGA_RANGE)
-    try:
-        na, nw = grid
-    except (TypeError, ValueError):
-        raise ValueError(f"grid must be two integers (got {grid!r})") from None
-    na = integer("grid[0]", na, 1, gp.MAX_CELLS)
-    nw = integer("grid[1]", nw, 1, gp.MAX_CELLS)
-    check_acceleration(a1, w1)
+    (a0, a1, na), (w0, w1, nw) = gp.forcing_axes(alpha_range, omega_range, grid, gp.MAX_CELLS)
     starts = [initial_state(z, forcing, integration) for z in _states(state)]
     z = np.array([s[:2] + s[3:] for s in starts])
     phis = [s[2] for s in starts]

@@ -21,12 +21,11 @@ from .. import measures as M
 from ..basins.erosion import erosion
 from ..grids.identity import identify
 from ..entry import entry_point
-from ..excitation import ALPHA_MAX, OMEGA_RANGE, check_acceleration
 from ..grids import plan as gp
 from ..grids import runner
 from ..grids.basin_grid import lattice as as_lattice
 from ..settings import Execution, Lattice
-from ..validate import integer, pair
+from ..validate import integer
 
 __all__ = ["MAX_SIDE", "SafetyPlan", "SafetyResult", "run", "safety"]
 
@@ -278,14 +277,7 @@ def safety(block, alpha_range, omega_range, *, grid=(20, 20), lattice=50, forcin
     integration, classification, execution = gp.objects(block, integration, classification,
                                                         execution)
     forcing = gp.harmonic(forcing, "-alpha", "-omega", why="a safety chart")
-    a0, a1 = pair("alpha_range", alpha_range, 0.0, ALPHA_MAX)
-    w0, w1 = pair("omega_range", omega_range, *OMEGA_RANGE)
-    try:
-        na, nw = grid
-    except (TypeError, ValueError):
-        raise ValueError(f"grid must be two integers (na, nw) (got {grid!r})") from None
-    na = integer("grid[0]", na, 1, MAX_SIDE)
-    nw = integer("grid[1]", nw, 1, MAX_SIDE)
+    (a0, a1, na), (w0, w1, nw) = gp.forcing_axes(alpha_range, omega_range, grid, MAX_SIDE)
     if na > 1 and not a0 < a1:
         raise ValueError(f"alpha_range must have start < end for {na} amplitudes "
                          f"(got ({a0:g}, {a1:g}))")
@@ -297,7 +289,6 @@ def safety(block, alpha_range, omega_range, *, grid=(20, 20), lattice=50, forcin
     if lat.grid < 2:
         raise ValueError(f"lattice must have >= 2 points per side: the integrity measures need "
                          f"a two-dimensional lattice (got {lat.grid})")
-    check_acceleration(a1, w1)
     alphas, omegas = np.linspace(a0, a1, na), np.linspace(w0, w1, nw)
     classification = classification.replace(attractors=True, uncertainty=None)
     # every column is checked now (its steps and memory), before any runs

@@ -133,6 +133,32 @@ def test_shock_is_fatal_and_its_safe_end_is_safe():
         assert bool(b.label[0, 0] == OVERTURN) is want
 
 
+@pytest.mark.parametrize("kw, message", [
+    (dict(grid=(2,)), r"^grid must be two integers \(na, nw\) \(got \(2,\)\)$"),
+    (dict(grid=5), r"^grid must be two integers \(na, nw\) \(got 5\)$"),
+    # the sides' bounds differ (the plane's grids are bounded by their memory only)
+    (dict(grid=(0, 2)), r"^grid\[0\] must be in \[1, 10+\] \(got 0\)$"),
+    (dict(grid=(2, 2.5)), r"^grid\[1\] must be an integer"),
+    (dict(alpha_range=(0.7, 0.6)), r"^alpha_range must satisfy start <= end"),
+    (dict(omega_range=(0, 1.3)), r"^omega_range\[0\]"),
+    # a frequency above 1e4; then alpha omega^2 = 1e9 above the largest acceleration, 1e8
+    (dict(alpha_range=(0.5, 1.0), omega_range=(1.2, 2e4)), r"^omega_range\[1\]"),
+    (dict(alpha_range=(0.5, 1e3), omega_range=(1.2, 1e3)),
+     r"^the forcing acceleration alpha \* omega\*\*2 must be <= 1e\+08 "
+     r"\(got alpha = 1000, omega = 1000: 1e\+09\)$"),
+])
+def test_plane_and_chart_refuse_a_bad_forcing_grid_alike(kw, message):
+    """The (alpha, omega) grid of the plane and of the safety chart is checked by the same
+    rules, with the same words."""
+    args = dict(alpha_range=(0.6, 0.7), omega_range=(1.2, 1.3), grid=(2, 2))
+    args.update(kw)
+    a, w = args.pop("alpha_range"), args.pop("omega_range")
+    with pytest.raises(ValueError, match=message):
+        rockjit.plane.plan(BLOCK, a, w, **args)
+    with pytest.raises(ValueError, match=message):
+        rockjit.safety.plan(BLOCK, a, w, lattice=4, **args)
+
+
 def test_shock_refuses_bad_input():
     with pytest.raises(ValueError, match="point"):
         rockjit.fatal_shock(BLOCK, FORCING, (1.4, 3.0), integration=SHORT)
