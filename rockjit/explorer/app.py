@@ -40,7 +40,6 @@ AGREE_COLOURS = {"same": style.AGREE_COLOUR, "different": style.DISAGREE_COLOUR}
 #: Opacity of a view whose parameters changed and whose new result is not there yet.
 STALE_ALPHA = 0.35
 BASIN_SIZE = 400
-LAW_NAMES = {"housner": "Housner", "mao": "Mao", "constant": "constant e"}
 #: How often a page looks whether its websocket is still open, in milliseconds.
 WATCH_MS = 400
 #: Mathematical notation of the figures' labels (matplotlib's ``$...$``) in plain text.
@@ -55,6 +54,12 @@ def plain_text(label):
     for tex, out in _TEX:
         text = text.replace(tex, out)
     return text
+
+
+def _law_name(law):
+    """A restitution law's name as the figures write it (:data:`rockjit.plotting.style.LAW_NAMES`),
+    in plain text."""
+    return plain_text(style.LAW_NAMES.get(law, law))
 
 
 def _finite(*values):
@@ -267,7 +272,7 @@ class ExplorerApp:
 
         controls.append(number("hb", "h/b (slenderness)", p.hb))
         law = Select(title="restitution law", value=p.law, width=210, css_classes=["rj-law"],
-                     options=[(k, v) for k, v in LAW_NAMES.items()])
+                     options=[(k, plain_text(v)) for k, v in style.LAW_NAMES.items()])
         law.on_change("value", lambda attr, old, new: self._control("law", new))
         self.w["law"] = law
         controls.append(self._with_error("law", law))
@@ -470,7 +475,7 @@ class ExplorerApp:
         self._draw_basin(view)
         self.basin_code.text = view.call
         p = view.params
-        self.basin_fig.title.text = (f"basin {view.grid}², {LAW_NAMES[p.law]}, h/b = "
+        self.basin_fig.title.text = (f"basin {view.grid}², {_law_name(p.law)}, h/b = "
                                      f"{_fmt(p.hb)}, α = {_fmt(p.alpha)}, ω = {_fmt(p.omega)}")
         self.basin_state.text = (
             f'<span class="rj-basin-shown" data-grid="{view.grid}" '
@@ -732,7 +737,7 @@ class ExplorerApp:
             for n in present)
             + " &nbsp; <span style='color:#666'>(strip: the behaviour of every α)</span></div>")
         p = v.params
-        self.bif_figs[0].title.text = (f"{LAW_NAMES[p.law]}, h/b = {_fmt(p.hb)}, ω = "
+        self.bif_figs[0].title.text = (f"{_law_name(p.law)}, h/b = {_fmt(p.hb)}, ω = "
                                        f"{_fmt(p.omega)}: θ′(kT) from the study's z0")
         _dim(self.bif_figs, False)
         a0, a1 = p.alpha_range
@@ -783,7 +788,7 @@ class ExplorerApp:
         lut = [colours[n] for n in BEHAVIOURS]
         for key, res in (("housner", v.housner), ("mao", v.mao)):
             self.cmp_src[key].data = _image_data(res, rgba_image(res.label, lut))
-            self.cmp_figs[key].title.text = f"{LAW_NAMES[key]} (e = {res.block.restitution:.3f})"
+            self.cmp_figs[key].title.text = f"{_law_name(key)} (e = {res.block.restitution:.3f})"
         agree = rgba_image(v.agree.astype(int), [AGREE_COLOURS["different"], AGREE_COLOURS["same"]])
         self.cmp_src["agree"].data = _image_data(v.housner, agree)
         self.cmp_figs["agree"].title.text = f"agreement: {v.percent:.1f} % of cells"

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..plotting.style import LAW_NAMES
 from ..plotting.style import styled as _styled
 from .response import OUTCOMES
 
@@ -17,7 +18,6 @@ __all__ = ["OUTCOME_COLOURS", "fig_fragility", "fig_rotation", "fig_spectrum",
 
 #: One colour per outcome (rockjit.ground.response.OUTCOMES).
 OUTCOME_COLOURS = ("#f2f2f2", "#f4a259", "#b2182b", "#e377c2")
-_LAW_NAMES = {"housner": "Housner", "mao": "Mao et al.", "constant": "constant e"}
 _STYLES = ("-", "--", ":", "-.")
 
 
@@ -116,7 +116,7 @@ def fig_spectrum(results, comparison=None):
         _outcome_map(ax, sp)
         _closed_form(ax, sp)
         _boundaries(ax, sp)
-        ax.set_title(f"{letters[i]}) {_LAW_NAMES.get(sp.block.law, sp.block.law)} "
+        ax.set_title(f"{letters[i]}) {LAW_NAMES.get(sp.block.law, sp.block.law)} "
                      f"($e = {sp.block.restitution:.3f}$)", loc="left")
     extra = []
     if len(sps) == 2:
@@ -131,7 +131,7 @@ def fig_spectrum(results, comparison=None):
                 ax.plot(sp.ratio[fin], sp.min_overturn[fin], ls=ls, lw=1.0,
                         marker="o" if sp.ratio.size <= 30 else "", ms=2,
                         color=_law_colour(sp.block.law),
-                        label=f"{_LAW_NAMES.get(sp.block.law)}: minimum overturning")
+                        label=f"{LAW_NAMES.get(sp.block.law, sp.block.law)}: minimum overturning")
         pct = 100.0 * float(diff.mean())
         ax.set_title(f"c) the laws differ: {pct:.1f} %", loc="left")
         if diff.any():
@@ -204,7 +204,7 @@ def fig_fragility(res):
             handles.append(_curve(ax, res.intensity, frac[li, si],
                                   res.fits[law][float(size)]["overturn"], _law_colour(law),
                                   _STYLES[si % len(_STYLES)],
-                                  f"{_LAW_NAMES.get(law, law)}, $R = {size:g}$ m",
+                                  f"{LAW_NAMES.get(law, law)}, $R = {size:g}$ m",
                                   _law_marker(law)))
     ax.set_xlabel(_xlabel(res))
     ax.set_ylabel("P(overturn)")
@@ -230,7 +230,7 @@ def fig_rotation(res):
                 handles.append(_curve(ax, res.intensity, frac[li, si],
                                       res.fits[law][float(size)][f"exceed_{lv:g}"],
                                       _law_colour(law), _STYLES[si % len(_STYLES)],
-                                      f"{_LAW_NAMES.get(law, law)}, $R = {size:g}$ m",
+                                      f"{LAW_NAMES.get(law, law)}, $R = {size:g}$ m",
                                       _law_marker(law)))
         ax.set_xlabel(_xlabel(res))
         ax.set_title(f"$\\max|\\theta| / (\\pi/2 - \\theta_c) \\geq {lv:g}$")

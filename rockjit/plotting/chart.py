@@ -18,6 +18,7 @@ try:  # the palette's home after the figures' rework; figures.py's until then
 except ImportError:  # pragma: no cover - depends on the rework's state
     from .figures import BEHAVIOUR_COLOURS, LAW_COLOURS
 
+from .style import LAW_NAMES
 from .style import styled as _styled
 
 __all__ = ["CURVE_LABELS", "CURVE_STYLES", "fig_chart"]
@@ -32,7 +33,6 @@ _NAMES = {"fold": "fold", "symmetry_breaking": "symmetry breaking",
           "period_doubling": "period doubling", "grazing": "grazing"}
 _SUB = str.maketrans("0123456789", "\u2080\u2081\u2082\u2083\u2084\u2085\u2086\u2087\u2088"
                                    "\u2089")
-_LAW_NAMES = {"housner": "Housner", "mao": "Mao", "constant": "constant e"}
 #: The hatching of the cells where two laws' behaviours differ.
 DIFFER_HATCH = "////"
 #: The overturn boundary's colour (apart from the behaviours' and the curves').
@@ -99,11 +99,6 @@ def _map(ax, lab, x, y, **kw):
 
 def _label(curve):
     return CURVE_LABELS[curve.type] + str(curve.period).translate(_SUB)
-
-
-def _law(block):
-    return _LAW_NAMES.get(block.law, block.law) if block.law != "constant" else \
-        f"e = {block.restitution:g}"
 
 
 def _curves(ax, res, colour, halo, lw1=1.5, labels=True):
@@ -179,7 +174,7 @@ def _chart_panel(ax, res, i, show_y=True):
     if show_y:
         ax.set_ylabel("$\\alpha$")
     b = res.block
-    letter(ax, i, f"{_law(b)} ($e = {b.restitution:.3f}$)")
+    letter(ax, i, f"{LAW_NAMES.get(b.law, b.law)} ($e = {b.restitution:.3f}$)")
     return placed
 
 
@@ -298,7 +293,7 @@ def fig_chart(results, title=None):
                       f"({_share_words(100.0 * differ.mean())} of cells)")
         h = _legend_handles(res)
         h += [Line2D([], [], color=LAW_COLOURS.get(law, "k"), lw=1.6,
-                     label=f"{_LAW_NAMES.get(law, law)}'s curves and overturn boundary")
+                     label=f"{LAW_NAMES.get(law, law)}'s curves and overturn boundary")
               for law in laws]
         if differ.any() and min(differ.shape) > 1:
             h.append(Patch(facecolor="white", edgecolor="0.4", lw=0.4, hatch=DIFFER_HATCH,
