@@ -23,6 +23,7 @@ def _tables():
     from ..ground.pulses import AMPLITUDE_MAX, RATIO_RANGE
     from ..ground.records import SIZE_RANGE
     from ..ground.settings import TIME_MAX
+    from ..integrity.chart import MAX_LATTICE, MAX_SIDE
     from ..model import HB_RANGE, XI_MAX
     from ..settings import MAX_IMPACTS, MAX_N, MAX_PERIODS, REST_SPEED_RANGE
     half_pi = 0.5 * math.pi
@@ -48,14 +49,14 @@ def _tables():
         "--hb-values": ("real", 1 / math.sqrt(2), HB_RANGE[1]),
         "--hb-max": ("real", 1 / math.sqrt(2), 100.0), "--zoom": ("real", 0.5, 1.0),
         "--zoom-step": ("real", 0.0, 1.0), "--erosion-step": ("real", 0.0, 1.0),
-        "--erosion-grid": ("int", 2, 10**5), "--lattice": ("int", 2, 10**5),
+        "--erosion-grid": ("int", 2, 10**5), "--lattice": ("int", 2, MAX_LATTICE),
         "--levels": ("real", 0.0, 1.0), "--port": ("int", 0, 65535),
     }
     by_command = {("chart", "--max-period"): ("int", 1, 16),
                   ("plane", "--grid"): ("int", 1, 10**18), ("chart", "--grid"): ("int", 1, 10**18),
                   ("spectrum", "--grid"): ("int", 1, 10**4), ("paper", "--grid"): ("int", 2, 10**5),
                   ("paper", "--alpha-step"): ("real", 0.0, 1.0),
-                  ("safety", "--grid"): ("int", 1, 1000)}
+                  ("safety", "--grid"): ("int", 1, MAX_SIDE)}
     return common, by_command
 
 

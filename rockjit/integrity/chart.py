@@ -27,11 +27,14 @@ from ..grids.basin_grid import lattice as as_lattice
 from ..settings import Execution, Lattice
 from ..validate import integer
 
-__all__ = ["MAX_SIDE", "SafetyPlan", "SafetyResult", "run", "safety"]
+__all__ = ["MAX_LATTICE", "MAX_SIDE", "SafetyPlan", "SafetyResult", "run", "safety"]
 
 #: Most forcings along each side of a chart (every basin is reduced in Python: a million
 #: forcings would take hours of that alone).
 MAX_SIDE = 1000
+
+#: Most initial states along each side of every basin's lattice.
+MAX_LATTICE = 10**5
 
 
 @dataclass(frozen=True)
@@ -285,7 +288,7 @@ def safety(block, alpha_range, omega_range, *, grid=(20, 20), lattice=50, forcin
         raise ValueError(f"omega_range must have start < end for {nw} frequencies "
                          f"(got ({w0:g}, {w1:g}))")
     lat = as_lattice(lattice if isinstance(lattice, Lattice) else
-                     integer("lattice", lattice, 2, 10**5))
+                     integer("lattice", lattice, 2, MAX_LATTICE))
     if lat.grid < 2:
         raise ValueError(f"lattice must have >= 2 points per side: the integrity measures need "
                          f"a two-dimensional lattice (got {lat.grid})")
