@@ -551,9 +551,11 @@ def free_rocking_decided(theta, dtheta, max_theta, thc, th_top):
     if not abs(theta) < th_top:
         return False
     en = energy(theta, dtheta, thc)
-    if not en < 0.75 * math.sin(thc + th_top):
-        return False
-    return en <= 0.75 * math.sin(thc + min(max_theta, th_top))
+    widest = min(max_theta, th_top)
+    lim = 0.75 * math.sin(thc + widest)
+    if widest == th_top:  # the two bounds are one: the strict one decides
+        return en < lim
+    return en <= lim and en < 0.75 * math.sin(thc + th_top)
 
 
 @jit
