@@ -226,7 +226,7 @@ def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, label, executi
         run_chunks(kernel.run_chunk, (bool(tangent), y0s, pars, ipar, cpar, n_pts, n_imp_pts,
                                       threads, ex.lanes), n, chunk, outputs_, client=client,
                    store=cs, progress=ex.progress, label=label, message=ex.message,
-                   worker_timeout=ex.worker_timeout, at_once=at_once, split=at_once > 1)
+                   worker_timeout=ex.worker_timeout, at_once=at_once)
     return outputs_
 
 
@@ -331,7 +331,7 @@ class _Callback:
 
 def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, progress=False,
                label="cells", task_prefix="rockjit", message=None, worker_timeout=None,
-               at_once=1, split=False):
+               at_once=1):
     """Run ``runner`` over chunks of ``n`` cells and fill ``outputs`` in place.
 
     Parameters
@@ -372,14 +372,12 @@ def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, pr
     at_once : int
         In this process, how many calls of ``runner`` run at once, each in a thread of its own
         (``runner`` must release the GIL to gain from it, as numba's kernels do); default one
-        at a time, in the calling thread. Chunks are placed as they finish. When a call, the
-        progress callback or an interrupt raises, no call starts any more; the calls already
-        running are waited for (and their finished chunks kept in the store) before the
-        exception propagates.
-    split : bool
-        With ``at_once > 1``, call ``runner`` on pieces of the chunks (:func:`pieces`; a
-        chunk's outputs are the concatenation of its pieces', so every output must have the
-        cells on its first axis) instead of whole chunks.
+        call per chunk, one at a time, in the calling thread. With more than one, ``runner`` is
+        called on pieces of the chunks (:func:`pieces`; a chunk's outputs are the concatenation
+        of its pieces', so every output must have the cells on its first axis), and each chunk
+        is placed once all its pieces are done. When a call, the progress callback or an
+        interrupt raises, no call starts any more; the calls already running are waited for
+        (and their finished chunks kept in the store) before the exception propagates.
     """
     if message is None and store is not None:
         message = store.message
@@ -388,14 +386,14 @@ def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, pr
     try:
         return _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, label,
                            task_prefix, message, _timeout(worker_timeout),
-                           max(1, int(at_once)), bool(split))
+                           max(1, int(at_once)))
     finally:
         if store is not None:
             store.close()
 
 
 def _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, label,
-                task_prefix, message, timeout, at_once=1, split=False):
+                task_prefix, message, timeout, at_once=1):
     bounds = [(a, min(n, a + chunk)) for a in range(0, n, chunk)]
     todo = []
     for a, b in bounds:
@@ -434,7 +432,7 @@ def _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, labe
             for a, b in todo:
                 place(a, b, runner(*args(a, b)))
         elif client is None:
-            _at_once(runner, todo, args, place, store, at_once, split)
+            _at_once(runner, todo, args, place, store, at_once)
         elif todo:
             _on_dask(client, runner, inputs, n, chunk, todo, args, place, task_prefix, message,
                      timeout)
@@ -443,11 +441,11 @@ def _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, labe
     return outputs
 
 
-def _at_once(runner, todo, args, place, store, at_once, split):
+def _at_once(runner, todo, args, place, store, at_once):
     """The chunks ``todo`` in this process, ``at_once`` calls running at a time, each in a
-    thread of its own, on whole chunks or (``split``) on their :func:`pieces`; each chunk
-    placed once all its calls are done (see :func:`run_chunks`)."""
-    work = pieces(todo, at_once) if split else ((a, b, k) for k, (a, b) in enumerate(todo))
+    thread of its own, on the chunks' :func:`pieces`; each chunk placed once all its pieces
+    are done (see :func:`run_chunks`)."""
+    work = pieces(todo, at_once)
     parts = [{} for _ in todo]  # per chunk: its finished pieces' outputs by their start
     left = [b - a for a, b in todo]  # per chunk: cells not yet finished
     pending = {}
