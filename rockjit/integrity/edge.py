@@ -29,11 +29,10 @@ from ..settings import Integration
 from ..single import DEFAULT_N, simulate
 from ..validate import integer, real
 from .outcome import Outcomes
+from .shock import _Search
 
 __all__ = ["EdgeState", "edge_state"]
 
-#: States run at once in one round of the bisection (each round shrinks the segment 16 times).
-K = 15
 #: Periods tracked at least before the tracked points are looked at for a period.
 MIN_TRACK = 20
 
@@ -87,17 +86,17 @@ class EdgeState:
 
 
 def _bisect(oc, a, b, tol):
-    """``(a, b)`` closer than ``tol`` on the segment from safe ``a`` to fatal ``b``."""
-    while np.linalg.norm(b - a) > tol:
-        t = np.arange(1, K + 1) / (K + 1)
-        z = a + t[:, None] * (b - a)
-        f = oc.fatal(z)
-        k = int(np.argmax(f)) if f.any() else -1
-        if k == -1:
-            a = z[-1]
-        else:
-            a, b = (z[k - 1] if k > 0 else a), z[k]
-    return a, b
+    """``(a, b)`` closer than ``tol`` on the segment from safe ``a`` to fatal ``b``: the
+    multisection of the fatal shock's rays (:class:`.shock._Search`), on the ray from ``a``
+    through ``b``."""
+    d = b - a
+    length = float(np.linalg.norm(d))
+    if length <= tol:
+        return a, b
+    angle = np.array([math.atan2(d[1], d[0])])
+    lo, hi = _Search(oc, a).narrow(angle, np.zeros(1), np.array([length]), 0.0, atol=tol)
+    u = np.array([math.cos(angle[0]), math.sin(angle[0])])
+    return a + lo[0] * u, a + hi[0] * u
 
 
 def _step(block, forcing, integration, z):

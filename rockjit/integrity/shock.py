@@ -118,12 +118,13 @@ class _Search:
         new_lo = np.where(k > 0, r[rows, np.maximum(k - 1, 0)], 0.0)
         return new_lo, new_hi
 
-    def narrow(self, angles, lo, hi, rtol):
-        """Multisection of every finite bracket until ``hi - lo <= rtol * hi``."""
+    def narrow(self, angles, lo, hi, rtol, atol=0.0):
+        """Multisection of every finite bracket until ``hi - lo <= rtol * hi`` or
+        ``hi - lo <= atol``."""
         lo, hi = lo.copy(), hi.copy()
         u = _units(angles)
         while True:
-            todo = np.flatnonzero(np.isfinite(hi) & (hi - lo > rtol * hi))
+            todo = np.flatnonzero(np.isfinite(hi) & (hi - lo > np.maximum(rtol * hi, atol)))
             if todo.size == 0:
                 return lo, hi
             t = np.arange(1, K + 1) / (K + 1)
