@@ -35,6 +35,8 @@ ALPHA_RANGE, OMEGA_RANGE = (0.2, 1.0), (1.0, 2.0)
 TARGET_GRID = (60, 60)
 TARGET_CHART_S = 600.0
 TARGET_SHOCK_S = 10.0
+#: The edge state's shooting residual it should reach.
+TARGET_EDGE_RESIDUAL = 1e-10
 FORCING = Harmonic(alpha=0.66, omega=1.3)
 POINT = (-0.2825, -0.164)
 
@@ -142,7 +144,9 @@ def main(argv=None):
           f"Edge state from that shock: period {edge['period']} at "
           f"({edge['state'][0]:.6f}, {edge['state'][1]:.6f}), |multipliers| "
           f"{', '.join(f'{m:.4g}' for m in edge['multipliers'])}, shooting residual "
-          f"{edge['residual']:.1e}, {edge['rebisections']} rebisections, "
+          f"{edge['residual']:.1e} (goal {TARGET_EDGE_RESIDUAL:g}: "
+          f"{'reached' if edge['residual'] <= TARGET_EDGE_RESIDUAL else 'not reached'}), "
+          f"{edge['rebisections']} rebisections, "
           f"**{edge['wall_s']:.2f} s**."]
     b.report("safety", markdown="\n".join(md), csv=(cols, rows),
              data=dict(quick=b.quick, environment=b.env, charts=[dict(zip(cols, r))
