@@ -32,7 +32,6 @@ import concurrent.futures as cf
 import contextlib
 import contextvars
 import itertools
-import json
 import secrets
 import sys
 import time
@@ -174,20 +173,6 @@ def pieces(bounds, at_once, smallest=PIECE_MIN, largest=PIECE_MAX):
             a = end
 
 
-def _stored_chunk(store, key, n):
-    """The chunk length of a store already begun for this computation (its manifest), or
-    ``None``: a rerun keeps the chunks of the first run whatever its thread count."""
-    from pathlib import Path
-    try:
-        have = json.loads((Path(store) / chunks.ChunkStore.MANIFEST).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    if isinstance(have, dict) and have.get("key") == key and have.get("n") == n and \
-            isinstance(have.get("chunk"), int) and have["chunk"] >= 1:
-        return have["chunk"]
-    return None
-
-
 def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, label, execution):
     """All cells through :func:`rockjit._engine.kernel.run_chunk`, chunk by chunk, as
     ``execution`` (a :class:`rockjit.Execution`) says: threads, chunk size, lanes, in this
@@ -212,7 +197,7 @@ def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, label, executi
                                  dict(tangent=bool(tangent), n_pts=n_pts, n_imp_pts=n_imp_pts))
     chunk = ex.chunk
     if chunk is None and key is not None:
-        chunk = _stored_chunk(ex.store, key, n)
+        chunk = chunks.ChunkStore.stored_chunk(ex.store, key, n)
     if chunk is None:
         chunk = kernel.default_chunk(n)
     with _client(ex) as client:

@@ -334,14 +334,35 @@ class ChunkStore:
             self._lock.release()
             raise
 
+    @classmethod
+    def _read_manifest(cls, directory):
+        """The manifest of the store in ``directory`` (``{"key", "n", "chunk"}``), or ``None``
+        where it is absent, unreadable or not a JSON object."""
+        try:
+            have = json.loads((Path(directory) / cls.MANIFEST).read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return None
+        return have if isinstance(have, dict) else None
+
+    @classmethod
+    def stored_chunk(cls, directory, key, n):
+        """The chunk length of the store in ``directory`` if its manifest is that of the
+        computation ``key`` on ``n`` cells, else ``None`` (no store, another computation, an
+        unreadable manifest). Read without opening the store (its lock is not taken).
+
+        A rerun that gives no chunk uses it: the first run may have been given a chunk other
+        than the default, and the store refuses any other chunk as another computation."""
+        have = cls._read_manifest(directory)
+        if have is None or have.get("key") != key or have.get("n") != n:
+            return None
+        chunk = have.get("chunk")
+        return chunk if type(chunk) is int and chunk >= 1 else None
+
     def _check_manifest(self):
         man = self.dir / self.MANIFEST
         want = {"key": self.key, "n": self.n, "chunk": self.chunk}
         if man.exists():
-            try:
-                have = json.loads(man.read_text(encoding="utf-8"))
-            except (OSError, ValueError):
-                have = None
+            have = self._read_manifest(self.dir)
             if have != want:
                 raise ValueError(
                     f"{self.dir} holds the chunks of a different computation (other inputs or "

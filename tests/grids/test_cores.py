@@ -6,6 +6,7 @@ at once); a runner that counts, for a fact, how many of its calls run at once; t
 manifest as written; numba's own answer on whether a CUDA device is usable here.
 """
 
+import json
 import threading
 import time
 
@@ -199,14 +200,21 @@ def test_a_failing_chunk_raises_after_the_others_finish():
     assert len(calls) < n // chunk
 
 
-def test_a_rerun_keeps_the_stores_chunks_whatever_the_threads(tmp_path, monkeypatch):
+def test_a_rerun_without_a_chunk_keeps_the_chunk_the_first_run_gave(tmp_path, monkeypatch):
     p = _plan(grid=6, periods=30)
     first = _chunked(p, chunk=5, threads=1, store=tmp_path / "s")
     manifest = (tmp_path / "s" / "manifest.json").read_text()
     assert '"chunk": 5' in manifest
+    from rockjit.storage.chunkstore import ChunkStore
+    key, n = json.loads(manifest)["key"], p.y0s.shape[0]
+    assert ChunkStore.stored_chunk(tmp_path / "s", key, n) == 5
+    for other in ((tmp_path / "s", key, n - 1), (tmp_path / "s", "other", n),
+                  (tmp_path / "none", key, n)):
+        assert ChunkStore.stored_chunk(*other) is None
     calls = []
     monkeypatch.setattr(kernel, "run_chunk", lambda *a: calls.append(a) or None)
-    again = _chunked(p, store=tmp_path / "s")  # default chunk, all threads: loads them all
+    assert kernel.default_chunk(p.y0s.shape[0]) != 5
+    again = _chunked(p, store=tmp_path / "s")  # no chunk given: loads them all
     assert calls == []
     _same(again, first)
 
