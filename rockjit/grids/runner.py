@@ -142,17 +142,15 @@ def _thread_safe_layer():
         return False
 
 
-def local_plan(threads, concurrent=None):
+def local_plan(threads):
     """How a grid runs in this process on ``threads`` threads: ``(threads_per_call, at_once)``.
 
-    Where the threading layer lets several threads launch kernels at once (``concurrent``;
-    default: asked of numba), ``(1, threads)``: pieces of one thread each, ``threads`` at once
-    (never more threads busy than asked for). Otherwise ``(threads, 1)``: one chunk at a time
-    on all the threads."""
+    Where numba's threading layer lets several threads launch kernels at once
+    (:func:`_thread_safe_layer`), ``(1, threads)``: pieces of one thread each, ``threads`` at
+    once (never more threads busy than asked for). Otherwise ``(threads, 1)``: one chunk at a
+    time on all the threads."""
     threads = max(1, int(threads))
-    if concurrent is None:
-        concurrent = _thread_safe_layer()
-    return (1, threads) if concurrent else (threads, 1)
+    return (1, threads) if _thread_safe_layer() else (threads, 1)
 
 
 def pieces(bounds, at_once, smallest=PIECE_MIN, largest=PIECE_MAX):

@@ -60,31 +60,41 @@ def test_grids_with_exponents_too():
     _same(_chunked(p, chunk=3), _whole(p))
 
 
-def test_local_plan_never_asks_for_more_threads_than_given():
-    for threads in (1, 2, 3, 16, 64):
-        assert runner.local_plan(threads, concurrent=True) == (1, threads)
-        assert runner.local_plan(threads, concurrent=False) == (threads, 1)
+@pytest.mark.parametrize("safe, plans", [
+    (True, {1: (1, 1), 3: (1, 3), 16: (1, 16)}),  # pieces of one thread, `threads` at once
+    (False, {1: (1, 1), 3: (3, 1), 16: (16, 1)}),  # one call at a time on every thread
+])
+def test_local_plan_never_asks_for_more_threads_than_given(monkeypatch, safe, plans):
+    monkeypatch.setattr(runner, "_thread_safe_layer", lambda: safe)
+    for threads, plan in plans.items():
+        assert runner.local_plan(threads) == plan
 
 
-@pytest.mark.parametrize("bounds, at_once", [([(0, 10000)], 16), ([(0, 500), (500, 1000),
-                                              (1000, 1003)], 2), ([(0, 5), (5, 10)], 4),
-                                             ([(3, 900), (1200, 5000)], 8)])
-def test_pieces_cover_each_chunk_in_order_and_shrink_to_the_end(bounds, at_once):
-    got = list(runner.pieces(bounds, at_once, smallest=32, largest=4096))
+# the pieces by hand: each holds (cells not yet given out) // (2 * at_once) cells, at least 32
+# and at most `largest`, and ends at its chunk's end if that comes first
+@pytest.mark.parametrize("bounds, at_once, largest, expected", [
+    # 200 // 4 = 50, 150 // 4 = 37, then 28, 20, 12 and 4 cells: 32, the last cut to 17
+    ([(0, 200)], 2, 4096, [(0, 50, 0), (50, 87, 0), (87, 119, 0), (119, 151, 0),
+                           (151, 183, 0), (183, 200, 0)]),
+    # 130 // 2 = 65 and 90 // 2 = 45: 40 at most; 50 // 2 = 25: 32, cut to 20 at the chunk's
+    # end; 30 // 2 = 15: 32, the whole second chunk
+    ([(0, 100), (100, 130)], 1, 40, [(0, 40, 0), (40, 80, 0), (80, 100, 0), (100, 130, 1)]),
+    # 10000 // 2 = 5000: 4096 at most; then 5904 // 2 = 2952, 1476, 738, 369, 184, 92, 46,
+    # then 47 // 2 = 23: 32, then the last 15
+    ([(0, 10000)], 1, 4096, [(0, 4096, 0), (4096, 7048, 0), (7048, 8524, 0), (8524, 9262, 0),
+                             (9262, 9631, 0), (9631, 9815, 0), (9815, 9907, 0),
+                             (9907, 9953, 0), (9953, 9985, 0), (9985, 10000, 0)]),
+    # chunks shorter than the smallest piece are one piece each
+    ([(0, 5), (5, 10)], 4, 4096, [(0, 5, 0), (5, 10, 1)]),
+])
+def test_pieces_cover_each_chunk_in_order_and_shrink_to_the_end(bounds, at_once, largest,
+                                                                 expected):
+    got = list(runner.pieces(bounds, at_once, smallest=32, largest=largest))
+    assert got == expected
     for k, (a, b) in enumerate(bounds):
         mine = [(p, q) for p, q, kk in got if kk == k]
         assert mine[0][0] == a and mine[-1][1] == b
         assert all(q0 == p1 for (_, q0), (p1, _) in zip(mine, mine[1:]))
-        # every piece but a chunk's last is within the bounds
-        assert all(32 <= q - p <= 4096 for p, q in mine[:-1])
-    sizes = [q - p for p, q, _ in got]
-    total = sum(b - a for a, b in bounds)
-    # guided: a piece never holds more than the cells left over twice the callers
-    left = total
-    for size in sizes:
-        assert size <= max(32, left // (2 * at_once))
-        left -= size
-    assert sizes[-1] <= 32
 
 
 def _counting(calls, state, lock, delay=0.02, fail_at=None):
@@ -128,7 +138,9 @@ def test_chunks_run_at_once_and_land_in_place(at_once):
         assert spans == [(a, min(n, a + chunk)) for a in range(0, n, chunk)]
     else:
         assert len(spans) > n // chunk  # the chunks were cut into pieces
-    assert state["most"] == at_once
+    # at most at_once calls at a time, and (with their sleeps) more than one when allowed
+    assert state["most"] >= 2 if at_once > 1 else state["most"] == 1
+    assert state["most"] <= at_once
     # progress is told once at the start, then once per chunk, in whole chunks
     assert seen[0] == 0 and seen[-1] == n and seen == sorted(seen) and len(seen) == 12
     assert all(d % chunk == 0 for d in seen[:-1])
@@ -153,12 +165,22 @@ def test_a_grid_keeps_to_its_threads(monkeypatch):
                 state["now"] -= 1
 
     monkeypatch.setattr(kernel, "run_chunk", counted)
-    threads = numba.config.NUMBA_NUM_THREADS
+    real_layer = runner._thread_safe_layer
+    threads = min(2, numba.config.NUMBA_NUM_THREADS)
+    # a layer that cannot launch kernels from several threads: one call at a time on them all
+    monkeypatch.setattr(runner, "_thread_safe_layer", lambda: False)
     _same(_chunked(p, threads=threads, chunk=50), ref)
-    if numba.threading_layer() in ("omp", "tbb"):
-        assert set(per_call) == {1} and state["most"] == threads
-    else:
-        assert set(per_call) == {threads} and state["most"] == 1
+    assert set(per_call) == {threads} and state["most"] == 1
+    if not real_layer():
+        pytest.skip("numba's threading layer here cannot launch kernels from two threads")
+    # one that can: calls of one thread each, never more at once than the threads
+    monkeypatch.setattr(runner, "_thread_safe_layer", lambda: True)
+    per_call.clear()
+    state["most"] = 0
+    _same(_chunked(p, threads=threads, chunk=50), ref)
+    assert set(per_call) == {1}
+    assert state["most"] >= 2 if threads > 1 else state["most"] == 1
+    assert state["most"] <= threads
 
 
 def test_a_cancelled_run_starts_nothing_more_and_stores_what_ran(tmp_path):
