@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..plotting.style import LAW_NAMES
+from ..plotting import cells
+from ..plotting.style import LAW_NAMES, figure
 from ..plotting.style import styled as _styled
 from .response import OUTCOMES
 
@@ -21,15 +22,10 @@ OUTCOME_COLOURS = ("#f2f2f2", "#f4a259", "#b2182b", "#e377c2")
 _STYLES = ("-", "--", ":", "-.")
 
 
-def _figure(width, aspect):
-    """A figure a journal's column (``"single"``) or page (``"double"``) wide, in the style in
-    force (:func:`rockjit.plotting.style.current`)."""
-    from matplotlib.figure import Figure
-    from matplotlib.layout_engine import ConstrainedLayoutEngine
-
-    from ..plotting.style import current
-    return Figure(figsize=current().size(width, aspect),
-                  layout=ConstrainedLayoutEngine(w_pad=0.04, h_pad=0.04))
+def _edges(v):
+    """Cell edges around increasing centres ``v`` (a single one spans 0.9-1.1 of itself: the
+    axes are logarithmic)."""
+    return cells.edges(v, lone_ratio=0.1)
 
 
 #: The axes' quantities, in the study's symbols (theta_c the block's critical angle).
@@ -40,16 +36,6 @@ AMPLITUDE = r"$a_p / (g \cot\theta_c)$"
 def _law_colour(law):
     from ..plotting.style import LAW_COLOURS
     return LAW_COLOURS.get(law, "k")
-
-
-def _edges(v):
-    """Cell edges around increasing centres ``v`` (geometric when all positive)."""
-    v = np.asarray(v, dtype=float)
-    if v.size == 1:
-        return np.array([v[0] * 0.9, v[0] * 1.1]) if v[0] > 0 else np.array([v[0] - 0.5,
-                                                                                v[0] + 0.5])
-    mid = 0.5 * (v[1:] + v[:-1])
-    return np.concatenate(([v[0] - (mid[0] - v[0])], mid, [v[-1] + (v[-1] - mid[-1])]))
 
 
 def _outcome_map(ax, sp):
@@ -106,7 +92,7 @@ def fig_spectrum(results, comparison=None):
         results = {results.block.law: results}
     sps = list(results.values())
     n = len(sps) + (1 if len(sps) == 2 else 0)
-    fig = _figure("single" if n == 1 else "double", 1.05 if n == 1 else 0.5)
+    fig = figure("single" if n == 1 else "double", 1.05 if n == 1 else 0.5)
     axes = fig.subplots(1, n, sharey=True, squeeze=False)[0]
     first = sps[0]
     kind = {"sine": "one-sine pulse", "cosine": "one-cosine pulse",
@@ -195,7 +181,7 @@ def fig_fragility(res):
     fraction of records that overturned the block at each intensity (circles) and the fitted
     lognormal curves over the intensities run (a fit whose status is not ``"ok"`` draws no
     curve; its legend entry says why), one colour per law and one line style per size."""
-    fig = _figure("single", 1.1)
+    fig = figure("single", 1.1)
     ax = fig.subplots()
     frac = res.fraction("overturn")
     handles = []
@@ -220,7 +206,7 @@ def fig_rotation(res):
     """Rotation exceedance: ``P(max |theta| / (pi/2 - theta_c) >= level)`` for each fitted
     level, one panel each, laws and sizes as in :func:`fig_fragility`."""
     from .fragility import EXCEEDANCE
-    fig = _figure("double", 0.55)
+    fig = figure("double", 0.55)
     axes = fig.subplots(1, len(EXCEEDANCE), sharey=True, squeeze=False)[0]
     for ax, lv in zip(axes, EXCEEDANCE):
         frac = res.fraction(f"exceed_{lv:g}")
@@ -245,7 +231,7 @@ def fig_rotation(res):
 def fig_transient(result):
     """One transient run: ``theta / (pi/2 - theta_c)`` and the base acceleration
     ``f / cot theta_c`` against time, the impacts marked."""
-    fig = _figure("double", 0.5)
+    fig = figure("double", 0.5)
     ax, axf = fig.subplots(2, 1, sharex=True, height_ratios=(2, 1))
     a = result.alpha_s
     tr = result.trajectory

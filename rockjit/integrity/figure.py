@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..plotting import cells
 from ..plotting import style as S
 
 __all__ = ["fig_fatal_shock", "fig_safety", "fig_safety_difference", "write"]
@@ -16,23 +17,10 @@ _DASHES = ("-", "--", ":", "-.")
 OMEGA_STUDY = 1.3
 
 
-def _figure():
-    from matplotlib.figure import Figure
-    return Figure(figsize=S.current().size("single", 0.85), layout="constrained")
-
-
 def _axes_labels(ax):
     from ..plotting.style import SYMBOLS
     ax.set_xlabel(SYMBOLS.get("omega", r"$\omega$"))
     ax.set_ylabel(SYMBOLS.get("alpha", r"$\alpha$"))
-
-
-def _edges(x):
-    x = np.asarray(x, dtype=float)
-    if x.size == 1:
-        return np.array([x[0] - 0.5, x[0] + 0.5]) if x[0] else np.array([-0.5, 0.5])
-    mid = 0.5 * (x[1:] + x[:-1])
-    return np.concatenate([[2 * x[0] - mid[0]], mid, [2 * x[-1] - mid[-1]]])
 
 
 def _legend(fig, handles):
@@ -53,9 +41,9 @@ def fig_safety(chart, levels=LEVELS):
     """The safe fraction of one law's chart over ``(omega, alpha)``, with its contours at
     ``levels`` (e.g. the forcings where 50 % and 90 % of the initial states are safe)."""
     from matplotlib.lines import Line2D
-    fig = _figure()
+    fig = S.figure("single", 0.85, pad=None)
     ax = fig.add_subplot()
-    mesh = ax.pcolormesh(_edges(chart.omega), _edges(chart.alpha), chart.safe, vmin=0, vmax=1,
+    mesh = ax.pcolormesh(cells.edges(chart.omega), cells.edges(chart.alpha), chart.safe, vmin=0, vmax=1,
                          cmap="viridis", shading="flat")
     fig.colorbar(mesh, ax=ax, label="safe fraction")
     handles = []
@@ -79,10 +67,10 @@ def fig_safety_difference(charts):
     alpha)``."""
     (la, a), (lb, b) = list(charts.items())[:2]
     d = a.safe - b.safe
-    fig = _figure()
+    fig = S.figure("single", 0.85, pad=None)
     ax = fig.add_subplot()
     top = float(np.nanmax(np.abs(d))) or 1.0
-    mesh = ax.pcolormesh(_edges(a.omega), _edges(a.alpha), d, vmin=-top, vmax=top,
+    mesh = ax.pcolormesh(cells.edges(a.omega), cells.edges(a.alpha), d, vmin=-top, vmax=top,
                          cmap="RdBu", shading="flat")
     fig.colorbar(mesh, ax=ax, label="difference of safe fractions")
     handles = []
@@ -103,10 +91,10 @@ def fig_fatal_shock(basin_result, shocks, edge=None):
     from matplotlib.lines import Line2D
     from matplotlib.patches import Circle, Patch
     b = basin_result
-    fig = _figure()
+    fig = S.figure("single", 0.85, pad=None)
     ax = fig.add_subplot()
     safe = (np.asarray(b.label) != 0).astype(float)
-    ax.pcolormesh(_edges(b.theta0), _edges(b.dtheta0), safe.T, cmap=ListedColormap(
+    ax.pcolormesh(cells.edges(b.theta0), cells.edges(b.dtheta0), safe.T, cmap=ListedColormap(
         ["white", "#c6dbef"]), vmin=0, vmax=1, shading="flat")
     handles = [Patch(facecolor="#c6dbef", edgecolor="0.5", label="safe initial states")]
     for k, (aid, sh) in enumerate(shocks.items()):

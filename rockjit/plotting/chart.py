@@ -18,7 +18,8 @@ try:  # the palette's home after the figures' rework; figures.py's until then
 except ImportError:  # pragma: no cover - depends on the rework's state
     from .figures import BEHAVIOUR_COLOURS, LAW_COLOURS
 
-from .style import LAW_NAMES
+from .cells import extent
+from .style import LAW_NAMES, behaviour_cmap, figure
 from .style import styled as _styled
 
 __all__ = ["CURVE_LABELS", "CURVE_STYLES", "fig_chart"]
@@ -37,27 +38,6 @@ _SUB = str.maketrans("0123456789", "\u2080\u2081\u2082\u2083\u2084\u2085\u2086\u
 DIFFER_HATCH = "////"
 #: The overturn boundary's colour (apart from the behaviours' and the curves').
 OVERTURN_EDGE = "#ffd400"
-
-
-def _figure(width, aspect):
-    from matplotlib.figure import Figure
-    from matplotlib.layout_engine import ConstrainedLayoutEngine
-    from .style import current
-    return Figure(figsize=current().size(width, aspect),
-                  layout=ConstrainedLayoutEngine(w_pad=0.04, h_pad=0.04))
-
-
-def _extent(x, y):
-    def half(v):
-        return (v[-1] - v[0]) / (len(v) - 1) / 2 if len(v) > 1 and v[-1] > v[0] else 0.5
-    dx, dy = half(x), half(y)
-    return (x[0] - dx, x[-1] + dx, y[0] - dy, y[-1] + dy)
-
-
-def _cmap():
-    from matplotlib.colors import BoundaryNorm, ListedColormap
-    cmap = ListedColormap([BEHAVIOUR_COLOURS[n] for n in BEHAVIOURS])
-    return cmap, BoundaryNorm(np.arange(len(BEHAVIOURS) + 1) - 0.5, cmap.N)
 
 
 #: The chart's cells are drawn this many times finer: each behaviour's share interpolated
@@ -94,7 +74,7 @@ def _map(ax, lab, x, y, **kw):
     codes, sh = _shares(lab, x, y)
     fine = codes[np.argmax(sh, axis=0)]
     ax.imshow(fine, origin="lower", aspect="auto", interpolation="nearest",
-              extent=_extent(_fine(x), _fine(y)), **kw)
+              extent=extent(_fine(x), _fine(y)), **kw)
 
 
 def _label(curve):
@@ -164,7 +144,7 @@ def _overturn_edge(ax, res, colour=OVERTURN_EDGE):
 
 def _chart_panel(ax, res, i, show_y=True):
     from .style import letter
-    cmap, norm = _cmap()
+    cmap, norm = behaviour_cmap()
     _map(ax, res.label(), res.plane.omega, res.plane.alpha, cmap=cmap, norm=norm)
     _overturn_edge(ax, res)
     placed = _curves(ax, res, "k", "w")
@@ -251,12 +231,12 @@ def fig_chart(results, title=None):
     first = res[0]
     legend_kw = dict(handlelength=4.0, frameon=False)
     if len(res) == 1:
-        fig = _figure("double", 0.58)
+        fig = figure("double", 0.58)
         ax = fig.add_subplot(1, 1, 1)
         placed = _chart_panel(ax, first, 0)
         fig.legend(handles=_legend_handles(res), loc="outside right center", **legend_kw)
     else:
-        fig = _figure("double", 0.86)
+        fig = figure("double", 0.86)
         gs = fig.add_gridspec(2, 2)
         axes = [fig.add_subplot(gs[0, 0])]
         axes.append(fig.add_subplot(gs[0, 1], sharey=axes[0]))

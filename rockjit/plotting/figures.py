@@ -23,6 +23,7 @@ import numpy as np
 
 from ..model import delta_e_percent, e_housner, e_mao, thc_from_hb
 from ..result import BEHAVIOURS, fractions
+from . import cells
 from . import style as S
 from .style import AGREE_COLOUR, BEHAVIOUR_COLOURS, DISAGREE_COLOUR, LAW_LINES, SYMBOLS
 
@@ -31,17 +32,14 @@ __all__ = ["BEHAVIOUR_COLOURS", "BIFURCATION_MARKERS", "END_MARKERS", "branch_ca
            "fig_branches", "fig_erosion", "fig_fate", "fig_gallery", "fig_laws_timeseries",
            "fig_plane", "fig_restitution", "fig_trajectory"]
 
+#: The figures' constrained-layout pads, in inches: a little more than the default (3 points),
+#: since constrained layout can leave a rotated axis label a point or two beyond the canvas's
+#: edge when a column's tick labels widen.
+PAD = (0.06, 0.05)
+#: Half the width of the cell of a diagram's single amplitude.
+LONE_HALF = 0.5e-3
 #: Lines of a behaviour: its colour, except the pale ones (rest), darkened to be seen as a line.
 LINE_COLOURS = dict(BEHAVIOUR_COLOURS, rest="#8C8C8C")
-
-
-def _figure(width, aspect):
-    from matplotlib.figure import Figure
-    from matplotlib.layout_engine import ConstrainedLayoutEngine
-    # a little more than the default pads (3 points): constrained layout can leave a rotated
-    # axis label a point or two beyond the canvas's edge when a column's tick labels widen
-    return Figure(figsize=S.current().size(width, aspect),
-                  layout=ConstrainedLayoutEngine(w_pad=0.06, h_pad=0.05))
 
 
 def _params(res):
@@ -76,25 +74,6 @@ def _behaviour_handles(names, labels=None, marker=False):
     return out
 
 
-def _extent(x, y):
-    """``imshow`` extent of a grid over axes ``x, y``: half a cell beyond the end points (half
-    a unit for an axis of one point, or of equal points, so the extent is never empty)."""
-    def half(v):
-        return (v[-1] - v[0]) / (len(v) - 1) / 2 if len(v) > 1 and v[-1] > v[0] else 0.5
-    dx, dy = half(x), half(y)
-    return (x[0] - dx, x[-1] + dx, y[0] - dy, y[-1] + dy)
-
-
-def _edges(x):
-    """Cell edges around the points ``x`` (increasing): midpoints, and half a step beyond the
-    ends."""
-    x = np.asarray(x, float)
-    if x.size == 1:
-        return np.array([x[0] - 0.5e-3, x[0] + 0.5e-3])
-    d = np.diff(x)
-    return np.concatenate([[x[0] - d[0] / 2], x[:-1] + d / 2, [x[-1] + d[-1] / 2]])
-
-
 # ---------------------------------------------------------------------------------------------
 # Figure 1: restitution laws
 # ---------------------------------------------------------------------------------------------
@@ -118,7 +97,7 @@ def fig_restitution(hb_range=(1.0 / math.sqrt(2.0), 6.0), n=400, marks=(1.0, 2.0
     thc = np.linspace(thc_from_hb(lo), thc_from_hb(hi), n)
     eh, em = e_housner(thc), e_mao(thc)
     de = delta_e_percent(em, eh)
-    fig = _figure("single", 0.95)
+    fig = S.figure("single", 0.95, pad=PAD)
     ax = fig.add_subplot()
     deg = np.degrees(thc)
     ax.plot(deg, eh, color="k", ls=LAW_LINES["housner"]["ls"], lw=1.5,
@@ -324,7 +303,7 @@ def fig_trajectory(result, behaviour, *, exponent=None, title=None, first=8, las
     _need_traj(result)
     colour = LINE_COLOURS[behaviour[0]]
     lam = result.lyapunov_running
-    fig = _figure("double", 0.52)
+    fig = S.figure("double", 0.52, pad=PAD)
     gs = fig.add_gridspec(2, 3, width_ratios=(1.5, 1.0, 1.25))
     wins = _windows(result, first, last)
     axes_t = []
@@ -410,7 +389,7 @@ def fig_gallery(results, behaviours, notes=None, *, first=8, last=4):
     if not results:
         raise ValueError("results must hold at least one run")
     n = len(results)
-    fig = _figure("double", 0.25 * n + 0.08)
+    fig = S.figure("double", 0.25 * n + 0.08, pad=PAD)
     subs = np.atleast_1d(fig.subfigures(n, 1))
     for r, ((caption, res), sub) in enumerate(zip(results.items(), subs)):
         _need_traj(res)
@@ -483,7 +462,7 @@ def fig_laws_timeseries(runs, behaviours, captions=None, *, periods=8):
     if not runs:
         raise ValueError("runs must hold at least one initial state")
     n = len(runs)
-    fig = _figure("double", 0.27 * n + 0.04)
+    fig = S.figure("double", 0.27 * n + 0.04, pad=PAD)
     subs = np.atleast_1d(fig.subfigures(n, 1))
     for i, (row, sub) in enumerate(zip(runs, subs)):
         laws = list(row)
@@ -569,7 +548,7 @@ def _bifurcation_column(fig, gs_col, sw, alpha_limits, show_y, col, short=False)
 
     # a strip: the behaviour of every alpha, including those without stroboscopic points
     cmap, norm = S.behaviour_cmap()
-    edges = _edges(alpha)
+    edges = cells.edges(alpha, lone=LONE_HALF)
     ax_s.pcolormesh(edges, [0, 1], label[None, :], cmap=cmap, norm=norm, rasterized=True)
     # the strip's name as its one tick label (a horizontal axis label is laid out badly)
     ax_s.set_yticks([0.5], ["class"] if show_y else [""])
@@ -640,8 +619,8 @@ def fig_bifurcation(sweeps, alpha_limits=None, title=None):
         alpha_limits = tuple(float(v) for v in alpha_limits)
     n = len(sweeps)
     from matplotlib.lines import Line2D
-    fig = _figure("single" if n == 1 and S.current().name == "paper"
-                  else ("double" if n > 1 else 0.6), 0.95 if n == 1 else 0.58)
+    fig = S.figure("single" if n == 1 and S.current().name == "paper"
+                   else ("double" if n > 1 else 0.6), 0.95 if n == 1 else 0.58, pad=PAD)
     gs = fig.add_gridspec(3, n, height_ratios=(2.4, 0.12, 1.0))
     present, any_rest = set(), False
     for c, sw in enumerate(sweeps.values()):
@@ -671,7 +650,7 @@ def _basin_axes(ax, b, show_y=True):
     # label[i, j] belongs to theta0[i], dtheta0[j]: rows of the image are dtheta0
     ax.imshow(np.asarray(b.label).T, origin="lower", cmap=cmap, norm=norm,
               interpolation="nearest", aspect="auto",
-              extent=_extent(np.asarray(b.theta0), np.asarray(b.dtheta0)))
+              extent=cells.extent(np.asarray(b.theta0), np.asarray(b.dtheta0)))
     ax.set_xlabel(SYMBOLS["theta0"])
     if show_y:
         ax.set_ylabel(SYMBOLS["dtheta0"])
@@ -693,7 +672,7 @@ def _cells(b):
 def fig_basin(basin_result, title=None):
     """Figure 6 (one law): the behaviour of each ``(theta0, theta0')``, with percentages."""
     b = basin_result
-    fig = _figure("single" if S.current().name == "paper" else 0.48, 1.12)
+    fig = S.figure("single" if S.current().name == "paper" else 0.48, 1.12, pad=PAD)
     ax = fig.add_subplot()
     _basin_axes(ax, b)
     _basin_legend(ax, b)
@@ -717,7 +696,7 @@ def fig_basin_compare(housner_basin, mao_basin, title=None):
         raise ValueError("the two basins must be computed on the same grid")
     agree = np.asarray(a.label) == np.asarray(b.label)
     pct = 100.0 * float(np.mean(agree)) if agree.size else math.nan
-    fig = _figure("double", 0.46)
+    fig = S.figure("double", 0.46, pad=PAD)
     axes = fig.subplots(1, 3, sharey=True)
     for i, res in enumerate((a, b)):
         _basin_axes(axes[i], res, show_y=i == 0)
@@ -725,7 +704,8 @@ def fig_basin_compare(housner_basin, mao_basin, title=None):
         S.letter(axes[i], i, S.law_name(res.block))
     axes[2].imshow(agree.T.astype(int), origin="lower", interpolation="nearest",
                    aspect="auto", cmap=ListedColormap([DISAGREE_COLOUR, AGREE_COLOUR]),
-                   vmin=0, vmax=1, extent=_extent(np.asarray(a.theta0), np.asarray(a.dtheta0)))
+                   vmin=0, vmax=1,
+                   extent=cells.extent(np.asarray(a.theta0), np.asarray(a.dtheta0)))
     axes[2].set_xlabel(SYMBOLS["theta0"])
     S.letter(axes[2], 2, f"agreement: {pct:.1f} %")
     axes[2].legend(handles=[Patch(facecolor=AGREE_COLOUR, edgecolor="0.5", lw=0.5,
@@ -759,7 +739,7 @@ def _attractor_panel(ax, ids, theta0, dtheta0, attractors, show_y=True):
                           + colours)
     norm = BoundaryNorm(np.arange(-2, n + 1) - 0.5, cmap.N)
     ax.imshow(np.asarray(ids).T, origin="lower", cmap=cmap, norm=norm, interpolation="nearest",
-              aspect="auto", extent=_extent(np.asarray(theta0), np.asarray(dtheta0)))
+              aspect="auto", extent=cells.extent(np.asarray(theta0), np.asarray(dtheta0)))
     ax.set_xlabel(SYMBOLS["theta0"])
     if show_y:
         ax.set_ylabel(SYMBOLS["dtheta0"])
@@ -796,7 +776,8 @@ def fig_attractors(basins, measures=None, title=None):
     if not isinstance(basins, dict):
         basins = {basins.block.law: basins}
     measures = measures or {law: b.measures() for law, b in basins.items()}
-    fig = _figure("double" if len(basins) > 1 else 0.5, 0.62 if len(basins) > 1 else 1.2)
+    fig = S.figure("double" if len(basins) > 1 else 0.5, 0.62 if len(basins) > 1 else 1.2,
+                   pad=PAD)
     axes = np.atleast_1d(fig.subplots(1, len(basins), sharey=True))
     for i, (ax, (law, b)) in enumerate(zip(axes, basins.items())):
         handles = _attractor_panel(ax, b.attractor, b.theta0, b.dtheta0, b.attractors,
@@ -869,7 +850,7 @@ def fig_erosion(profiles, title=None):
     if not isinstance(profiles, dict):
         profiles = {profiles.block.law: profiles}
     n = len(profiles)
-    fig = _figure("double", 0.30 + 0.30 * n)
+    fig = S.figure("double", 0.30 + 0.30 * n, pad=PAD)
     gs = fig.add_gridspec(1 + n, 2, height_ratios=[1.0] + [1.15] * n,
                           width_ratios=(1.0, 1.0))
     ax_g = fig.add_subplot(gs[0, 0])
@@ -890,7 +871,7 @@ def fig_erosion(profiles, title=None):
         axk = fig.add_subplot(gs[1 + k, 0], sharex=ax_g)
         ax_leg = fig.add_subplot(gs[1 + k, 1])
         ax_leg.axis("off")
-        edges = _edges(r.alpha)
+        edges = cells.edges(r.alpha, lone=LONE_HALF)
         areas = _erosion_areas(r)
         bottom = np.zeros(r.alpha.size)
         from matplotlib.patches import Patch
@@ -956,7 +937,7 @@ def fig_fate(fate_result, title=None):
     """An ensemble of nearby runs: each outcome's probability, and when each member stopped
     against its initial perturbation, with the predictability horizon marked."""
     fr = fate_result
-    fig = _figure("double", 0.4)
+    fig = S.figure("double", 0.4, pad=PAD)
     ax, ax_t = fig.subplots(1, 2, width_ratios=(1, 1.5))
     keys = list(fr.probabilities)
     words, behs = _outcome_names(keys)
@@ -1006,9 +987,9 @@ def fig_plane(plane_result, state=0, title=None):
     p = plane_result
     lab = np.asarray(p.label)[state]
     lam = np.array(p.lambda_max, dtype=float)[state]
-    ext = _extent(np.asarray(p.omega), np.asarray(p.alpha))
+    ext = cells.extent(np.asarray(p.omega), np.asarray(p.alpha))
     cmap, norm = S.behaviour_cmap()
-    fig = _figure("double", 0.5)
+    fig = S.figure("double", 0.5, pad=PAD)
     ax, axl = fig.subplots(1, 2, sharey=True)
     ax.imshow(lab, origin="lower", cmap=cmap, norm=norm, interpolation="nearest",
               aspect="auto", extent=ext)
@@ -1161,7 +1142,7 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
         raise ValueError(f"component must be 0 (theta) or 1 (theta') (got {component!r})")
     pname = c.parameter
     sym = SYMBOLS.get(pname, pname)
-    fig = _figure("double", 0.66)
+    fig = S.figure("double", 0.66, pad=PAD)
     ax = fig.add_subplot()
     # legend entry -> (handle, artists it names): an entry is kept when one of its artists
     # draws within the view

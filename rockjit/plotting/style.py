@@ -42,7 +42,7 @@ from .legibility import TEXT_POINTS, WIDTHS
 
 __all__ = ["AGREE_COLOUR", "BEHAVIOUR_COLOURS", "DISAGREE_COLOUR", "FORMATS", "LAW_COLOURS",
            "LAW_LINES", "LAW_NAMES", "STYLES", "SYMBOLS", "Style", "TEXT_POINTS", "WIDTHS",
-           "attractor_colours", "attractor_names", "behaviour_cmap", "current", "cvd_distances", "law_name", "letter", "shade",
+           "attractor_colours", "attractor_names", "behaviour_cmap", "current", "cvd_distances", "figure", "law_name", "letter", "shade",
            "styled", "suptitle", "tint", "use", "variant"]
 
 #: One colour per behaviour (rockjit.result.BEHAVIOURS), in every figure and command.
@@ -199,6 +199,18 @@ def styled(fn):
                         ax.tick_params(axis=axis, which="both", labelsize=size)
         return fig
     return drawn_in_style
+
+
+def figure(width, aspect, pad=(0.04, 0.04)):
+    """A figure without pyplot, a journal's column (``"single"``) or page (``"double"``) wide in
+    the style in force (:meth:`Style.size`), laid out by constrained layout with ``pad =
+    (w_pad, h_pad)`` inches around each axes (``None``: matplotlib's defaults)."""
+    from matplotlib.figure import Figure
+    from matplotlib.layout_engine import ConstrainedLayoutEngine
+    size = current().size(width, aspect)
+    if pad is None:
+        return Figure(figsize=size, layout="constrained")
+    return Figure(figsize=size, layout=ConstrainedLayoutEngine(w_pad=pad[0], h_pad=pad[1]))
 
 
 def suptitle(fig, text, **kw):

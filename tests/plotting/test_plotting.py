@@ -234,3 +234,19 @@ def test_basin_compare_agreement():
     assert agreement(a.label, b.label) == pytest.approx(pct)
     with pytest.raises(ValueError, match="same grid"):
         P.fig_basin_compare(a, _basin("mao", 2, n=5))
+
+
+def test_cell_edges_and_extent():
+    from rockjit.plotting import cells
+    x = np.array([0.3, 0.5, 0.6, 1.0])
+    # the midpoints, and beyond each end as far as the nearest midpoint is inside it
+    np.testing.assert_allclose(cells.edges(x), [0.2, 0.4, 0.55, 0.8, 1.2], rtol=0, atol=1e-15)
+    # a single point: half a unit either side by default, ``lone`` when given, or a share of
+    # itself when positive and ``lone_ratio`` is given (a log axis)
+    assert cells.edges([0.7]).tolist() == [0.7 - 0.5, 0.7 + 0.5]
+    assert cells.edges([0.0]).tolist() == [-0.5, 0.5]
+    assert cells.edges([0.7], lone=0.5e-3).tolist() == [0.7 - 0.5e-3, 0.7 + 0.5e-3]
+    assert cells.edges([2.0], lone_ratio=0.1).tolist() == [1.8, 2.2]
+    assert cells.edges([-2.0], lone_ratio=0.1).tolist() == [-2.5, -1.5]
+    # an image's extent: half a step beyond the ends, half a unit for a single point
+    assert cells.extent(np.array([1.0, 2.0, 3.0]), np.array([4.0])) == (0.5, 3.5, 3.5, 4.5)
