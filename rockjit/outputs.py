@@ -272,7 +272,7 @@ def spectrum(out, res, *, npz="spectrum.npz", png="spectrum.png"):
                    "into outcomes), max rotation and the located minimum overturning amplitude "
                    "per ratio with its mode", **arrays)
     comparison = compare(*res.values()) if two else None
-    _figure(out, png, lambda: fig_spectrum(res, comparison),
+    _figure(out, png, lambda: fig_spectrum(res),
             f"the overturning spectrum: the two modes of overturning and the safe region, per "
             f"law (data: {npz})")
     if len(res) == 1:

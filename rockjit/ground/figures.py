@@ -81,7 +81,7 @@ def _closed_form(ax, sp):
 
 
 @_styled
-def fig_spectrum(results, comparison=None):
+def fig_spectrum(results):
     """Overturning spectra: per law, the outcome of every cell over
     ``(omega_p / p, a_p / (g cot theta_c))`` with the located boundaries; with two laws, a
     third panel of the cells where they differ and both laws' minimum overturning amplitude.

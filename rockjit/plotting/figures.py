@@ -437,7 +437,7 @@ def fig_gallery(results, behaviours, notes=None, *, first=8, last=4):
 # ---------------------------------------------------------------------------------------------
 
 @S.styled
-def fig_laws_timeseries(runs, behaviours, captions=None, *, periods=8):
+def fig_laws_timeseries(runs, behaviours, *, periods=8):
     """Figure 4: the two laws from the same initial states, one row per initial state: each
     law's ``theta(t)`` over the last ``periods`` periods of its run, where it has settled (the
     whole run when it overturns or comes to rest sooner), one above the other so that neither
@@ -451,10 +451,6 @@ def fig_laws_timeseries(runs, behaviours, captions=None, *, periods=8):
         One row per initial state; in each row the runs of each law (with trajectories).
     behaviours : sequence of dict law -> (str, int)
         Each run's behaviour and period.
-    captions : sequence of str, optional
-        Not drawn: the caption of each row, for the text beside the figure
-        (:func:`rockjit.study.paper.laws_captions` writes them); accepted so that a caller can
-        pass the figure and its captions together.
     periods : int
         Forcing periods of ``theta(t)`` shown.
     """

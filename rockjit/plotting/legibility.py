@@ -298,7 +298,7 @@ def _entry_colour(h):
     return None
 
 
-def _entry_form(h, legend):
+def _entry_form(h):
     """What besides colour tells an entry apart: its line's dash pattern as drawn, its marker,
     whether it is a filled area."""
     from matplotlib.lines import Line2D
@@ -371,7 +371,7 @@ def legend_colour_problems(fig, delta=LEGEND_DELTA):
     _renderer(fig)
     bad = []
     for lg in _legends(fig):
-        entries = [(lab, _entry_colour(h), _entry_form(h, lg)) for lab, h in _entries(lg)]
+        entries = [(lab, _entry_colour(h), _entry_form(h)) for lab, h in _entries(lg)]
         for (la, ca, fa), (lb, cb, fb) in itertools.combinations(entries, 2):
             if ca is None or cb is None or fa != fb:
                 continue

@@ -175,8 +175,6 @@ def test_laws_timeseries(short_runs, ref_run):
     titles = [ax.get_title() for ax in fig.axes if ax.get_title()]
     assert titles == ["Housner:\nsymmetric, $p = 1$", f"Housner:\nat rest from $t = {rest.t:.3g}$"]
     assert fig.subfigs[0].get_supxlabel() == ""
-    fig = P.fig_laws_timeseries([row], beh, ["both as said"])
-    assert fig.subfigs[0].get_supxlabel() == ""
 
 
 def test_bifurcation_draws_every_finite_point_and_clips_rest():
