@@ -94,7 +94,7 @@ def one_call_per_chunk():
     """Within the block, each chunk runs as one call of the parallel kernel on all the threads
     (no pieces): with one chunk, the whole grid in one call."""
     real = runner.local_plan
-    runner.local_plan = lambda threads, concurrent=None: (max(1, int(threads)), 1)
+    runner.local_plan = lambda threads: (max(1, int(threads)), 1)
     try:
         yield
     finally:
