@@ -382,7 +382,7 @@ def corner(f, side, sthc, cthc):
 @jit
 def accel_pq(P, Q, s, c, dtheta, xi):
     """``theta''`` from :func:`corner`'s ``P, Q`` and ``s, c = sin(theta), cos(theta)``."""
-    return fma(-0.75 * xi, dtheta, fma(P, c, Q * s))
+    return fma(-damping_rate(xi), dtheta, fma(P, c, Q * s))
 
 
 @jit
@@ -400,7 +400,7 @@ def accel_near(P, Q, d, dtheta, xi):
     while the polynomials are evaluated, a multiplication off the integrator's critical path.
     """
     sn, cn = near_poly(d)
-    return fma(-0.75 * xi, dtheta, fma(P, cn, (Q * d) * sn))
+    return fma(-damping_rate(xi), dtheta, fma(P, cn, (Q * d) * sn))
 
 
 @jit
@@ -468,7 +468,7 @@ def accel_jac(theta, dtheta, f, side, thc, xi):
     P, Q = corner(f, side, sthc, cthc)
     s, c = sincos(theta)
     # d/df of P cos + Q sin is 3/4 (sin(thc) cos(theta) + side cos(thc) sin(theta))
-    return slope_pq(P, Q, s, c), -0.75 * xi, 0.75 * fma(sthc, c, side * cthc * s)
+    return slope_pq(P, Q, s, c), -damping_rate(xi), 0.75 * fma(sthc, c, side * cthc * s)
 
 
 @jit

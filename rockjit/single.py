@@ -19,7 +19,7 @@ import numpy as np
 
 from ._engine import kernel
 from .excitation import STUDY_PHASE, Harmonic
-from .model import Block, initial_side
+from .model import Block, damping_rate, initial_side
 from .result import Result
 from ._engine.classify import classify
 from .result import BEHAVIOURS
@@ -132,8 +132,8 @@ def check_step(period, n_steps, forcing="closed", radius=1.0, xi=0.0):
     """
     h_max = STEP_LIMIT
     why = f"the step T/N must be <= {STEP_LIMIT}"
-    if xi > 0 and STABLE_DAMPING / (0.75 * xi) < h_max:
-        h_max = STABLE_DAMPING / (0.75 * xi)
+    if xi > 0 and STABLE_DAMPING / damping_rate(xi) < h_max:
+        h_max = STABLE_DAMPING / damping_rate(xi)
         why = (f"the damping xi = {xi:g} needs a step T/N <= {h_max:.3g} to stay stable "
                f"(3/4 xi T/N <= {STABLE_DAMPING})")
     if forcing == "embedded":
@@ -155,7 +155,7 @@ def steps_per_period(period, default, xi=0.0):
     n = int(default)
     h_max = MAX_STEP
     if xi > 0:
-        c = 0.75 * xi
+        c = damping_rate(xi)
         h_max = min(h_max, DAMPING_STEP / c)
         if c > DAMPING_ONSET:
             n = max(n, 2 * math.ceil(n * (c / DAMPING_ONSET) ** 0.4 / 2))

@@ -29,7 +29,7 @@ from . import integrate as ig
 from .cell import (C_LAMTOL, C_TOL, N_RES, R_K0, R_K1, R_LABEL, R_LAM1, R_LAM2,  # noqa: F401
                    R_MOTION, R_NIMP, R_PERIOD, R_STATUS, R_T, R_TOVER, _classify, _collect)
 from .._jit import jit
-from ..model import initial_side
+from ..model import damping_rate, initial_side
 from ..result import Result
 from ..validate import integer
 
@@ -115,7 +115,7 @@ def default_qr_every(n_steps, h, xi):
     (rate ``3/4 xi``, step ``h``) separates the two vectors by at most
     ``exp(-QR_CONTRACTION)``."""
     n = n_steps // 2
-    c = 0.75 * xi * h
+    c = damping_rate(xi) * h
     if c > 0.0:
         # compared in floating point first: for a damping as small as 1e-320 the quotient is
         # infinite (or beyond any integer a step counter holds), and then twice a period stays

@@ -25,7 +25,7 @@ import numba
 import numpy as np
 
 from .._engine import transient as T
-from ..model import initial_side
+from ..model import damping_rate, initial_side
 from ..validate import memory
 from .pulses import KINDS, Pulse
 from .response import STATUS_CODES, TransientResult, alpha_s, empty_outputs
@@ -86,7 +86,7 @@ def _shrink(blocks):
     xi = max(b.xi for b in blocks)
     if xi <= 0.0:
         return 1.0
-    return min(1.0, DAMPED_STEP / (0.75 * xi * max(H_PULSE, H_RECORD, H_FREE)))
+    return min(1.0, DAMPED_STEP / (damping_rate(xi) * max(H_PULSE, H_RECORD, H_FREE)))
 
 
 def compiled_kernel(blocks, sources, block_of, source_of, gain, settings, method):
