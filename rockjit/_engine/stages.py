@@ -56,7 +56,8 @@ def chain(stage, coef=None, *, arith="fma", form="nystrom", h="hh", last=ROWS - 
     ----------
     stage : callable
         ``stage(i)`` -> the line(s) (a string, ``\\n``-separated) that set ``k{i}`` from
-        ``x{i}, v{i}`` (with ``arith="plain"``, ``c{i}`` is the row's node as a literal).
+        ``x{i}, v{i}``; the row's node is not defined in the chain: a stage that needs it
+        writes it in, as :func:`node` gives it (a literal, ``1.0`` at the step's end).
     coef : callable, optional
         With ``arith="fma"``: ``coef(kind, i, j)`` -> the expression of the step-scaled
         coefficient ``j`` of row ``i`` (``kind`` ``"A"``: ``h A``/``h B``; ``"AA"``:
