@@ -434,10 +434,18 @@ def test_renormalisation_interval_by_brute_force():
 
 def test_default_impact_bound_fits_the_kernels_counter_for_every_period_count():
     # 10,000 x 922337203685478 periods overflowed int64 (OverflowError from numpy)
+    # docs/theory/impacts.md: 10,000 impacts a period, at least 100,000; capped at 2**62 (the
+    # settings' MAX_IMPACTS), which the bound of 461168601842739 periods or more would pass
     from rockjit.settings import MAX_PERIODS
-    for periods in (1, 10, 10**4, 922337203685478, MAX_PERIODS):
+    expected = {1: 100_000, 10: 100_000, 500: 5_000_000, 10**4: 100_000_000,
+                461168601842738: 4_611_686_018_427_380_000,
+                461168601842739: 4_611_686_018_427_387_904,
+                922337203685478: 4_611_686_018_427_387_904,
+                10**15: 4_611_686_018_427_387_904}
+    assert MAX_PERIODS in expected
+    for periods, want in expected.items():
         bound = Integration(periods=periods).impact_bound()
-        assert bound == min(2**62, max(100_000, 10_000 * periods)) and bound < 2**63
+        assert bound == want and bound < 2**63
 
 
 @pytest.mark.parametrize("periods", [922337203685478, 10**15])
