@@ -21,7 +21,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
 import rockjit  # noqa: E402
-from rockjit import Block, Harmonic, Integration  # noqa: E402
+from rockjit import Block, Harmonic, Integration, Pulse, Transient  # noqa: E402
 from rockjit.plotting import figures as P  # noqa: E402
 from rockjit.plotting import legibility as L  # noqa: E402
 from rockjit.plotting import style  # noqa: E402
@@ -151,7 +151,9 @@ def runs():
                             **dict(RUN, record_stride=1))
     over = rockjit.simulate(Block(hb=2.0), Harmonic(alpha=0.448, omega=1.3), **RUN)
     mao = rockjit.simulate(Block(hb=1.0, law="mao"), Harmonic(alpha=0.6, omega=1.3), **RUN)
-    return dict(sym=sym, rest=rest, over=over, mao=mao)
+    pulse = rockjit.simulate(Block(hb=4.0), Pulse("ricker", ratio=2.0, amplitude=2.0),
+                             integration=Transient(free_time=5.0))
+    return dict(sym=sym, rest=rest, over=over, mao=mao, pulse=pulse)
 
 
 @pytest.fixture(scope="module")
@@ -163,9 +165,11 @@ def grids():
     bs = {law: rockjit.basin(Block(hb=1.0, law=law), Harmonic(alpha=0.66, omega=1.3), 8,
                              integration=integ) for law in ("housner", "mao")}
     pl = rockjit.plane(Block(hb=1.0), (0.5, 0.9), (1.2, 1.4), grid=(3, 3), integration=integ)
+    pl2 = rockjit.plane(Block(hb=1.0), (0.5, 0.9), (1.2, 1.4), grid=(3, 3),
+                        state=[(0.0, 0.0), (0.1, 0.0)], integration=integ)
     fr = rockjit.fate(Block(hb=1.0), Harmonic(alpha=0.969, omega=1.3),
                       integration=Integration(periods=60), ensemble=8)
-    return dict(sweeps=sw, basins=bs, plane=pl, fate=fr)
+    return dict(sweeps=sw, basins=bs, plane=pl, plane2=pl2, fate=fr)
 
 
 def _branch(period, symmetric, value, y0, slope, ends=("range", "range"), stable=None):
@@ -295,7 +299,7 @@ def _fragility():
 
 
 def _builders():
-    from rockjit.ground.figures import fig_fragility, fig_rotation, fig_spectrum
+    from rockjit.ground.figures import fig_fragility, fig_rotation, fig_spectrum, fig_transient
     from rockjit.plotting.chart import fig_chart
     from rockjit.study import paper
     cont = _continuation()
@@ -312,6 +316,9 @@ def _builders():
         "fig5": lambda r, g: paper.draw_fig5(g["sweeps"], 1),
         "fig5_branches": lambda r, g: P.fig_branches(cont),
         "fig5_branches_zoom": lambda r, g: P.fig_branches(cont, limits=(0.9, 1.0)),
+        "fig5_one_sweep": lambda r, g: P.fig_bifurcation(g["sweeps"]["housner"]),
+        "branches_over_sweep": lambda r, g: P.fig_branches(cont, g["sweeps"]["housner"]),
+        "fig6_one_law": lambda r, g: P.fig_basin(g["basins"]["housner"]),
         "fig6": lambda r, g: P.fig_basin_compare(g["basins"]["housner"], g["basins"]["mao"]),
         "fig7": lambda r, g: P.fig_attractors(g["basins"]),
         "fig8": lambda r, g: P.fig_erosion({"housner": _erosion(), "mao": _erosion()}),
@@ -319,11 +326,13 @@ def _builders():
                                         "mao": _chart("mao", 0.05)}),
         "chart": lambda r, g: fig_chart(_chart("housner")),
         "plane": lambda r, g: P.fig_plane(g["plane"]),
+        "plane_second_state": lambda r, g: P.fig_plane(g["plane2"], state=1),
         "fate": lambda r, g: P.fig_fate(g["fate"]),
         "spectrum": lambda r, g: fig_spectrum({"housner": _spectrum("housner"),
                                                "mao": _spectrum("mao")}),
         "fragility": lambda r, g: fig_fragility(_fragility()),
         "rotation": lambda r, g: fig_rotation(_fragility()),
+        "transient": lambda r, g: fig_transient(r["pulse"]),
     }
 
 
