@@ -17,7 +17,7 @@ import numpy as np
 from ..plotting.style import LAW_NAMES
 from ..settings import Integration
 from .paper import (BASIN_CASES, CHART, E_FIGURE_HB_MAX, FIRST_PERIODS, GALLERY, LAST_PERIODS,
-                    LAWS_RUN, REFERENCE_RUN)
+                    LAWS_PERIODS, LAWS_RUN, REFERENCE_RUN)
 
 __all__ = ["E_TABLE_PUBLISHED", "FATES_NOTE", "FATES_PUBLISHED", "GIM_PUBLISHED", "SHARES_PUBLISHED",
            "TRANSITIONS", "published_beside", "write_index"]
@@ -248,7 +248,8 @@ def _captions(results, plan):
         4: f"Housner against Mao et al. in time: <i>h/b</i> = {laws['hb']:g}, &alpha; = "
            f"{laws['alpha']:g}, &omega; = {laws['omega']:g}, "
            "(<i>r</i><sub>0</sub>, <i>s</i><sub>0</sub>) = (0, 1), from three initial states. "
-           f"Each row: each law's &theta;(<i>t</i>) over the last {first} periods of its run, "
+           f"Each row: each law's &theta;(<i>t</i>) over the last {LAWS_PERIODS} periods of its "
+           f"run, "
            "where it has settled (the whole run when it overturns or rests sooner), and its phase "
            f"portrait, in its behaviour's colour. {caps4}",
         5: "Bifurcation diagrams: &theta;'(<i>kT</i>) over the classified stretch against "
