@@ -55,27 +55,19 @@ from .classify import orbit_scale, repeats
 from ..model import forcing_closed, jump, saltation, sincos, uplift_time
 # the tableau (scipy's names) and the step's table, the layout, the step and the events: each
 # a module of its own, named here too (the kernels' one entry point)
-from .tableau import (A, B, C, E, N_STAGES, N_TAB, P, T_HAA, T_HB, T_HBA, T_HC,  # noqa: F401
-                      T_ROTC, T_ROTS, _AA, _BA, step_table, tab_entry)
+from .tableau import A, B, C, E, N_STAGES, N_TAB, P, step_table, tab_entry  # noqa: F401
 from .layout import (RUNNING, DONE, OVERTURNED, REST, MAX_IMPACTS, NONFINITE, SETTLED,  # noqa: F401
-                     STATUS_NAMES, Outputs, Work, P_THC, P_XI, P_E, P_AW2, P_OMEGA,
-                     P_PHI, P_COT, P_THOVER, P_REST, P_H, P_SETTLE_TOL, N_PAR, P_STHC,
-                     P_CTHC, N_PARW, I_N, I_PERIODS, I_MAXIMP, I_STRIDE, I_WINDOW,
-                     I_SETTLE, I_QR, I_PMAX, I_CONTINUE, N_IPAR, O_STATUS, O_STEPS,
-                     O_IMPACTS, O_RHS, O_NSTROBE, O_NHALF, O_NTRAJ, O_NREST,
-                     O_NREST_WIN, O_SUBSTEPS, O_NIMP_WIN, O_PERIOD, O_NCOL,
-                     O_UNCONVERGED, O_RESTEP, N_IOUT, F_T, F_TH, F_DTH, F_R, F_S,
-                     F_MAXERR, F_LAM1, F_LAM2, F_WINTIME, F_V, F_TOVER, N_FOUT, FT_DF0,
-                     FT_DF1, FT_SIN, FT_COS, N_FTAB, EV_NONE, EV_IMPACT, EV_OVERTURN,
-                     EV_UPLIFT, BISECT_ITERS, NEWTON_ITERS, DELTA_EULER, LOCATE_TOL,
-                     OFF_GRID)
-from .step import (block_stage, rhs, _tab_coef, _BLOCK_STEP, block_step, osc_step,  # noqa: F401
-                   tangent_column, tangent_step, phase_before, forcing_at, rk_step,
-                   dense_coeffs)
-from .events import (event_g, event_value, dense_event, turning_point,  # noqa: F401
-                     dense_event_slope, end_derivs, hermite7, poly7, poly6,
-                     interpolant, interp_error, interp_at, newton_bracketed,
-                     locate_interp, locate, locate_step, detect)
+                     STATUS_NAMES, Outputs, Work, P_THC, P_XI, P_E, P_AW2, P_OMEGA, P_PHI, P_COT,
+                     P_THOVER, P_REST, P_H, P_SETTLE_TOL, N_PAR, P_STHC, P_CTHC, N_PARW, I_N,
+                     I_PERIODS, I_MAXIMP, I_STRIDE, I_WINDOW, I_SETTLE, I_QR, I_PMAX, I_CONTINUE,
+                     N_IPAR, O_STATUS, O_STEPS, O_IMPACTS, O_RHS, O_NSTROBE, O_NHALF, O_NTRAJ,
+                     O_NREST, O_NREST_WIN, O_SUBSTEPS, O_NIMP_WIN, O_PERIOD, O_NCOL, O_UNCONVERGED,
+                     O_RESTEP, N_IOUT, F_T, F_TH, F_S, F_MAXERR, F_LAM1, F_LAM2, F_WINTIME, F_V,
+                     F_TOVER, N_FOUT, FT_DF0, FT_DF1, FT_SIN, FT_COS, N_FTAB, EV_NONE, EV_IMPACT,
+                     EV_OVERTURN, EV_UPLIFT, BISECT_ITERS, OFF_GRID)
+from .step import rhs, block_step, phase_before, forcing_at, rk_step  # noqa: F401
+from .events import (turning_point, interp_at, locate_interp, locate, locate_step,  # noqa: F401
+                     detect)
 
 
 def build(embed4: bool = False, tangent: bool = False):
