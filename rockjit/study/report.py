@@ -16,8 +16,8 @@ import numpy as np
 
 from ..plotting.style import LAW_NAMES
 from ..settings import Integration
-from .paper import (BASIN_CASES, CHART, E_FIGURE_HB_MAX, FIRST_PERIODS, GALLERY, LAST_PERIODS,
-                    LAWS_PERIODS, LAWS_RUN, REFERENCE_RUN)
+from .settings import (BASIN_CASES, CHART, E_FIGURE_HB_MAX, FIRST_PERIODS, GALLERY,
+                       LAST_PERIODS, LAWS_PERIODS, LAWS_RUN, REFERENCE_RUN)
 
 __all__ = ["E_TABLE_PUBLISHED", "FATES_NOTE", "FATES_PUBLISHED", "GIM_PUBLISHED", "SHARES_PUBLISHED",
            "TRANSITIONS", "published_beside", "write_index"]
