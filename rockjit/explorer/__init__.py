@@ -3,8 +3,10 @@ browser, recomputed as the parameters change.
 
 The compute side (:mod:`.requests`: parameters, coarse-to-fine stages, the Python call of each
 view; :mod:`.worker`: the worker thread, newer requests superseding older ones) needs nothing
-beyond rockjit; the user interface (:mod:`.app`) and its server (:mod:`.server`) need Bokeh, the
-``explore`` extra: ``pip install 'rockjit[explore]'``. What the server lets in is
+beyond rockjit; the user interface (:mod:`.app`, the page, with one module per view:
+:mod:`.basin_panel`, :mod:`.run_panel`, :mod:`.sweep_panel`, :mod:`.compare_panel`; the
+exports, :mod:`.export`; what they draw with, :mod:`.drawing`) and its server (:mod:`.server`)
+need Bokeh, the ``explore`` extra: ``pip install 'rockjit[explore]'``. What the server lets in is
 :mod:`.guard`'s; how many pages compute at once, :mod:`.pages`.
 
 ``rockjit.explore()`` starts the server (:func:`explore`).

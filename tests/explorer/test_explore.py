@@ -293,14 +293,14 @@ def test_every_view_exports_its_figure_as_a_png():
     pytest.importorskip("bokeh", reason="the explore extra is not installed")
     import base64
 
-    from rockjit.explorer.app import _png
+    from rockjit.explorer.export import png_of
     p = R.Params(periods=40).check()
     basin = R.basin_stages(p, levels=(10,))[0]()
     views = dict(basin=basin, sweep=R.sweep_stages(p.with_(alpha_range=(0.6, 0.7)))[0](),
                  run=R.run_stages(p, (0.1, 0.2))[0](), compare=R.compare_stages(p, grid=10)[0]())
     for view, shown in views.items():
         for colour_by in ("behaviour", "attractor") if view == "basin" else ("behaviour",):
-            data, name = _png(view, shown, colour_by)
+            data, name = png_of(view, shown, colour_by)
             assert base64.b64decode(data)[:8] == b"\x89PNG\r\n\x1a\n"
             assert name.endswith(".png") and "/" not in name
 
