@@ -25,7 +25,10 @@ from functools import cached_property
 
 import numpy as np
 
+from . import laws
 from ._jit import fma, jit
+from .laws.housner import HB_MIN_HOUSNER, e_housner
+from .laws.mao import e_mao
 from .validate import choice, real
 
 __all__ = [
@@ -50,6 +53,7 @@ __all__ = [
     "oscillator_jac",
     "rotate",
     "saltation",
+    "saltation_at",
     "sincos",
     "sincos_poly",
     "slope_pq",
@@ -57,12 +61,12 @@ __all__ = [
     "uplift_time",
 ]
 
-LAWS = ("housner", "mao", "constant")
-HB_MIN_HOUSNER = 1.0 / math.sqrt(2.0)
+#: The names of the package's restitution laws (:mod:`rockjit.laws`, where they are defined).
+LAWS = laws.names()
 
 
 # --------------------------------------------------------------------------------------------
-# Restitution laws (plain NumPy: evaluated once per run, and vectorised for the figures)
+# The diagonal's angle (the restitution laws are in rockjit.laws)
 # --------------------------------------------------------------------------------------------
 
 def thc_from_hb(hb):
@@ -85,72 +89,6 @@ def thc_from_hb(hb):
     (0.785398, 1.1071)
     """
     return np.arctan(hb)
-
-
-def e_housner(thc):
-    """Housner's coefficient of restitution ``e_H = 1 - 1.5 cos^2(thc)``.
-
-    Conserves angular momentum about the new corner (Housner 1963). Negative for
-    ``thc < arctan(1/sqrt(2))``, where the law has no physical meaning.
-
-    Parameters
-    ----------
-    thc : float or array_like
-        Angle of the block's diagonal from the ground, radians (:func:`rockjit.thc_from_hb`).
-
-    Returns
-    -------
-    float or ndarray
-        ``e_H``.
-
-    See Also
-    --------
-    e_mao : Mao et al.'s law.
-
-    Examples
-    --------
-    >>> import rockjit
-    >>> round(float(rockjit.e_housner(rockjit.thc_from_hb(1.0))), 12)
-    0.25
-    >>> round(float(rockjit.e_housner(rockjit.thc_from_hb(2.0))), 12)
-    0.7
-    """
-    return 1.0 - 1.5 * np.cos(thc) ** 2
-
-
-def e_mao(thc):
-    """Mao et al. (2024) coefficient of restitution ``e_M = sqrt(N / D)``.
-
-    ``N = tan(thc)(tan^2(thc) - 3) + 3 tan^4(thc)(pi/2 - thc) + 3 thc`` and
-    ``D = 4 tan(thc) sec^2(thc)``: the kinetic energy kept through the impact
-    (docs/theory/impacts.md).
-
-    Parameters
-    ----------
-    thc : float or array_like
-        Angle of the block's diagonal from the ground, radians (:func:`rockjit.thc_from_hb`).
-
-    Returns
-    -------
-    float or ndarray
-        ``e_M``.
-
-    See Also
-    --------
-    e_housner : Housner's law.
-
-    Examples
-    --------
-    >>> import rockjit
-    >>> round(float(rockjit.e_mao(rockjit.thc_from_hb(1.0))), 3)
-    0.582
-    >>> round(float(rockjit.e_mao(rockjit.thc_from_hb(2.0))), 3)
-    0.83
-    """
-    t = np.tan(thc)
-    num = t * (t * t - 3.0) + 3.0 * t**4 * (0.5 * np.pi - thc) + 3.0 * thc
-    den = 4.0 * t / np.cos(thc) ** 2
-    return np.sqrt(num / den)
 
 
 def delta_e_percent(e1, e2):
@@ -199,8 +137,10 @@ class Block:
     ----------
     hb : float
         Slenderness ``h/b`` in ``[0.01, 100]`` (``>= 1/sqrt(2)`` for the Housner law).
-    law : {"housner", "mao", "constant"}, optional
-        Restitution law; default ``"housner"``, or ``"constant"`` when ``e`` is given.
+    law : str, optional
+        Restitution law, by its name in :mod:`rockjit.laws` (``"housner"``, ``"mao"``,
+        ``"constant"``, ``"speed"``, or one registered with :func:`rockjit.laws.register`);
+        default ``"housner"``, or ``"constant"`` when ``e`` is given.
     e : float, optional
         Coefficient of restitution in ``[0, 1]``, only with the constant law.
     xi : float
@@ -225,22 +165,21 @@ class Block:
         law = self.law
         if law is None:
             law = "housner" if self.e is None else "constant"
-        choice("law", law, LAWS)
-        if law == "constant":
+        if not isinstance(law, str):
+            raise ValueError(f"law must be a restitution law's name, one of "
+                             f"{', '.join(map(repr, laws.names()))} (got {law!r})")
+        rule = laws.get(law)
+        if rule.needs_e:
             if self.e is None:
-                raise ValueError("e is required for law='constant' (a number in [0, 1])")
+                raise ValueError(f"e is required for law={law!r} (a number in [0, 1])")
             e = real("e", self.e, 0.0, 1.0)
         elif self.e is not None:
             raise ValueError(f"e is only given with law='constant' (law={law!r}, e={self.e})")
-        elif law == "housner" and hb < HB_MIN_HOUSNER:
-            raise ValueError(
-                f"hb must be >= 1/sqrt(2) = {HB_MIN_HOUSNER:.6f} for the Housner law "
-                f"(got {hb}); e_H would be negative"
-            )
+        rule.check(hb)
         object.__setattr__(self, "hb", hb)
         object.__setattr__(self, "law", law)
         object.__setattr__(self, "xi", real("xi", self.xi, 0.0, XI_MAX))
-        object.__setattr__(self, "e", e if law == "constant" else None)
+        object.__setattr__(self, "e", e if rule.needs_e else None)
 
     # thc and the restitution are computed once per block (numpy on scalars: a microsecond
     # each, a run's fixed cost); cached_property writes the instance's __dict__ directly, which
@@ -250,14 +189,23 @@ class Block:
         """``arctan(hb)``."""
         return float(thc_from_hb(self.hb))
 
+    @property
+    def rule(self):
+        """The restitution law itself (:mod:`rockjit.laws`), the object named by ``law``."""
+        return laws.get(self.law)
+
     @cached_property
     def restitution(self) -> float:
-        """The coefficient of restitution of this block under its law."""
-        if self.law == "constant":
-            return self.e
-        if self.law == "housner":
-            return float(e_housner(self.thc))
-        return float(e_mao(self.thc))
+        """The coefficient of restitution of this block under its law (of a slow impact, for a
+        law that depends on the impact's speed)."""
+        return self.rule.coefficient(self.thc, self.e)
+
+    @property
+    def impact_law(self):
+        """``(kind, shape)``: how the integrator evaluates the law at an impact
+        (:func:`rockjit.laws.impact.restitution_at`)."""
+        rule = self.rule
+        return float(laws.impact.kind_of(rule)), float(rule.shape)
 
     @property
     def cot(self) -> float:
@@ -560,12 +508,21 @@ def free_rocking_decided(theta, dtheta, max_theta, thc, th_top):
 
 @jit
 def saltation(dtheta_minus, f, side_old, thc, xi, e):
+    """:func:`saltation_at` for a coefficient ``e`` fixed per block (``e' = e``)."""
+    return saltation_at(dtheta_minus, f, side_old, thc, xi, e, e)
+
+
+@jit
+def saltation_at(dtheta_minus, f, side_old, thc, xi, e, e_slope):
     """Lower-left entry of the saltation matrix of an impact on ``theta = 0``.
 
-    ``S = [[e, 0], [s10, e]]`` with ``s10 = (F+ - e F-) / theta'-``, ``F-`` the acceleration on
-    the old corner before the jump and ``F+`` on the new corner after it (docs/theory/exponents.md; Müller
-    1995). Both come from :func:`accel`, so damping cancels exactly as it does analytically.
+    ``S = [[e, 0], [s10, e']]`` with ``s10 = (F+ - e' F-) / theta'-``, ``F-`` the acceleration
+    on the old corner before the jump and ``F+`` on the new corner after it, ``e`` the
+    impact's coefficient and ``e' = d(e(v) v)/dv`` its slope in the approach speed ``v``
+    (``e' = e`` for a coefficient fixed per block) (docs/theory/exponents.md; Müller 1995).
+    Both accelerations come from :func:`accel`, so damping cancels exactly as it does
+    analytically.
     """
     f_minus = accel(0.0, dtheta_minus, f, side_old, thc, xi)
     f_plus = accel(0.0, jump(dtheta_minus, e), f, -side_old, thc, xi)
-    return (f_plus - e * f_minus) / dtheta_minus
+    return (f_plus - e_slope * f_minus) / dtheta_minus

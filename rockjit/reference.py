@@ -229,7 +229,7 @@ def simulate_scipy(p):
             t = float(sol.t_events[0][0])
             z = sol.y_events[0][0].copy()
         dth_m = z[1]
-        dth_p = jump(dth_m, e)
+        dth_p = jump(dth_m, block.rule.at_impact(abs(dth_m), e))
         impacts.append((t, dth_m, dth_p))
         side = -side
         z[0] = side * _TINY

@@ -69,9 +69,14 @@ def delta_e_percent(e1, e2):
     return abs(e1 - e2) / ((e1 + e2) / 2.0) * 100.0
 
 
+#: The speed-softened Housner law's ``v_half`` as rockjit registers it under ``"speed"``.
+V_HALF = 1.0
+
+
 def restitution(law, thc, e=None):
-    """The coefficient of the named law (``"housner"``, ``"mao"``, or ``"constant"`` with ``e``)."""
-    if law == "housner":
+    """The coefficient of the named law (``"housner"``, ``"mao"``, or ``"constant"`` with ``e``;
+    ``"speed"``: Housner's, the coefficient of a slow impact)."""
+    if law in ("housner", "speed"):
         return e_housner(thc)
     if law == "mao":
         return e_mao(thc)
@@ -107,6 +112,14 @@ def theta_ddot_partials(theta, dtheta, f, side, thc, xi):
 def jump(dtheta_minus, e):
     """The impact on ``theta = 0`` (Housner 1963): ``theta'(+) = e theta'(-)``."""
     return e * dtheta_minus
+
+
+def at_impact(law, e, dtheta_minus):
+    """The coefficient of an impact at ``theta'(-)``: the block's ``e``, or for the speed law
+    ``e / (1 + |theta'(-)| / V_HALF)``."""
+    if law == "speed":
+        return e / (1.0 + abs(dtheta_minus) / V_HALF)
+    return e
 
 
 def saltation_matrix(dtheta_minus, f, side_old, thc, xi, e):
@@ -257,7 +270,7 @@ def reference_run(hb, alpha, omega, *, law="housner", e=None, xi, theta0, dtheta
             break
         t = float(sol.t_events[0][0])
         dm = float(sol.y_events[0][0][1])
-        dp = jump(dm, e)
+        dp = jump(dm, at_impact(law, e, dm))
         impacts.append((t, dm, dp))
         side = -side
         y = np.array([0.0, dp])

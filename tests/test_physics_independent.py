@@ -158,6 +158,35 @@ def test_saltation_matches_muellers_formula():
     assert worst[0] <= 2e-14 and worst[1] <= 2e-14, worst
 
 
+def test_saltation_of_a_law_that_depends_on_the_impact_matches_muellers_formula():
+    """The saltation matrix of the speed-softened law, ``S = G + (F+ - G F-) n^T / (n^T F-)``
+    with the jump's Jacobian ``G = diag(1, g'(theta'-))`` of ``g(v) = e(v) v`` taken by central
+    differences of the reference's law (:func:`physics.at_impact`), against
+    ``model.saltation_at`` with the coefficient and slope of ``rockjit.laws.impact``, at 300
+    impacts: ``S[1, 0]`` to 1e-8 (the differences' own error) and the coefficient exactly."""
+    from rockjit.laws.impact import restitution_at
+    kind, shape = Block(1.0, "speed").impact_law
+    rng = np.random.default_rng(RNG_SEED + 5)
+    worst = 0.0
+    for _ in range(300):
+        side = int(rng.choice([-1, 1]))
+        dm = -side * rng.uniform(0.01, 3.0)
+        f, thc, xi = rng.uniform(-5.0, 5.0), math.atan(rng.uniform(0.75, 5.0)), rng.uniform(0, 0.5)
+        e = ph.e_housner(thc)
+        h = 1e-6 * abs(dm)
+        g = lambda v: ph.at_impact("speed", e, v) * v  # noqa: E731
+        slope = (g(dm + h) - g(dm - h)) / (2 * h)
+        a_minus = ph.theta_ddot(0.0, dm, f, side, thc, xi)
+        a_plus = ph.theta_ddot(0.0, g(dm), f, -side, thc, xi)
+        s10_ref = (a_plus - slope * a_minus) / dm
+        e_imp, e_slope = restitution_at(int(kind), abs(dm), e, shape)
+        assert e_imp == pytest.approx(ph.at_impact("speed", e, dm), rel=1e-15)
+        assert e_slope == pytest.approx(slope, rel=1e-8)
+        s10 = model.saltation_at(dm, f, side, thc, xi, e_imp, e_slope)
+        worst = max(worst, abs(s10 - s10_ref) / max(1.0, abs(s10_ref)))
+    assert worst <= 1e-8, worst
+
+
 def test_uplift_time_matches_a_brute_force_scan():
     """``model.uplift_time`` against a scan of |f(t)| > cot (step T/400, then bisection to
     rounding), at 300 random starts: measured 5.2e-15 of T. Edge cases: lifted already (t
@@ -206,6 +235,9 @@ RUNS = {
     # from rest, lifted every half period just past the threshold, back to rest each time
     # (seven impacts and a Zeno cut-off): 30 uplifts and 30 rests
     "uplift": (dict(hb=1.0, alpha=0.6, omega=1.3, law="housner"), (0.0, 0.0, 0.0, 1.0)),
+    # a law that depends on the impact (Housner's coefficient softened at fast impacts):
+    # the study's start into its period-1 orbit, two impacts a period
+    "speed": (dict(hb=1.0, alpha=0.8, omega=1.3, law="speed"), Z0),
 }
 
 #: The paths compared: rockjit.simulate's steps per period and method.
@@ -243,6 +275,9 @@ RUN_TOL = {
     ("uplift", "compiled"): 3e-10,           # 2.4e-11
     ("uplift", "compiled-N640"): 2e-12,      # 1.7e-13
     ("uplift", "scipy-DOP853"): 2e-9,        # 1.5e-10
+    ("speed", "compiled"): 4e-10,            # 3.9e-11
+    ("speed", "compiled-N640"): 1e-12,       # 7.1e-14
+    ("speed", "scipy-DOP853"): 1e-10,        # 9.7e-12
 }
 
 
@@ -297,6 +332,8 @@ ATTRACTORS = {
     "p2": (dict(hb=1.0, alpha=0.92, omega=1.3, law="housner"), Z0, 2),
     # a stable period-3 window of the sweep (alpha = 0.946; period 6 at 0.9465): mu = -0.482
     "p3": (dict(hb=1.0, alpha=0.946, omega=1.3, law="housner"), Z0, 3),
+    # the speed-softened law's period-1 orbit: the saltation matrix carries d(e(v) v)/dv
+    "p1-speed": (dict(hb=1.0, alpha=0.8, omega=1.3, law="speed"), Z0, 1),
 }
 
 #: Tolerances of the Floquet comparisons, by period. The finite-difference Jacobian's own error

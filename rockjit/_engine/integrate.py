@@ -52,13 +52,15 @@ import numpy as np
 
 from .._jit import cycles, fma, jit
 from .classify import orbit_scale, repeats
-from ..model import forcing_closed, jump, saltation, sincos, uplift_time
+from ..laws.impact import restitution_at
+from ..model import forcing_closed, jump, saltation_at, sincos, uplift_time
 # the tableau (scipy's names) and the step's table, the layout, the step and the events: each
 # a module of its own, named here too (the kernels' one entry point)
 from .tableau import A, B, C, E, N_STAGES, N_TAB, P, step_table, tab_entry  # noqa: F401
 from .layout import (RUNNING, DONE, OVERTURNED, REST, MAX_IMPACTS, NONFINITE, SETTLED,  # noqa: F401
                      STATUS_NAMES, Outputs, Work, P_THC, P_XI, P_E, P_AW2, P_OMEGA, P_PHI, P_COT,
-                     P_THOVER, P_REST, P_H, P_SETTLE_TOL, N_PAR, P_STHC, P_CTHC, N_PARW, I_N,
+                     P_THOVER, P_REST, P_H, P_SETTLE_TOL, P_LAW, P_LAW_SHAPE, N_PAR, P_STHC,
+                     P_CTHC, N_PARW, I_N,
                      I_PERIODS, I_MAXIMP, I_STRIDE, I_WINDOW, I_SETTLE, I_QR, I_PMAX, I_CONTINUE,
                      N_IPAR, O_STATUS, O_STEPS, O_IMPACTS, O_RHS, O_NSTROBE, O_NHALF, O_NTRAJ,
                      O_NREST, O_NREST_WIN, O_SUBSTEPS, O_NIMP_WIN, O_PERIOD, O_NCOL, O_UNCONVERGED,
@@ -351,20 +353,20 @@ def impact(EMBED4, TANGENT, t, r, t_lift, side, n_imp, in_window, par, out, w):
     """
     NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
     y = w.y
-    e = par[P_E]
     dth_m = y[1]
+    e, e_slope = restitution_at(int(par[P_LAW]), abs(dth_m), par[P_E], par[P_LAW_SHAPE])
     dth_p = jump(dth_m, e)
     if TANGENT is not None:
         if dth_m != 0.0:
-            s10 = saltation(dth_m, par[P_AW2] * (y[2] if EMBED4 is not None else r), side,
-                            par[P_THC], par[P_XI], e)
+            s10 = saltation_at(dth_m, par[P_AW2] * (y[2] if EMBED4 is not None else r), side,
+                               par[P_THC], par[P_XI], e, e_slope)
         else:
             s10 = 0.0
         for c in range(2):
             v0 = y[NS + 2 * c]
             v1 = y[NS + 2 * c + 1]
             y[NS + 2 * c] = e * v0
-            y[NS + 2 * c + 1] = s10 * v0 + e * v1
+            y[NS + 2 * c + 1] = s10 * v0 + e_slope * v1
     y[0] = 0.0
     y[1] = dth_p
     side = -side

@@ -51,6 +51,7 @@ def pack(block, forcing, phi, integration, n_steps, settle_tol=0.0):
     par[ig.P_THC] = block.thc
     par[ig.P_XI] = block.xi
     par[ig.P_E] = block.restitution
+    par[ig.P_LAW], par[ig.P_LAW_SHAPE] = block.impact_law
     par[ig.P_AW2] = forcing.alpha * forcing.omega**2
     par[ig.P_OMEGA] = forcing.omega
     par[ig.P_PHI] = phi

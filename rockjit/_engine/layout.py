@@ -40,8 +40,11 @@ Outputs = namedtuple("Outputs", "strobe half impacts traj lam_run per_imp iout f
 Work = namedtuple("Work", "K y ytmp ynew yev lam tab_h tab fr jac trig ftab")
 
 # ---- layout of the float parameter vector ``par`` ---------------------------------------------
-P_THC, P_XI, P_E, P_AW2, P_OMEGA, P_PHI, P_COT, P_THOVER, P_REST, P_H, P_SETTLE_TOL = range(11)
-N_PAR = 11
+P_THC, P_XI, P_E, P_AW2, P_OMEGA, P_PHI, P_COT, P_THOVER, P_REST, P_H, P_SETTLE_TOL, P_LAW, \
+    P_LAW_SHAPE = range(13)
+N_PAR = 13
+# P_E: the block's coefficient of restitution; P_LAW, P_LAW_SHAPE: its law's kind and shape
+# at an impact (rockjit.laws.impact.restitution_at; kind 0: the coefficient P_E itself)
 # ... which the kernel copies into a working vector with constants derived from it:
 P_STHC, P_CTHC = range(N_PAR, N_PAR + 2)  # sin(thc), cos(thc)
 N_PARW = N_PAR + 2

@@ -52,6 +52,7 @@ import numpy as np
 from numba import prange
 
 from .._jit import jit
+from ..laws.impact import restitution_at
 from ..model import accel, accel_pq, corner, free_rocking_decided, jump, sincos
 from .stages import chain, compile_step, node
 
@@ -61,9 +62,10 @@ K_SINE, K_COSINE, K_RICKER, K_RECORD = 0, 1, 2, 3
 X_KIND, X_AMP, X_OMEGA, X_END, X_DELAY, X_DT, X_OFF, X_N, X_STEPS = range(9)
 N_X = 9
 #: columns of a block's row ``bpar``: thc, xi, e, cot (uplift threshold), th_top (the tipping
-#: angle, or theta_over below it), alpha_s
-B_THC, B_XI, B_E, B_COT, B_THTOP, B_ALPHA = range(6)
-N_B = 6
+#: angle, or theta_over below it), alpha_s, the law's kind and shape at an impact
+#: (rockjit.laws.impact.restitution_at)
+B_THC, B_XI, B_E, B_COT, B_THTOP, B_ALPHA, B_LAW, B_LAW_SHAPE = range(8)
+N_B = 8
 #: the run's settings ``spar``: theta_over, rest_speed, the step length of free rocking
 S_THOVER, S_REST, S_HFREE = range(3)
 N_S = 3
@@ -493,7 +495,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp,
         n_step += ns
         t = t + tau
         n_tr = _keep(traj, n_tr, t, 0.0, v2)
-        dth_p = jump(v2, e)
+        dth_p = jump(v2, restitution_at(int(b[B_LAW]), abs(v2), e, b[B_LAW_SHAPE])[0])
         if n_imp < n_imp_buf:
             imp[n_imp, 0] = t
             imp[n_imp, 1] = v2

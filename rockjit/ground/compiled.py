@@ -51,7 +51,8 @@ assert STATUS_CODES[T.ST_DECIDED] == "decided" and STATUS_CODES[T.ST_REST] == "r
 
 def _block_row(block, theta_over):
     th_top = min(alpha_s(block.hb), theta_over)
-    return (block.thc, block.xi, block.restitution, block.cot, th_top, alpha_s(block.hb))
+    return (block.thc, block.xi, block.restitution, block.cot, th_top, alpha_s(block.hb),
+            *block.impact_law)
 
 
 def _sources(sources, shrink):

@@ -236,7 +236,7 @@ def run_scipy(block, excitation, state, settings, method) -> TransientResult:
         if keep_traj:
             traj.append((t, 0.0, z[1]))
         dth_m = float(z[1])
-        dth_p = jump(dth_m, e)
+        dth_p = jump(dth_m, block.rule.at_impact(abs(dth_m), e))
         impacts.append((t, dth_m, dth_p))
         side = -side
         z = np.array([side * _TINY, dth_p])

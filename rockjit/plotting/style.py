@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import laws
 from .legibility import TEXT_POINTS, WIDTHS
 
 __all__ = ["AGREE_COLOUR", "BEHAVIOUR_COLOURS", "DISAGREE_COLOUR", "FORMATS", "LAW_COLOURS",
@@ -60,16 +61,13 @@ BEHAVIOUR_COLOURS = {
 AGREE_COLOUR = "#FFFFFF"
 DISAGREE_COLOUR = "#000000"
 
-#: The laws' names, and their lines where two laws share an axis (black: colour is behaviour).
-LAW_NAMES = {"housner": "Housner", "mao": "Mao et al.", "constant": "constant $e$"}
-LAW_LINES = {"housner": dict(color="k", ls="-", marker="o"),
-             "mao": dict(color="k", ls=(0, (5, 2)), marker="s"),
-             "constant": dict(color="k", ls=":", marker="^")}
-
-#: The laws' colours where a figure shows no behaviour and compares the laws in colour (the
-#: ground-motion spectra and fragility curves): Okabe and Ito's blue and vermillion, apart under
-#: every colour-vision deficiency.
-LAW_COLOURS = {"housner": "#0072B2", "mao": "#D55E00", "constant": "#009E73"}
+#: The laws' names, their lines where two laws share an axis (black: colour is behaviour), and
+#: their colours where a figure shows no behaviour and compares the laws in colour (the
+#: ground-motion spectra and fragility curves; Okabe and Ito's palette, apart under every
+#: colour-vision deficiency): live views of the one table, the laws' own (rockjit.laws).
+LAW_NAMES = laws.Table("label")
+LAW_LINES = laws.Table("line")
+LAW_COLOURS = laws.Table("colour")
 
 #: Mathtext of the quantities on the axes.
 SYMBOLS = {"theta": r"$\theta$", "dtheta": r"$\theta'$", "theta0": r"$\theta_0$",

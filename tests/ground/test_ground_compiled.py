@@ -208,3 +208,29 @@ def test_a_recorded_run_too_long_for_memory_is_refused_naming_its_settings():
     with pytest.raises(ValueError, match=r"free_time or duration\) would need .* fits"):
         simulate(Block(hb=4), Pulse("sine", ratio=1, amplitude=2),
                  integration=Transient(free_time=1e9))
+
+
+def test_a_law_that_depends_on_the_impact_runs_on_the_compiled_path():
+    """The speed-softened Housner law under pulses: the compiled kernel against scipy's, and
+    every impact of a single compiled run keeps the law's closed form
+    ``theta'(+) = e_H theta'(-) / (1 + |theta'(-)|)`` (``v_half = 1``)."""
+    cells = [(Block(hb=hb, law="speed"), Pulse(kind, ratio=ratio, amplitude=1.0, hb=hb), amp)
+             for hb, kind, ratio, amp in ((4.0, "sine", 2.0, 2.0), (2.0, "cosine", 5.0, 1.2),
+                                          (2.0, "ricker", 2.5, 1.2), (4.0, "cosine", 1.0, 1.2))]
+    batch = _batch(cells)
+    got = compiled_kernel(*batch, SETTINGS, "rockjit")
+    ref = B.scipy_kernel(*batch, SETTINGS, REF)
+    assert max(ref["n_impacts"]) >= 5
+    _agree(got, ref)
+    block = Block(hb=2.0, e=None, law="speed")
+    r = rockjit.simulate(block, Pulse("cosine", ratio=5.0, amplitude=1.2),
+                         integration=Transient(free_time=20.0))
+    e_h = 1.0 - 1.5 * np.cos(np.arctan(2.0)) ** 2
+    dm, dp = r.impacts[:, 1], r.impacts[:, 2]
+    assert len(dm) >= 5
+    np.testing.assert_allclose(dp, e_h * dm / (1.0 + np.abs(dm)), rtol=1e-15, atol=0)
+    # and not Housner's constant coefficient: at the fast impacts, a relative difference of
+    # |v| / (1 + |v|)
+    fast = np.abs(dm) > 0.01
+    assert fast.sum() >= 2
+    assert np.all(np.abs(dp - e_h * dm)[fast] > 0.5 * e_h * dm[fast] ** 2)
