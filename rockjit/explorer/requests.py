@@ -16,7 +16,8 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 
 from ..excitation import Harmonic
-from ..model import XI_STUDY, Block
+# LAWS: the restitution laws the law control offers, the model's own table, named here too.
+from ..model import LAWS, XI_STUDY, Block
 from ..settings import Execution, Integration
 
 __all__ = ["BasinView", "CompareView", "LAWS", "MAX_CELL_STEPS", "MAX_PERIODS", "Params",
@@ -31,8 +32,6 @@ COMPARE_GRID = 100
 SWEEP_POINTS = 500
 #: At most this many recorded points of a run's trajectory.
 RUN_POINTS = 20_000
-#: The laws the law control offers.
-LAWS = ("housner", "mao", "constant")
 
 # The explorer's own limits, narrower than the library's: they keep every view interactive and
 # every piece of work that cannot be interrupted (a chunk of a grid's cells, a cell's run, a

@@ -311,6 +311,11 @@ def test_rockjit_explore_is_the_explorers_function():
     assert pkg.requests is R
 
 
+def test_the_explorers_laws_are_the_models_table_not_a_copy():
+    import rockjit.model
+    assert R.LAWS is rockjit.model.LAWS
+
+
 # ---------------------------------------------------------------------------------------------
 # the app in a headless browser
 # ---------------------------------------------------------------------------------------------
