@@ -16,7 +16,7 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 
 from ..excitation import Harmonic
-# LAWS: the restitution laws the law control offers, the model's own table, named here too.
+# LAWS, the restitution laws' names, is the model's own table, exported here too.
 from ..model import LAWS, XI_STUDY, Block
 from ..settings import Execution, Integration
 
