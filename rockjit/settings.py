@@ -26,7 +26,7 @@ from .validate import boolean, integer, pair, real
 
 __all__ = ["DEVICES", "Classification", "Execution", "Integration", "Lattice", "MAX_IMPACTS",
            "MAX_N", "MAX_PERIODS", "REST_SPEED_RANGE", "cuda_missing", "cuda_refusal",
-           "default_max_impacts"]
+           "cuda_unsupported", "default_max_impacts"]
 
 #: Largest number of periods, and of steps per period, a run may ask for: bounds that keep the
 #: kernels' step counter in 64 bits. The memory check refuses most large requests first, with
@@ -270,15 +270,24 @@ def cuda_missing():
 
 
 def cuda_refusal(what='device="cuda"', instead='device="cpu"'):
-    """The one line that refuses ``what`` (the CUDA device, as the caller names it): what it
-    needs, what is missing here, and ``instead``."""
-    need = (f'{what} needs a CUDA-capable NVIDIA GPU with its driver and numba-cuda '
-            f'(pip install "rockjit[cuda]")')
+    """The one line that refuses ``what`` (the CUDA device, as the caller names it) where this
+    machine cannot run it: what it needs, what is missing here, and ``instead``; ``None``
+    where nothing is missing."""
     missing = cuda_missing()
-    if missing is not None:
-        return f"{need}; {missing}: use {instead}"
-    return f"{need}, and CUDA kernels, which this version of rockjit does not have yet: " \
-        f"use {instead}"
+    if missing is None:
+        return None
+    return (f'{what} needs a CUDA-capable NVIDIA GPU with its driver and numba-cuda '
+            f'(pip install "rockjit[cuda]"); {missing}: use {instead}')
+
+
+#: What runs on the GPU with ``device="cuda"``: the grids of the harmonic kernels.
+CUDA_COVERS = ("the cells of sweeps, basins, planes, erosion profiles, fates, safety and chart "
+               "grids")
+
+
+def cuda_unsupported(what, name='device="cuda"', instead='device="cpu"'):
+    """The one line that refuses ``name`` for ``what``, a computation the GPU does not run."""
+    return f"{name} runs {CUDA_COVERS}; {what} run on the CPU only: use {instead}"
 
 
 @dataclass(frozen=True)
@@ -291,9 +300,11 @@ class Execution(_Replace):
     device : {"cpu", "cuda"}
         Where the cells run: the CPU's cores (default), or an NVIDIA GPU through numba's CUDA
         target, which needs a CUDA-capable GPU with its driver and ``numba-cuda``
-        (``pip install "rockjit[cuda]"``). This version has no CUDA kernels yet:
-        ``device="cuda"`` is refused with a ``ValueError`` saying so, or saying what of the GPU,
-        its driver and ``numba-cuda`` this machine lacks.
+        (``pip install "rockjit[cuda]"``): the cells of sweeps, basins, planes, erosion
+        profiles, fates and the safety and chart grids run one per GPU thread
+        (docs/guide/gpu.md); spectra and fragility refuse it. Where this machine lacks the
+        GPU, its driver or ``numba-cuda``, ``device="cuda"`` is refused with a ``ValueError``
+        saying what is missing.
     threads : int, optional
         numba threads (default: all).
     chunk : int, optional
@@ -351,8 +362,9 @@ class Execution(_Replace):
         if not isinstance(self.device, str) or self.device not in DEVICES:
             raise ValueError(f"device must be one of {', '.join(map(repr, DEVICES))} "
                              f"(got {self.device!r})")
-        if self.device == "cuda":
-            raise ValueError(cuda_refusal())
+        refusal = cuda_refusal() if self.device == "cuda" else None
+        if refusal is not None:
+            raise ValueError(refusal)
         if self.threads is not None:
             import numba
             _set(self, threads=integer("threads", self.threads, 1,

@@ -179,7 +179,9 @@ def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, label, executi
     The chunk defaults to :func:`rockjit._engine.kernel.default_chunk` (a twentieth of the
     grid), or to the chunk of the store already begun for the same computation. In this
     process the cells run as pieces on one thread each, as many at once as threads
-    (:func:`local_plan`, :func:`pieces`).
+    (:func:`local_plan`, :func:`pieces`). With ``execution.device == "cuda"`` each chunk runs
+    on the GPU instead (:func:`rockjit._engine.gpu.run_chunk`, chunks of
+    :func:`rockjit._engine.gpu.default_chunk` cells by default), here or on a Dask worker.
 
     Returns the outputs by name: ``res`` (the kernels' rows; :func:`rockjit._engine.kernel.
     grid_results` names them), ``pts``, ``imp``, ``n_got``, ``n_imp_got``. With a Dask
@@ -189,25 +191,33 @@ def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, label, executi
     ex = execution
     n = y0s.shape[0]
     outputs_ = kernel.grid_outputs(n, n_pts, n_imp_pts)
+    cuda = ex.device == "cuda"
+    # on the GPU (rockjit._engine.gpu), one cell per thread; the same inputs and outputs
+    run_chunk = kernel.run_chunk
+    if cuda:
+        from .._engine import gpu
+        run_chunk = gpu.run_chunk
     key = None
     if ex.store is not None:
+        # the GPU's results differ from the CPU's in the last bits: a store is one device's
+        how = dict(tangent=bool(tangent), n_pts=n_pts, n_imp_pts=n_imp_pts)
         key = chunks.fingerprint((y0s, pars, ipar, cpar),
-                                 dict(tangent=bool(tangent), n_pts=n_pts, n_imp_pts=n_imp_pts))
+                                 dict(how, device="cuda") if cuda else how)
     chunk = ex.chunk
     if chunk is None and key is not None:
         chunk = chunks.ChunkStore.stored_chunk(ex.store, key, n)
     if chunk is None:
-        chunk = kernel.default_chunk(n)
+        chunk = gpu.default_chunk(n) if cuda else kernel.default_chunk(n)
     with _client(ex) as client:
         threads, at_once = ex.threads, 1
-        if client is None:
+        if client is None and not cuda:
             # the calling thread's count (numba.set_num_threads is per thread)
             total = numba.get_num_threads() if ex.threads is None else ex.threads
             threads, at_once = local_plan(total)
         cs = None if key is None else chunks.ChunkStore(ex.store, key, n, chunk,
                                                         message=ex.message)
-        run_chunks(kernel.run_chunk, (bool(tangent), y0s, pars, ipar, cpar, n_pts, n_imp_pts,
-                                      threads, ex.lanes), n, chunk, outputs_, client=client,
+        run_chunks(run_chunk, (bool(tangent), y0s, pars, ipar, cpar, n_pts, n_imp_pts,
+                               threads, ex.lanes), n, chunk, outputs_, client=client,
                    store=cs, progress=ex.progress, label=label, message=ex.message,
                    worker_timeout=ex.worker_timeout, at_once=at_once)
     return outputs_

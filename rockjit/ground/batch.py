@@ -175,6 +175,9 @@ def run_batch(batch, settings, method, execution=None, label="cells"):
     from ..settings import Execution
     from ..storage import chunkstore
     ex = Execution() if execution is None else execution
+    if ex.device == "cuda":
+        from ..settings import cuda_unsupported
+        raise ValueError(cuda_unsupported("spectra and fragility curves"))
     kernel = kernel_for(method)
     n = len(batch)
     outputs = empty_outputs(n)

@@ -1,0 +1,180 @@
+"""The GPU driver (rockjit._engine.gpu), without a GPU: its kernels compile to PTX for sm_90, and
+under numba's CUDA simulator it gives the CPU kernels' results; device="cuda" where it cannot
+run is one line."""
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+cuda = pytest.importorskip("numba.cuda", reason="numba-cuda is not installed")
+
+from rockjit import Block, Classification, Execution, Harmonic, Integration  # noqa: E402
+from rockjit._engine import kernel  # noqa: E402
+from rockjit._engine.cell import R_LABEL, R_PERIOD, R_STATUS  # noqa: E402
+
+
+@pytest.fixture
+def sm90(monkeypatch):
+    """numba-cuda asks the current device for its compute capability when it types a device
+    function; with no device here, it is told sm_90's."""
+    import numba.cuda.dispatcher as d
+    monkeypatch.setattr(d, "get_current_device",
+                        lambda: type("Device", (), {"compute_capability": (9, 0)})())
+
+
+@pytest.mark.parametrize("name", ["tables", "cells", "cells+tangent"])
+def test_kernels_compile_to_ptx_for_sm90(sm90, name):
+    from rockjit._engine import gpu
+    kern = gpu.kernels()[name]
+    ptx, _ = cuda.compile_ptx(kern, gpu.signatures()[name], cc=(9, 0))
+    assert ".target sm_90" in ptx
+    assert ptx.count(".entry ") == 1
+    # the stage chain's and the polynomials' explicit fused multiply-adds, as on the CPU
+    assert "fma.rn.f64" in ptx
+    entry = {"tables": "_tables", "cells": "_cells_plain", "cells+tangent": "_cells_tangent"}
+    assert entry[name] in ptx.split(".entry ")[1].split("(")[0]
+
+
+#: The cases run under the simulator: a grid plan's constructor and its arguments (small: the
+#: simulator runs each thread's Python, the compiled pieces on the CPU).
+CASES = {
+    "basin housner early": ("basin", dict(law="housner", early=True)),
+    "basin mao full": ("basin", dict(law="mao", early=False)),
+    "sweep exponents": ("sweep", dict(law="housner", early=False)),
+    "plane exponents": ("plane", dict(law="mao", early=True)),
+}
+
+_PLANS = textwrap.dedent('''
+    import numpy as np
+    import rockjit
+    from rockjit import Block, Classification, Harmonic, Integration
+
+    def plan(kind, law, early):
+        block = Block(hb=1, law=law)
+        integ = Integration(periods=24, window=12)
+        cl = Classification(early_stop=early)
+        if kind == "basin":
+            return rockjit.basin.plan(block, Harmonic(alpha=0.66, omega=1.3), grid=4,
+                                      integration=integ, classification=cl)
+        if kind == "sweep":
+            return rockjit.sweep.plan(block, Harmonic(omega=1.3), np.linspace(0.3, 0.9, 6),
+                                      integration=integ, classification=cl, lyapunov=True,
+                                      n_impact_points=8)
+        return rockjit.plane.plan(block, (0.3, 0.9), (1.0, 2.0), grid=(3, 3), integration=integ,
+                                  classification=cl, lyapunov=True)
+''')
+
+_SIMULATED = _PLANS + textwrap.dedent('''
+    import json, sys
+    from rockjit import Execution
+    from rockjit._engine import gpu
+    assert gpu.SIMULATOR
+    cases, path = json.loads(sys.argv[1]), sys.argv[2]
+    got = {}
+    for name, (kind, kw) in cases.items():
+        p = plan(kind, **kw)
+        # two launches of 5 and 11 cells: the scratch is reused
+        out = gpu.run_chunk(p.tangent, p.y0s, p.pars, p.ipar, p.cpar, p.n_pts, p.n_imp_pts,
+                            batch=min(5, len(p.y0s)))
+        for k, v in out.items():
+            got[f"{name}/{k}"] = v
+    # the public path: a basin with Execution(device="cuda")
+    b = rockjit.basin(Block(hb=1), Harmonic(alpha=0.66, omega=1.3), grid=4,
+                      integration=Integration(periods=24, window=12),
+                      execution=Execution(device="cuda"))
+    got["api/label"] = b.label
+    np.savez(path, **got)
+''')
+
+
+def _cpu(kind, law, early):
+    namespace = {}
+    exec(_PLANS, namespace)  # noqa: S102 - the same plans as the simulated run's
+    p = namespace["plan"](kind, law, early)
+    return kernel.run_chunk(p.tangent, p.y0s, p.pars, p.ipar, p.cpar, p.n_pts, p.n_imp_pts,
+                            threads=1)
+
+
+def test_simulated_gpu_gives_the_cpu_kernels_results(tmp_path):
+    """The driver's logic (tables per forcing, per-thread scratch, launches of part of the
+    cells, classification and samples) run by numba's CUDA simulator against the CPU
+    kernels (the lanes for the basins, the single-lane loop for the grids with exponents)."""
+    path = tmp_path / "gpu.npz"
+    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
+    proc = subprocess.run([sys.executable, "-c", _SIMULATED, json.dumps(CASES), str(path)],
+                          env=env, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    got = np.load(path)
+    labels = set()
+    for name, (kind, kw) in CASES.items():
+        cpu = _cpu(kind, **kw)
+        res, gres = cpu["res"], got[f"{name}/res"]
+        for col in (R_STATUS, R_LABEL, R_PERIOD):
+            np.testing.assert_array_equal(gres[:, col], res[:, col], err_msg=name)
+        labels |= set(res[:, R_LABEL].astype(int))
+        np.testing.assert_array_equal(got[f"{name}/n_got"], cpu["n_got"], err_msg=name)
+        np.testing.assert_array_equal(got[f"{name}/n_imp_got"], cpu["n_imp_got"], err_msg=name)
+        # the strobe samples of the classified stretch (NaN where a cell has none)
+        np.testing.assert_allclose(got[f"{name}/pts"], cpu["pts"], rtol=0, atol=1e-9,
+                                   err_msg=name)
+        np.testing.assert_allclose(got[f"{name}/imp"], cpu["imp"], rtol=0, atol=1e-9,
+                                   err_msg=name)
+        np.testing.assert_allclose(gres, res, rtol=1e-9, atol=1e-12, err_msg=name)
+    assert len(labels) >= 3  # the cases reach several behaviours, not one
+    cpu_basin = _cpu("basin", "housner", True)
+    np.testing.assert_array_equal(got["api/label"].ravel(), cpu_basin["res"][:, R_LABEL])
+
+
+def test_cuda_without_a_gpu_is_refused(monkeypatch):
+    """Here (no GPU): one line naming what is missing; the grid is not run."""
+    from rockjit.settings import cuda_missing
+    if cuda_missing() is None:
+        pytest.skip("this machine has a GPU")
+    with pytest.raises(ValueError) as exc:
+        Execution(device="cuda")
+    text = str(exc.value)
+    assert "\n" not in text and "GPU" in text and 'device="cpu"' in text
+
+
+def test_cuda_with_a_gpu_is_taken_and_cpu_only_work_refuses_it(monkeypatch):
+    """Where a GPU is usable, Execution(device="cuda") is accepted; the spectra's and
+    fragility's batches, which have no GPU kernel, refuse it in one line naming what runs."""
+    import rockjit.settings as st
+    monkeypatch.setattr(st, "cuda_missing", lambda: None)
+    ex = Execution(device="cuda", progress=False)
+    assert ex.device == "cuda"
+    from rockjit.ground.batch import run_batch
+    with pytest.raises(ValueError) as exc:
+        run_batch([None], None, "rockjit", ex)
+    text = str(exc.value)
+    assert "\n" not in text and "basins" in text and "spectra" in text
+    assert 'device="cpu"' in text
+
+
+def test_cli_refuses_cuda_for_spectra_in_one_line(tmp_path, capsys, monkeypatch):
+    import rockjit.settings as st
+    from rockjit.cli.main import main
+    monkeypatch.setattr(st, "cuda_missing", lambda: None)
+    code = main(["spectrum", "--hb", "1", "--ratio-range", "1", "2", "--amplitude-range", "1",
+                 "2", "--grid", "2", "2", "--out", str(tmp_path / "s"), "--device", "cuda",
+                 "--quiet"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "\n" not in err and "--device cuda runs" in err
+    assert "--device cpu" in err and not (tmp_path / "s").exists()
+
+
+def test_chunks_on_the_gpu_fill_it():
+    """A chunk is the whole grid up to 2**18 cells, about a twentieth beyond; a launch holds
+    what half the free memory holds in scratch."""
+    from rockjit._engine import gpu
+    assert gpu.default_chunk(10_000) == 2**18 and gpu.default_chunk(10**7) == 500_000
+    per = 8 * (4 * 501 + 4 * 501 + 3 + 3 + 501)  # 500 periods, no exponents: 20,072 bytes
+    assert gpu.cell_bytes(500, 0, False) == per
+    assert gpu.batch_cells(10**6, 500, 0, False, 2 * per * 1000) == 1000
+    assert gpu.batch_cells(10, 500, 0, False, 10**12) == 10
+    assert gpu.batch_cells(10**6, 500, 0, False, 10) == gpu.BLOCK
