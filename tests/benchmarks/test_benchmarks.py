@@ -95,6 +95,9 @@ SCRIPTS = {
     "bench_chart.py": (
         ["run", "chart_s", "seeds_s", "curves_s", "total_s", "cpu_s", "cells", "curves",
          "curve_points", "load1"], ["chart.png", "chart_laws.png"]),
+    "bench_gpu.py": (
+        ["case", "cells", "gpu_s", "cpu_s", "cpu_basis", "speedup", "cells_per_s_gpu",
+         "labels_differ", "differ_unflagged", "max_strobe_diff", "measured"], []),
 }
 
 #: bench_stress.py exits with this status when the suite ran and its checks found failures
@@ -329,6 +332,15 @@ VALUES = {
         [("one lane is the unit of the speed-ups and has no cycle counts; more have them",
           lambda r: (num(r, "speedup_vs_1") == 1.0 and r["bound"] == "") if r["lanes"] == "1"
           else r["bound"] != "")]),
+    "bench_gpu.py": (
+        dict(case=text, cells=count(1), gpu_s=empty_or(positive),
+             cpu_s=empty_or(nan_or(positive)), speedup=empty_or(nan_or(positive)), cells_per_s_gpu=empty_or(positive),
+             labels_differ=empty_or(count(0)), differ_unflagged=empty_or(count(0)),
+             max_strobe_diff=empty_or(nan_or(nonneg)), measured=one_of("yes", "no")),
+        [("a case not measured has no times; a measured one has its GPU time",
+          lambda r: (r["measured"] == "no") == (r["gpu_s"] == "")),
+         ("no more cells differ, not flagged, than differ", lambda r:
+          r["differ_unflagged"] == "" or num(r, "differ_unflagged") <= num(r, "labels_differ"))]),
     "bench_stress.py": (
         dict(id=text, category=one_of(*STRESS_CATEGORIES), hb=positive, alpha=nonneg,
              omega=positive, law=one_of(*LAWS), e=empty_or(between(0, 1)), n_steps=count(8),
