@@ -147,7 +147,7 @@ def measure(cfg, t0):
 
 def device_name():
     from numba import cuda
-    name = cuda.get_current_device().name
+    name = getattr(cuda.get_current_device(), "name", "numba's CUDA simulator")
     return name.decode() if isinstance(name, bytes) else str(name)
 
 

@@ -178,3 +178,25 @@ def test_chunks_on_the_gpu_fill_it():
     assert gpu.batch_cells(10**6, 500, 0, False, 2 * per * 1000) == 1000
     assert gpu.batch_cells(10, 500, 0, False, 10**12) == 10
     assert gpu.batch_cells(10**6, 500, 0, False, 10) == gpu.BLOCK
+
+
+def test_cells_share_tables_exactly_when_their_forcing_is_the_same():
+    """The tables are made once per forcing: two cells get the same tables if and only if
+    their rows agree in alpha omega^2, omega, the phase and the step (checked pair by pair)."""
+    from rockjit._engine import gpu
+    from rockjit._engine.layout import N_PAR, P_AW2, P_H, P_OMEGA, P_PHI, P_THC
+    rng = np.random.default_rng(3)
+    pars = np.zeros((40, N_PAR))
+    pars[:, P_THC] = rng.uniform(0.1, 0.3, 40)  # not a forcing column: may differ freely
+    for col in (P_AW2, P_OMEGA, P_PHI, P_H):
+        pars[:, col] = rng.choice([0.5, 1.5], 40)
+    rows, index = gpu._forcings(pars)
+    cols = [P_AW2, P_OMEGA, P_PHI, P_H]
+    for i in range(40):
+        np.testing.assert_array_equal(rows[index[i], cols], pars[i, cols])
+        for j in range(40):
+            assert (index[i] == index[j]) == bool((pars[i, cols] == pars[j, cols]).all())
+    same = np.tile(pars[:1], (5, 1))
+    same[:, P_THC] = np.arange(5)
+    rows, index = gpu._forcings(same)
+    assert rows.shape[0] == 1 and not index.any()
