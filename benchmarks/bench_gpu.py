@@ -8,8 +8,10 @@ each, eight cells per thread in lockstep where there are no exponents). Cases: t
 basin (h/b = 1, Housner, alpha = 0.66, omega = 1.3, 500 periods) at 100 x 100, 300 x 300 and
 1000 x 1000, full length and early-stopped; the study's sweep (omega = 1.3, 501 amplitudes in
 [0.5, 1], 500 periods, full length, with exponents); a 200 x 200 (alpha, omega) plane with
-exponents (early-stopped). Times are medians of repeats, GPU and CPU interleaved, compile
-excluded (a warm-up call first); the CPU's 1000 x 1000 full-length basin is extrapolated from
+exponents (early-stopped); and a balanced yardstick, one source compiled for both devices:
+10^6 cells, each 2000 RK4 steps of a damped linear oscillator in registers (what the devices'
+fp64 arithmetic gives with every cell the same work and no memory traffic). Times are medians
+of repeats, GPU and CPU interleaved, compile excluded (a warm-up call first); the CPU's 1000 x 1000 full-length basin is extrapolated from
 its 300 x 300 cells per second (it would take minutes). Agreement: the cells whose label or
 period differ between the devices, and of those at 100 x 100 how many the uncertainty test
 (initial states moved by 1e-9, on the CPU) does not flag; the largest difference of the
@@ -35,6 +37,11 @@ import numpy as np
 if not hasattr(np, "row_stack"):  # numba-cuda 0.30 still calls it; numpy 2.5 removed it
     np.row_stack = np.vstack
 
+try:
+    from numba import cuda
+except Exception:  # numba-cuda absent: the page says the GPU was not measured
+    cuda = None
+
 import _common as H
 
 import rockjit
@@ -47,9 +54,9 @@ from rockjit.result import ASYMMETRIC, MULTIPERIODIC, SYMMETRIC
 from rockjit.settings import cuda_missing
 
 FULL = dict(basins=(100, 300, 1000), periods=500, alphas=501, plane=200, repeats=3,
-            cpu_cells_max=100_000, budget_s=240.0)
+            cpu_cells_max=100_000, budget_s=220.0, yard_cells=10**6, yard_steps=2000)
 QUICK = dict(basins=(12, 20), periods=60, alphas=21, plane=10, repeats=1,
-             cpu_cells_max=400, budget_s=120.0)
+             cpu_cells_max=400, budget_s=120.0, yard_cells=1000, yard_steps=100)
 #: Relative move of the initial states in the uncertainty test of the agreement.
 EPS = 1e-9
 HEADERS = ("case", "cells", "gpu_s", "cpu_s", "cpu_basis", "speedup", "cells_per_s_gpu",
@@ -145,8 +152,64 @@ def measure(cfg, t0):
     return rows, raw
 
 
+def _rk4(y, v, n_steps):
+    """``n_steps`` RK4 steps of ``y'' = -y - 0.1 y'`` in registers (the yardstick's cell)."""
+    h = 0.01
+    for _ in range(n_steps):
+        k1y, k1v = v, -y - 0.1 * v
+        y2, v2 = y + 0.5 * h * k1y, v + 0.5 * h * k1v
+        k2y, k2v = v2, -y2 - 0.1 * v2
+        y3, v3 = y + 0.5 * h * k2y, v + 0.5 * h * k2v
+        k3y, k3v = v3, -y3 - 0.1 * v3
+        y4, v4 = y + h * k3y, v + h * k3v
+        k4y, k4v = v4, -y4 - 0.1 * v4
+        y += h / 6.0 * (k1y + 2.0 * k2y + 2.0 * k3y + k4y)
+        v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v)
+    return y
+
+
+def yardsticks():
+    """The balanced yardstick, one source compiled for the CPU's cores (``prange``) and for
+    the GPU (one cell per thread): every cell the same work, in registers."""
+    import numba
+    step = numba.njit(cache=True)(_rk4)
+
+    @numba.njit(parallel=True, cache=True)
+    def on_cpu(n_cells, n_steps, out):
+        for i in numba.prange(n_cells):
+            out[i] = step(1.0 + 1e-9 * i, 0.0, n_steps)
+
+    @cuda.jit
+    def kernel(n_steps, out):
+        i = cuda.grid(1)
+        if i < out.shape[0]:
+            out[i] = step(1.0 + 1e-9 * i, 0.0, n_steps)
+
+    def on_gpu(n_cells, n_steps, out):
+        d = cuda.device_array(n_cells)
+        kernel[(n_cells + 127) // 128, 128](n_steps, d)
+        d.copy_to_host(out)
+
+    return on_cpu, on_gpu
+
+
+def yardstick(cfg):
+    """The yardstick's row: both devices, median of the repeats, and the largest difference
+    of the cells' final values."""
+    n, steps = cfg["yard_cells"], cfg["yard_steps"]
+    on_cpu, on_gpu = yardsticks()
+    a, b = np.zeros(n), np.zeros(n)
+    on_cpu(n, 2, a)
+    on_gpu(n, 2, b)
+    t = H.side_by_side({"gpu": lambda: on_gpu(n, steps, b), "cpu": lambda: on_cpu(n, steps, a)},
+                       cfg["repeats"])
+    g, c = t.median("gpu"), t.median("cpu")
+    return (f"yardstick: {n} cells of {steps} RK4 steps in registers", n, g, c,
+            f"median of {cfg['repeats']}", c / g, n / g, "", "", float(np.abs(a - b).max()),
+            "yes"), dict(gpu=t.wall["gpu"], cpu=t.wall["cpu"])
+
+
 def device_name():
-    from numba import cuda
     name = getattr(cuda.get_current_device(), "name", "numba's CUDA simulator")
     return name.decode() if isinstance(name, bytes) else str(name)
 
@@ -162,6 +225,8 @@ def main(argv=None):
     if missing is not None:
         rows = [(key, p.y0s.shape[0], "", "", "", "", "", "", "", "", "no")
                 for key, p in cases(cfg)]
+        rows.append((f"yardstick: {cfg['yard_cells']} cells of {cfg['yard_steps']} RK4 steps "
+                     f"in registers", cfg["yard_cells"], "", "", "", "", "", "", "", "", "no"))
         md = (head + "Not measured on a GPU yet: this machine has none (" + missing + "). "
               "The cases a run on a machine with an NVIDIA GPU measures:\n\n"
               + H.md_table(("case", "cells"), [r[:2] for r in rows]))
@@ -174,6 +239,8 @@ def main(argv=None):
     warm_up(cfg)
     warm = time.monotonic() - warm
     rows, raw = measure(cfg, t0)
+    row, raw["yardstick"] = yardstick(cfg)
+    rows.append(row)
     gpu = device_name()
     md = (head + H.md_table(HEADERS[:8] + ("differ, not flagged", "max strobe diff"),
                             [r[:10] for r in rows])
