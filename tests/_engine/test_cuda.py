@@ -200,3 +200,40 @@ def test_cells_share_tables_exactly_when_their_forcing_is_the_same():
     same[:, P_THC] = np.arange(5)
     rows, index = gpu._forcings(same)
     assert rows.shape[0] == 1 and not index.any()
+
+
+def test_the_runner_sends_cuda_grids_to_the_gpu_driver_with_stores_of_their_own(
+        tmp_path, monkeypatch):
+    """device="cuda" runs every chunk through rockjit._engine.gpu.run_chunk (here a stand-in
+    that runs the CPU kernel and counts its cells), one chunk for a small grid; a chunk store
+    begun on the CPU is refused for the GPU's computation (their last bits differ), and the
+    GPU's own store is resumed."""
+    import rockjit
+    import rockjit.settings as st
+    from rockjit._engine import gpu
+    monkeypatch.setattr(st, "cuda_missing", lambda: None)
+    calls = []
+
+    def stand_in(tangent, y0s, *args, **kw):
+        calls.append(len(y0s))
+        return kernel.run_chunk(tangent, y0s, *args[:5], threads=1)
+
+    monkeypatch.setattr(gpu, "run_chunk", stand_in)
+    kw = dict(grid=6, integration=Integration(periods=20, window=10))
+    forcing = Harmonic(alpha=0.66, omega=1.3)
+    store = tmp_path / "store"
+    cpu = rockjit.basin(Block(hb=1), forcing, **kw, execution=Execution(store=store))
+    assert calls == []
+    with pytest.raises(ValueError, match="holds the chunks of a different computation"):
+        rockjit.basin(Block(hb=1), forcing, **kw, execution=Execution(device="cuda",
+                                                                     store=store))
+    assert calls == []
+    store = tmp_path / "gpu store"
+    on_gpu = rockjit.basin(Block(hb=1), forcing, **kw,
+                           execution=Execution(device="cuda", store=store))
+    assert calls == [36]  # all the cells, in one chunk
+    np.testing.assert_array_equal(on_gpu.label, cpu.label)
+    again = rockjit.basin(Block(hb=1), forcing, **kw,
+                          execution=Execution(device="cuda", store=store))
+    assert calls == [36]  # resumed from the GPU's own chunks
+    np.testing.assert_array_equal(again.label, cpu.label)
