@@ -33,7 +33,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import cuda, float64, int64
+from numba import config, cuda, float64, int64
 
 from . import integrate as ig
 from .cell import _classify, _collect
@@ -55,7 +55,7 @@ NK = N_STAGES + 1
 #: The forcing's columns of a parameter row: cells that agree in them share their tables.
 FORCING_COLS = (P_AW2, P_OMEGA, P_PHI, P_H)
 #: Whether numba runs CUDA kernels in its simulator (``NUMBA_ENABLE_CUDASIM=1``), as Python.
-SIMULATOR = bool(getattr(__import__("numba").config, "ENABLE_CUDASIM", False))
+SIMULATOR = bool(getattr(config, "ENABLE_CUDASIM", False))
 
 if SIMULATOR:
     def _a(x):

@@ -100,6 +100,7 @@ def _cpu(kind, law, early):
                             threads=1)
 
 
+@pytest.mark.slow  # about 2 s once numba's cache holds the driver's loop; a minute before
 def test_simulated_gpu_gives_the_cpu_kernels_results(tmp_path):
     """The driver's logic (tables per forcing, per-thread scratch, launches of part of the
     cells, classification and samples) run by numba's CUDA simulator against the CPU
@@ -119,12 +120,13 @@ def test_simulated_gpu_gives_the_cpu_kernels_results(tmp_path):
         labels |= set(res[:, R_LABEL].astype(int))
         np.testing.assert_array_equal(got[f"{name}/n_got"], cpu["n_got"], err_msg=name)
         np.testing.assert_array_equal(got[f"{name}/n_imp_got"], cpu["n_imp_got"], err_msg=name)
-        # the strobe samples of the classified stretch (NaN where a cell has none)
+        # the strobe samples of the classified stretch (NaN where a cell has none): within
+        # 1e-9 is what a GPU must give; the simulator runs the pieces compiled for the CPU, so
+        # there every output is the CPU kernels' bit for bit
         np.testing.assert_allclose(got[f"{name}/pts"], cpu["pts"], rtol=0, atol=1e-9,
                                    err_msg=name)
-        np.testing.assert_allclose(got[f"{name}/imp"], cpu["imp"], rtol=0, atol=1e-9,
-                                   err_msg=name)
-        np.testing.assert_allclose(gres, res, rtol=1e-9, atol=1e-12, err_msg=name)
+        for k in ("res", "pts", "imp"):
+            np.testing.assert_array_equal(got[f"{name}/{k}"], cpu[k], err_msg=f"{name} {k}")
     assert len(labels) >= 3  # the cases reach several behaviours, not one
     cpu_basin = _cpu("basin", "housner", True)
     np.testing.assert_array_equal(got["api/label"].ravel(), cpu_basin["res"][:, R_LABEL])
