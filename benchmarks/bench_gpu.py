@@ -11,11 +11,12 @@ basin (h/b = 1, Housner, alpha = 0.66, omega = 1.3, 500 periods) at 100 x 100, 3
 exponents (early-stopped); and a balanced yardstick, one source compiled for both devices:
 10^6 cells, each 2000 RK4 steps of a damped linear oscillator in registers (what the devices'
 fp64 arithmetic gives with every cell the same work and no memory traffic). Times are medians
-of repeats, GPU and CPU interleaved, compile excluded (a warm-up call first); the CPU's 1000 x 1000 full-length basin is extrapolated from
-its 300 x 300 cells per second (it would take minutes). Agreement: the cells whose label or
-period differ between the devices, and of those at 100 x 100 how many the uncertainty test
-(initial states moved by 1e-9, on the CPU) does not flag; the largest difference of the
-stroboscopic samples of the cells both call periodic.
+of repeats, GPU and CPU interleaved, compile excluded (a warm-up call first); the CPU's
+1000 x 1000 full-length basin is extrapolated from its 300 x 300 cells per second (it would
+take minutes). Agreement: the cells whose label or period differ between the devices, and
+of those at 100 x 100 how many the uncertainty test (initial states moved by 1e-9, on the
+CPU) does not flag; the largest difference of the stroboscopic samples of the cells both call
+periodic.
 
     PYTHONPATH=. python benchmarks/bench_gpu.py           # full, on a machine with a GPU
     PYTHONPATH=. python benchmarks/bench_gpu.py --quick   # smoke: small grids, 60 periods
