@@ -19,7 +19,7 @@ _HOMES = {
     "fatal_shock": "rockjit.integrity", "edge_state": "rockjit.integrity",
     "fate": "rockjit.basins.fate",
     "Harmonic": "rockjit.excitation",
-    "Pulse": "rockjit.ground", "Record": "rockjit.ground", "Transient": "rockjit.ground",
+    "Pulse": "rockjit.ground", "Record": "rockjit.ground", "HarmonicSum": "rockjit.ground", "Transient": "rockjit.ground",
     "fragility": "rockjit.ground", "spectrum": "rockjit.ground",
     "chart": "rockjit.orbits.plane_chart", "ChartCurves": "rockjit.orbits.plane_chart",
     "alpha_grid": "rockjit.grids", "basin": "rockjit.grids", "plane": "rockjit.grids",

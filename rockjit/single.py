@@ -254,7 +254,7 @@ def simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
     ----------
     block : Block
         The block: slenderness, restitution law, damping.
-    forcing : Harmonic, Pulse or Record
+    forcing : Harmonic, Pulse, Record or an excitation plug
         The excitation: harmonic, with its amplitude ``alpha`` and frequency ``omega`` (and
         phase, or the study's); or a transient one, a :class:`rockjit.Pulse` (with its
         ``ratio`` and ``amplitude``) or a :class:`rockjit.Record` (with the block's ``size``),

@@ -38,10 +38,12 @@ windows are the compiled twins of ``Pulse.scalar``/``Pulse.windows`` and
 the scipy path, which evaluates those.
 
 The forcing of a cell is described by a row of ``xpar`` (columns ``X_*``): the kind (0, 1, 2:
-the pulses of :data:`rockjit.ground.pulses.KINDS`; 3: a record), its amplitude in ``g``, the
-pulse's ``omega_p``, the end, the Ricker wavelet's delay, the record's model time step, the
-offset and length of its samples in one flat array, and the steps of the grid (per pulse, or
-per record sample).
+the pulses of :data:`rockjit.ground.pulses.KINDS`; 3: a record; from
+:data:`rockjit.plugs.FIRST_KIND` on, an excitation plug), its amplitude in ``g`` (a gain, for a
+plug), the pulse's ``omega_p``, the end, the Ricker wavelet's delay, the record's model time
+step, the offset and length of its samples (a plug's numbers) in one flat array, and the steps
+of the grid (per pulse or plug, or per record sample). A plug's value and windows are its own
+compiled functions (:func:`rockjit.plugs.plug_value`, :func:`rockjit.plugs.plug_window`).
 """
 
 from __future__ import annotations
@@ -54,6 +56,7 @@ from numba import prange
 from .._jit import jit
 from ..laws.impact import restitution_at
 from ..model import accel, accel_pq, corner, free_rocking_decided, jump, sincos
+from ..plugs import FIRST_KIND, plug_value, plug_window
 from .stages import chain, compile_step, node
 
 # ---- codes --------------------------------------------------------------------------------------
@@ -98,6 +101,8 @@ def forcing(t, x, rec):
         u = 0.5 * x[X_OMEGA] * (t - x[X_DELAY])
         u2 = u * u
         return a * (1.0 - 2.0 * u2) * math.exp(-u2)
+    if kind >= FIRST_KIND:
+        return a * plug_value(kind, t, rec, int(x[X_OFF]), int(x[X_N]))
     off = int(x[X_OFF])
     last = int(x[X_N]) - 1
     q = t / x[X_DT]
@@ -290,12 +295,20 @@ def record_window(tq, x, rec, thr):
 def next_uplift(t, x, rec, win, nwin, thc, xi, thr):
     """``(t_up, side)``: the first instant ``>= t`` at which the block at rest accelerates away
     from it, ``side`` 0 when there is none (the reference path's ``next_uplift``)."""
-    is_record = int(x[X_KIND]) == K_RECORD
+    kind = int(x[X_KIND])
     k = 0
     tq = t
     while True:
-        if is_record:
+        if kind == K_RECORD:
             t0, t1, sg = record_window(tq, x, rec, thr)
+            if sg == 0.0:
+                return 0.0, 0
+        elif kind >= FIRST_KIND:
+            a = x[X_AMP]
+            if not a > 0.0:
+                return 0.0, 0
+            t0, t1, sg = plug_window(kind, tq, x[X_END], rec, int(x[X_OFF]), int(x[X_N]),
+                                     thr / a)
             if sg == 0.0:
                 return 0.0, 0
         else:
@@ -392,7 +405,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp,
     else:
         h_exc = end / x[X_STEPS]
     h_free = s[S_HFREE]
-    nwin = 0 if kind == K_RECORD else pulse_windows(x, thr, win)
+    nwin = pulse_windows(x, thr, win) if kind < K_RECORD else 0  # the others: found as needed
     n_imp_buf = imp.shape[0]
 
     t = 0.0

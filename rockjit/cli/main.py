@@ -650,10 +650,19 @@ def _grid(args, run, plan, name):
 # the parser
 # ---------------------------------------------------------------------------------------------
 
-def _add_block(p, alpha=True, omega=True, laws="housner, mao or constant"):
+def _law_names(both):
+    """The ``--law`` values in words: the registered laws' names (rockjit.laws), and ``both``
+    (Housner's and Mao's) where a command compares two laws."""
+    from ..laws import names
+    options = list(names()) + (["both"] if both else [])
+    return ", ".join(options[:-1]) + " or " + options[-1]
+
+
+def _add_block(p, alpha=True, omega=True, both=False):
     p.add_argument("--hb", type=float, required=True, help="slenderness h/b")
     p.add_argument("--law", default=None,
-                   help=f"restitution law: {laws} (default housner, or constant with --e)")
+                   help=f"restitution law: {_law_names(both)} (default housner, or constant "
+                        f"with --e)")
     p.add_argument("--e", type=float, default=None,
                    help="constant coefficient of restitution in [0, 1] (with --law constant)")
     p.add_argument("--xi", type=float, default=None,
@@ -810,7 +819,7 @@ def build_parser():
                  "Classify a grid of initial states (theta0, dtheta0); write basin.npz "
                  "(label[i, j] belongs to theta0[i], dtheta0[j]), basin.png and summary.json "
                  "(percentages; with --law both, per law and the agreement).")
-    _add_block(p, laws="housner, mao, constant or both")
+    _add_block(p, both=True)
     p.add_argument("--grid", type=int, default=100, help="cells per side (default 100)")
     p.add_argument("--theta-range", type=float, nargs=2, default=(-1.0, 1.0),
                    metavar=("LO", "HI"), help="theta0 range (default -1 1)")
@@ -838,7 +847,7 @@ def build_parser():
                  "A basin at each amplitude; its attractors continued from one amplitude to the "
                  "next; write erosion.npz, erosion.png (GIM and IF against alpha, and each "
                  "attractor's basin fraction, stacked) and summary.json.")
-    _add_block(p, alpha=False, laws="housner, mao, constant or both")
+    _add_block(p, alpha=False, both=True)
     _add_alphas(p, 0.01)
     p.add_argument("--grid", type=int, default=100, help="cells per side (default 100)")
     _add_phase(p, "default (r0, s0) = (0, 1)")
@@ -855,7 +864,7 @@ def build_parser():
                  "(the safe fraction with contours at --levels; with --law both also "
                  "safety_difference.png) and summary.json. Column by column, resumable, on "
                  "Dask with --scheduler.")
-    _add_block(p, alpha=False, omega=False, laws="housner, mao, constant or both")
+    _add_block(p, alpha=False, omega=False, both=True)
     _add_alphas(p, None)
     p.add_argument("--omega-range", type=float, nargs=2, required=True,
                    metavar=("START", "END"), help="frequencies (ends included)")
@@ -892,7 +901,7 @@ def build_parser():
                  "write chart.npz, chart.png (with --law both: both laws side by side and "
                  "their curves on one chart) and summary.json (\"curves\": type, period, law, "
                  "points).")
-    _add_block(p, alpha=False, omega=False, laws="housner, mao, constant or both")
+    _add_block(p, alpha=False, omega=False, both=True)
     _add_alphas(p, None)
     p.add_argument("--omega-range", type=float, nargs=2, required=True,
                    metavar=("START", "END"), help="frequencies (ends included)")
@@ -937,7 +946,7 @@ def build_parser():
                  "located by bisection to --tol. Writes spectrum.npz, spectrum.png and "
                  "summary.json (\"min_overturn\", per law with --law both). Compiled path; "
                  "--method scipy for the reference path.")
-    _add_block(p, alpha=False, omega=False, laws="housner, mao, constant or both")
+    _add_block(p, alpha=False, omega=False, both=True)
     p.add_argument("--pulse", default="sine", choices=("sine", "cosine", "ricker"),
                    help="the pulse (default sine)")
     p.add_argument("--ratio-range", type=float, nargs=2, required=True,
@@ -959,7 +968,7 @@ def build_parser():
                  "size and law, and fit lognormal fragility curves (median and dispersion by "
                  "maximum likelihood) to overturning and to max|theta|/(pi/2 - theta_c) >= "
                  "0.5, 1. Writes fragility.npz, fragility.png, rotation.png and summary.json.")
-    _add_block(p, alpha=False, omega=False, laws="housner, mao, constant or both")
+    _add_block(p, alpha=False, omega=False, both=True)
     p.add_argument("--size", type=float, nargs="+", required=True, metavar="R",
                    help="the block's half-diagonal R in metres (several: the size effect)")
     p.add_argument("--records", nargs="+", required=True, metavar="SET|FILE",

@@ -32,14 +32,16 @@ from .response import OUTCOMES, TransientResult
 from .settings import Transient
 from .spectrum import SpectrumResult, spectrum
 
-__all__ = ["FragilityResult", "LognormalFit", "OUTCOMES", "Pulse", "Record", "SpectrumResult",
-           "Transient", "TransientResult", "fema_set", "fit_capacities", "fit_lognormal",
+__all__ = ["FragilityResult", "HarmonicSum", "LognormalFit", "OUTCOMES", "Pulse", "Record",
+           "SpectrumResult", "Transient", "TransientResult", "fema_set", "fit_capacities", "fit_lognormal",
            "fragility", "read_at2", "read_record", "read_table", "spectrum"]
 
 from .plan import plan_run  # noqa: E402
+from ..plugs import HarmonicSum, TransientPlug  # noqa: E402
 
 # A single run under a pulse or a record takes the transient path: rockjit.simulate asks the
 # excitation for its plan (Excitation.plan_run), and the transient excitations answer here,
 # above both the excitations and their runs (a Pulse or a Record is only made through this
-# package, so the answer is always in place).
-Pulse.plan_run = Record.plan_run = plan_run
+# package, so the answer is always in place; an excitation plug, rockjit.plugs, answers here
+# too, and rockjit.HarmonicSum comes through this package).
+Pulse.plan_run = Record.plan_run = TransientPlug.plan_run = plan_run

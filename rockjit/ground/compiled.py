@@ -26,6 +26,7 @@ import numpy as np
 
 from .._engine import transient as T
 from ..model import damping_rate, initial_side
+from ..plugs import TransientPlug
 from ..validate import memory
 from .pulses import KINDS, Pulse
 from .response import STATUS_CODES, TransientResult, alpha_s, empty_outputs
@@ -69,6 +70,14 @@ def _sources(sources, shrink):
             row[T.X_OMEGA] = src.omega_p
             row[T.X_DELAY] = src.delay
             row[T.X_STEPS] = max(MIN_PULSE_STEPS, math.ceil(src.end / (shrink * H_PULSE)))
+        elif isinstance(src, TransientPlug):
+            coef = np.asarray(src.coefficients(), dtype=float)
+            row[T.X_KIND] = src.kind
+            row[T.X_OFF] = off
+            row[T.X_N] = coef.size
+            row[T.X_STEPS] = src.steps(shrink)
+            chunks.append(coef)
+            off += coef.size
         else:
             dt = src.dt_model
             row[T.X_KIND] = T.K_RECORD

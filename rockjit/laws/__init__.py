@@ -4,7 +4,7 @@ Every module of this package defines and registers its laws (:func:`register`): 
 Mao et al.'s (one coefficient per block, from its slenderness), the constant law (a number given
 with the block) and a law that depends on the impact (:class:`SpeedDependent`). The table of
 names, labels, colours and line styles that figures, the command line and the explorer use is
-read from the registered laws (:func:`names`, :func:`labels`, :func:`colours`, :func:`lines`).
+read from the registered laws (:func:`names`, :class:`Table`).
 A new law is one module here (docs/guide/extending.md).
 """
 
@@ -14,11 +14,11 @@ import importlib
 import pkgutil
 from collections.abc import Mapping
 
-from . import impact
-from .base import RestitutionLaw, register, registered
+from . import base, impact
+from .base import RestitutionLaw, register, registered, unregister
 
-__all__ = ["Constant", "Housner", "Mao", "RestitutionLaw", "SpeedDependent", "Table", "colours",
-           "get", "labels", "lines", "names", "register", "registered"]
+__all__ = ["Constant", "Housner", "Mao", "RestitutionLaw", "SpeedDependent", "Table", "get",
+           "names", "register", "registered", "unregister"]
 
 _OWN = ("base", "impact")
 for _m in sorted(m.name for m in pkgutil.iter_modules(__path__)):
@@ -32,9 +32,28 @@ from .housner import Housner  # noqa: E402
 from .mao import Mao  # noqa: E402
 from .speed import SpeedDependent  # noqa: E402
 
+base.keep_own()
+
 
 def get(name):
-    """The registered law named ``name``; ``ValueError`` naming the registered ones else."""
+    """The registered law named ``name``.
+
+    Parameters
+    ----------
+    name : str
+        A registered law's name (:func:`names`); another is refused with a ``ValueError``
+        naming them.
+
+    Returns
+    -------
+    RestitutionLaw
+
+    Examples
+    --------
+    >>> from rockjit import laws
+    >>> laws.get("speed").describe()
+    'Housner, speed-softened (v_half = 1)'
+    """
     for law in registered():
         if law.name == name:
             return law
@@ -42,28 +61,32 @@ def get(name):
 
 
 def names():
-    """The registered laws' names, in table order."""
+    """The registered laws' names, in table order.
+
+    Examples
+    --------
+    >>> from rockjit import laws
+    >>> laws.names()[:3]
+    ('housner', 'mao', 'constant')
+    """
     return tuple(law.name for law in registered())
-
-
-def labels():
-    """``{name: label}``: how figures and tables write each law."""
-    return {law.name: law.label for law in registered()}
-
-
-def colours():
-    """``{name: colour}``: each law's colour where figures compare laws in colour."""
-    return {law.name: law.colour for law in registered()}
-
-
-def lines():
-    """``{name: dict(color, ls, marker)}``: each law's line where laws share an axis."""
-    return {law.name: dict(law.line) for law in registered()}
 
 
 class Table(Mapping):
     """A live ``{name: value}`` view of one attribute of the registered laws (a law registered
-    later is in it too): ``Table("label")``, ``Table("colour")``, ``Table("line")``."""
+    later is in it too).
+
+    Parameters
+    ----------
+    attr : {"label", "colour", "line"}
+        The attribute.
+
+    Examples
+    --------
+    >>> from rockjit import laws
+    >>> laws.Table("label")["mao"]
+    'Mao et al.'
+    """
 
     def __init__(self, attr):
         self._attr = attr

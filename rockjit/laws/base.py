@@ -11,9 +11,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["RestitutionLaw", "register", "registered"]
+__all__ = ["RestitutionLaw", "register", "registered", "unregister"]
 
 _REGISTRY = {}
+_OWN = set()
 
 
 @dataclass(frozen=True)
@@ -39,6 +40,13 @@ class RestitutionLaw:
         ``impact(speed, e, shape) -> (e_impact, slope)``: the coefficient at an impact of
         approach speed ``speed`` and the derivative ``d(e(v) v)/dv`` there, from the block's
         coefficient ``e`` and the law's ``shape``; ``None`` for a coefficient fixed per block.
+
+    Examples
+    --------
+    >>> from rockjit import Block, laws
+    >>> law = laws.get("mao")
+    >>> law.label, round(law.coefficient(Block(hb=1).thc), 3)
+    ('Mao et al.', 0.582)
     """
 
     name = ""
@@ -51,7 +59,8 @@ class RestitutionLaw:
 
     def coefficient(self, thc, e=None):
         """The block's coefficient of restitution for the diagonal angle ``thc`` (``e``: the
-        block's own, for a law that ``needs_e``)."""
+        block's own, for a law that ``needs_e``); of a slow impact, for a law that depends on
+        the impact."""
         raise NotImplementedError
 
     def check(self, hb):
@@ -76,12 +85,37 @@ class RestitutionLaw:
 
 
 def register(law):
-    """Make ``law`` (an instance) selectable by its name: ``Block(hb, law=law.name)``, the
-    command line's ``--law`` and every table of laws.
+    """Make ``law`` selectable by its name: ``Block(hb, law=law.name)``, the command line's
+    ``--law`` and every table of laws.
+
+    Parameters
+    ----------
+    law : RestitutionLaw
+        An instance, named (its class's ``name``) and not taken by another law.
+
+    Returns
+    -------
+    RestitutionLaw
+        ``law``.
 
     A law whose ``impact`` is a compiled function must be defined in a module of
     :mod:`rockjit.laws`: the integrator's kernels are compiled with the impact functions of
     the package's laws (:mod:`rockjit.laws.impact`), and a function they do not know is refused.
+
+    Examples
+    --------
+    >>> from dataclasses import dataclass
+    >>> from rockjit import Block, laws
+    >>> @dataclass(frozen=True)
+    ... class Measured(laws.RestitutionLaw):
+    ...     name = "measured-0.9"
+    ...     label = "Housner x 0.9"
+    ...     def coefficient(self, thc, e=None):
+    ...         return 0.9 * float(laws.housner.e_housner(thc))
+    >>> _ = laws.register(Measured())
+    >>> round(Block(hb=1, law="measured-0.9").restitution, 4)
+    0.225
+    >>> laws.unregister("measured-0.9")
     """
     if not isinstance(law, RestitutionLaw) or not law.name:
         raise ValueError(f"law must be a named RestitutionLaw instance (got {law!r})")
@@ -94,6 +128,42 @@ def register(law):
     return law
 
 
+def unregister(name):
+    """Take the law named ``name`` out of the registry (a law a user registered; the package's
+    own laws stay).
+
+    Parameters
+    ----------
+    name : str
+        The name of a law :func:`register` added.
+
+    Examples
+    --------
+    >>> from rockjit import laws
+    >>> laws.unregister("housner")
+    Traceback (most recent call last):
+    ...
+    ValueError: the package's own law 'housner' stays registered
+    """
+    if name in _OWN:
+        raise ValueError(f"the package's own law {name!r} stays registered")
+    if name not in _REGISTRY:
+        raise ValueError(f"no restitution law named {name!r} is registered")
+    del _REGISTRY[name]
+
+
+def keep_own():
+    """Mark the laws registered so far as the package's own (:func:`unregister` keeps them)."""
+    _OWN.update(_REGISTRY)
+
+
 def registered():
-    """The registered laws, in table order (``order``, then name)."""
+    """The registered laws, in table order (``order``, then name).
+
+    Examples
+    --------
+    >>> from rockjit import laws
+    >>> [law.name for law in laws.registered()][:2]
+    ['housner', 'mao']
+    """
     return sorted(_REGISTRY.values(), key=lambda law: (law.order, law.name))

@@ -8,7 +8,15 @@ __all__ = ["Constant"]
 
 
 class Constant(RestitutionLaw):
-    """``e`` given with the block (``Block(hb, e=0.5)``), the same at every impact."""
+    """``e`` given with the block (``Block(hb, e=0.5)``), the same at every impact.
+
+    Examples
+    --------
+    >>> from rockjit import Block
+    >>> b = Block(hb=2, e=0.5)
+    >>> b.law, b.restitution
+    ('constant', 0.5)
+    """
 
     name = "constant"
     order = 2
@@ -18,6 +26,7 @@ class Constant(RestitutionLaw):
     needs_e = True
 
     def coefficient(self, thc, e=None):
+        """The block's coefficient (see :meth:`RestitutionLaw.coefficient`)."""
         return e
 
 

@@ -54,7 +54,14 @@ def check_housner(hb, name="the Housner law"):
 
 class Housner(RestitutionLaw):
     """Housner's law (1963): ``e = e_H(thc)``, one coefficient per block
-    (:func:`e_housner`)."""
+    (:func:`e_housner`).
+
+    Examples
+    --------
+    >>> from rockjit import Block
+    >>> round(Block(hb=2, law="housner").restitution, 12)
+    0.7
+    """
 
     name = "housner"
     order = 0
@@ -63,9 +70,11 @@ class Housner(RestitutionLaw):
     line = dict(color="k", ls="-", marker="o")
 
     def coefficient(self, thc, e=None):
+        """The block's coefficient (see :meth:`RestitutionLaw.coefficient`)."""
         return float(e_housner(thc))
 
     def check(self, hb):
+        """Refuse ``hb < 1/sqrt(2)``, where ``e_H`` would be negative."""
         check_housner(hb)
 
 

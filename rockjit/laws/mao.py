@@ -45,7 +45,14 @@ def e_mao(thc):
 
 
 class Mao(RestitutionLaw):
-    """Mao et al.'s law (2024): ``e = e_M(thc)``, one coefficient per block (:func:`e_mao`)."""
+    """Mao et al.'s law (2024): ``e = e_M(thc)``, one coefficient per block (:func:`e_mao`).
+
+    Examples
+    --------
+    >>> from rockjit import Block
+    >>> round(Block(hb=2, law="mao").restitution, 3)
+    0.83
+    """
 
     name = "mao"
     order = 1
@@ -54,6 +61,7 @@ class Mao(RestitutionLaw):
     line = dict(color="k", ls=(0, (5, 2)), marker="s")
 
     def coefficient(self, thc, e=None):
+        """The block's coefficient (see :meth:`RestitutionLaw.coefficient`)."""
         return float(e_mao(thc))
 
 

@@ -66,15 +66,19 @@ class SpeedDependent(RestitutionLaw):
 
     @property
     def shape(self):
+        """``v_half``, the compiled impact function's parameter."""
         return self.v_half
 
     def coefficient(self, thc, e=None):
+        """Housner's ``e_H``: the coefficient of a slow impact."""
         return float(e_housner(thc))
 
     def check(self, hb):
+        """Refuse ``hb < 1/sqrt(2)``, where ``e_H`` would be negative."""
         check_housner(hb, "the speed-softened Housner law")
 
     def describe(self):
+        """The law and its ``v_half``."""
         return f"{self.label} (v_half = {self.v_half:g})"
 
 

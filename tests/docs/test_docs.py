@@ -38,7 +38,9 @@ PUBLIC_MODULES = [
     "rockjit.orbits.curves", "rockjit.orbits.plane_chart", "rockjit.ground.pulses",
     "rockjit.ground.records", "rockjit.ground.fema", "rockjit.ground.settings",
     "rockjit.ground.response", "rockjit.ground.spectrum", "rockjit.ground.fitting",
-    "rockjit.ground.fragility", "rockjit.reprs",
+    "rockjit.ground.fragility", "rockjit.reprs", "rockjit.laws", "rockjit.laws.base",
+    "rockjit.laws.housner", "rockjit.laws.mao", "rockjit.laws.constant", "rockjit.laws.speed",
+    "rockjit.plugs", "rockjit.plugs.base", "rockjit.plugs.harmonic_sum",
 ]
 if importlib.util.find_spec("bokeh") is not None:  # the explorer's example starts its server
     PUBLIC_MODULES.append("rockjit.explorer")
@@ -90,6 +92,9 @@ def _public_objects():
             ("rockjit.orbits.ChartResult", orbits.ChartResult),
             ("rockjit.orbits.BifurcationCurve", orbits.BifurcationCurve)]
     out += [(f"rockjit.measures.{n}", getattr(measures, n)) for n in measures.__all__]
+    from rockjit import laws, plugs
+    out += [(f"rockjit.laws.{n}", getattr(laws, n)) for n in laws.__all__]
+    out += [(f"rockjit.plugs.{n}", getattr(plugs, n)) for n in plugs.__all__]
     out += [("rockjit.basins.erosion.ErosionResult", erosion.ErosionResult),
             ("rockjit.basins.fate.FateResult", fate.FateResult),
             ("rockjit.storage.output_dir.OutputDir", output_dir.OutputDir)]

@@ -1,0 +1,118 @@
+"""What an excitation plug is: a transient excitation the compiled transient kernel runs through
+two compiled functions of its own.
+
+A plug is an :class:`rockjit.Excitation` that ends (``transient = True``), written in one module
+of :mod:`rockjit.plugs`. The compiled kernel of pulses and records
+(:mod:`rockjit._engine.transient`) keeps a plug's numbers, :meth:`TransientPlug.coefficients`,
+in its array of samples and calls the plug's two compiled functions:
+
+- ``value(t, rec, off, n)``: the base acceleration (``g``, at unit gain) at model time
+  ``0 <= t <= end``, from the ``n`` numbers ``rec[off:off + n]``;
+- ``window(tq, end, rec, off, n, thr)``: the first interval ``(t0, t1, sign)`` of
+  ``[0, end]`` with ``t1 > tq`` where ``|f| > thr`` (``sign`` of ``f`` there, 0 if none):
+  where a block at rest may lift off.
+
+The kernel steps a plug in :meth:`TransientPlug.steps` equal steps over ``[0, end]`` and adds
+its own steps at every event. The scipy reference path uses the plug's Python side
+(:meth:`scalar`, :meth:`windows`, ``breaks``, ``max_step``), which each plug writes
+independently of its compiled functions.
+"""
+
+from __future__ import annotations
+
+from ..excitation import Excitation
+
+__all__ = ["TransientPlug", "register", "registered"]
+
+#: The registered plugs' classes, in the order of their kinds.
+_PLUGS = []
+
+
+class TransientPlug(Excitation):
+    """The base of an excitation plug (see the module's description).
+
+    Subclasses set the class attributes ``value`` and ``window`` (``staticmethod`` of compiled
+    functions), the excitation's fields, and the methods below; the module registers the class
+    with :func:`register`.
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> from rockjit.plugs import TransientPlug
+    >>> isinstance(rockjit.HarmonicSum(duration=5.0), TransientPlug)
+    True
+    """
+
+    transient = True
+    value = None
+    window = None
+    #: The kernel's code of the plug (set by :func:`register`).
+    kind = -1
+
+    # ---- what the compiled kernel needs ----------------------------------------------------
+    def coefficients(self):
+        """The numbers ``value`` and ``window`` read (a 1-d float array)."""
+        raise NotImplementedError
+
+    def steps(self, shrink):
+        """How many equal steps the kernel takes over ``[0, end]`` (``shrink`` <= 1: the step
+        of a heavily damped block is that much shorter)."""
+        raise NotImplementedError
+
+    @property
+    def scale(self):
+        """The factor the kernel multiplies ``value`` by (a grid's gain multiplies it)."""
+        return 1.0
+
+    # ---- what every transient excitation gives ---------------------------------------------
+    def bind(self, block):
+        """This excitation on ``block`` (a plug in units of ``g`` needs nothing of it)."""
+        return self
+
+    def plan_run(self, block, state, integration, lyapunov, record_stride, method):
+        """The plan of a single run: :mod:`rockjit.ground` plans it (and replaces this method
+        when it is imported, as ``rockjit.HarmonicSum`` and every entry point do)."""
+        raise ValueError(f"a run under {type(self).__name__} is planned by rockjit.ground: "
+                         f"import rockjit.ground first")
+
+
+def register(cls):
+    """Register the plug class ``cls``: a class decorator for the plugs of this package (the
+    kernel is compiled with their functions when :mod:`rockjit.plugs` is imported, which
+    gives each its ``kind``).
+
+    Parameters
+    ----------
+    cls : type
+        A :class:`TransientPlug` subclass with compiled ``value`` and ``window``.
+
+    Returns
+    -------
+    type
+        ``cls``.
+
+    Examples
+    --------
+    >>> from rockjit.plugs import HarmonicSum, registered
+    >>> HarmonicSum in registered(), HarmonicSum.kind
+    (True, 4)
+    """
+    if not (isinstance(cls, type) and issubclass(cls, TransientPlug)) or cls.value is None \
+            or cls.window is None:
+        raise ValueError(f"a plug must be a TransientPlug subclass with compiled value and "
+                         f"window functions (got {cls!r})")
+    if cls not in _PLUGS:
+        _PLUGS.append(cls)
+    return cls
+
+
+def registered():
+    """The registered plug classes, in the order their kinds are given.
+
+    Examples
+    --------
+    >>> from rockjit import plugs
+    >>> [cls.__name__ for cls in plugs.registered()]
+    ['HarmonicSum']
+    """
+    return list(_PLUGS)
