@@ -155,6 +155,38 @@ def measure(cfg, t0):
     return rows, raw
 
 
+#: Register caps tried on the largest basin (numba-cuda's ``max_registers``; None: the
+#: compiler's own choice, the driver's default).
+REGISTERS = (None, 128)
+
+
+def registers(cfg, t0):
+    """The largest basin, full length and early-stopped, in one call of the driver with each
+    register cap of :data:`REGISTERS`: rows, and the cells whose label differs from the
+    default's (a cap changes where values live, not the arithmetic: none should)."""
+    from rockjit._engine import gpu
+    rows, raw = [], {}
+    for key, p in cases(cfg):
+        if p.kind != "basin" or p.shape[0] != cfg["basins"][-1]:
+            continue
+        args = (p.tangent, p.y0s, p.pars, p.ipar, p.cpar, p.n_pts, p.n_imp_pts)
+        fns = {r: (lambda r=r: gpu.run_chunk(*args, max_registers=r)) for r in REGISTERS}
+        for r in REGISTERS:
+            gpu.run_chunk(*args[:1], p.y0s[:8], p.pars[:8], *args[3:], max_registers=r)
+        reps = cfg["repeats"] if time.monotonic() - t0 < 0.5 * cfg["budget_s"] else 1
+        t = H.side_by_side(fns, reps)
+        base = t.result[None]["res"][:, R_LABEL]
+        for r in REGISTERS:
+            n, g = p.y0s.shape[0], t.median(r)
+            differ = int((t.result[r]["res"][:, R_LABEL] != base).sum())
+            cap = "registers as the compiler chose" if r is None else f"at most {r} registers"
+            name = f"{key}, one call, {cap}"
+            rows.append((name, n, g, "", "", "", n / g, differ, "", "", "yes"))
+            raw[name] = dict(gpu=t.wall[r])
+            print(f"{name}: GPU {g:.3f} s", flush=True)
+    return rows, raw
+
+
 def _rk4(y, v, n_steps):
     """``n_steps`` RK4 steps of ``y'' = -y - 0.1 y'`` in registers (the yardstick's cell)."""
     h = 0.01
@@ -242,6 +274,9 @@ def main(argv=None):
     warm_up(cfg)
     warm = time.monotonic() - warm
     rows, raw = measure(cfg, t0)
+    more, more_raw = registers(cfg, t0)
+    rows += more
+    raw.update(more_raw)
     row, raw["yardstick"] = yardstick(cfg)
     rows.append(row)
     gpu = device_name()
@@ -256,7 +291,11 @@ def main(argv=None):
             f"differ between the devices; differ, not flagged: of those, at the smallest "
             f"basin, the cells the uncertainty test (initial states moved by {EPS:g}, on the "
             f"CPU) does not flag. max strobe diff: the largest difference of the "
-            f"stroboscopic samples of the cells both devices call periodic. Load before: "
+            f"stroboscopic samples of the cells both devices call periodic. The rows 'one "
+            f"call': the largest basin in one call of the driver (no chunks), with the "
+            f"compiler's choice of registers a thread and with a cap (more threads resident, "
+            f"more spilled); labels_differ there counts the cells whose label differs from "
+            f"the uncapped call's. Load before: "
             f"{H.load_text()}.\n")
     b.report("gpu", markdown=md, csv=(HEADERS, rows),
              data=dict(measured=True, device=gpu, env=b.env, warm_up_s=warm, raw=raw,

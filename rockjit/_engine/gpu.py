@@ -30,6 +30,7 @@ boundary or in chaos may take another branch.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -45,8 +46,8 @@ from .tableau import N_STAGES, N_TAB
 from .._jit import jit
 from ..model import initial_side
 
-__all__ = ["BLOCK", "GPU_CHUNK", "SIMULATOR", "batch_cells", "cell_bytes", "default_chunk",
-           "kernels", "run_cell", "run_chunk", "signatures"]
+__all__ = ["BLOCK", "GPU_CHUNK", "SIMULATOR", "batch_cells", "cell_bytes", "cells_kernel",
+           "default_chunk", "kernels", "run_cell", "run_chunk", "signatures"]
 
 #: Threads per block of the cells' kernels.
 BLOCK = 128
@@ -199,6 +200,21 @@ _cells_tangent = compile_step("_cells_tangent", _CELL_ARGS,
                               cuda.jit(cache=not SIMULATOR), doc=_DOC)
 
 
+@functools.lru_cache(maxsize=None)
+def cells_kernel(tangent, max_registers=None):
+    """The cells' kernel with or without tangent vectors; ``max_registers`` caps the registers
+    a thread may use (more threads resident on a multiprocessor, more values spilled to local
+    memory: which is faster depends on the device, ``benchmarks/bench_gpu.py`` measures it);
+    ``None``, as many as the compiler takes (all 255 for the kernel without exponents)."""
+    if max_registers is None or SIMULATOR:
+        return _cells_tangent if tangent else _cells_plain
+    r = int(max_registers)
+    name = f"_cells_{'tangent' if tangent else 'plain'}_r{r}"
+    lines = _CELLS.format(TANGENT="True" if tangent else "None", NY=6 if tangent else 2)
+    return compile_step(name, _CELL_ARGS, lines.split("\n"), globals(),
+                        cuda.jit(cache=True, max_registers=r), doc=_DOC)
+
+
 def kernels():
     """The CUDA kernels the driver launches, by name: ``tables``, ``cells`` (no tangent
     vectors), ``cells+tangent``."""
@@ -262,10 +278,11 @@ def _free_bytes():
 
 
 def run_chunk(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=None, lanes=None,
-              batch=None):
+              batch=None, max_registers=None):
     """:func:`rockjit._engine.kernel.run_chunk` on the GPU: the same inputs, the same outputs
     by name (``threads`` and ``lanes`` are the CPU's and ignored here); ``batch`` cells at
-    most per launch (default :func:`batch_cells`)."""
+    most per launch (default :func:`batch_cells`); ``max_registers``, as
+    :func:`cells_kernel` takes it."""
     from .kernel import grid_outputs
     y0s = np.ascontiguousarray(y0s, dtype=np.float64)
     pars = np.ascontiguousarray(pars, dtype=np.float64)
@@ -295,7 +312,7 @@ def run_chunk(tangent, y0s, pars, ipar, cpar, n_pts, n_imp_pts, threads=None, la
     impacts = cuda.device_array((b, max(n_imp_pts, 1), 3))
     lam_run = cuda.device_array((b, p1 if tangent else 1, 3))
     per_imp = cuda.device_array((b, p1), dtype=np.int64)
-    cells = _cells_tangent if tangent else _cells_plain
+    cells = cells_kernel(bool(tangent), max_registers)
     for a in range(0, n, b):
         e = min(n, a + b)
         m = e - a
