@@ -249,13 +249,16 @@ def batch_cells(n, periods, n_imp_pts, tangent, free_bytes):
 
 
 #: The fewest cells of a chunk on the GPU by default (:func:`default_chunk`).
-GPU_CHUNK = 1 << 18
+GPU_CHUNK = 1 << 20
 
 
 def default_chunk(n):
     """Cells per chunk on the GPU when none is given: the whole grid up to
-    :data:`GPU_CHUNK` cells (a smaller launch leaves most of a large GPU idle), else about a
-    twentieth of it (:func:`rockjit._engine.kernel.default_chunk`)."""
+    :data:`GPU_CHUNK` cells, else about a twentieth of it
+    (:func:`rockjit._engine.kernel.default_chunk`). A chunk's launch ends with its slowest
+    cell, while the device empties: fewer, larger chunks pay that tail fewer times (an
+    early-stopped basin's slowest cells run the full length), and a small one leaves most of a
+    large GPU idle."""
     from .kernel import default_chunk as cpu_chunk
     return max(GPU_CHUNK, cpu_chunk(n))
 

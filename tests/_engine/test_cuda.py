@@ -181,10 +181,11 @@ def test_cli_refuses_cuda_for_spectra_in_one_line(tmp_path, capsys, monkeypatch)
 
 
 def test_chunks_on_the_gpu_fill_it():
-    """A chunk is the whole grid up to 2**18 cells, about a twentieth beyond; a launch holds
+    """A chunk is the whole grid up to 2**20 cells, about a twentieth beyond; a launch holds
     what half the free memory holds in scratch."""
     from rockjit._engine import gpu
-    assert gpu.default_chunk(10_000) == 2**18 and gpu.default_chunk(10**7) == 500_000
+    assert gpu.default_chunk(10_000) == 2**20 and gpu.default_chunk(10**6) == 2**20
+    assert gpu.default_chunk(10**8) == 5_000_000
     per = 8 * (4 * 501 + 4 * 501 + 3 + 3 + 501)  # 500 periods, no exponents: 20,072 bytes
     assert gpu.cell_bytes(500, 0, False) == per
     assert gpu.batch_cells(10**6, 500, 0, False, 2 * per * 1000) == 1000
