@@ -119,16 +119,16 @@ def kernels():
     @numba.njit(cache=False, _nrt=False)
     def load(l, y, K, par, jac, trig, lin, tab):
         restart(l, y, K, par, jac, trig)
-        lin[ln.I_X * W + l] = y[l, 0]
-        lin[ln.I_V * W + l] = y[l, 1]
-        lin[ln.I_K * W + l] = K[l, 0, 1]
-        lin[ln.I_S * W + l] = trig[l, 0]
-        lin[ln.I_C * W + l] = trig[l, 1]
-        lin[ln.I_SG * W + l] = 1.0
-        lin[ln.I_STHC * W + l] = par[ig.P_STHC]
-        lin[ln.I_CTHC * W + l] = par[ig.P_CTHC]
-        lin[ln.I_XI * W + l] = par[ig.P_XI]
-        lin[ln.I_THOVER * W + l] = par[ig.P_THOVER]
+        lin[ln.LI_X * W + l] = y[l, 0]
+        lin[ln.LI_V * W + l] = y[l, 1]
+        lin[ln.LI_K * W + l] = K[l, 0, 1]
+        lin[ln.LI_S * W + l] = trig[l, 0]
+        lin[ln.LI_C * W + l] = trig[l, 1]
+        lin[ln.LI_SG * W + l] = 1.0
+        lin[ln.LI_STHC * W + l] = par[ig.P_STHC]
+        lin[ln.LI_CTHC * W + l] = par[ig.P_CTHC]
+        lin[ln.LI_XI * W + l] = par[ig.P_XI]
+        lin[ln.LI_THOVER * W + l] = par[ig.P_THOVER]
         ln.lane_tables(tab, lin, l)
 
     @numba.njit(cache=False, _nrt=False)
@@ -143,7 +143,7 @@ def kernels():
         for _ in range(n):
             ln.block_step_lanes(nv.shape[0], j, lin, lout, ftl)  # all W lanes, one vector
             for l in range(L):
-                if lout[ln.O_FAST * W + l] == 0.0:
+                if lout[ln.LO_FAST * W + l] == 0.0:
                     load(l, y, K, par, jac, trig, lin, tab)
             j += 1
             if j == n_per:

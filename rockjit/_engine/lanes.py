@@ -56,9 +56,9 @@ LANE_ROWS = _lane_rows()
 @jit(nrt=False)
 def lane_tables(tab, lin, lane):
     """Copy the entries of integrate's step table ``tab`` that the block's step reads into
-    column ``lane`` of the lanes' input ``lin`` (rows ``I_TAB ..``)."""
+    column ``lane`` of the lanes' input ``lin`` (rows ``LI_TAB ..``)."""
     for r in range(N_LTAB):
-        lin[(I_TAB + r) * W + lane] = tab[LANE_ROWS[r, 0], LANE_ROWS[r, 1]]
+        lin[(LI_TAB + r) * W + lane] = tab[LANE_ROWS[r, 0], LANE_ROWS[r, 1]]
 
 
 
@@ -68,14 +68,14 @@ W = 8
 
 
 # rows of the lanes' input ``lin`` and output ``lout`` (:func:`block_step_lanes`)
-I_X, I_V, I_K, I_S, I_C, I_SG, I_STHC, I_CTHC, I_XI, I_THOVER = range(10)
-I_TAB = 10                     # N_LTAB rows: the step's table
-N_LIN = I_TAB + N_LTAB
-O_X, O_V, O_S, O_C, O_FAR = range(5)
-O_KV = O_FAR                    # rows O_KV + 1 .. O_KV + 6
-O_KA = O_KV + ig.N_STAGES       # rows O_KA + 1 .. O_KA + 6
-O_FAST = O_KA + ig.N_STAGES + 1
-N_LOUT = O_FAST + 1
+LI_X, LI_V, LI_K, LI_S, LI_C, LI_SG, LI_STHC, LI_CTHC, LI_XI, LI_THOVER = range(10)
+LI_TAB = 10                     # N_LTAB rows: the step's table
+N_LIN = LI_TAB + N_LTAB
+LO_X, LO_V, LO_S, LO_C, LO_FAR = range(5)
+LO_KV = LO_FAR                    # rows LO_KV + 1 .. LO_KV + 6
+LO_KA = LO_KV + ig.N_STAGES       # rows LO_KA + 1 .. LO_KA + 6
+LO_FAST = LO_KA + ig.N_STAGES + 1
+N_LOUT = LO_FAST + 1
 
 
 def _lane_coef(kind, i, j):
@@ -93,39 +93,39 @@ def _lane_stage(i):
 _STEP_LANES = (
     ["for l in range(n):"]
     + ["    " + ln for ln in (
-        ["x0 = lin[I_X * W + l]",
-         "v0 = lin[I_V * W + l]",
-         "k0 = lin[I_K * W + l]",
-         "sl = lin[I_S * W + l]",
-         "cl = lin[I_C * W + l]",
-         "side = lin[I_SG * W + l]",
-         "st = lin[I_STHC * W + l]",
-         "ct = lin[I_CTHC * W + l]",
-         "dmp = lin[I_XI * W + l]",
-         "tb = I_TAB * W + l  # the lane's step table: row r at tb + r W"]
+        ["x0 = lin[LI_X * W + l]",
+         "v0 = lin[LI_V * W + l]",
+         "k0 = lin[LI_K * W + l]",
+         "sl = lin[LI_S * W + l]",
+         "cl = lin[LI_C * W + l]",
+         "side = lin[LI_SG * W + l]",
+         "st = lin[LI_STHC * W + l]",
+         "ct = lin[LI_CTHC * W + l]",
+         "dmp = lin[LI_XI * W + l]",
+         "tb = LI_TAB * W + l  # the lane's step table: row r at tb + r W"]
         + chain(_lane_stage, _lane_coef, arith="fma", form="nystrom")
         + ["xe = x0 + x6",
            "s6, c6 = sincos_poly(xe)",
            "f = max(max(max(abs(x1), abs(x2)), max(abs(x3), abs(x4))), max(abs(x5), abs(x6)))",
            "far = max(f * (1.0 / NEAR_RANGE), abs(xe) * (1.0 / SINCOS_RANGE))",
-           "lout[O_FAR * W + l] = far"]
-        + [f"lout[(O_KV + {i}) * W + l] = v{i}" for i in range(1, ig.N_STAGES + 1)]
-        + [f"lout[(O_KA + {i}) * W + l] = k{i}" for i in range(1, ig.N_STAGES + 1)]
-        + ["lout[O_X * W + l] = xe",
-           "lout[O_V * W + l] = v6",
-           "lout[O_S * W + l] = s6",
-           "lout[O_C * W + l] = c6",
+           "lout[LO_FAR * W + l] = far"]
+        + [f"lout[(LO_KV + {i}) * W + l] = v{i}" for i in range(1, ig.N_STAGES + 1)]
+        + [f"lout[(LO_KA + {i}) * W + l] = k{i}" for i in range(1, ig.N_STAGES + 1)]
+        + ["lout[LO_X * W + l] = xe",
+           "lout[LO_V * W + l] = v6",
+           "lout[LO_S * W + l] = s6",
+           "lout[LO_C * W + l] = c6",
            "g0 = side * x0",
            "g1 = side * xe",
            "graze = (g0 > 0.0) & (side * v0 < 0.0) & (side * v6 > 0.0)",
-           "fast = ((side != 0.0) & (far <= 1.0) & (g1 < lin[I_THOVER * W + l]) & (g1 >= 0.0)"
+           "fast = ((side != 0.0) & (far <= 1.0) & (g1 < lin[LI_THOVER * W + l]) & (g1 >= 0.0)"
            " & (not graze))",
-           "lout[O_FAST * W + l] = 1.0 if fast else 0.0",
-           "lin[I_X * W + l] = xe if fast else x0",
-           "lin[I_V * W + l] = v6 if fast else v0",
-           "lin[I_K * W + l] = k6 if fast else k0",
-           "lin[I_S * W + l] = s6 if fast else sl",
-           "lin[I_C * W + l] = c6 if fast else cl"])])
+           "lout[LO_FAST * W + l] = 1.0 if fast else 0.0",
+           "lin[LI_X * W + l] = xe if fast else x0",
+           "lin[LI_V * W + l] = v6 if fast else v0",
+           "lin[LI_K * W + l] = k6 if fast else k0",
+           "lin[LI_S * W + l] = s6 if fast else sl",
+           "lin[LI_C * W + l] = c6 if fast else cl"])])
 
 block_step_lanes = compile_step("block_step_lanes", "n, j, lin, lout, ftl", _STEP_LANES,
                                 globals(), jit(nrt=False), doc="""One Dormand–Prince step of the block in ``n`` lanes at once (fast path, no slopes).
@@ -140,13 +140,13 @@ block_step_lanes = compile_step("block_step_lanes", "n, j, lin, lout, ftl", _STE
         Each lane's state and constants, row ``r`` of lane ``l`` at ``r * W + l`` (rows
         ``I_*``): angle, velocity, acceleration, and sine and cosine of the angle at the step's
         start; the corner (as a float: +1, -1, or 0 at rest), ``sin(thc)``, ``cos(thc)``, the
-        damping, the overturning angle; the step's table (``I_TAB + r``, :func:`lane_tables`).
+        damping, the overturning angle; the step's table (``LI_TAB + r``, :func:`lane_tables`).
         A lane whose step is *fast* (below) has its state advanced to the step's end here.
     lout : ndarray, (N_LOUT * W,)
-        Receives the stages' velocities and accelerations (``O_KV + i``, ``O_KA + i``, rows
+        Receives the stages' velocities and accelerations (``LO_KV + i``, ``LO_KA + i``, rows
         ``i = 1..6``: ``K[i, 0]`` and ``K[i, 1]`` of :func:`rockjit._engine.step.block_step`), the
         angle and velocity at the step's end, the sine and cosine of that angle, ``far``
-        (``> 1``: the step left the polynomials' range) and ``O_FAST``: 1 when the step is
+        (``> 1``: the step left the polynomials' range) and ``LO_FAST``: 1 when the step is
         accepted as it is (in flight, in range, and none of the events that
         :func:`rockjit._engine.events.detect` looks for), else 0 (the lane's state is left as it was,
         for the single-lane code to take the step).
@@ -171,14 +171,14 @@ block_step_lanes = compile_step("block_step_lanes", "n, j, lin, lout, ftl", _STE
 
 # layout of a lane's loop state: integers ``st`` and floats ``fs`` (the variables of
 # rockjit._engine.integrate._loop)
-(S_STATUS, S_SIDE, S_NIMP, S_STEP, S_JPER, S_KPER, S_JQR, S_JREC, S_NCOL, S_NCOLWIN,
- S_CELL) = range(11)
+(LS_STATUS, LS_SIDE, LS_NIMP, LS_STEP, LS_JPER, LS_KPER, LS_JQR, LS_JREC, LS_NCOL, LS_NCOLWIN,
+ LS_CELL) = range(11)
 N_ST = 11
-F_TT, F_MAXERR, F_TLIFT, F_TUP = range(4)
-# F_TUP: at rest, the instant the forcing lifts the block (rockjit.model.uplift_time)
+LF_TT, LF_MAXERR, LF_TLIFT, LF_TUP = range(4)
+# LF_TUP: at rest, the instant the forcing lifts the block (rockjit.model.uplift_time)
 # the forcing and grid the lane's tables were made for: alpha omega^2, omega, phi, h, N
-F_KEY = 4
-N_FS = F_KEY + 5
+LF_KEY = 4
+N_FS = LF_KEY + 5
 
 
 @jit(nrt=False, inline=True)
@@ -192,23 +192,23 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, prof, counts):
     stayed in range), so it is not taken again. With ``prof``, ``counts[6:13]`` receive the
     cycles of its parts (see :func:`rockjit._engine.integrate.grid_step`)."""
     (status, t, side, n_imp, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win, t_lift,
-     max_err) = ig.grid_step(None, TANGENT, False, prof, pre, fs[F_TT], st[S_SIDE], st[S_NIMP],
-                             st[S_STEP], st[S_JPER], st[S_KPER], st[S_JQR], st[S_JREC],
-                             st[S_NCOL], st[S_NCOLWIN], fs[F_TLIFT], fs[F_MAXERR], par, ipar,
+     max_err) = ig.grid_step(None, TANGENT, False, prof, pre, fs[LF_TT], st[LS_SIDE], st[LS_NIMP],
+                             st[LS_STEP], st[LS_JPER], st[LS_KPER], st[LS_JQR], st[LS_JREC],
+                             st[LS_NCOL], st[LS_NCOLWIN], fs[LF_TLIFT], fs[LF_MAXERR], par, ipar,
                              out, w, counts)
-    st[S_STATUS] = status
-    st[S_SIDE] = side
-    st[S_NIMP] = n_imp
-    st[S_STEP] = step
-    st[S_JPER] = j_per
-    st[S_KPER] = k_per
-    st[S_JQR] = j_qr
-    st[S_JREC] = j_rec
-    st[S_NCOL] = n_col
-    st[S_NCOLWIN] = n_col_win
-    fs[F_TT] = t
-    fs[F_MAXERR] = max_err
-    fs[F_TLIFT] = t_lift
+    st[LS_STATUS] = status
+    st[LS_SIDE] = side
+    st[LS_NIMP] = n_imp
+    st[LS_STEP] = step
+    st[LS_JPER] = j_per
+    st[LS_KPER] = k_per
+    st[LS_JQR] = j_qr
+    st[LS_JREC] = j_rec
+    st[LS_NCOL] = n_col
+    st[LS_NCOLWIN] = n_col_win
+    fs[LF_TT] = t
+    fs[LF_MAXERR] = max_err
+    fs[LF_TLIFT] = t_lift
 
 
 #: A block of lanes' arrays: each lane's loop state (``st``, ``fs``), parameters (``par``,
@@ -298,9 +298,9 @@ def _load(l, i, y0s, pars, ipar, b):
     fs = b.fs[l]
     # the lane's tables serve the next cell too when its forcing and grid are the same (every
     # cell of a basin): they are made by the same code from the same numbers
-    same = (fs[F_KEY] == par[ig.P_AW2] and fs[F_KEY + 1] == par[ig.P_OMEGA]
-            and fs[F_KEY + 2] == par[ig.P_PHI] and fs[F_KEY + 3] == par[ig.P_H]
-            and fs[F_KEY + 4] == ipar[ig.I_N])
+    same = (fs[LF_KEY] == par[ig.P_AW2] and fs[LF_KEY + 1] == par[ig.P_OMEGA]
+            and fs[LF_KEY + 2] == par[ig.P_PHI] and fs[LF_KEY + 3] == par[ig.P_H]
+            and fs[LF_KEY + 4] == ipar[ig.I_N])
     if not same:
         _zero(b.tab_h[l])
         _zero(b.ftab[l])
@@ -309,26 +309,26 @@ def _load(l, i, y0s, pars, ipar, b):
         for jj in range(ipar[ig.I_N]):
             for s in range(ig.N_STAGES + 1):
                 b.ftl[(jj * (ig.N_STAGES + 1) + s) * W + l] = w.ftab[jj, s]
-        fs[F_KEY] = par[ig.P_AW2]
-        fs[F_KEY + 1] = par[ig.P_OMEGA]
-        fs[F_KEY + 2] = par[ig.P_PHI]
-        fs[F_KEY + 3] = par[ig.P_H]
-        fs[F_KEY + 4] = ipar[ig.I_N]
+        fs[LF_KEY] = par[ig.P_AW2]
+        fs[LF_KEY + 1] = par[ig.P_OMEGA]
+        fs[LF_KEY + 2] = par[ig.P_PHI]
+        fs[LF_KEY + 3] = par[ig.P_H]
+        fs[LF_KEY + 4] = ipar[ig.I_N]
     status = ig.start_state(None, None, y0, side0, par, ipar, out, w)
     for m in range(N_ST):
         st[m] = 0
-    st[S_STATUS] = status
-    st[S_SIDE] = side0
-    st[S_NCOL] = out.iout[ig.O_NCOL]
-    st[S_NCOLWIN] = st[S_NCOL] if ipar[ig.I_WINDOW] == 0 else 0
-    st[S_CELL] = i
-    fs[F_TT] = 0.0
-    fs[F_MAXERR] = 0.0
-    fs[F_TLIFT] = -math.inf
-    fs[F_TUP] = _uplift(st, fs, par)
-    b.lin[I_STHC * W + l] = par[ig.P_STHC]
-    b.lin[I_CTHC * W + l] = par[ig.P_CTHC]
-    b.lin[I_XI * W + l] = par[ig.P_XI]
+    st[LS_STATUS] = status
+    st[LS_SIDE] = side0
+    st[LS_NCOL] = out.iout[ig.O_NCOL]
+    st[LS_NCOLWIN] = st[LS_NCOL] if ipar[ig.I_WINDOW] == 0 else 0
+    st[LS_CELL] = i
+    fs[LF_TT] = 0.0
+    fs[LF_MAXERR] = 0.0
+    fs[LF_TLIFT] = -math.inf
+    fs[LF_TUP] = _uplift(st, fs, par)
+    b.lin[LI_STHC * W + l] = par[ig.P_STHC]
+    b.lin[LI_CTHC * W + l] = par[ig.P_CTHC]
+    b.lin[LI_XI * W + l] = par[ig.P_XI]
     _refresh(l, b)
     return status == ig.RUNNING and ipar[ig.I_N] * ipar[ig.I_PERIODS] > 0
 
@@ -342,34 +342,34 @@ REST_MARGIN = 1e-9
 @jit(nrt=False, inline=True)
 def _uplift(st, fs, par):
     """At rest (``side`` 0): the next uplift after the lane's time; else -inf."""
-    if st[S_SIDE] != 0 or st[S_STATUS] != ig.RUNNING:
+    if st[LS_SIDE] != 0 or st[LS_STATUS] != ig.RUNNING:
         return -math.inf
-    return uplift_time(fs[F_TT], par[ig.P_AW2], par[ig.P_COT], par[ig.P_OMEGA], par[ig.P_PHI])
+    return uplift_time(fs[LF_TT], par[ig.P_AW2], par[ig.P_COT], par[ig.P_OMEGA], par[ig.P_PHI])
 
 
 @jit(nrt=False, inline=True)
 def _refresh(l, b):
     """The lane's step input from its state (after a load or a step)."""
     s = b.states[l]
-    b.lin[I_X * W + l] = s[0, 0]
-    b.lin[I_V * W + l] = s[0, 1]
-    b.lin[I_K * W + l] = b.K[l, 0, 1]
-    b.lin[I_S * W + l] = b.trig[l, 0]
-    b.lin[I_C * W + l] = b.trig[l, 1]
-    b.lin[I_SG * W + l] = b.st[l, S_SIDE]
-    b.lin[I_THOVER * W + l] = b.par[l, ig.P_THOVER]
+    b.lin[LI_X * W + l] = s[0, 0]
+    b.lin[LI_V * W + l] = s[0, 1]
+    b.lin[LI_K * W + l] = b.K[l, 0, 1]
+    b.lin[LI_S * W + l] = b.trig[l, 0]
+    b.lin[LI_C * W + l] = b.trig[l, 1]
+    b.lin[LI_SG * W + l] = b.st[l, LS_SIDE]
+    b.lin[LI_THOVER * W + l] = b.par[l, ig.P_THOVER]
 
 
 @jit(nrt=False, inline=True)
 def _sync(l, b):
     """The lane's single-lane state from its step input (the fast path keeps it there only)."""
     s = b.states[l]
-    s[0, 0] = b.lin[I_X * W + l]
-    s[0, 1] = b.lin[I_V * W + l]
-    b.K[l, 0, 0] = b.lin[I_V * W + l]
-    b.K[l, 0, 1] = b.lin[I_K * W + l]
-    b.trig[l, 0] = b.lin[I_S * W + l]
-    b.trig[l, 1] = b.lin[I_C * W + l]
+    s[0, 0] = b.lin[LI_X * W + l]
+    s[0, 1] = b.lin[LI_V * W + l]
+    b.K[l, 0, 0] = b.lin[LI_V * W + l]
+    b.K[l, 0, 1] = b.lin[LI_K * W + l]
+    b.trig[l, 0] = b.lin[LI_S * W + l]
+    b.trig[l, 1] = b.lin[LI_C * W + l]
 
 
 @jit(nrt=False, inline=True)
@@ -378,13 +378,13 @@ def _stages(l, b):
     :func:`rockjit._engine.step.rk_step` would leave them (no tangent)."""
     K = b.K[l]
     for i in range(1, ig.N_STAGES + 1):
-        K[i, 0] = b.lout[(O_KV + i) * W + l]
-        K[i, 1] = b.lout[(O_KA + i) * W + l]
+        K[i, 0] = b.lout[(LO_KV + i) * W + l]
+        K[i, 1] = b.lout[(LO_KA + i) * W + l]
     s = b.states[l]
-    s[2, 0] = b.lout[O_X * W + l]  # ynew
-    s[2, 1] = b.lout[O_V * W + l]
-    b.trig[l, 2] = b.lout[O_S * W + l]
-    b.trig[l, 3] = b.lout[O_C * W + l]
+    s[2, 0] = b.lout[LO_X * W + l]  # ynew
+    s[2, 1] = b.lout[LO_V * W + l]
+    b.trig[l, 2] = b.lout[LO_S * W + l]
+    b.trig[l, 3] = b.lout[LO_C * W + l]
 
 
 @jit(nrt=False)
@@ -396,17 +396,17 @@ def _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b
     par = b.par[l]
     out = lane_outputs(b, l)
     w = lane_work(b, l)
-    status = st[S_STATUS]
+    status = st[LS_STATUS]
     if status == ig.RUNNING:
         status = ig.DONE
-    out.iout[ig.O_NCOL] = st[S_NCOL]
-    ig.finish(None, None, status, fs[F_TT], st[S_STEP], st[S_NIMP], st[S_NCOLWIN],
-              fs[F_MAXERR], ipar, par, out, w)
-    i = st[S_CELL]
+    out.iout[ig.O_NCOL] = st[LS_NCOL]
+    ig.finish(None, None, status, fs[LF_TT], st[LS_STEP], st[LS_NIMP], st[LS_NCOLWIN],
+              fs[LF_MAXERR], ipar, par, out, w)
+    i = st[LS_CELL]
     cell._classify(None, status, ipar, cpar, out, res[i])
     cell._collect(i, par[ig.P_H] * ipar[ig.I_N], n_pts, n_imp_pts, out, res, pts, imp_pts,
                 n_got, n_imp_got)
-    st[S_CELL] = -1
+    st[LS_CELL] = -1
 
 
 @jit(nrt=False)
@@ -439,20 +439,20 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
     ftl = b.ftl
     nxt = i0
     for l in range(W):
-        b.st[l, S_CELL] = -1
+        b.st[l, LS_CELL] = -1
     j = np.int64(0)  # the step's index in the period, the same in every lane (int64, not the
     # literal 0: block_step_lanes would be compiled once more for the literal)
     while True:
         busy = 0
         for l in range(n_lanes):
-            while j == 0 and b.st[l, S_CELL] < 0 and nxt < i1:
+            while j == 0 and b.st[l, LS_CELL] < 0 and nxt < i1:
                 i = nxt
                 nxt += 1
                 if not _load(l, i, y0s, pars, ipar, b):
-                    b.st[l, S_CELL] = i
+                    b.st[l, LS_CELL] = i
                     _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got,
                          n_imp_got, b)
-            if b.st[l, S_CELL] >= 0:
+            if b.st[l, LS_CELL] >= 0:
                 busy += 1
         if busy == 0:
             if nxt >= i1:
@@ -469,53 +469,53 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
         counts[3] += c1 - c0
         for l in range(n_lanes):
             st = b.st[l]
-            if st[S_CELL] < 0:
+            if st[LS_CELL] < 0:
                 continue
-            fast = lout[O_FAST * W + l] != 0.0
+            fast = lout[LO_FAST * W + l] != 0.0
             hl = b.par[l, ig.P_H]
             # at rest with the uplift beyond the grid point: held there, as the scalar step
             # would (rockjit._engine.integrate.leave_rest), without taking it
-            held = (st[S_SIDE] == 0
-                    and b.fs[l, F_TUP] - (st[S_STEP] + 1) * hl > REST_MARGIN * hl)
+            held = (st[LS_SIDE] == 0
+                    and b.fs[l, LF_TUP] - (st[LS_STEP] + 1) * hl > REST_MARGIN * hl)
             if fast or held:
                 counts[0] += 1
                 if fast:
                     iout = b.iout[l]
                     iout[ig.O_RHS] += ig.N_STAGES
                     iout[ig.O_SUBSTEPS] += 1
-                step = st[S_STEP] + 1
-                st[S_STEP] = step
+                step = st[LS_STEP] + 1
+                st[LS_STEP] = step
                 t = step * b.par[l, ig.P_H]
-                b.fs[l, F_TT] = t
-                if not (math.isfinite(lin[I_X * W + l]) and math.isfinite(lin[I_V * W + l])):
-                    st[S_STATUS] = ig.NONFINITE
+                b.fs[l, LF_TT] = t
+                if not (math.isfinite(lin[LI_X * W + l]) and math.isfinite(lin[LI_V * W + l])):
+                    st[LS_STATUS] = ig.NONFINITE
                 elif j + 1 != n_per and j + 1 != half:
-                    st[S_JPER] = j + 1
+                    st[LS_JPER] = j + 1
                 else:
                     _sync(l, b)
                     status, j_per, k_per, j_qr, j_rec, collapsed = ig.grid_point(
-                        None, None, False, t, step, st[S_SIDE], st[S_NIMP], st[S_NCOL],
+                        None, None, False, t, step, st[LS_SIDE], st[LS_NIMP], st[LS_NCOL],
                         step - 1 >= ipar[ig.I_WINDOW] * n_per, ipar, b.par[l],
-                        lane_outputs(b, l), lane_work(b, l), st[S_JPER], st[S_KPER],
-                        st[S_JQR], st[S_JREC])
-                    st[S_STATUS] = status
-                    st[S_JPER] = j_per
-                    st[S_KPER] = k_per
-                    st[S_JQR] = j_qr
-                    st[S_JREC] = j_rec
+                        lane_outputs(b, l), lane_work(b, l), st[LS_JPER], st[LS_KPER],
+                        st[LS_JQR], st[LS_JREC])
+                    st[LS_STATUS] = status
+                    st[LS_JPER] = j_per
+                    st[LS_KPER] = k_per
+                    st[LS_JQR] = j_qr
+                    st[LS_JREC] = j_rec
             else:
                 counts[1] += 1
                 c0 = cycles() if prof else 0
                 _sync(l, b)
-                pre = st[S_SIDE] != 0 and lout[O_FAR * W + l] <= 1.0
+                pre = st[LS_SIDE] != 0 and lout[LO_FAR * W + l] <= 1.0
                 if pre:
                     _stages(l, b)
                 scalar_step(None, st, b.fs[l], b.par[l], ipar, lane_outputs(b, l),
                             lane_work(b, l), pre, prof, counts)
                 _refresh(l, b)
-                b.fs[l, F_TUP] = _uplift(st, b.fs[l], b.par[l])
+                b.fs[l, LF_TUP] = _uplift(st, b.fs[l], b.par[l])
                 counts[4] += (cycles() - c0) if prof else 0
-            if st[S_STATUS] != ig.RUNNING or st[S_STEP] >= total:
+            if st[LS_STATUS] != ig.RUNNING or st[LS_STEP] >= total:
                 _sync(l, b)
                 _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b)
         j += 1

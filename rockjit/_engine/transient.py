@@ -75,7 +75,7 @@ N_S = 3
 #: statuses, in the order of rockjit.ground.response.STATUSES
 ST_OVERTURNED, ST_REST, ST_DECIDED, ST_TIME_LIMIT, ST_MAX_IMPACTS, ST_NONFINITE = range(6)
 #: outcomes, in the order of rockjit.ground.response.OUTCOMES
-O_SAFE, O_OVER_IMPACT, O_OVER_NO_IMPACT, O_UNRESOLVED = range(4)
+OC_SAFE, OC_OVER_IMPACT, OC_OVER_NO_IMPACT, OC_UNRESOLVED = range(4)
 
 _TINY = float(np.finfo(float).tiny)
 _EPS = float(np.finfo(float).eps)
@@ -362,13 +362,13 @@ def grid_next(t, end, h_exc, nsub, dt, h_free, t_lim):
 
 #: a cell's float outputs ``out_f``: max|theta| / alpha_s, t_overturn, the time it stopped,
 #: the first uplift, theta and theta' there, max|theta|
-F_MAXROT, F_TOVER, F_T, F_TUP, F_TH, F_DTH, F_MAXTH = range(7)
-N_F = 7
+TF_MAXROT, TF_TOVER, TF_T, TF_TUP, TF_TH, TF_DTH, TF_MAXTH = range(7)
+N_TF = 7
 #: its integer outputs ``out_i``: outcome, impacts, status, rest phases entered after an impact,
 #: trajectory points (recorded up to the buffer's length), steps taken (each six evaluations
 #: of the right-hand side), the events' included
-I_OUTCOME, I_IMPACTS, I_STATUS, I_REST, I_TRAJ, I_STEPS = range(6)
-N_I = 6
+TI_OUTCOME, TI_IMPACTS, TI_STATUS, TI_REST, TI_TRAJ, TI_STEPS = range(6)
+N_TI = 6
 
 
 @jit(nrt=False, inline=True)
@@ -529,24 +529,24 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp,
             break
 
     if status == ST_OVERTURNED:
-        outcome = O_OVER_IMPACT if n_imp > 0 else O_OVER_NO_IMPACT
+        outcome = OC_OVER_IMPACT if n_imp > 0 else OC_OVER_NO_IMPACT
     elif status == ST_REST or status == ST_DECIDED or (status == ST_TIME_LIMIT and t >= end):
-        outcome = O_SAFE
+        outcome = OC_SAFE
     else:
-        outcome = O_UNRESOLVED
-    out_f[F_MAXROT] = max_th / b[B_ALPHA]
-    out_f[F_TOVER] = t_over
-    out_f[F_T] = t
-    out_f[F_TUP] = t_up_first
-    out_f[F_TH] = th
-    out_f[F_DTH] = v
-    out_f[F_MAXTH] = max_th
-    out_i[I_OUTCOME] = outcome
-    out_i[I_IMPACTS] = n_imp
-    out_i[I_STATUS] = status
-    out_i[I_REST] = n_rest
-    out_i[I_TRAJ] = n_tr
-    out_i[I_STEPS] = n_step
+        outcome = OC_UNRESOLVED
+    out_f[TF_MAXROT] = max_th / b[B_ALPHA]
+    out_f[TF_TOVER] = t_over
+    out_f[TF_T] = t
+    out_f[TF_TUP] = t_up_first
+    out_f[TF_TH] = th
+    out_f[TF_DTH] = v
+    out_f[TF_MAXTH] = max_th
+    out_i[TI_OUTCOME] = outcome
+    out_i[TI_IMPACTS] = n_imp
+    out_i[TI_STATUS] = status
+    out_i[TI_REST] = n_rest
+    out_i[TI_TRAJ] = n_tr
+    out_i[TI_STEPS] = n_step
 
 
 @jit(parallel=True)

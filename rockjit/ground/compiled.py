@@ -115,17 +115,17 @@ def compiled_kernel(blocks, sources, block_of, source_of, gain, settings, method
     xpar[:, T.X_AMP] = _amplitudes(sources, source_of, gain)
     t_lim = np.array([settings.limit(float(src.end)) for src in sources])[source_of]
     spar = np.array([settings.theta_over, settings.rest_speed, shrink * H_FREE])
-    out_f = np.empty((n, T.N_F))
-    out_i = np.empty((n, T.N_I), dtype=np.int64)
+    out_f = np.empty((n, T.N_TF))
+    out_i = np.empty((n, T.N_TI), dtype=np.int64)
     T.run_cells(xpar, samples, bpar, np.asarray(block_of, dtype=np.int64), spar, t_lim,
                 int(settings.impact_bound()), bool(settings.stop_when_decided),
                 numba.get_num_threads(), out_f, out_i)
-    out["max_rotation"][:] = out_f[:, T.F_MAXROT]
-    out["t_overturn"][:] = out_f[:, T.F_TOVER]
-    out["t_end"][:] = out_f[:, T.F_T]
-    out["outcome"][:] = out_i[:, T.I_OUTCOME]
-    out["n_impacts"][:] = out_i[:, T.I_IMPACTS]
-    out["status"][:] = out_i[:, T.I_STATUS]
+    out["max_rotation"][:] = out_f[:, T.TF_MAXROT]
+    out["t_overturn"][:] = out_f[:, T.TF_TOVER]
+    out["t_end"][:] = out_f[:, T.TF_T]
+    out["outcome"][:] = out_i[:, T.TI_OUTCOME]
+    out["n_impacts"][:] = out_i[:, T.TI_IMPACTS]
+    out["status"][:] = out_i[:, T.TI_STATUS]
     return out
 
 
@@ -165,24 +165,24 @@ def run_compiled(block, excitation, state, settings) -> TransientResult:
         n_traj = int(steps + (t_lim - min(end, t_lim)) / (shrink * H_FREE)) + 2 * n_imp + 16
     memory(f"a run recorded over {t_lim:.4g} time units (the Transient's free_time or "
            f"duration)", 24.0 * (float(n_traj) + float(n_imp)))
-    out_f = np.empty(T.N_F)
-    out_i = np.zeros(T.N_I, dtype=np.int64)
+    out_f = np.empty(T.N_TF)
+    out_i = np.zeros(T.N_TI, dtype=np.int64)
     for _ in range(2):
         imp = np.empty((n_imp, 3))
         traj = np.empty((n_traj, 3))
         T.run_cell(rows[0], samples, bpar, spar, t_lim, max_imp,
                    bool(settings.stop_when_decided), th0, v0, side0, np.empty((3, 3)), imp, traj,
                    out_f, out_i)
-        got_imp, got_traj = int(out_i[T.I_IMPACTS]), int(out_i[T.I_TRAJ])
+        got_imp, got_traj = int(out_i[T.TI_IMPACTS]), int(out_i[T.TI_TRAJ])
         if got_imp <= n_imp and (not settings.record or got_traj <= n_traj):
             break
         n_imp, n_traj = got_imp, (got_traj if settings.record else 0)
     return TransientResult(
         block=block, excitation=excitation, settings=settings, method="rockjit",
-        status=STATUS_CODES[int(out_i[T.I_STATUS])], t=float(out_f[T.F_T]),
-        state=np.array([out_f[T.F_TH], out_f[T.F_DTH]]), t_uplift=float(out_f[T.F_TUP]),
-        max_theta=float(out_f[T.F_MAXTH]), impacts=imp[:got_imp].copy(),
-        t_overturn=float(out_f[T.F_TOVER]),
+        status=STATUS_CODES[int(out_i[T.TI_STATUS])], t=float(out_f[T.TF_T]),
+        state=np.array([out_f[T.TF_TH], out_f[T.TF_DTH]]), t_uplift=float(out_f[T.TF_TUP]),
+        max_theta=float(out_f[T.TF_MAXTH]), impacts=imp[:got_imp].copy(),
+        t_overturn=float(out_f[T.TF_TOVER]),
         trajectory=traj[:got_traj].copy() if settings.record else None,
-        n_rhs=6 * int(out_i[T.I_STEPS]), n_rest=int(out_i[T.I_REST]))
+        n_rhs=6 * int(out_i[T.TI_STEPS]), n_rest=int(out_i[T.TI_REST]))
 

@@ -189,45 +189,45 @@ def test_vector_step_equals_single_lane_step():
         if trial % 5 == 0:
             v[:2] = 12.0  # far from the start within the step
         for l in range(W):
-            lin[ln.I_X * W + l] = x[l]
-            lin[ln.I_V * W + l] = v[l]
-            lin[ln.I_K * W + l] = rng.uniform(-2.0, 2.0)
-            lin[ln.I_S * W + l] = math.sin(x[l])
-            lin[ln.I_C * W + l] = math.cos(x[l])
-            lin[ln.I_SG * W + l] = side[l]
-            lin[ln.I_STHC * W + l] = par[ig.P_STHC]
-            lin[ln.I_CTHC * W + l] = par[ig.P_CTHC]
-            lin[ln.I_XI * W + l] = par[ig.P_XI]
-            lin[ln.I_THOVER * W + l] = par[ig.P_THOVER]
+            lin[ln.LI_X * W + l] = x[l]
+            lin[ln.LI_V * W + l] = v[l]
+            lin[ln.LI_K * W + l] = rng.uniform(-2.0, 2.0)
+            lin[ln.LI_S * W + l] = math.sin(x[l])
+            lin[ln.LI_C * W + l] = math.cos(x[l])
+            lin[ln.LI_SG * W + l] = side[l]
+            lin[ln.LI_STHC * W + l] = par[ig.P_STHC]
+            lin[ln.LI_CTHC * W + l] = par[ig.P_CTHC]
+            lin[ln.LI_XI * W + l] = par[ig.P_XI]
+            lin[ln.LI_THOVER * W + l] = par[ig.P_THOVER]
             ln.lane_tables(tab, lin, l)
         before = lin.copy()
         ln.block_step_lanes(W, j, lin, lout, ftl)
         for l in range(W):
             K = np.zeros((ig.N_STAGES + 1, 2))
-            K[0, 1] = before[ln.I_K * W + l]
-            trig = np.array([before[ln.I_S * W + l], before[ln.I_C * W + l], 0.0, 0.0])
+            K[0, 1] = before[ln.LI_K * W + l]
+            trig = np.array([before[ln.LI_S * W + l], before[ln.LI_C * W + l], 0.0, 0.0])
             fr = np.array([ftl[(j * 7 + i) * W + l] for i in range(7)])
             sd = int(side[l])
             xe, ve, far = _block_step(x[l], v[l], fr, tab, sd if sd else 1, par, K, trig)
             if sd == 0:  # the vector computes a corner of 0; only its flag matters
-                assert lout[ln.O_FAST * W + l] == 0.0
+                assert lout[ln.LO_FAST * W + l] == 0.0
                 continue
-            assert lout[ln.O_X * W + l] == xe and lout[ln.O_V * W + l] == ve
-            assert lout[ln.O_FAR * W + l] == far
-            assert lout[ln.O_S * W + l] == trig[2] and lout[ln.O_C * W + l] == trig[3]
+            assert lout[ln.LO_X * W + l] == xe and lout[ln.LO_V * W + l] == ve
+            assert lout[ln.LO_FAR * W + l] == far
+            assert lout[ln.LO_S * W + l] == trig[2] and lout[ln.LO_C * W + l] == trig[3]
             for i in range(1, 7):
-                assert lout[(ln.O_KV + i) * W + l] == K[i, 0]
-                assert lout[(ln.O_KA + i) * W + l] == K[i, 1]
+                assert lout[(ln.LO_KV + i) * W + l] == K[i, 0]
+                assert lout[(ln.LO_KA + i) * W + l] == K[i, 1]
             # fast: in range and none of detect's events (written out from detect's tests)
             g0, g1 = sd * x[l], sd * xe
             event = g1 >= par[ig.P_THOVER] or g1 < 0.0 or (g0 > 0 and sd * v[l] < 0
                                                            and sd * ve > 0)
             fast = far <= 1.0 and not event
-            assert lout[ln.O_FAST * W + l] == (1.0 if fast else 0.0)
+            assert lout[ln.LO_FAST * W + l] == (1.0 if fast else 0.0)
             # a fast lane's state is advanced, any other left as it was
             want = (xe, ve, K[6, 1], trig[2], trig[3]) if fast else \
-                tuple(before[r * W + l] for r in (ln.I_X, ln.I_V, ln.I_K, ln.I_S, ln.I_C))
-            got = tuple(lin[r * W + l] for r in (ln.I_X, ln.I_V, ln.I_K, ln.I_S, ln.I_C))
+                tuple(before[r * W + l] for r in (ln.LI_X, ln.LI_V, ln.LI_K, ln.LI_S, ln.LI_C))
+            got = tuple(lin[r * W + l] for r in (ln.LI_X, ln.LI_V, ln.LI_K, ln.LI_S, ln.LI_C))
             assert got == want
             n_far += far > 1.0
             n_fast += fast
