@@ -24,7 +24,6 @@ from .result import Result
 from ._engine.classify import classify
 from .result import BEHAVIOURS
 from .settings import Classification, Integration
-from .entry import entry_point
 from .validate import boolean, choice, integer, memory, real, real_array
 
 __all__ = ["DAMPING_ONSET", "DAMPING_STEP", "DEFAULT_N", "IVP_METHODS", "MAX_STEP", "RunPlan", "STABLE_DAMPING",
@@ -245,71 +244,19 @@ def run(p: RunPlan, execution=None) -> Result:
     return kernel.run_single(p)
 
 
-@entry_point(run)
-def simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
-             record_stride=None, method="rockjit") -> Result:
-    """Simulate the rocking block under an excitation.
-
-    Parameters
-    ----------
-    block : Block
-        The block: slenderness, restitution law, damping.
-    forcing : Harmonic, Pulse, Record or an excitation plug
-        The excitation: harmonic, with its amplitude ``alpha`` and frequency ``omega`` (and
-        phase, or the study's); or a transient one, a :class:`rockjit.Pulse` (with its
-        ``ratio`` and ``amplitude``) or a :class:`rockjit.Record` (with the block's ``size``),
-        which runs on the scipy path only for now and returns a
-        :class:`rockjit.ground.TransientResult` (docs/guide/earthquakes.md).
-    state : pair of float, optional
-        The initial ``(theta0, theta0')``, ``|theta0| < theta_over``. Default: the study's
-        ``z0`` (docs/theory/study.md), at the study's forcing phase unless ``forcing`` gives
-        one; at rest, ``(0, 0)``, under a pulse or a record.
-    integration : Integration or Transient, optional
-        Steps per period, periods, window, impact bound, Zeno cut-off, overturning threshold
-        (:class:`rockjit.Integration`; default N here is :data:`rockjit.DEFAULT_N`); for a pulse or a
-        record, a :class:`rockjit.Transient` (free rocking time or a duration, in model
-        units).
-    lyapunov : bool
-        Compute the block's Lyapunov exponents (docs/theory/exponents.md); compiled path only.
-    record_stride : int, optional
-        Record ``(t, theta, theta', r, s)`` every this many grid steps.
-    method : {"rockjit", "scipy", "scipy:<METHOD>"} or Scipy
-        The compiled path (default), or the reference path through
-        ``scipy.integrate.solve_ivp`` (default BDF at the study's tolerances; a
-        :class:`rockjit.Scipy` chooses the method and tolerances).
-
-    Returns
-    -------
-    Result
-        The run's samples, impacts, exponents and status.
-
-    Raises
-    ------
-    ValueError
-        For any parameter out of its range (the message names it, the allowed range and the
-        value given), a step too coarse to be stable, or a run whose arrays would not fit in
-        memory.
-
-    See Also
-    --------
-    rockjit.fate : runs from nearby initial states: each outcome's probability and the
-        predictability horizon.
-
-    Examples
-    --------
-    >>> import rockjit
-    >>> from rockjit import Block, Harmonic
-    >>> res = rockjit.simulate(Block(hb=1), Harmonic(alpha=0.6, omega=1.3), lyapunov=True)
-    >>> res.status, rockjit.classify_result(res)
-    ('done', ('symmetric', 1))
-    """
+def plan_simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
+                  record_stride=None, method="rockjit"):
+    """The plan of :func:`simulate` (``rockjit.simulate.plan``): its parameters checked
+    together, before any work; a :class:`RunPlan`, or for a transient excitation its own plan.
+    ``run(plan)`` executes it."""
     if not isinstance(block, Block):
         raise ValueError(f"block must be a rockjit.Block (got {type(block).__name__})")
     if getattr(forcing, "transient", False) and not isinstance(forcing, Harmonic):
         return forcing.plan_run(block, state, integration, lyapunov, record_stride,
                                 _method(method))
     if not isinstance(forcing, Harmonic):
-        raise ValueError(f"forcing must be a rockjit excitation: Harmonic, Pulse or Record "
+        raise ValueError(f"forcing must be a rockjit excitation: Harmonic, Pulse, Record or a "
+                         f"plug of rockjit.plugs "
                          f"(got {type(forcing).__name__})")
     forcing.require("alpha", "omega", why="a single run")
     integration = Integration() if integration is None else integration
@@ -427,22 +374,78 @@ without the checks, the packing and the kernel's look-up."""
 #: Prepared runs :func:`simulate` reuses, by its arguments but the state (a few at most).
 _PREPARED = {}
 _PREPARED_MAX = 64
-_plan_and_run = simulate
 
 
-def _simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
-              record_stride=None, method="rockjit"):
+def simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
+             record_stride=None, method="rockjit") -> Result:
+    """Simulate the rocking block under an excitation.
+
+    Parameters
+    ----------
+    block : Block
+        The block: slenderness, restitution law, damping.
+    forcing : Harmonic, Pulse, Record or an excitation plug
+        The excitation: harmonic, with its amplitude ``alpha`` and frequency ``omega`` (and
+        phase, or the study's); or a transient one, a :class:`rockjit.Pulse` (with its
+        ``ratio`` and ``amplitude``), a :class:`rockjit.Record` (with the block's ``size``)
+        or an excitation plug such as :class:`rockjit.HarmonicSum`, which runs on the compiled
+        transient kernel (or the scipy path) and returns a
+        :class:`rockjit.ground.TransientResult` (docs/guide/earthquakes.md,
+        docs/guide/extending.md).
+    state : pair of float, optional
+        The initial ``(theta0, theta0')``, ``|theta0| < theta_over``. Default: the study's
+        ``z0`` (docs/theory/study.md), at the study's forcing phase unless ``forcing`` gives
+        one; at rest, ``(0, 0)``, under a pulse or a record.
+    integration : Integration or Transient, optional
+        Steps per period, periods, window, impact bound, Zeno cut-off, overturning threshold
+        (:class:`rockjit.Integration`; default N here is :data:`rockjit.DEFAULT_N`); for a pulse or a
+        record, a :class:`rockjit.Transient` (free rocking time or a duration, in model
+        units).
+    lyapunov : bool
+        Compute the block's Lyapunov exponents (docs/theory/exponents.md); compiled path only.
+    record_stride : int, optional
+        Record ``(t, theta, theta', r, s)`` every this many grid steps.
+    method : {"rockjit", "scipy", "scipy:<METHOD>"} or Scipy
+        The compiled path (default), or the reference path through
+        ``scipy.integrate.solve_ivp`` (default BDF at the study's tolerances; a
+        :class:`rockjit.Scipy` chooses the method and tolerances).
+
+    Returns
+    -------
+    Result
+        The run's samples, impacts, exponents and status.
+
+    Raises
+    ------
+    ValueError
+        For any parameter out of its range (the message names it, the allowed range and the
+        value given), a step too coarse to be stable, or a run whose arrays would not fit in
+        memory.
+
+    See Also
+    --------
+    rockjit.fate : runs from nearby initial states: each outcome's probability and the
+        predictability horizon.
+
+    Examples
+    --------
+    >>> import rockjit
+    >>> from rockjit import Block, Harmonic
+    >>> res = rockjit.simulate(Block(hb=1), Harmonic(alpha=0.6, omega=1.3), lyapunov=True)
+    >>> res.status, rockjit.classify_result(res)
+    ('done', ('symmetric', 1))
+    """
     # a run from the study's state starts at the study's forcing phase, one from a given state
     # at phase 0 (unless the excitation gives one): the two never share a prepared run
     key = (block, forcing, integration, lyapunov, record_stride, method, state is None)
     try:
         prepared = _PREPARED.get(key)
     except TypeError:  # an argument that cannot be hashed: no reuse (and no error here)
-        return _plan_and_run(block, forcing, state, integration=integration,
-                             lyapunov=lyapunov, record_stride=record_stride, method=method)
+        return run(plan_simulate(block, forcing, state, integration=integration,
+                                 lyapunov=lyapunov, record_stride=record_stride, method=method))
     if prepared is not None:
         return prepared(state)
-    p = simulate.plan(block, forcing, state, integration=integration, lyapunov=lyapunov,
+    p = plan_simulate(block, forcing, state, integration=integration, lyapunov=lyapunov,
                       record_stride=record_stride, method=method)
     if p.method == "rockjit" and type(lyapunov) is bool and not getattr(forcing, "transient",
                                                                          False):
@@ -453,8 +456,7 @@ def _simulate(block, forcing, state=None, *, integration=None, lyapunov=False,
     return run(p)
 
 
-simulate = functools.wraps(_plan_and_run)(_simulate)
-simulate.plan = _plan_and_run.plan
+simulate.plan = plan_simulate
 simulate.prepare = _prepare
 
 
