@@ -35,10 +35,9 @@ __all__ = ["DAMPING_ONSET", "DAMPING_STEP", "DEFAULT_N", "IVP_METHODS", "MAX_STE
 #: phase unless the excitation gives another.
 Z0_STUDY = (-0.2254, -0.1597) + STUDY_PHASE
 
-#: Default number of steps per forcing period of single runs. Impact times over 20 periods are
-#: within 1e-10 of a converged solution (N = 2048) on the study's orbits from N = 160 on; the
-#: most demanding of them, the asymmetric orbit (hb=1, alpha=0.8), needs it: 2.1e-10 at N = 128,
-#: 6.5e-11 at N = 160 (benchmarks/results/work_precision.md).
+#: Default number of steps per forcing period of single runs: the least that keeps impact times
+#: over 20 periods within 1e-10 of a converged solution on every orbit of the study
+#: (benchmarks/results/work_precision.md).
 DEFAULT_N = 160
 
 #: Largest step (in units of 1/Omega0) a default N may give: at slow forcing, N steps per period
@@ -46,26 +45,20 @@ DEFAULT_N = 160
 MAX_STEP = 0.1
 
 #: Coarsest step accepted at all: the block's own time scale is ~1, so a longer step is no
-#: integration of it (and a stress case: omega = 0.05 with N = 8 gave h = 16).
+#: integration of it.
 STEP_LIMIT = 1.0
 
 #: Damping: the velocity's own rate is ``c = 3/4 xi``. The Dormand–Prince step is stable on it
 #: for ``h c < 3.307`` (its stability polynomial's real boundary); an explicit N is refused
-#: beyond ``h c = STABLE_DAMPING``, and a default N is raised until ``h c <= DAMPING_STEP``
-#: (found by the stress suite: xi = 200 at N = 160, h c = 3.6, overturned at t = 2.2 with an
-#: error estimate of 1e2), and for accuracy (below).
+#: beyond ``h c = STABLE_DAMPING``, and a default N is raised until ``h c <= DAMPING_STEP``,
+#: and for accuracy (below).
 STABLE_DAMPING = 3.0
 DAMPING_STEP = 1.0
 #: Accuracy under damping. At a fixed step the stroboscopic error of a damped run grows about
-#: as ``xi^2 h^5`` (measured from xi = 5 to 500, both laws, against DOP853 at rtol 1e-12:
-#: benchmarks/results/event_accuracy.md, "Strong damping"). A cap on ``h c`` alone therefore
-#: let it grow with xi below the cap: with ``h c <= 1`` only, the single runs' default was
-#: up to 2.9e-8 off at xi = 20 and 1.1e-8 at xi = 50, against 1.1e-11 at xi = 500.
-#: So once ``c`` exceeds ``DAMPING_ONSET`` a default N is also raised to ``default *
+#: as ``xi^2 h^5``, so a cap on ``h c`` alone would let it grow with xi below the cap. Once
+#: ``c`` exceeds ``DAMPING_ONSET`` a default N is also raised to ``default *
 #: (c / DAMPING_ONSET)^(2/5)``, which keeps ``xi^2 h^5``, and with it the error, near the
-#: undamped default's: single runs over 50 periods are within 3.2e-11 for xi <= 2 and 1.1e-11
-#: from xi = 50 to 500 (undamped: 2e-12 to 2.6e-11), and within 5.4e-10 between, where hb = 2
-#: rests and is lifted every half period (before: up to 2.9e-8).
+#: undamped default's (benchmarks/results/event_accuracy.md, "Strong damping").
 DAMPING_ONSET = 1.0
 
 #: ``solve_ivp`` methods of the reference path.

@@ -316,9 +316,9 @@ def accept(EMBED4, TANGENT, side, hh, max_err, w):
     last stage as the next step's first (first same as last). Returns the largest error
     estimate so far.
 
-    It takes the compile-time switches, not the state's sizes: compiled on its own with sizes
-    unknown, LLVM vectorised its copies behind run-time overlap checks before inlining it, and
-    a run with exponents took 9 % longer a step (found by bisecting the commits)."""
+    It takes the compile-time switches, not the state's sizes: with the sizes known when it is
+    compiled, its copies are straight loads and stores (with sizes unknown, LLVM vectorises
+    them behind run-time overlap checks, a slower step)."""
     NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
     NY = NS + (4 if TANGENT is not None else 0)  # plus the tangent matrix, column-major
     K = w.K
@@ -527,7 +527,7 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
     # Held at rest until the grid point: set when a flight that began at an uplift ends at
     # rest within rounding of that instant (forcing a hair above the uplift threshold, where
     # the acceleration rounds to zero); otherwise the uplift would be found again at the
-    # same instant forever (found by the stress suite).
+    # same instant forever.
     hold = step < 0  # False, typed bool rather than the literal (one compilation of leave_rest)
     while True:
         if side == 0:

@@ -105,9 +105,8 @@ def classification_vector(classification):
 #: Between two renormalisations the second tangent vector may lose at most exp(-QR_CONTRACTION)
 #: against the first: damping separates the two exponents by about 3/4 xi, and once the second
 #: vector's own direction falls below rounding relative to the first, Gram-Schmidt finds
-#: nothing left of it and the kernel takes it for a collapse (found by the stress suite: xi =
-#: 105 renormalised twice a period, exp(-73), gave lambda2 = -inf with no rest and no impact).
-#: exp(-20) = 2e-9 keeps seven digits of it.
+#: nothing left of it and the kernel would take it for a collapse (lambda2 = -inf with no rest
+#: and no impact). exp(-20) = 2e-9 keeps seven digits of it.
 QR_CONTRACTION = 20.0
 
 
@@ -383,11 +382,9 @@ N_LANE_COUNTS = 13
 #: Cells per thread in lockstep at most (:data:`rockjit._engine.lanes.W`, the vector's width).
 LANES_MAX = 8
 #: Cells per thread in lockstep by default, for grids without tangent vectors (basins, erosion,
-#: fates; the grids with exponents run one cell at a time). Measured (benchmarks/bench_lanes.py,
-#: the study's basin, 2 threads): 8 lanes 1.86x the cells per second of one full length, 2.08x
-#: early-stopped; 2 lanes lose, 4 about even full length. The same outputs bit for bit whatever
-#: the count.
-#: The lanes' kernel replaces the single-lane one in the ``grid`` variant (a cold compile ~20 s).
+#: fates; the grids with exponents run one cell at a time): the fastest count on the study's
+#: basin (benchmarks/results/lanes.md). The same outputs bit for bit whatever the count. The
+#: lanes' kernel replaces the single-lane one in the ``grid`` variant.
 DEFAULT_LANES = 8
 
 
@@ -426,8 +423,8 @@ VARIANTS = {
 }
 #: What ``rockjit compile`` (and a cold ``rockjit paper``) compiles: every variant, since
 #: ``rockjit paper`` (README's first command) uses each one; the longest first (the lanes'
-#: grid kernel, ~20 s, compiles the step again inside its own loop), so that the others share
-#: the second core meanwhile (measured on 2 cores when adopted: 35 s, against 48 s with it last).
+#: grid kernel compiles the step again inside its own loop), so that the others share the
+#: second core meanwhile (benchmarks/results/compile.md).
 COMMON = ("grid", "run", "run+tangent", "embedded", "embedded+tangent", "grid+tangent")
 assert sorted(COMMON) == sorted(VARIANTS)
 
