@@ -274,9 +274,13 @@ def _forcings(pars):
 
 
 def _free_bytes():
+    """The device's free memory, once the arrays of earlier calls numba still holds for
+    deferred freeing are freed."""
     if SIMULATOR:
         return 1 << 30
-    free, _ = cuda.current_context().get_memory_info()
+    ctx = cuda.current_context()
+    ctx.deallocations.clear()
+    free, _ = ctx.get_memory_info()
     return free
 
 
