@@ -29,19 +29,30 @@ What lives where
     :func:`continue_branches` (the branches of a sweep's periodic attractors) and the entry
     point :func:`orbits_of_sweep` (the sweep and its branches; its ``.plan`` validates, and
     :func:`rockjit.orbits.arclength.run` executes a plan).
+:mod:`.curve_types`
+    What the curves in the forcing plane ``(alpha, omega)`` are: :data:`CURVE_TYPES`, the
+    codimension-two points met (:class:`Codim2Point`, :data:`CODIM2_TYPES`), the ends
+    (:data:`CURVE_ENDS`) and :class:`CurveSettings`.
+:mod:`.extended`
+    The extended system of each curve type (the fixed-point equations and one defining
+    condition, unknowns ``(theta, theta', alpha, omega)``) and its Jacobian.
+:mod:`.tracer`
+    Pseudo-arclength continuation of an extended system: the corrector, the march, the
+    codimension-two points met and the ends.
+:mod:`.bifurcation_curve`
+    The curve followed, :class:`BifurcationCurve`.
 :mod:`.curves`
-    Codimension-one curves in the forcing plane ``(alpha, omega)``: a located fold, symmetry
-    breaking, period doubling or grazing followed in both forcing parameters by
-    pseudo-arclength continuation of an extended system (:func:`continue_curve`,
-    :class:`BifurcationCurve`, the codimension-two points met, :func:`relocate` to check a
-    point against the one-parameter location).
+    Codimension-one curves in the forcing plane: a located fold, symmetry breaking, period
+    doubling or grazing followed in both forcing parameters (:func:`continue_curve`),
+    :func:`relocate` to check a point against the one-parameter location.
 :mod:`.plane_chart`
     The entry point :func:`chart`: the brute-force chart of behaviours over ``(alpha, omega)``
     and every curve seeded from the bifurcations located on a few ``omega`` lines of it (its
     ``.plan`` validates, :func:`rockjit.orbits.plane_chart.run` executes a plan).
 
 The imports go one way: ``types`` <- ``shooting`` <- ``grazing`` <- ``bifurcations`` <-
-``arclength`` <- ``curves`` <- ``plane_chart``. Cycles are compared with
+``arclength`` <- ``curve_types`` <- ``extended`` <- ``tracer`` <- ``bifurcation_curve`` <-
+``curves`` <- ``plane_chart``. Cycles are compared with
 ``rockjit.grids.cycles.cycle_distance``, as the attractors of the grids.
 
 Examples
@@ -63,8 +74,9 @@ and nonlinear eigenvalue problems", in *Applications of Bifurcation Theory*, Aca
 """
 
 from .arclength import continuation, continue_branches, orbits_of_sweep
-from .curves import (CODIM2_TYPES, CURVE_ENDS, CURVE_TYPES, BifurcationCurve, Codim2Point,
-                     CurveSettings, continue_curve, relocate)
+from .bifurcation_curve import BifurcationCurve
+from .curve_types import CODIM2_TYPES, CURVE_ENDS, CURVE_TYPES, Codim2Point, CurveSettings
+from .curves import continue_curve, relocate
 from .plane_chart import ChartCurves, ChartResult, chart
 from .shooting import N_ORBIT, periodic_orbit
 from .types import (BIFURCATION_TYPES, REASONS, Bifurcation, Branch, Continuation,

@@ -41,7 +41,8 @@ from ..result import BEHAVIOURS
 from ..settings import Classification, Execution
 from ..validate import boolean, choice, integer, pair, real, real_array
 from .arclength import continue_branches
-from .curves import CURVE_TYPES, CurveSettings, continue_curve
+from .curve_types import CURVE_TYPES, CurveSettings
+from .curves import continue_curve
 from .shooting import N_ORBIT, check_block, check_n_steps, check_shooting
 from .types import ContinuationSettings, OrbitRefused, Shooting
 
