@@ -72,9 +72,9 @@ def _npz(out, name, holds, **arrays):
 
 def trajectory(out, res, *, npz="trajectory.npz", png="trajectory.png"):
     """One run: its arrays (``Result.arrays``) and
-    :func:`rockjit.plotting.figures.fig_trajectory`."""
+    :func:`rockjit.plotting.timeseries.fig_trajectory`."""
     from .single import classify_result
-    from .plotting.figures import fig_trajectory
+    from .plotting.timeseries import fig_trajectory
     name, period = classify_result(res)
     _npz(out, npz, "the run's arrays: t, theta, dtheta, r, s (recorded trajectory), strobe, "
                    "strobe_half, impacts (t, dtheta-, dtheta+), lyapunov_running", **res.arrays())
@@ -86,7 +86,7 @@ def trajectory(out, res, *, npz="trajectory.npz", png="trajectory.png"):
 
 def sweep(out, sw, *, npz="sweep.npz", png="bifurcation.png"):
     """A sweep: its arrays and its bifurcation diagram."""
-    from .plotting.figures import fig_bifurcation
+    from .plotting.forcing import fig_bifurcation
     _npz(out, npz, "the sweep: alpha, label (behaviour codes, names), period, lambda_max "
                    "(exact where periodic), lambda_window (finite-window estimate), strobe "
                    "(theta, theta' at kT), impact_section, t_end, attractor", **sw.arrays())
@@ -106,7 +106,7 @@ def basins(out, res, *, npz="basin.npz", png="basin.png", attractors_png="attrac
     (when computed) exponents and uncertain cells, per law when there are two; the behaviour
     map (with the two laws' agreement) and the attractor map with its measures."""
     from .grids.identity import agreement, attractor_agreement
-    from .plotting.figures import fig_attractors, fig_basin, fig_basin_compare
+    from .plotting.basins import fig_attractors, fig_basin, fig_basin_compare
     if not isinstance(res, dict):
         res = {res.block.law: res}
     first = next(iter(res.values()))
@@ -155,7 +155,7 @@ def basins(out, res, *, npz="basin.npz", png="basin.png", attractors_png="attrac
 
 def plane(out, pl, *, npz="plane.npz", png="plane.png"):
     """A plane from its first initial state: its arrays and its map."""
-    from .plotting.figures import fig_plane
+    from .plotting.forcing import fig_plane
     arrays = dict(alpha=pl.alpha, omega=pl.omega, z0=pl.z0, label=pl.label[0],
                   period=pl.period[0], lambda_max=pl.lambda_max[0], t_end=pl.t_end[0],
                   names=np.asarray(pl.names, dtype=str))
@@ -179,7 +179,7 @@ def plane(out, pl, *, npz="plane.npz", png="plane.png"):
 def erosion(out, res, *, npz="erosion.npz", png="erosion.png"):
     """Erosion profiles (a dict ``law: ErosionResult``): per law, the profile's arrays, and the
     profile figure."""
-    from .plotting.figures import fig_erosion
+    from .plotting.basins import fig_erosion
     first = next(iter(res.values()))
     _npz(out, npz, "alpha, theta0, dtheta0 and per law (suffix _<law>): GIM, IF, fractions "
                    "(each attractor's percent at each alpha), overturn, basin_entropy, the "
@@ -195,7 +195,7 @@ def erosion(out, res, *, npz="erosion.npz", png="erosion.png"):
 def fate(out, fr, *, npz="fate.npz", png="fate.png"):
     """An ensemble's outcomes: the members' initial states, outcomes and end times, and a
     figure of the outcome probabilities and the end times against the horizon."""
-    from .plotting.figures import fig_fate
+    from .plotting.fates import fig_fate
     _npz(out, npz, "the members' initial states, outcome ids (-1 overturn, -2 unresolved, "
                    "attractors from 0) and end times", initial=fr.initial, outcome=fr.outcome,
          t_end=fr.t_end)
@@ -209,7 +209,7 @@ def orbits(out, res, *, npz="orbits.npz", png="orbits.png", caption="orbits.md")
     bifurcations' arrays, the diagram with the branches over the sweep's dots, its caption
     (every bifurcation and where each branch stops) and the summary (``"bifurcations"``: type,
     alpha, period, multipliers, state)."""
-    from .plotting.figures import branch_caption, fig_branches
+    from .plotting.branches import branch_caption, fig_branches
     cont, sw = res
     summary, arrays = cont.to_summary()
     _npz(out, npz, "per branch i: branch{i}_value, _cycle, _multipliers, _stable, ...; the "

@@ -13,13 +13,8 @@ import numpy as np
 
 from ..result import BEHAVIOURS, fractions
 
-try:  # the palette's home after the figures' rework; figures.py's until then
-    from .style import BEHAVIOUR_COLOURS, LAW_COLOURS
-except ImportError:  # pragma: no cover - depends on the rework's state
-    from .figures import BEHAVIOUR_COLOURS, LAW_COLOURS
-
 from .cells import extent
-from .style import LAW_NAMES, behaviour_cmap, figure
+from .style import BEHAVIOUR_COLOURS, LAW_COLOURS, LAW_NAMES, behaviour_cmap, figure
 from .style import styled as _styled
 
 __all__ = ["CURVE_LABELS", "CURVE_STYLES", "fig_chart"]

@@ -63,7 +63,7 @@ def e_table(hb_values):
 def write_e_table(out, hb_values, hb_max, fig_name, table_stem):
     """Figure 1 with its data (``<fig>.npz``: the curves) and the e-table into ``out``;
     returns the table as dicts."""
-    from ..plotting.figures import fig_restitution
+    from ..plotting.restitution import fig_restitution
     rows = e_table(hb_values)
     hb_range = (1 / math.sqrt(2), hb_max)
     fig = fig_restitution(hb_range)
@@ -177,7 +177,7 @@ def draw_fig5(sweeps, hb):
     """Figure 5 at slenderness ``hb``: the bifurcation diagrams of ``sweeps`` (``{law:
     SweepResult}``, the paper's sweeps) side by side. The paper draws its figure 5 with it,
     and so does the README's headline image (docs/_static/make_headline.py)."""
-    from ..plotting.figures import fig_bifurcation
+    from ..plotting.forcing import fig_bifurcation
     return fig_bifurcation(sweeps, title=f"Bifurcation diagrams, $h/b = {hb:g}$, "
                                          f"$\\omega = {STUDY[hb]['omega']}$")
 
@@ -272,7 +272,7 @@ def _drawn(res, prefix, first=FIRST_PERIODS, last=LAST_PERIODS):
     """The arrays a time-series figure draws of one run: ``theta(t)`` over its first and last
     periods and the phase portrait's stretch, impacts inserted (``t, theta, dtheta``), and its
     stroboscopic samples."""
-    from ..plotting.figures import with_impacts
+    from ..plotting.timeseries import with_impacts
     T = res.period
     t_w = res.window[0] if res.window is not None else 0.8 * res.periods * T
     out = {}
@@ -287,7 +287,7 @@ def _drawn(res, prefix, first=FIRST_PERIODS, last=LAST_PERIODS):
 
 
 def _outcome_words(probabilities):
-    from ..plotting.figures import _outcome_names
+    from ..plotting.fates import _outcome_names
     words, _ = _outcome_names(list(probabilities))
     return ", ".join(f"{words[k]} {v:.0%}" for k, v in probabilities.items())
 
@@ -350,9 +350,10 @@ def paper(out, plan=None, *, execution=None, say=None):
     """
     from ..grids.identity import agreement, attractor_agreement
     from ..orbits import continue_branches
-    from ..plotting.figures import (branch_caption, fig_attractors, fig_basin_compare,
-                                    fig_bifurcation, fig_branches, fig_erosion, fig_gallery,
-                                    fig_laws_timeseries, fig_trajectory)
+    from ..plotting.basins import fig_attractors, fig_basin_compare, fig_erosion
+    from ..plotting.branches import branch_caption, fig_branches
+    from ..plotting.forcing import fig_bifurcation
+    from ..plotting.timeseries import fig_gallery, fig_laws_timeseries, fig_trajectory
     from ..plotting.style import attractor_names
     from . import report
 

@@ -1186,7 +1186,7 @@ def test_a_figure_that_cannot_be_drawn_keeps_a_trajectorys_data(tmp_path, monkey
     def broken(*a, **k):
         raise RuntimeError("no room\nfor the legend")
 
-    monkeypatch.setattr(importlib.import_module("rockjit.plotting.figures"), "fig_trajectory",
+    monkeypatch.setattr(importlib.import_module("rockjit.plotting.timeseries"), "fig_trajectory",
                         broken)
     out = tmp_path / "failed"
     capsys.readouterr()
