@@ -38,9 +38,8 @@ from numba import config, cuda, float64, int64
 
 from . import integrate as ig
 from .cell import _classify, _collect
-from .layout import (I_N, I_PERIODS, I_WINDOW, N_FOUT, N_FTAB, N_IOUT, N_PAR, N_PARW, O_NCOL,
-                     Outputs, P_AW2, P_CTHC, P_H, P_OMEGA, P_PHI, P_STHC, P_THC, RUNNING, DONE,
-                     Work)
+from .layout import (I_N, I_PERIODS, N_FOUT, N_FTAB, N_IOUT, N_PAR, N_PARW, Outputs, P_AW2,
+                     P_CTHC, P_H, P_OMEGA, P_PHI, P_STHC, P_THC, Work)
 from .stages import compile_step
 from .tableau import N_STAGES, N_TAB
 from .._jit import jit
@@ -74,35 +73,12 @@ else:
 
 @jit(nrt=False)
 def run_cell(TANGENT, y0, side0, par, ipar, out, w):
-    """One cell's run: :func:`rockjit._engine.integrate._loop` with the tables ``w.tab_h`` and
-    ``w.ftab`` already made (:func:`rockjit._engine.integrate.tables`, once per forcing);
-    returns the status code. The same pieces in the same order, so that on the CPU the
-    outputs are :func:`~rockjit._engine.integrate._loop`'s bit for bit."""
-    n_per = ipar[I_N]
-    total = n_per * ipar[I_PERIODS]
+    """One cell's run with the tables ``w.tab_h`` and ``w.ftab`` already made
+    (:func:`rockjit._engine.integrate.tables`, once per forcing): the start and the driver loop
+    of :func:`rockjit._engine.integrate._loop` (:func:`~rockjit._engine.integrate.drive`);
+    returns the status code."""
     status = ig.start_state(None, TANGENT, y0, side0, par, ipar, out, w)
-    side = side0
-    t = 0.0
-    max_err = 0.0
-    n_imp = np.int64(0)
-    step = np.int64(0)
-    j_per = np.int64(0)
-    k_per = np.int64(0)
-    j_qr = np.int64(0)
-    j_rec = np.int64(0)
-    n_col = out.iout[O_NCOL]
-    n_col_win = n_col if ipar[I_WINDOW] == 0 else 0
-    t_lift = -math.inf
-    while step < total and status == RUNNING:
-        (status, t, side, n_imp, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win, t_lift,
-         max_err) = ig.grid_step(None, TANGENT, False, None, False, t, side, n_imp, step,
-                                 j_per, k_per, j_qr, j_rec, n_col, n_col_win, t_lift, max_err,
-                                 par, ipar, out, w, out.iout)
-    if status == RUNNING:
-        status = DONE
-    out.iout[O_NCOL] = n_col
-    ig.finish(None, TANGENT, status, t, step, n_imp, n_col_win, max_err, ipar, par, out, w)
-    return status
+    return ig.drive(None, TANGENT, False, status, side0, par, ipar, out, w)
 
 
 # ---- the kernels -----------------------------------------------------------------------------

@@ -58,7 +58,8 @@ from ..model import forcing_closed, jump, saltation_at, sincos, uplift_time
 # a module of its own, named here too (the kernels' one entry point)
 from .tableau import A, B, C, E, N_STAGES, N_TAB, P, step_table, tab_entry  # noqa: F401
 from .layout import (RUNNING, DONE, OVERTURNED, REST, MAX_IMPACTS, NONFINITE, SETTLED,  # noqa: F401
-                     STATUS_NAMES, Outputs, Work, P_THC, P_XI, P_E, P_AW2, P_OMEGA, P_PHI, P_COT,
+                     STATUS_NAMES, Loop, Outputs, Work, P_THC, P_XI, P_E, P_AW2, P_OMEGA, P_PHI,
+                     P_COT,
                      P_THOVER, P_REST, P_H, P_SETTLE_TOL, P_LAW, P_LAW_SHAPE, N_PAR, P_STHC,
                      P_CTHC, N_PARW, I_N,
                      I_PERIODS, I_MAXIMP, I_STRIDE, I_WINDOW, I_SETTLE, I_QR, I_PMAX, I_CONTINUE,
@@ -494,15 +495,14 @@ def tock(PROF, counts, k, c0):
 
 
 @jit(nrt=False, inline=True)
-def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k_per, j_qr,
-              j_rec, n_col, n_col_win, t_lift, max_err, par, ipar, out, w, counts):
+def grid_step(EMBED4, TANGENT, record, PROF, pre, s, par, ipar, out, w, counts):
     """One grid step, from ``t`` (the grid point ``step h``, or the block still at rest) to the
     next grid point (docs/theory/integrator.md): a step of the current corner, or of rest; an event in it is
     located, the state taken there (impact: :func:`impact`; uplift; overturning ends the run),
     and the step finished from the event to the grid point; then :func:`grid_point`.
 
-    The loop's state goes in and comes back out: ``(status, t, side, n_imp, step, j_per, k_per,
-    j_qr, j_rec, n_col, n_col_win, t_lift, max_err)``. The one step of the single-lane loop
+    The loop's state ``s`` (a :data:`~rockjit._engine.layout.Loop`) goes in and the next comes
+    back out. The one step of the single-lane loop
     (:func:`_loop`) and of a lane taken out of the lanes' lockstep (:mod:`rockjit._engine.lanes`): with
     ``pre`` the grid step's first Runge–Kutta step is already in ``K``, ``w.ynew``, ``w.jac``
     and ``w.trig``. With ``PROF``, ``counts[6:13]`` receive the cycles spent in rest phases,
@@ -512,6 +512,9 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
     """
     NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
     NY = NS + (4 if TANGENT is not None else 0)  # plus the tangent matrix, column-major
+    t, side, n_imp, step, j_per, k_per, j_qr, j_rec = (s.t, s.side, s.n_imp, s.step, s.j_per,
+                                                       s.k_per, s.j_qr, s.j_rec)
+    n_col, n_col_win, t_lift, max_err = s.n_col, s.n_col_win, s.t_lift, s.max_err
     h = par[P_H]
     y = w.y
     K = w.K
@@ -651,41 +654,40 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, t, side, n_imp, step, j_per, k
                 n_col += 1
                 if in_window:
                     n_col_win += 1
-    return (status, t, side, n_imp, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win, t_lift,
-            max_err)
+    return Loop(status, t, side, n_imp, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win,
+                t_lift, max_err)
 
 
 @jit(nrt=False)
 def _loop(EMBED4, TANGENT, record, y0, side0, par, ipar, out, w):
     """The integration: ``_run``'s arguments, the parameters with the derived constants
-    (``N_PARW``), and the :data:`Work` arrays ``w``; grid step by grid step
-    (:func:`grid_step`) to the end, then :func:`finish`."""
+    (``N_PARW``), and the :data:`Work` arrays ``w``: the tables and the start (:func:`start`),
+    then :func:`drive`."""
+    status = start(EMBED4, TANGENT, y0, side0, par, ipar, out, w)
+    return drive(EMBED4, TANGENT, record, status, side0, par, ipar, out, w)
+
+
+@jit(nrt=False, inline=True)
+def drive(EMBED4, TANGENT, record, status, side0, par, ipar, out, w):
+    """From the start (status ``status`` on corner ``side0``, the tables made), grid step by
+    grid step (:func:`grid_step`) to the end, then :func:`finish`; returns the status code.
+    The one driver loop of a run, on the CPU and on the GPU (:mod:`rockjit._engine.gpu`)."""
     n_per = ipar[I_N]
     total = n_per * ipar[I_PERIODS]
-    status = start(EMBED4, TANGENT, y0, side0, par, ipar, out, w)
-    side = side0
-    t = 0.0
-    max_err = 0.0
     # the counters start as int64, not as the literal 0: numba would type (and compile) every
     # piece they are passed to once more for the literal
-    n_imp = np.int64(0)
-    step = np.int64(0)
-    j_per = np.int64(0)  # grid steps into the current period
-    k_per = np.int64(0)  # completed periods
-    j_qr = np.int64(0)
-    j_rec = np.int64(0)
+    zero = np.int64(0)
     n_col = out.iout[O_NCOL]  # collapses of the tangent vectors (start at rest; see below)
-    n_col_win = n_col if ipar[I_WINDOW] == 0 else 0
-    t_lift = -math.inf  # instant of the latest uplift
-    while step < total and status == RUNNING:
-        (status, t, side, n_imp, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win, t_lift,
-         max_err) = grid_step(EMBED4, TANGENT, record, None, False, t, side, n_imp, step,
-                              j_per, k_per, j_qr, j_rec, n_col, n_col_win, t_lift, max_err,
-                              par, ipar, out, w, out.iout)
+    s = Loop(np.int64(status), 0.0, np.int64(side0), zero, zero, zero, zero, zero, zero, n_col,
+             n_col if ipar[I_WINDOW] == 0 else zero, -math.inf, 0.0)
+    while s.step < total and s.status == RUNNING:
+        s = grid_step(EMBED4, TANGENT, record, None, False, s, par, ipar, out, w, out.iout)
+    status = s.status
     if status == RUNNING:
         status = DONE
-    out.iout[O_NCOL] = n_col
-    finish(EMBED4, TANGENT, status, t, step, n_imp, n_col_win, max_err, ipar, par, out, w)
+    out.iout[O_NCOL] = s.n_col
+    finish(EMBED4, TANGENT, status, s.t, s.step, s.n_imp, s.n_col_win, s.max_err, ipar, par,
+           out, w)
     return status
 
 

@@ -191,24 +191,24 @@ def scalar_step(TANGENT, st, fs, par, ipar, out, w, pre, prof, counts):
     ``w`` already (``K[1:]``, ``ynew``, ``trig[2:4]``: the vector step's, which equals it when it
     stayed in range), so it is not taken again. With ``prof``, ``counts[6:13]`` receive the
     cycles of its parts (see :func:`rockjit._engine.integrate.grid_step`)."""
-    (status, t, side, n_imp, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win, t_lift,
-     max_err) = ig.grid_step(None, TANGENT, False, prof, pre, fs[LF_TT], st[LS_SIDE], st[LS_NIMP],
-                             st[LS_STEP], st[LS_JPER], st[LS_KPER], st[LS_JQR], st[LS_JREC],
-                             st[LS_NCOL], st[LS_NCOLWIN], fs[LF_TLIFT], fs[LF_MAXERR], par, ipar,
-                             out, w, counts)
-    st[LS_STATUS] = status
-    st[LS_SIDE] = side
-    st[LS_NIMP] = n_imp
-    st[LS_STEP] = step
-    st[LS_JPER] = j_per
-    st[LS_KPER] = k_per
-    st[LS_JQR] = j_qr
-    st[LS_JREC] = j_rec
-    st[LS_NCOL] = n_col
-    st[LS_NCOLWIN] = n_col_win
-    fs[LF_TT] = t
-    fs[LF_MAXERR] = max_err
-    fs[LF_TLIFT] = t_lift
+    s = ig.grid_step(None, TANGENT, False, prof, pre,
+                     ig.Loop(st[LS_STATUS], fs[LF_TT], st[LS_SIDE], st[LS_NIMP], st[LS_STEP],
+                             st[LS_JPER], st[LS_KPER], st[LS_JQR], st[LS_JREC], st[LS_NCOL],
+                             st[LS_NCOLWIN], fs[LF_TLIFT], fs[LF_MAXERR]),
+                     par, ipar, out, w, counts)
+    st[LS_STATUS] = s.status
+    st[LS_SIDE] = s.side
+    st[LS_NIMP] = s.n_imp
+    st[LS_STEP] = s.step
+    st[LS_JPER] = s.j_per
+    st[LS_KPER] = s.k_per
+    st[LS_JQR] = s.j_qr
+    st[LS_JREC] = s.j_rec
+    st[LS_NCOL] = s.n_col
+    st[LS_NCOLWIN] = s.n_col_win
+    fs[LF_TT] = s.t
+    fs[LF_MAXERR] = s.max_err
+    fs[LF_TLIFT] = s.t_lift
 
 
 #: A block of lanes' arrays: each lane's loop state (``st``, ``fs``), parameters (``par``,

@@ -39,6 +39,15 @@ Outputs = namedtuple("Outputs", "strobe half impacts traj lam_run per_imp iout f
 #: at each grid step of a period (columns ``FT_*`` below).
 Work = namedtuple("Work", "K y ytmp ynew yev lam tab_h tab fr jac trig ftab")
 
+#: The driver loop's state between two grid steps (:func:`rockjit._engine.integrate.grid_step`
+#: takes it and returns the next): the status code, the time, the corner (0 at rest), the
+#: impacts so far, the grid steps taken, the grid steps into the current period, the periods
+#: completed, the grid steps since the last renormalisation and since the last trajectory
+#: point, the tangent vectors' collapses (all, and in the averaging window), the latest
+#: uplift's instant and the largest error estimate so far.
+Loop = namedtuple("Loop", "status t side n_imp step j_per k_per j_qr j_rec n_col n_col_win "
+                          "t_lift max_err")
+
 # ---- layout of the float parameter vector ``par`` ---------------------------------------------
 P_THC, P_XI, P_E, P_AW2, P_OMEGA, P_PHI, P_COT, P_THOVER, P_REST, P_H, P_SETTLE_TOL, P_LAW, \
     P_LAW_SHAPE = range(13)
