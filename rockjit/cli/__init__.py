@@ -1,4 +1,5 @@
-"""The ``rockjit`` command line (:mod:`.main`: the parser and the commands, which write through
+"""The ``rockjit`` command line (:mod:`.main`: a command's run; :mod:`.parser` and the modules
+of the command groups it declares: the parser and the commands, which write through
 :mod:`rockjit.outputs`; :mod:`.signals`: SIGINT and SIGTERM), and its entry point :func:`main`,
 which handles SIGINT and SIGTERM from its first instant, the imports of rockjit's modules
 included.

@@ -73,11 +73,11 @@ elif point == "wrote":
     import importlib
     commands = importlib.import_module("rockjit.cli.main")
 
-    def say(args, message, real=commands._say):
+    def say(args, message, real=commands.say):
         real(args, message)
         if message.startswith(f"{args.command}: wrote"):
             pause()
-    commands._say = say
+    commands.say = say
 if how == "script":
     sys.exit(entry())
 sys.argv[0] = "rockjit"
