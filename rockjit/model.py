@@ -203,7 +203,7 @@ class Block:
     @property
     def impact_law(self):
         """``(kind, shape)``: how the integrator evaluates the law at an impact
-        (:func:`rockjit.laws.impact.restitution_at`)."""
+        (``rockjit.laws.impact.restitution_at``)."""
         rule = self.rule
         return float(laws.impact.kind_of(rule)), float(rule.shape)
 

@@ -4,7 +4,7 @@ Every module of this package defines and registers its laws (:func:`register`): 
 Mao et al.'s (one coefficient per block, from its slenderness), the constant law (a number given
 with the block) and a law that depends on the impact (:class:`SpeedDependent`). The table of
 names, labels, colours and line styles that figures, the command line and the explorer use is
-read from the registered laws (:func:`names`, :class:`Table`).
+read from the registered laws (:func:`names`, and ``Table``, a live view of one attribute).
 A new law is one module here (docs/guide/extending.md).
 """
 

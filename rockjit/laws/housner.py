@@ -54,7 +54,7 @@ def check_housner(hb, name="the Housner law"):
 
 class Housner(RestitutionLaw):
     """Housner's law (1963): ``e = e_H(thc)``, one coefficient per block
-    (:func:`e_housner`).
+    (:func:`rockjit.e_housner`).
 
     Examples
     --------

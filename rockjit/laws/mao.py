@@ -45,7 +45,8 @@ def e_mao(thc):
 
 
 class Mao(RestitutionLaw):
-    """Mao et al.'s law (2024): ``e = e_M(thc)``, one coefficient per block (:func:`e_mao`).
+    """Mao et al.'s law (2024): ``e = e_M(thc)``, one coefficient per block
+    (:func:`rockjit.e_mao`).
 
     Examples
     --------

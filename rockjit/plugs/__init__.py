@@ -2,9 +2,9 @@
 through functions of their own, one module each.
 
 Every module of this package defines and registers one plug (:mod:`rockjit.plugs.base` says what
-a plug gives): :class:`HarmonicSum`, a sum of harmonics over a given duration. When the package is
+a plug gives): :class:`rockjit.HarmonicSum`, a sum of harmonics over a given duration. When the package is
 imported, the kernel's two entry points are rendered over the registered plugs:
-:func:`plug_value` and :func:`plug_window` dispatch on the plug's kind (``FIRST_KIND``, the next,
+``plug_value`` and ``plug_window`` dispatch on the plug's kind (``FIRST_KIND``, the next,
 ...) to its compiled functions. A new excitation of this kind is one more module here
 (docs/guide/extending.md), and nothing else changes.
 """
@@ -29,7 +29,7 @@ for _m in sorted(m.name for m in pkgutil.iter_modules(__path__)):
 
 
 def _render():
-    """Compile the dispatch of :func:`plug_value` and :func:`plug_window` over the registered
+    """Compile the dispatch of ``plug_value`` and ``plug_window`` over the registered
     plugs, giving each its kind."""
     value = ['def plug_value(kind, t, rec, off, n):',
              '    """The registered plug of kind ``kind``: its ``value(t, rec, off, n)``."""']

@@ -46,7 +46,7 @@ class TransientPlug(Excitation):
     transient = True
     value = None
     window = None
-    #: The kernel's code of the plug (set by :func:`register`).
+    #: The kernel's code of the plug (set when :mod:`rockjit.plugs` is imported).
     kind = -1
 
     # ---- what the compiled kernel needs ----------------------------------------------------
@@ -76,20 +76,20 @@ class TransientPlug(Excitation):
                          f"import rockjit.ground first")
 
 
-def register(cls):
+def register(plug):
     """Register the plug class ``cls``: a class decorator for the plugs of this package (the
     kernel is compiled with their functions when :mod:`rockjit.plugs` is imported, which
     gives each its ``kind``).
 
     Parameters
     ----------
-    cls : type
+    plug : type
         A :class:`TransientPlug` subclass with compiled ``value`` and ``window``.
 
     Returns
     -------
     type
-        ``cls``.
+        ``plug``.
 
     Examples
     --------
@@ -97,13 +97,13 @@ def register(cls):
     >>> HarmonicSum in registered(), HarmonicSum.kind
     (True, 4)
     """
-    if not (isinstance(cls, type) and issubclass(cls, TransientPlug)) or cls.value is None \
-            or cls.window is None:
+    if not (isinstance(plug, type) and issubclass(plug, TransientPlug)) or plug.value is None \
+            or plug.window is None:
         raise ValueError(f"a plug must be a TransientPlug subclass with compiled value and "
-                         f"window functions (got {cls!r})")
-    if cls not in _PLUGS:
-        _PLUGS.append(cls)
-    return cls
+                         f"window functions (got {plug!r})")
+    if plug not in _PLUGS:
+        _PLUGS.append(plug)
+    return plug
 
 
 def registered():
