@@ -7,7 +7,7 @@ calls the compiled pieces the CPU kernels call: :func:`rockjit._engine.integrate
 :func:`~rockjit._engine.integrate.grid_step` (the Dormand–Prince step of
 :mod:`rockjit._engine.step`, the events of :mod:`rockjit._engine.events`, the physics of
 :mod:`rockjit.model`) and :func:`~rockjit._engine.integrate.finish`, through :func:`run_cell`
-(the loop of :func:`rockjit._engine.integrate._loop`, its tables made beforehand), then the
+(the loop of :func:`rockjit._engine.integrate.drive`, its tables made beforehand), then the
 cell's classification and samples (:func:`rockjit._engine.cell._classify`,
 :func:`~rockjit._engine.cell._collect`), as :func:`rockjit._engine.kernel._grid` does. numba's
 CUDA target compiles those ``numba.njit`` functions again for the device from their Python
@@ -75,7 +75,7 @@ else:
 def run_cell(TANGENT, y0, side0, par, ipar, out, w):
     """One cell's run with the tables ``w.tab_h`` and ``w.ftab`` already made
     (:func:`rockjit._engine.integrate.tables`, once per forcing): the start and the driver loop
-    of :func:`rockjit._engine.integrate._loop` (:func:`~rockjit._engine.integrate.drive`);
+    of a run on the CPU (:func:`~rockjit._engine.integrate.drive`);
     returns the status code."""
     status = ig.start_state(None, TANGENT, y0, side0, par, ipar, out, w)
     return ig.drive(None, TANGENT, False, status, side0, par, ipar, out, w)

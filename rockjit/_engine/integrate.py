@@ -24,7 +24,7 @@ detection and location of events in :mod:`~rockjit._engine.events`, the argument
 the status codes in :mod:`~rockjit._engine.layout`; this module drives them (the loop over the
 grid, impacts, samples, the exponents' renormalisation). A step is six stages in a chain, each
 waiting for the one before, so its cost is the chain's latency more than its arithmetic. The
-step's and the events' pieces are inlined into :func:`_loop` by LLVM (they are marked
+step's and the events' pieces are inlined into :func:`drive` by LLVM (they are marked
 ``alwaysinline``: :func:`rockjit._jit.jit`), which is compiled without numba's reference
 counting: out of line, each call would pass its dozen arrays as seven scalars apiece.
 
@@ -88,7 +88,7 @@ def build(embed4: bool = False, tangent: bool = False):
     -------
     run : numba dispatcher
         ``run(y0, side0, par, ipar, out)`` with ``out`` an :data:`Outputs`; returns the status
-        code (see :func:`_loop`). Recording is not a switch here: ``out.traj`` with more than
+        code (see :func:`drive`). Recording is not a switch here: ``out.traj`` with more than
         one row records the dense trajectory (see :func:`_run`).
     """
     return _build(True if embed4 else None, True if tangent else None)
@@ -205,7 +205,8 @@ def _run(EMBED4, TANGENT, y0, side0, par_in, ipar, out):
     # compile-time one: one compiled loop serves runs with and without it and the grids; its
     # test costs nothing measurable per step.
     record = out.traj.shape[0] > 1
-    return _loop(EMBED4, TANGENT, record, y0, side0, par, ipar, out, w)
+    status = start(EMBED4, TANGENT, y0, side0, par, ipar, out, w)
+    return drive(EMBED4, TANGENT, record, status, side0, par, ipar, out, w)
 
 
 @jit(nrt=False)
@@ -272,7 +273,7 @@ def start_state(EMBED4, TANGENT, y0, side0, par, ipar, out, w):
         status = OVERTURNED
     if TANGENT is not None and side0 == 0:
         # at rest from the start: every perturbation small enough dies in a Zeno cascade, and
-        # the block leaves rest when the forcing alone says (see _loop, rest phases)
+        # the block leaves rest when the forcing alone says (see drive, rest phases)
         out.iout[O_NCOL] = 1
     rhs(EMBED4, forcing_at(0.0, par), y, side0, par, w.K, w.jac, w.trig)
     out.iout[O_RHS] += 1
@@ -350,7 +351,7 @@ def impact(EMBED4, TANGENT, t, r, t_lift, side, n_imp, in_window, par, out, w):
 
     Returns ``(side, n_imp, rests, hold)``: the new corner (0 if the block came to rest), the
     impact count, whether a rest phase began, and whether it began within rounding of the
-    latest uplift (then it is held to the grid point, see :func:`_loop`).
+    latest uplift (then it is held to the grid point, see :func:`grid_step`).
     """
     NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
     y = w.y
@@ -503,7 +504,7 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, s, par, ipar, out, w, counts):
 
     The loop's state ``s`` (a :data:`~rockjit._engine.layout.Loop`) goes in and the next comes
     back out. The one step of the single-lane loop
-    (:func:`_loop`) and of a lane taken out of the lanes' lockstep (:mod:`rockjit._engine.lanes`): with
+    (:func:`drive`) and of a lane taken out of the lanes' lockstep (:mod:`rockjit._engine.lanes`): with
     ``pre`` the grid step's first Runge–Kutta step is already in ``K``, ``w.ynew``, ``w.jac``
     and ``w.trig``. With ``PROF``, ``counts[6:13]`` receive the cycles spent in rest phases,
     in the steps after an event, in locating, in impacts, in detection, in the first step and
@@ -659,19 +660,13 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, s, par, ipar, out, w, counts):
 
 
 @jit(nrt=False)
-def _loop(EMBED4, TANGENT, record, y0, side0, par, ipar, out, w):
-    """The integration: ``_run``'s arguments, the parameters with the derived constants
-    (``N_PARW``), and the :data:`Work` arrays ``w``: the tables and the start (:func:`start`),
-    then :func:`drive`."""
-    status = start(EMBED4, TANGENT, y0, side0, par, ipar, out, w)
-    return drive(EMBED4, TANGENT, record, status, side0, par, ipar, out, w)
-
-
-@jit(nrt=False, inline=True)
 def drive(EMBED4, TANGENT, record, status, side0, par, ipar, out, w):
-    """From the start (status ``status`` on corner ``side0``, the tables made), grid step by
-    grid step (:func:`grid_step`) to the end, then :func:`finish`; returns the status code.
-    The one driver loop of a run, on the CPU and on the GPU (:mod:`rockjit._engine.gpu`)."""
+    """The integration from its start (:func:`start`: the tables made, status ``status`` on
+    corner ``side0``), with the parameters and their derived constants (``N_PARW``) and the
+    :data:`Work` arrays ``w``: grid step by grid step (:func:`grid_step`) to the end, then
+    :func:`finish`; returns the status code. The one driver loop of a run, on the CPU
+    (:func:`_run`) and on the GPU (:mod:`rockjit._engine.gpu`); the step's pieces are inlined
+    into it."""
     n_per = ipar[I_N]
     total = n_per * ipar[I_PERIODS]
     # the counters start as int64, not as the literal 0: numba would type (and compile) every

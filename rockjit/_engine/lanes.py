@@ -170,7 +170,7 @@ block_step_lanes = compile_step("block_step_lanes", "n, j, lin, lout, ftl", _STE
 # ---------------------------------------------------------------------------------------------
 
 # layout of a lane's loop state: integers ``st`` and floats ``fs`` (the variables of
-# rockjit._engine.integrate._loop)
+# rockjit._engine.integrate.drive)
 (LS_STATUS, LS_SIDE, LS_NIMP, LS_STEP, LS_JPER, LS_KPER, LS_JQR, LS_JREC, LS_NCOL, LS_NCOLWIN,
  LS_CELL) = range(11)
 N_ST = 11
@@ -389,7 +389,7 @@ def _stages(l, b):
 
 @jit(nrt=False)
 def _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b):
-    """Lane ``l``'s run has ended: its outputs (:func:`rockjit._engine.integrate._loop`'s end), its
+    """Lane ``l``'s run has ended: its outputs (:func:`rockjit._engine.integrate.drive`'s end), its
     classification and samples (:func:`rockjit._engine.kernel._grid`); the lane is free."""
     st = b.st[l]
     fs = b.fs[l]

@@ -32,7 +32,7 @@ def render(functions):
         lines += [f"    if kind == {k}:", f"        return _impact_{k}(speed, e, shape)"]
     lines.append("    return e, e")
     exec(compile("\n".join(lines) + "\n", __file__, "exec"), globals())  # noqa: S102
-    restitution_at = jit(globals()["restitution_at"], nrt=False, inline=True)
+    restitution_at = jit(globals()["restitution_at"], nrt=False)
     return restitution_at
 
 
