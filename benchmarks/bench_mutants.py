@@ -80,6 +80,9 @@ def _m(name, area, file, old, new, breaks, tests):
 
 
 MODEL = "rockjit/model.py"
+HOUSNER = "rockjit/laws/housner.py"
+MAO = "rockjit/laws/mao.py"
+SPEED = "rockjit/laws/speed.py"
 INTEG = "rockjit/_engine/integrate.py"
 TABLEAU = "rockjit/_engine/tableau.py"
 EVENTS = "rockjit/_engine/events.py"
@@ -90,10 +93,10 @@ CLASSIFY = "rockjit/_engine/classify.py"
 
 MUTANTS = [
     # ---- restitution laws
-    _m("housner-restitution", "restitution", MODEL,
+    _m("housner-restitution", "restitution", HOUSNER,
        "return 1.0 - 1.5 * np.cos(thc) ** 2", "return 1.0 - 1.4 * np.cos(thc) ** 2",
        "Housner's coefficient 1 - 1.5 cos^2 becomes 1 - 1.4 cos^2", RESTITUTION),
-    _m("mao-restitution", "restitution", MODEL,
+    _m("mao-restitution", "restitution", MAO,
        "3.0 * t**4 * (0.5 * np.pi - thc)", "3.0 * t**3 * (0.5 * np.pi - thc)",
        "a power of tan(thc) in Mao's numerator (equal at hb = 1 only)", RESTITUTION),
     # ---- vector field
@@ -134,10 +137,17 @@ MUTANTS = [
        "    side = -side\n    impacts = out.impacts", "    impacts = out.impacts",
        "the block stays on its corner after an impact", RUN_SYMMETRIC),
     _m("saltation-entry", "saltation", MODEL,
-       "return (f_plus - e * f_minus) / dtheta_minus", "return (f_plus - f_minus) / dtheta_minus",
+       "return (f_plus - e_slope * f_minus) / dtheta_minus",
+       "return (f_plus - f_minus) / dtheta_minus",
        "Müller's (F+ - e F-) / theta'- loses its e", SALTATION),
+    _m("speed-law-slope", "saltation", SPEED,
+       "return e * q, e * q * q", "return e * q, e * q",
+       "the speed-dependent law's jump slope d(e(v) v)/dv taken as e(v)",
+       [PI + "test_saltation_of_a_law_that_depends_on_the_impact_matches_muellers_formula",
+        PI + "test_floquet_multipliers_match_the_finite_difference_monodromy[p1-speed]"]),
     _m("saltation-applied", "saltation", INTEG,
-       "y[NS + 2 * c + 1] = s10 * v0 + e * v1", "y[NS + 2 * c + 1] = s10 * v1 + e * v1",
+       "y[NS + 2 * c + 1] = s10 * v0 + e_slope * v1",
+       "y[NS + 2 * c + 1] = s10 * v1 + e_slope * v1",
        "the saltation matrix applied to the wrong tangent component", FLOQUET),
     # ---- rest and uplift
     _m("rest-cutoff", "rest/uplift", INTEG,
