@@ -78,7 +78,9 @@ def run_cell(TANGENT, y0, side0, par, ipar, out, w):
     of a run on the CPU (:func:`~rockjit._engine.integrate.drive`);
     returns the status code."""
     status = ig.start_state(None, TANGENT, y0, side0, par, ipar, out, w)
-    return ig.drive(None, TANGENT, False, status, side0, par, ipar, out, w)
+    # recording is the CPU loop's run-time switch (off here: one trajectory row), so that the
+    # CPU's compilation of the loop serves this one too
+    return ig.drive(None, TANGENT, out.traj.shape[0] > 1, status, side0, par, ipar, out, w)
 
 
 # ---- the kernels -----------------------------------------------------------------------------
