@@ -187,27 +187,12 @@ def registers(cfg, t0):
     return rows, raw
 
 
-def _rk4(y, v, n_steps):
-    """``n_steps`` RK4 steps of ``y'' = -y - 0.1 y'`` in registers (the yardstick's cell)."""
-    h = 0.01
-    for _ in range(n_steps):
-        k1y, k1v = v, -y - 0.1 * v
-        y2, v2 = y + 0.5 * h * k1y, v + 0.5 * h * k1v
-        k2y, k2v = v2, -y2 - 0.1 * v2
-        y3, v3 = y + 0.5 * h * k2y, v + 0.5 * h * k2v
-        k3y, k3v = v3, -y3 - 0.1 * v3
-        y4, v4 = y + h * k3y, v + h * k3v
-        k4y, k4v = v4, -y4 - 0.1 * v4
-        y += h / 6.0 * (k1y + 2.0 * k2y + 2.0 * k3y + k4y)
-        v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v)
-    return y
-
-
 def yardsticks():
     """The balanced yardstick, one source compiled for the CPU's cores (``prange``) and for
     the GPU (one cell per thread): every cell the same work, in registers."""
     import numba
-    step = numba.njit(cache=True)(_rk4)
+    from bench_cores import rk4_cell
+    step = numba.njit(cache=True)(rk4_cell)
 
     @numba.njit(parallel=True, cache=True)
     def on_cpu(n_cells, n_steps, out):

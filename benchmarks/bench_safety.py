@@ -30,6 +30,7 @@ import _common as H  # noqa: E402
 
 import rockjit  # noqa: E402
 from rockjit import Block, Execution, Harmonic, Integration, Lattice  # noqa: E402
+from rockjit.plotting.style import LAW_NAMES  # noqa: E402
 
 ALPHA_RANGE, OMEGA_RANGE = (0.2, 1.0), (1.0, 2.0)
 TARGET_GRID = (60, 60)
@@ -108,7 +109,7 @@ def plot(charts, rows):
                             linestyles=["solid", "dashed"])
             ax.clabel(cs, fmt=lambda v: f"{v:.0%} safe", fontsize=7)
         wall = next(r[5] for r in rows if r[0] == law)
-        ax.set_title(f"{law}: safe fraction ({wall:.0f} s)", fontsize=9)
+        ax.set_title(f"{LAW_NAMES[law]}: safe fraction ({wall:.0f} s)", fontsize=9)
         ax.set_xlabel(r"$\omega$")
         ax.set_ylabel(r"$\alpha$")
     fig.colorbar(m, ax=axes, label="safe fraction (initial states that never overturn)")

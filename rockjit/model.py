@@ -27,7 +27,7 @@ import numpy as np
 
 from . import laws
 from ._jit import fma, jit
-from .laws.housner import HB_MIN_HOUSNER, e_housner
+from .laws.housner import e_housner
 from .laws.mao import e_mao
 from .validate import choice, real
 

@@ -255,3 +255,14 @@ def test_the_runner_sends_cuda_grids_to_the_gpu_driver_with_stores_of_their_own(
                           execution=Execution(device="cuda", store=store))
     assert calls == [36]  # resumed from the GPU's own chunks
     np.testing.assert_array_equal(again.label, cpu.label)
+
+
+def test_the_gpu_guide_quotes_the_default_chunk():
+    # docs/guide/gpu.md: "a chunk defaults to the whole grid up to N cells"
+    import re
+    from pathlib import Path
+
+    from rockjit._engine import gpu
+    page = (Path(__file__).resolve().parents[2] / "docs" / "guide" / "gpu.md").read_text()
+    quoted = re.search(r"the whole grid up to ([\d,]+) cells", " ".join(page.split()))
+    assert quoted and int(quoted.group(1).replace(",", "")) == gpu.GPU_CHUNK
