@@ -504,6 +504,22 @@ def uncertain_fraction_sampled(outcome, lo, hi, eps, n=10_000, seed=0):
     if not callable(outcome):
         raise ValueError(f"outcome must be a callable outcome(points) -> ids "
                          f"(got {type(outcome).__name__})")
+    lo_a, hi_a = _box(lo, hi)
+    e = _sampled_eps(eps)
+    npts = _int(n, "n", 1)
+    if not isinstance(seed, numbers.Integral) or isinstance(seed, bool):
+        raise ValueError(f"seed must be an integer (got {seed!r})")
+    unit = _perturbed_unit_points(np.random.default_rng(seed), e, npts)
+    points = lo_a + unit * (hi_a - lo_a)
+    got = _outcomes_of(outcome, points)
+    counts = _uncertain_counts(got, npts, e.size)
+    frac = counts / npts
+    return SampledUncertainty(eps=e, f=frac, stderr=np.sqrt(frac * (1.0 - frac) / npts),
+                              uncertain=counts, n=npts)
+
+
+def _box(lo, hi):
+    """The corners ``lo < hi`` of a sampled box as float arrays, or a ValueError naming them."""
     lo_a = np.asarray(lo, dtype=float)
     hi_a = np.asarray(hi, dtype=float)
     for name, v in (("lo", lo_a), ("hi", hi_a)):
@@ -513,14 +529,21 @@ def uncertain_fraction_sampled(outcome, lo, hi, eps, n=10_000, seed=0):
     if not np.all(hi_a > lo_a):
         raise ValueError(f"hi must exceed lo componentwise (got lo {lo_a.tolist()}, "
                          f"hi {hi_a.tolist()})")
+    return lo_a, hi_a
+
+
+def _sampled_eps(eps):
+    """``eps`` as fractions of the box's sides in ``(0, 0.5)``, or a ValueError naming it."""
     e, _ = _eps_list(eps, "eps", "float")
     if not np.all(np.isfinite(e)) or np.any(e <= 0) or np.any(e >= 0.5):
         raise ValueError(f"eps must be in (0, 0.5), fractions of the box's sides "
                          f"(got {e.tolist()})")
-    npts = _int(n, "n", 1)
-    if not isinstance(seed, numbers.Integral) or isinstance(seed, bool):
-        raise ValueError(f"seed must be an integer (got {seed!r})")
-    rng = np.random.default_rng(seed)
+    return e
+
+
+def _perturbed_unit_points(rng, e, npts):
+    """The base points and, for each ``eps``, their ``+`` and ``-`` perturbations, in the unit
+    box: ``npts`` rows per block, blocks ``[base, +e[0], -e[0], +e[1], ...]``."""
     margin = float(e.max())
     u = margin + (1.0 - 2.0 * margin) * rng.random((npts, 2))
     phi = 2.0 * np.pi * rng.random(npts)
@@ -529,22 +552,29 @@ def uncertain_fraction_sampled(outcome, lo, hi, eps, n=10_000, seed=0):
     for ek in e:
         blocks.append(u + ek * direction)
         blocks.append(u - ek * direction)
-    unit = np.clip(np.concatenate(blocks), 0.0, 1.0)  # clip only rounding at the box's edge
-    points = lo_a + unit * (hi_a - lo_a)
+    return np.clip(np.concatenate(blocks), 0.0, 1.0)  # clip only rounding at the box's edge
+
+
+def _outcomes_of(outcome, points):
+    """``outcome(points)``, checked to be one integer id per point."""
     got = np.asarray(outcome(points))
     if got.shape != (points.shape[0],) or got.dtype.kind not in "iu":
         raise ValueError(f"outcome must return an integer array of shape ({points.shape[0]},) "
                          f"for points of shape {points.shape} (got dtype {got.dtype}, "
                          f"shape {got.shape})")
+    return got
+
+
+def _uncertain_counts(got, npts, k_eps):
+    """For each ``eps``, the number of base points whose ``+`` or ``-`` perturbation changes
+    the outcome (``got`` in the blocks of :func:`_perturbed_unit_points`)."""
     base = got[:npts]
-    counts = np.empty(e.size, dtype=np.int64)
-    for k in range(e.size):
+    counts = np.empty(k_eps, dtype=np.int64)
+    for k in range(k_eps):
         plus = got[npts * (1 + 2 * k):npts * (2 + 2 * k)]
         minus = got[npts * (2 + 2 * k):npts * (3 + 2 * k)]
         counts[k] = np.count_nonzero((plus != base) | (minus != base))
-    frac = counts / npts
-    return SampledUncertainty(eps=e, f=frac, stderr=np.sqrt(frac * (1.0 - frac) / npts),
-                              uncertain=counts, n=npts)
+    return counts
 
 
 # --------------------------------------------------------------------------- dynamical integrity
@@ -568,6 +598,41 @@ class Integrity:
         Its centre ``(theta, theta')`` (a grid node), ``None`` when nothing is safe.
     half_width : float
         The normalisation: half the shorter side of the sampled region, state units.
+
+    Notes
+    -----
+    Definitions of Soliman & Thompson (1989) and Rega & Lenci (2005; Lenci & Rega 2019), on
+    the safe basin of docs/theory/global-dynamics.md:
+
+    - **Safe cells** are those with an attractor id ``>= 0``. Unresolved cells (``-2``) are
+      *not* safe: nothing shows they stay bounded, and an integrity measure must not claim
+      safety it has not seen (the conservative choice).
+    - **GIM** is the number of safe cells over the number of cells: the safe basin's area as a
+      fraction of the sampled region's.
+    - **IF** is the radius of the largest disc, in state units (``theta`` and ``theta'`` as
+      they are), lying inside the safe basin, over the region's half-width. The sampled region is
+      the rectangle ``[theta[0], theta[-1]] x [dtheta[0], dtheta[-1]]``; what lies outside it is
+      unknown, so the disc must also stay inside the region (as in Lenci & Rega's usage, where the
+      hypersphere lies in the safe basin, itself a subset of the region of interest). The
+      half-width is half the shorter side, ``min(theta[-1] - theta[0], dtheta[-1] -
+      dtheta[0]) / 2``, the radius of the largest disc the region holds, so that ``0 <= IF <= 1``
+      and an all-safe region has ``IF = 1`` (exactly when the grid has a node at the region's
+      centre, within one spacing otherwise).
+    - The disc radius at a safe node is the smaller of its distance to the nearest *unsafe node*
+      (``scipy.ndimage.distance_transform_edt`` with ``sampling=`` the two spacings, so the
+      distance is Euclidean in state units) and its distance to the region's edge; the largest
+      over the safe nodes is IF's radius. The map does not show where between a safe and an
+      unsafe node the boundary lies, so the radius can exceed the continuous one by up to one
+      grid spacing, and a centre off the nodes could gain up to half a diagonal.
+    - **LIM** of an attractor is the radius of the largest disc centred on the attractor that
+      stays in the basin, same normalisation. For a cycle of ``p`` points this is the *minimum*
+      over its points: the LIM is the distance from the attractor, a set, to the basin's
+      boundary (Soliman & Thompson 1989; Rega & Lenci 2005), which is the smallest distance of
+      its points; a disturbance at the most exposed point is the one that loses the orbit. A
+      point's radius is its distance to the nearest node outside the basin and to the region's
+      edge, measured from the point itself (not its node); it is ``0`` when the point's nearest
+      node is outside the basin, and ``nan`` when the point lies outside the sampled region (the
+      map says nothing there).
 
     Examples
     --------
@@ -648,38 +713,9 @@ def integrity(ids, theta, dtheta, points=None, lim_basin="safe"):
 
     Notes
     -----
-    Definitions of Soliman & Thompson (1989) and Rega & Lenci (2005; Lenci & Rega 2019), on
-    the safe basin of docs/theory/global-dynamics.md:
-
-    - **Safe cells** are those with an attractor id ``>= 0``. Unresolved cells (``-2``) are
-      *not* safe: nothing shows they stay bounded, and an integrity measure must not claim
-      safety it has not seen (the conservative choice).
-    - **GIM** is the number of safe cells over the number of cells: the safe basin's area as a
-      fraction of the sampled region's.
-    - **IF** is the radius of the largest disc, in state units (``theta`` and ``theta'`` as
-      they are), lying inside the safe basin, over the region's half-width. The sampled region is
-      the rectangle ``[theta[0], theta[-1]] x [dtheta[0], dtheta[-1]]``; what lies outside it is
-      unknown, so the disc must also stay inside the region (as in Lenci & Rega's usage, where the
-      hypersphere lies in the safe basin, itself a subset of the region of interest). The
-      half-width is half the shorter side, ``min(theta[-1] - theta[0], dtheta[-1] -
-      dtheta[0]) / 2``, the radius of the largest disc the region holds, so that ``0 <= IF <= 1``
-      and an all-safe region has ``IF = 1`` (exactly when the grid has a node at the region's
-      centre, within one spacing otherwise).
-    - The disc radius at a safe node is the smaller of its distance to the nearest *unsafe node*
-      (``scipy.ndimage.distance_transform_edt`` with ``sampling=`` the two spacings, so the
-      distance is Euclidean in state units) and its distance to the region's edge; the largest
-      over the safe nodes is IF's radius. The map does not show where between a safe and an
-      unsafe node the boundary lies, so the radius can exceed the continuous one by up to one
-      grid spacing, and a centre off the nodes could gain up to half a diagonal.
-    - **LIM** of an attractor is the radius of the largest disc centred on the attractor that
-      stays in the basin, same normalisation. For a cycle of ``p`` points this is the *minimum*
-      over its points: the LIM is the distance from the attractor, a set, to the basin's
-      boundary (Soliman & Thompson 1989; Rega & Lenci 2005), which is the smallest distance of
-      its points; a disturbance at the most exposed point is the one that loses the orbit. A
-      point's radius is its distance to the nearest node outside the basin and to the region's
-      edge, measured from the point itself (not its node); it is ``0`` when the point's nearest
-      node is outside the basin, and ``nan`` when the point lies outside the sampled region (the
-      map says nothing there).
+    Soliman & Thompson (1989) and Rega & Lenci (2005; Lenci & Rega 2019), on the safe basin of
+    docs/theory/global-dynamics.md (the cells with an attractor id ``>= 0``; unresolved cells
+    are *not* safe). :class:`Integrity`'s notes define each measure and rockjit's choices.
 
     Examples
     --------
@@ -695,6 +731,23 @@ def integrity(ids, theta, dtheta, points=None, lim_basin="safe"):
     >>> round(m.GIM, 4), round(m.IF, 6), m.LIM
     (0.7619, 0.8, {0: 0.5})
     """
+    a, th, h0, dth, h1 = _outcome_map(ids, theta, dtheta)
+    if lim_basin not in ("safe", "own"):
+        raise ValueError(f"lim_basin must be 'safe' or 'own' (got {lim_basin!r})")
+    pts = _points(points)
+    safe = a >= 0
+    half = 0.5 * float(min(th[-1] - th[0], dth[-1] - dth[0]))
+    radius, centre = _largest_safe_disc(safe, th, dth, h0, h1)
+    lim = {}
+    for key, cyc in pts.items():
+        basin = safe if lim_basin == "safe" else (a == key)
+        lim[key] = float(_lim(cyc, basin, th, dth, h0, h1) / half)
+    return Integrity(GIM=float(np.count_nonzero(safe)) / safe.size, IF=float(radius / half),
+                     LIM=lim, radius=radius, centre=centre, half_width=float(half))
+
+
+def _outcome_map(ids, theta, dtheta):
+    """The checked map and its axes: ``(ids, theta, theta's spacing, dtheta, its spacing)``."""
     a = _ids_2d(ids)
     n, m = a.shape
     if a.min() < UNRESOLVED:
@@ -702,27 +755,21 @@ def integrity(ids, theta, dtheta, points=None, lim_basin="safe"):
                          f"(got {int(a.min())})")
     th, h0 = _axis(theta, "theta", n)
     dth, h1 = _axis(dtheta, "dtheta", m)
-    if lim_basin not in ("safe", "own"):
-        raise ValueError(f"lim_basin must be 'safe' or 'own' (got {lim_basin!r})")
-    pts = _points(points)
+    return a, th, h0, dth, h1
 
-    safe = a >= 0
-    half = 0.5 * float(min(th[-1] - th[0], dth[-1] - dth[0]))
+
+def _largest_safe_disc(safe, th, dth, h0, h1):
+    """IF's disc: the largest radius over the safe nodes of a disc in the safe basin and the
+    region, and its centre node (``None`` when nothing is safe)."""
     border = np.minimum(_border_distance(th, th)[:, None], _border_distance(dth, dth)[None, :])
     radius_at = np.where(safe, np.minimum(_edt(safe, (h0, h1)), border), 0.0)
     k = int(np.argmax(radius_at))
     radius = float(radius_at.flat[k])
     centre = None
     if safe.any():
-        i, j = divmod(k, m)
+        i, j = divmod(k, safe.shape[1])
         centre = (float(th[i]), float(dth[j]))
-
-    lim = {}
-    for key, cyc in pts.items():
-        basin = safe if lim_basin == "safe" else (a == key)
-        lim[key] = float(_lim(cyc, basin, th, dth, h0, h1) / half)
-    return Integrity(GIM=float(np.count_nonzero(safe)) / safe.size, IF=float(radius / half),
-                     LIM=lim, radius=radius, centre=centre, half_width=float(half))
+    return radius, centre
 
 
 def _edt(mask, sampling):
