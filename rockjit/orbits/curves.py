@@ -53,6 +53,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -91,7 +92,8 @@ def _grazing_seed(solver, seed, lam0, shooting):
     or whose largest ``|theta|`` nears ``theta_over``. On the other side of a grazing the
     excursion touches down twice at low speed and comes back: if only that orbit is found,
     it is returned with ``count``, the impacts of the orbit without that pair (otherwise
-    ``None``), and the solve starts by leaving it (:meth:`Tracer.enter_side`)."""
+    ``None``), and the solve starts by leaving it
+    (:meth:`rockjit.orbits.tracer.Tracer.enter_side`)."""
     p = seed.period
     alpha, omega = lam0
     scale = max(float(np.abs(seed.cycle).max()), 1e-12)
@@ -197,6 +199,25 @@ def continue_curve(block, seed, *, phase, alpha_range, omega_range, n_steps=N_OR
     block = check_block(block)
     seed = _check_seed(seed)
     phase = real("phase", phase)
+    box = _chart_box(seed, alpha_range, omega_range)
+    n_steps = check_n_steps(n_steps)
+    shooting = check_shooting(shooting)
+    settings = _curve_settings(settings)
+    flow = PlaneFlow(block, phase, n_steps, shooting)
+    solver = Solver(flow, shooting)
+    orbit = _seed_orbit(solver, block, seed, shooting)
+    _, _, ext, tracer = _system(block, seed.type, seed.period, orbit.symmetric, orbit.kind,
+                                orbit.count, phase, n_steps, shooting, box, settings, flow,
+                                solver)
+    start = _start(tracer, ext, seed, orbit, settings.max_multiplier)
+    pts, ends = _both_ways(tracer, start)
+    return _curve(seed, orbit, pts, ends, tracer.codim2, ext, block=block, phase=phase,
+                  n_simulate=flow.calls, wall_s=time.perf_counter() - t0, n_steps=n_steps,
+                  shooting=shooting)
+
+
+def _chart_box(seed, alpha_range, omega_range):
+    """The chart ``(a0, a1, w0, w1)``, checked, with the seed inside it."""
     a0, a1 = pair("alpha_range", alpha_range, 0.0, ALPHA_MAX)
     w0, w1 = pair("omega_range", omega_range, *OMEGA_RANGE)
     if a1 <= a0 or w1 <= w0:
@@ -207,17 +228,34 @@ def continue_curve(block, seed, *, phase, alpha_range, omega_range, n_steps=N_OR
         raise ValueError(f"the seed's {seed.type} at (alpha, omega) = ({alpha:.6g}, "
                          f"{omega:.6g}) lies outside the chart alpha_range = ({a0:g}, {a1:g}), "
                          f"omega_range = ({w0:g}, {w1:g})")
-    n_steps = check_n_steps(n_steps)
-    shooting = check_shooting(shooting)
+    return a0, a1, w0, w1
+
+
+def _curve_settings(settings):
+    """The curve's settings, checked (default :class:`CurveSettings`)."""
     settings = CurveSettings() if settings is None else settings
     if not isinstance(settings, CurveSettings):
         raise ValueError(f"settings must be a rockjit.orbits.CurveSettings (got "
                          f"{type(settings).__name__})")
-    flow = PlaneFlow(block, phase, n_steps, shooting)
-    solver = Solver(flow, shooting)
-    p = seed.period
-    lam0 = (alpha, omega)
-    kind = None
+    return settings
+
+
+@dataclass
+class _SeedOrbit:
+    """The seed's orbit as its curve starts from it."""
+
+    kind: str | None  #: a grazing's ``"impact"`` or ``"overturn"``; else ``None``
+    x: np.ndarray  #: ``(theta, theta')`` at the computational section ``j``
+    j: int
+    lam: tuple  #: ``(alpha, omega)``
+    symmetric: bool  #: solved on the half map
+    count: int  #: impacts per cycle (over the half map's stretch when symmetric)
+
+
+def _seed_orbit(solver, block, seed, shooting):
+    """The seed's orbit at its computational section, with the impact count its curve keeps."""
+    flow, p = solver.flow, seed.period
+    lam0 = (float(seed.alpha), float(seed.omega))
     if seed.type == "grazing":
         kind, x, info, lam0, count = _grazing_seed(solver, seed, lam0, shooting)
         symmetric = bool(info.symmetric) and p % 2 == 1
@@ -235,10 +273,14 @@ def continue_curve(block, seed, *, phase, alpha_range, omega_range, n_steps=N_OR
     if count is None:
         count = int(r.n_impacts) if kind is None else \
             Depth(block, flow, kind, p, symmetric).count(r, lam0)
-    _, _, ext, tracer = _system(block, seed.type, p, symmetric, kind, count, phase, n_steps,
-                                shooting, (a0, a1, w0, w1), settings, flow, solver)
-    depth = ext.depth
-    if depth is not None:
+    return _SeedOrbit(kind, xj, j, lam0, symmetric, count)
+
+
+def _start(tracer, ext, seed, orbit, max_multiplier):
+    """The curve's first point: the seed's orbit corrected on the extended system at its
+    ``omega`` (a grazing's first moved onto the side without the impact)."""
+    xj, j, lam0, p = orbit.x, orbit.j, orbit.lam, seed.period
+    if ext.depth is not None:
         ev0 = ext(np.r_[xj, lam0], j)
         if not ev0.ok:
             ev0 = tracer.enter_side(np.r_[xj, lam0], j, ev0)
@@ -246,22 +288,27 @@ def continue_curve(block, seed, *, phase, alpha_range, omega_range, n_steps=N_OR
                 raise OrbitRefused("grazing", "no state next to the seed's orbit misses "
                                               "theta = 0 without impact")
             xj = ev0.y[:2]
-    # the seed corrected at its omega, then the curve both ways
     ok, y, ev, _, why = tracer.correct(np.r_[xj, lam0], np.array([0.0, 0.0, 0.0, 1.0]), j,
                                        max_iter=40, max_jac=40)
     if not ok:
         raise OrbitRefused(why or "no_convergence",
                            f"the extended system at the seed ({seed.type}, p={p})")
+    alpha = float(seed.alpha)
     if abs(y[2] - alpha) > 1e-6 * max(1.0, alpha):
         raise OrbitRefused("grazing", f"the {seed.type} condition holds at alpha = "
                                       f"{y[2]:.10g} at this omega, not at the seed's "
                                       f"{alpha:.10g}: the seed's branch ends otherwise")
     start = tracer.point(y, j, ev)
     start.g, start.res = float(ev.g), float(np.abs(ev.F).max())
-    if float(np.abs(start.info.mu).max()) > settings.max_multiplier:
+    if float(np.abs(start.info.mu).max()) > max_multiplier:
         raise OrbitRefused("unstable", f"the seed's orbit has |mu| = "
                                        f"{float(np.abs(start.info.mu).max()):.3g} > "
-                                       f"max_multiplier = {settings.max_multiplier:g}")
+                                       f"max_multiplier = {max_multiplier:g}")
+    return start
+
+
+def _both_ways(tracer, start):
+    """The curve followed both ways from ``start``: its points in order, and its two ends."""
     t = tracer.tangent(start)
     if t is None:
         raise OrbitRefused("singular", "no tangent to the curve at the seed")
@@ -271,30 +318,32 @@ def continue_curve(block, seed, *, phase, alpha_range, omega_range, n_steps=N_OR
     else:
         start2 = BranchPoint(start.y.copy(), start.j, start.jt, start.info)
         minus, end_m = tracer.march(start2, -t)
-    pts = minus[::-1] + [start] + plus
+    return minus[::-1] + [start] + plus, (end_m, end_p)
+
+
+def _curve(seed, orbit, pts, ends, codim2, ext, *, block, **rest):
+    """The :class:`BifurcationCurve` through the points ``pts``, its codimension-two points
+    placed along it; ``rest``: the run's phase, counts, timing and settings."""
     A = np.array([P.y[2] for P in pts])
     W = np.array([P.y[3] for P in pts])
-    codim2 = tracer.codim2
     for c2 in codim2:  # the curve point each lies at or after
         c2.index = int(np.argmin(np.hypot(A - c2.alpha, W - c2.omega)))
     codim2.sort(key=lambda c: c.index)
-    crit = [float(np.min(np.abs(P.info.mu - ext.c))) if depth is None else math.nan
+    crit = [float(np.min(np.abs(P.info.mu - ext.c))) if ext.depth is None else math.nan
             for P in pts]
     seed_rec = dict(type=seed.type, parameter=seed.parameter, alpha=float(seed.alpha),
                     omega=float(seed.omega), period=int(seed.period),
                     state=np.asarray(seed.state, float).tolist())
     return BifurcationCurve(
-        type=seed.type, period=p, law=block.law, symmetric=symmetric, grazing=kind,
-        alpha=A, omega=W, state=np.array([P.info.cycle[0] for P in pts]),
+        type=seed.type, period=seed.period, law=block.law, symmetric=orbit.symmetric,
+        grazing=orbit.kind, alpha=A, omega=W, state=np.array([P.info.cycle[0] for P in pts]),
         cycle=np.array([P.info.cycle for P in pts]),
         cycle_half=np.array([P.info.half for P in pts]),
         multipliers=np.array([P.info.mu for P in pts]),
         impacts=np.array([P.info.nimp for P in pts], np.int64),
         condition=np.array([P.g for P in pts]), residual=np.array([P.res for P in pts]),
-        critical=np.array(crit),
-        ends=(end_m, end_p), codim2=codim2, phase=phase, seed=seed_rec,
-        n_simulate=flow.calls, wall_s=time.perf_counter() - t0, n_steps=n_steps,
-        block=block, shooting=shooting, count=count)
+        critical=np.array(crit), ends=ends, codim2=codim2, seed=seed_rec, block=block,
+        count=orbit.count, **rest)
 
 
 # ---------------------------------------------------------------------------------------------
