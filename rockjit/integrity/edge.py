@@ -120,6 +120,98 @@ def _period(points, max_period, tol):
     return None
 
 
+@dataclass(frozen=True)
+class _Tracking:
+    """The edge tracking's settings (see :func:`edge_state`), checked."""
+
+    periods: int
+    track: int
+    separation: float
+    bisect_tol: float
+    max_period: int
+    n_steps: int
+
+    @classmethod
+    def checked(cls, periods, track, separation, bisect_tol, max_period, n_steps):
+        """The settings, or a ValueError naming the first one out of its range."""
+        periods = integer("periods", periods, 10, 10**6)
+        track = integer("track", track, 10, 10**6)
+        bisect_tol = real("bisect_tol", bisect_tol, 1e-14, 1e-3)
+        separation = real("separation", separation, bisect_tol, 0.1, lo_open=True)
+        max_period = integer("max_period", max_period, 1, 64)
+        n_steps = integer("n_steps", n_steps, 8, 100_000)
+        return cls(periods, track, separation, bisect_tol, max_period, n_steps)
+
+    @property
+    def recur_tol(self):
+        """Distance within which tracked points count as recurring."""
+        return 10 * self.separation
+
+
+def _sides(oc, safe, fatal, periods):
+    """``safe`` and ``fatal`` as states, checked to be finite and to be what they say."""
+    a = np.asarray(safe, dtype=float).reshape(-1)
+    b = np.asarray(fatal, dtype=float).reshape(-1)
+    if a.shape != (2,) or b.shape != (2,) or not (np.isfinite(a).all() and
+                                                   np.isfinite(b).all()):
+        raise ValueError("safe and fatal must each be two finite numbers (theta0, theta0')")
+    f = oc.fatal(np.stack([a, b]))
+    if f[0] or not f[1]:
+        raise ValueError(f"safe must not overturn and fatal must overturn within periods = "
+                         f"{periods} (safe overturns: {bool(f[0])}, fatal overturns: "
+                         f"{bool(f[1])})")
+    return a, b
+
+
+class _Pair:
+    """The tracked pair: a safe state ``a`` and a fatal one ``b`` on either side of the edge,
+    carried by the stroboscopic map and bisected again whenever they drift apart."""
+
+    def __init__(self, block, oc, settings, a, b):
+        self.block, self.oc, self.s = block, oc, settings
+        self.one = Integration(periods=1, n_steps=settings.n_steps)
+        self.a, self.b = _bisect(oc, a, b, settings.bisect_tol)
+        self.rebisections = 0
+
+    def advance(self):
+        """The pair one period on; ``False`` when the fatal state overturned at once (the pair
+        is then bisected again nearer the safe one, and has no new point)."""
+        a1 = _step(self.block, self.oc.forcing, self.one, self.a)
+        b1 = _step(self.block, self.oc.forcing, self.one, self.b)
+        if a1 is None:
+            raise ValueError("the safe state of the pair overturned within one period: give a "
+                             "longer horizon (periods)")
+        if b1 is None:
+            self._rebisect(0.01 * self.s.bisect_tol + 0.5 * np.linalg.norm(self.b - self.a))
+            return False
+        self.a, self.b = a1, b1
+        if np.linalg.norm(self.b - self.a) > self.s.separation:
+            ends = self.oc.fatal(np.stack([self.a, self.b]))
+            if ends[0] or not ends[1]:
+                raise ValueError("the tracked pair lost its sides (a fate changed within "
+                                 "the horizon): give a longer horizon (periods)")
+            self._rebisect(self.s.bisect_tol)
+        return True
+
+    def _rebisect(self, tol):
+        """Bisect the pair again, to ``tol``."""
+        self.a, self.b = _bisect(self.oc, self.a, self.b, tol)
+        self.rebisections += 1
+
+    def track(self):
+        """The pair's midpoints, one per period, until they recur with a period (looked at
+        every five periods from :data:`MIN_TRACK` on) or ``track`` periods are done."""
+        tracked = []
+        for _ in range(self.s.track):
+            if not self.advance():
+                continue
+            tracked.append(0.5 * (self.a + self.b))
+            if len(tracked) >= MIN_TRACK and len(tracked) % 5 == 0 and \
+                    _period(np.asarray(tracked), self.s.max_period, self.s.recur_tol) is not None:
+                break
+        return np.asarray(tracked)
+
+
 def edge_state(block, forcing, safe, fatal, *, periods=500, track=300, separation=1e-4,
                bisect_tol=1e-9, max_period=8, n_steps=DEFAULT_N, shooting=None,
                threads=None) -> EdgeState:
@@ -178,58 +270,18 @@ def edge_state(block, forcing, safe, fatal, *, periods=500, track=300, separatio
     (1, True, True)
     """
     from ..orbits import periodic_orbit
-    periods = integer("periods", periods, 10, 10**6)
-    track = integer("track", track, 10, 10**6)
-    bisect_tol = real("bisect_tol", bisect_tol, 1e-14, 1e-3)
-    separation = real("separation", separation, bisect_tol, 0.1, lo_open=True)
-    max_period = integer("max_period", max_period, 1, 64)
-    n_steps = integer("n_steps", n_steps, 8, 100_000)
-    horizon = Integration(periods=periods, n_steps=n_steps)
-    one = Integration(periods=1, n_steps=n_steps)
-    oc = Outcomes(block, forcing, horizon, threads=threads)
-    a = np.asarray(safe, dtype=float).reshape(-1)
-    b = np.asarray(fatal, dtype=float).reshape(-1)
-    if a.shape != (2,) or b.shape != (2,) or not (np.isfinite(a).all() and
-                                                   np.isfinite(b).all()):
-        raise ValueError("safe and fatal must each be two finite numbers (theta0, theta0')")
-    f = oc.fatal(np.stack([a, b]))
-    if f[0] or not f[1]:
-        raise ValueError(f"safe must not overturn and fatal must overturn within periods = "
-                         f"{periods} (safe overturns: {bool(f[0])}, fatal overturns: "
-                         f"{bool(f[1])})")
-    a, b = _bisect(oc, a, b, bisect_tol)
-    tracked, rebisections = [], 0
-    for _ in range(track):
-        a1 = _step(block, oc.forcing, one, a)
-        b1 = _step(block, oc.forcing, one, b)
-        if a1 is None:
-            raise ValueError("the safe state of the pair overturned within one period: give a "
-                             "longer horizon (periods)")
-        if b1 is None:  # the fatal one left at once: bisect again nearer the safe one
-            a, b = _bisect(oc, a, b, 0.01 * bisect_tol + 0.5 * np.linalg.norm(b - a))
-            rebisections += 1
-            continue
-        a, b = a1, b1
-        if np.linalg.norm(b - a) > separation:
-            ends = oc.fatal(np.stack([a, b]))
-            if ends[0] or not ends[1]:
-                raise ValueError("the tracked pair lost its sides (a fate changed within "
-                                 "the horizon): give a longer horizon (periods)")
-            a, b = _bisect(oc, a, b, bisect_tol)
-            rebisections += 1
-        tracked.append(0.5 * (a + b))
-        # settled: the last points recur with a period (checked every few periods)
-        if len(tracked) >= MIN_TRACK and len(tracked) % 5 == 0 and \
-                _period(np.asarray(tracked), max_period, 10 * separation) is not None:
-            break
-    tracked = np.asarray(tracked)
-    p = _period(tracked, max_period, 10 * separation)
+    s = _Tracking.checked(periods, track, separation, bisect_tol, max_period, n_steps)
+    oc = Outcomes(block, forcing, Integration(periods=s.periods, n_steps=s.n_steps),
+                  threads=threads)
+    pair = _Pair(block, oc, s, *_sides(oc, safe, fatal, s.periods))
+    tracked = pair.track()
+    p = _period(tracked, s.max_period, s.recur_tol)
     if p is None:
-        raise ValueError(f"the tracked edge shows no period up to max_period = {max_period}: "
+        raise ValueError(f"the tracked edge shows no period up to max_period = {s.max_period}: "
                          f"an edge state that is not periodic, or too few periods tracked")
     orbit = periodic_orbit(block, oc.forcing, tracked[-1], p, shooting=shooting)
     return EdgeState(state=np.asarray(orbit.state, dtype=float), period=int(orbit.period),
                      multipliers=np.asarray(orbit.multipliers), residual=float(orbit.residual),
-                     orbit=orbit, tracked=tracked, rebisections=rebisections,
-                     settings=dict(periods=periods, track=track, separation=separation,
-                                   bisect_tol=bisect_tol, n_steps=n_steps, runs=oc.runs))
+                     orbit=orbit, tracked=tracked, rebisections=pair.rebisections,
+                     settings=dict(periods=s.periods, track=s.track, separation=s.separation,
+                                   bisect_tol=s.bisect_tol, n_steps=s.n_steps, runs=oc.runs))
