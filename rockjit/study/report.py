@@ -201,109 +201,160 @@ def _img(name, alt):
     return f'<img src="{html.escape(name)}" alt="{html.escape(alt)}">'
 
 
-def _captions(results, plan):
-    """Each figure's caption (the study's words, docs/theory/study.md, and what is drawn)."""
+def _caption_restitution(results, plan):
+    """Figure 1's caption: the two laws against the block's angle."""
+    return ("The restitution laws. Housner's <i>e</i><sub>H</sub> (solid) and Mao et al.'s "
+            "<i>e</i><sub>M</sub> (dashed) against the block's angle &theta;<sub>c</sub>, for "
+            f"<i>h/b</i> from 1/&radic;2 to {E_FIGURE_HB_MAX:g}, with their symmetric difference "
+            "&Delta;<i>e</i> "
+            "(dotted, right axis). The boxes give the values at <i>h/b</i> = 1 and 2 (the "
+            "e-table below).")
+
+
+def _caption_reference(results, plan):
+    """Figure 2's caption: the reference run, its window and its two exponents."""
     f2 = results.get("fig2", {})
     lam = _num(f2.get("lambda_window"), ".4f")
     flo = _num(f2.get("lambda_max"), ".4f")
+    w0, w1 = Integration(periods=plan.periods).window_start(), plan.periods
+    ref = REFERENCE_RUN
+    return (f"The reference symmetric run: &alpha; = {ref['alpha']:g}, &omega; = "
+            f"{ref['omega']:g}, <i>h/b</i> = {ref['hb']:g}, {ref['law'].capitalize()}, from the "
+            "study's <i>z</i><sub>0</sub>. a) &theta;(<i>t</i>) over the "
+            f"first {FIRST_PERIODS} periods (the transient) and b) over the last "
+            f"{LAST_PERIODS}; c) the running "
+            "largest Lyapunov exponent from <i>t</i> = 0, its average over the asymptotic window "
+            f"[{w0}<i>T</i>, {w1}<i>T</i>] ({lam}, dashed) and the Floquet exponent of the "
+            f"orbit ({flo}, dotted); d) the phase portrait over the window. Impacts are the "
+            "vertical jumps at &theta; = 0, circles the stroboscopic points <i>t</i> = "
+            "<i>kT</i>.")
+
+
+def _caption_gallery(results, plan):
+    """Figure 3's caption: the gallery's cases, with the transient chaos's fates."""
     fates = results.get("fig3_fates", {})
     fw = "; ".join(f"{k}: " + ", ".join(f"{n} {v:.0%}" for n, v in
                                         f.get("probabilities", {}).items())
                    for k, f in fates.items())
     n_fate = (fates.get("closed", {}).get("settings") or {}).get("ensemble", "the")
+    tilt = GALLERY["rest after damped rocking"][3][0]
+    return ("The behaviour gallery (Housner), one row per case: &theta;(<i>t</i>) over the "
+            f"first {FIRST_PERIODS} and the last {LAST_PERIODS} periods (the whole run when it "
+            "is short), and "
+            "the phase portrait of the asymptotic window (the whole run when it ended before). "
+            f"a) rest after damped rocking, from a tilt &theta;<sub>0</sub> = {tilt:g} (the "
+            "study's smaller tilt comes to rest too soon to show the decay); b) asymmetric; "
+            "c) a robust period-2 orbit of the "
+            "multiperiodic family; d) the study's 'multiperiodic' example, transient chaos "
+            f"that overturns (over {n_fate} runs within 10<sup>-10</sup> of <i>z</i><sub>0</sub>: "
+            f"{html.escape(fw)}); e) overturn.")
+
+
+def _caption_laws(results, plan):
+    """Figure 4's caption: the two laws in time, with each row's own line."""
     caps4 = " ".join(f"{'abc'[i]}) {html.escape(r.get('caption', ''))}"
                      for i, r in enumerate(results.get("fig4", [])))
-    g, eg, es = plan.grid, plan.erosion_grid, plan.erosion_step
-    first, last = FIRST_PERIODS, LAST_PERIODS
-    w0, w1 = Integration(periods=plan.periods).window_start(), plan.periods
-    ref, laws = REFERENCE_RUN, LAWS_RUN
+    laws = LAWS_RUN
+    return (f"Housner against Mao et al. in time: <i>h/b</i> = {laws['hb']:g}, &alpha; = "
+            f"{laws['alpha']:g}, &omega; = {laws['omega']:g}, "
+            "(<i>r</i><sub>0</sub>, <i>s</i><sub>0</sub>) = (0, 1), from three initial states. "
+            f"Each row: each law's &theta;(<i>t</i>) over the last {LAWS_PERIODS} periods of its "
+            f"run, "
+            "where it has settled (the whole run when it overturns or rests sooner), and its "
+            f"phase portrait, in its behaviour's colour. {caps4}")
+
+
+def _caption_diagrams(results, plan):
+    """Figure 5's caption: the bifurcation diagrams, the zoom and the study's way."""
+    return ("Bifurcation diagrams: &theta;'(<i>kT</i>) over the classified stretch against "
+            "&alpha;, coloured by behaviour, the behaviour of every amplitude in the strip, "
+            "and &lambda;<sub>max</sub>(&alpha;) below: the Floquet exponent "
+            "ln|&mu;<sub>1</sub>|/(<i>pT</i>) of the exact monodromy where the run settled on "
+            "a periodic orbit, the finite-window estimate elsewhere (chaotic, aperiodic); "
+            "triangles at the bottom: &lambda; = &minus;&infin; (rest, or an orbit through "
+            "rest). Both laws at <i>h/b</i> = 1 (&omega; = 1.3) and 2 (&omega; = 1.6), and a "
+            f"zoom of Housner's <i>h/b</i> = 1 diagram over &alpha; &isin; "
+            f"[{plan.zoom[0]:g}, {plan.zoom[1]:g}] at a step of {plan.zoom_step:g}."
+            + (" The <code>_as_published</code> figures put beside each law the study's way: "
+               "integrated on past overturning (grey points: what a fallen block did), its "
+               "&lambda;<sub>max</sub> the finite-window estimate." if plan.published else ""))
+
+
+def _caption_branches(results, plan):
+    """Figure 5's continuation: the branches of periodic orbits over the diagrams."""
+    return ("Beyond the study: the branches of periodic orbits continued in &alpha; over "
+            "each diagram's points (stable solid, unstable dashed; the mirror image of "
+            "every asymmetric orbit too, so both arms of each pitchfork), each branch in "
+            "the colour of the behaviour its stable orbits have, periods 3 and 4 with "
+            "triangles and squares along the line and periods 5 and more as one group "
+            "(circles). Markers: the located "
+            "bifurcations, and where a branch stops (the block overturns or comes to rest, "
+            "an impact grazes). Each figure's list of bifurcations with their multipliers, "
+            "and of branches with where they stop, is its <code>.md</code> file.")
+
+
+def _caption_basins(results, plan):
+    """Figure 6's caption: both laws' basins of the two cases and where they agree."""
+    g = plan.grid
     (hb1, a1, o1), (hb2, a2, o2) = BASIN_CASES
-    tilt = GALLERY["rest after damped rocking"][3][0]
+    return (f"Basins of attraction of both laws ({g} &times; {g} initial states "
+            "(&theta;<sub>0</sub>, &theta;'<sub>0</sub>) at (<i>r</i><sub>0</sub>, "
+            f"<i>s</i><sub>0</sub>) = (0, 1)) at <i>h/b</i> = {hb1:g} (&alpha; = {a1:g}, "
+            f"&omega; = {o1:g}) and {hb2:g} (&alpha; = {a2:g}, &omega; = {o2:g}), with the "
+            "percentage of each behaviour, and "
+            "c) the cells where the laws give the same behaviour (white) or not (black).")
+
+
+def _caption_attractors(results, plan):
+    """Figure 7's caption: the attractor maps and their measures."""
+    return ("Beyond the study: the attractor each initial state of figure 6 reaches, each in "
+            "a tint of its behaviour's colour and named by what it is (the study's single "
+            "'symmetric' class is two attractors: a rocking orbit and an orbit that comes to "
+            "rest every half period, with Floquet multipliers 0), cycle points starred; basin "
+            "entropy <i>S</i><sub>b</sub>, boundary basin entropy <i>S</i><sub>bb</sub>, "
+            "global integrity GIM and integrity factor IF in the titles.")
+
+
+def _caption_erosion(results, plan):
+    """Figure 8's caption: the erosion profiles, their grid and their step."""
+    eg, es = plan.erosion_grid, plan.erosion_step
+    return (f"Beyond the study: erosion profiles, a {eg} &times; {eg} basin every "
+            f"&Delta;&alpha; = {es:g}. a) GIM and b) IF against &alpha; for both laws; below, "
+            "for each law, "
+            "the basin of each attractor followed across the amplitudes, stacked as steps "
+            "(each basin holds for its own amplitude), overturn on top. Attractors of one kind "
+            "(behaviour, period, rocking or through rest: hatched) share one colour and one "
+            "legend entry, parted by thin white lines. The basins compute no Lyapunov "
+            "exponent, so what figure 5 calls chaotic is counted as aperiodic here (no period "
+            "up to 16).")
+
+
+def _caption_plane(results, plan):
+    """Figure 9's caption: the forcing plane with its curves, seeded where the chart says."""
     seeds = " and ".join(f"{w:g}" for w in CHART["curves"]["seed_omegas"])
-    return {
-        1: "The restitution laws. Housner's <i>e</i><sub>H</sub> (solid) and Mao et al.'s "
-           "<i>e</i><sub>M</sub> (dashed) against the block's angle &theta;<sub>c</sub>, for "
-           f"<i>h/b</i> from 1/&radic;2 to {E_FIGURE_HB_MAX:g}, with their symmetric difference "
-           "&Delta;<i>e</i> "
-           "(dotted, right axis). The boxes give the values at <i>h/b</i> = 1 and 2 (the "
-           "e-table below).",
-        2: f"The reference symmetric run: &alpha; = {ref['alpha']:g}, &omega; = "
-           f"{ref['omega']:g}, <i>h/b</i> = {ref['hb']:g}, {ref['law'].capitalize()}, from the "
-           "study's <i>z</i><sub>0</sub>. a) &theta;(<i>t</i>) over the "
-           f"first {first} periods (the transient) and b) over the last {last}; c) the running "
-           "largest Lyapunov exponent from <i>t</i> = 0, its average over the asymptotic window "
-           f"[{w0}<i>T</i>, {w1}<i>T</i>] ({lam}, dashed) and the Floquet exponent of the "
-           f"orbit ({flo}, dotted); d) the phase portrait over the window. Impacts are the "
-           "vertical jumps at &theta; = 0, circles the stroboscopic points <i>t</i> = "
-           "<i>kT</i>.",
-        3: "The behaviour gallery (Housner), one row per case: &theta;(<i>t</i>) over the "
-           f"first {first} and the last {last} periods (the whole run when it is short), and "
-           "the phase portrait of the asymptotic window (the whole run when it ended before). "
-           f"a) rest after damped rocking, from a tilt &theta;<sub>0</sub> = {tilt:g} (the "
-           "study's smaller tilt comes to rest too soon to show the decay); b) asymmetric; "
-           "c) a robust period-2 orbit of the "
-           "multiperiodic family; d) the study's 'multiperiodic' example, transient chaos "
-           f"that overturns (over {n_fate} runs within 10<sup>-10</sup> of <i>z</i><sub>0</sub>: "
-           f"{html.escape(fw)}); e) overturn.",
-        4: f"Housner against Mao et al. in time: <i>h/b</i> = {laws['hb']:g}, &alpha; = "
-           f"{laws['alpha']:g}, &omega; = {laws['omega']:g}, "
-           "(<i>r</i><sub>0</sub>, <i>s</i><sub>0</sub>) = (0, 1), from three initial states. "
-           f"Each row: each law's &theta;(<i>t</i>) over the last {LAWS_PERIODS} periods of its "
-           f"run, "
-           "where it has settled (the whole run when it overturns or rests sooner), and its phase "
-           f"portrait, in its behaviour's colour. {caps4}",
-        5: "Bifurcation diagrams: &theta;'(<i>kT</i>) over the classified stretch against "
-           "&alpha;, coloured by behaviour, the behaviour of every amplitude in the strip, "
-           "and &lambda;<sub>max</sub>(&alpha;) below: the Floquet exponent "
-           "ln|&mu;<sub>1</sub>|/(<i>pT</i>) of the exact monodromy where the run settled on "
-           "a periodic orbit, the finite-window estimate elsewhere (chaotic, aperiodic); "
-           "triangles at the bottom: &lambda; = &minus;&infin; (rest, or an orbit through "
-           "rest). Both laws at <i>h/b</i> = 1 (&omega; = 1.3) and 2 (&omega; = 1.6), and a "
-           f"zoom of Housner's <i>h/b</i> = 1 diagram over &alpha; &isin; "
-           f"[{plan.zoom[0]:g}, {plan.zoom[1]:g}] at a step of {plan.zoom_step:g}."
-           + (" The <code>_as_published</code> figures put beside each law the study's way: "
-              "integrated on past overturning (grey points: what a fallen block did), its "
-              "&lambda;<sub>max</sub> the finite-window estimate." if plan.published else ""),
-        "5b": "Beyond the study: the branches of periodic orbits continued in &alpha; over "
-              "each diagram's points (stable solid, unstable dashed; the mirror image of "
-              "every asymmetric orbit too, so both arms of each pitchfork), each branch in "
-              "the colour of the behaviour its stable orbits have, periods 3 and 4 with "
-              "triangles and squares along the line and periods 5 and more as one group "
-              "(circles). Markers: the located "
-              "bifurcations, and where a branch stops (the block overturns or comes to rest, "
-              "an impact grazes). Each figure's list of bifurcations with their multipliers, "
-              "and of branches with where they stop, is its <code>.md</code> file.",
-        6: f"Basins of attraction of both laws ({g} &times; {g} initial states "
-           "(&theta;<sub>0</sub>, &theta;'<sub>0</sub>) at (<i>r</i><sub>0</sub>, "
-           f"<i>s</i><sub>0</sub>) = (0, 1)) at <i>h/b</i> = {hb1:g} (&alpha; = {a1:g}, "
-           f"&omega; = {o1:g}) and {hb2:g} (&alpha; = {a2:g}, &omega; = {o2:g}), with the "
-           "percentage of each behaviour, and "
-           "c) the cells where the laws give the same behaviour (white) or not (black).",
-        7: "Beyond the study: the attractor each initial state of figure 6 reaches, each in a "
-           "tint of its behaviour's colour and named by what it is (the study's single "
-           "'symmetric' class is two attractors: a rocking orbit and an orbit that comes to "
-           "rest every half period, with Floquet multipliers 0), cycle points starred; basin "
-           "entropy <i>S</i><sub>b</sub>, boundary basin entropy <i>S</i><sub>bb</sub>, "
-           "global integrity GIM and integrity factor IF in the titles.",
-        8: f"Beyond the study: erosion profiles, a {eg} &times; {eg} basin every &Delta;&alpha; "
-           f"= {es:g}. a) GIM and b) IF against &alpha; for both laws; below, for each law, "
-           "the basin of each attractor followed across the amplitudes, stacked as steps "
-           "(each basin holds for its own amplitude), overturn on top. Attractors of one kind "
-           "(behaviour, period, rocking or through rest: hatched) share one colour and one "
-           "legend entry, parted by thin white lines. The basins compute no Lyapunov "
-           "exponent, so what figure 5 calls chaotic is counted as aperiodic here (no period "
-           "up to 16).",
-        9: "Beyond the study: the forcing plane (&alpha;, &omega;) of both laws at <i>h/b</i> "
-           "= 1 and 2, from the study's <i>z</i><sub>0</sub>, a coarse brute-force chart of "
-           "behaviours with the bifurcation curves of the period-1 orbits followed across it "
-           "by two-parameter continuation (fold solid, symmetry breaking dashed, period "
-           f"doubling dash-dotted, grazing dotted), seeded on the lines &omega; = {seeds}; "
-           "a) and b) each law alone, c) both laws' curves overlaid (hatched: the laws' "
-           "behaviours differ). Cells are drawn six times finer, each behaviour's share "
-           "interpolated linearly between the computed cells. "
-           "<code>rockjit chart</code> computes the 200 &times; 200 chart and the period-2 "
-           "curves.",
-    }
+    return ("Beyond the study: the forcing plane (&alpha;, &omega;) of both laws at <i>h/b</i> "
+            "= 1 and 2, from the study's <i>z</i><sub>0</sub>, a coarse brute-force chart of "
+            "behaviours with the bifurcation curves of the period-1 orbits followed across it "
+            "by two-parameter continuation (fold solid, symmetry breaking dashed, period "
+            f"doubling dash-dotted, grazing dotted), seeded on the lines &omega; = {seeds}; "
+            "a) and b) each law alone, c) both laws' curves overlaid (hatched: the laws' "
+            "behaviours differ). Cells are drawn six times finer, each behaviour's share "
+            "interpolated linearly between the computed cells. "
+            "<code>rockjit chart</code> computes the 200 &times; 200 chart and the period-2 "
+            "curves.")
+
+
+#: Each figure's caption, written from the results and the plan (the study's words,
+#: docs/theory/study.md, and what is drawn).
+_CAPTIONS = {1: _caption_restitution, 2: _caption_reference, 3: _caption_gallery,
+             4: _caption_laws, 5: _caption_diagrams, "5b": _caption_branches,
+             6: _caption_basins, 7: _caption_attractors, 8: _caption_erosion,
+             9: _caption_plane}
+
+
+def _captions(results, plan):
+    """Each figure's caption (the study's words, docs/theory/study.md, and what is drawn)."""
+    return {k: caption(results, plan) for k, caption in _CAPTIONS.items()}
 
 
 _TITLES = {1: "Figure 1. Restitution laws", 2: "Figure 2. The reference symmetric run",
