@@ -133,67 +133,14 @@ class ExplorerApp(BasinPanel, RunPanel, SweepPanel, ComparePanel, Exports):
     # the page
     # ---------------------------------------------------------------------------------------
     def _build(self):
-        p = self.params
+        """Build the page: its controls, the views' panels, the layout and the timing log."""
         # fixed sizes: a progress update rerenders the line without laying the page out again
         self.status = {c: Div(text="", width=280, height=40, css_classes=[f"rj-status-{c}"])
                        for c in ("basin", "run", "sweep", "compare")}
         self.errors = {}
-        controls = [Div(text="<b>Block</b>")]
         self.w = {}
-
-        def number(name, title, value, mode="float", placeholder=""):
-            w = NumericInput(title=title, value=value, mode=mode, width=210,
-                             placeholder=placeholder, css_classes=[f"rj-{name}"])
-            w.on_change("value", lambda attr, old, new, name=name: self._control(name, new))
-            self.w[name] = w
-            return self._with_error(name, w)
-
-        controls.append(number("hb", "h/b (slenderness)", p.hb))
-        law = Select(title="restitution law", value=p.law, width=210, css_classes=["rj-law"],
-                     options=[(k, plain_text(v)) for k, v in style.LAW_NAMES.items()])
-        law.on_change("value", lambda attr, old, new: self._control("law", new))
-        self.w["law"] = law
-        controls.append(self._with_error("law", law))
-        controls.append(number("e", "e (constant law)", p.e))
-        self.w["e"].visible = p.law == "constant"
-        controls.append(number("xi", "ξ (viscous damping)", p.xi))
-        controls.append(Div(text="<b>Forcing</b>"))
-        slider = Slider(title="α (amplitude A/R)", start=0.0, end=1.5, step=0.001, value=p.alpha,
-                        width=210, css_classes=["rj-alpha-slider"])
-        slider.on_change("value_throttled",
-                         lambda attr, old, new: self._control("alpha", new, source="slider"))
-        self.w["alpha_slider"] = slider
-        controls.append(slider)
-        controls.append(number("alpha", "α", p.alpha))
-        controls.append(number("omega", "ω (frequency Ω/Ω₀)", p.omega))
-        controls.append(number("phase", "forcing phase φ [rad]", p.phase))
-        controls.append(Div(text="<b>Integration</b>"))
-        controls.append(number("n_steps", "N (steps per period)", p.n_steps, mode="int",
-                               placeholder="default"))
-        controls.append(number("periods", f"periods (at most {R.MAX_PERIODS:,})", p.periods,
-                               mode="int"))
-        self.limits = Div(text=self._limits_html(), width=215, css_classes=["rj-limits"])
-        controls.append(self.limits)
-        controls.append(Div(text='<div style="color:#666;font-size:11px;max-width:215px">'
-                                 'A value the library refuses is shown here with its message '
-                                 'and the views keep the last accepted parameters.</div>'))
-        self.controls = column(*controls, width=230, css_classes=["rj-controls"])
-
-        self.download = ColumnDataSource(data=dict(name=[], b64=[], mime=[]))
-        self.download.js_on_change("data", CustomJS(args=dict(src=self.download), code="""
-            const d = src.data;
-            if (!d.name || d.name.length == 0) return;
-            const bin = atob(d.b64[0]);
-            const bytes = new Uint8Array(bin.length);
-            for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
-            const a = document.createElement('a');
-            a.href = URL.createObjectURL(new Blob([bytes], {type: d.mime[0]}));
-            a.download = d.name[0];
-            document.body.appendChild(a);
-            a.click();
-            setTimeout(() => { URL.revokeObjectURL(a.href); a.remove(); }, 2000);
-        """))
-
+        self.controls = self._build_controls()
+        self.download = self._download_source()
         self._build_basin()
         self._build_run()
         self._build_sweep()
@@ -213,9 +160,84 @@ class ExplorerApp(BasinPanel, RunPanel, SweepPanel, ComparePanel, Exports):
                                       self.compare_panel)),
         ))
         self.doc.add_root(self.download)  # not drawn: in the document so that it syncs
-        # the page's own timing log, window.rockjitLog: [what, value, time in ms], stamped
-        # when the user changes alpha and after the frame that shows a new basin or diagram
-        # (benchmarks/bench_explore.py reads it; nothing polls the page's DOM)
+        self._log_timings()
+        self.doc.title = "rockjit explore"
+
+    def _build_controls(self):
+        """The column of controls (block, forcing, integration), each with its error line."""
+        p = self.params
+        number = self._number
+        controls = [Div(text="<b>Block</b>"),
+                    number("hb", "h/b (slenderness)", p.hb),
+                    self._law_control(p.law),
+                    number("e", "e (constant law)", p.e)]
+        self.w["e"].visible = p.law == "constant"
+        controls += [number("xi", "ξ (viscous damping)", p.xi),
+                     Div(text="<b>Forcing</b>"),
+                     self._alpha_slider(p.alpha),
+                     number("alpha", "α", p.alpha),
+                     number("omega", "ω (frequency Ω/Ω₀)", p.omega),
+                     number("phase", "forcing phase φ [rad]", p.phase),
+                     Div(text="<b>Integration</b>"),
+                     number("n_steps", "N (steps per period)", p.n_steps, mode="int",
+                            placeholder="default"),
+                     number("periods", f"periods (at most {R.MAX_PERIODS:,})", p.periods,
+                            mode="int")]
+        self.limits = Div(text=self._limits_html(), width=215, css_classes=["rj-limits"])
+        controls.append(self.limits)
+        controls.append(Div(text='<div style="color:#666;font-size:11px;max-width:215px">'
+                                 'A value the library refuses is shown here with its message '
+                                 'and the views keep the last accepted parameters.</div>'))
+        return column(*controls, width=230, css_classes=["rj-controls"])
+
+    def _number(self, name, title, value, mode="float", placeholder=""):
+        """The number box of parameter ``name`` (``self.w[name]``) with its error line."""
+        w = NumericInput(title=title, value=value, mode=mode, width=210,
+                         placeholder=placeholder, css_classes=[f"rj-{name}"])
+        w.on_change("value", lambda attr, old, new, name=name: self._control(name, new))
+        self.w[name] = w
+        return self._with_error(name, w)
+
+    def _law_control(self, value):
+        """The restitution law's menu (``self.w["law"]``) with its error line."""
+        law = Select(title="restitution law", value=value, width=210, css_classes=["rj-law"],
+                     options=[(k, plain_text(v)) for k, v in style.LAW_NAMES.items()])
+        law.on_change("value", lambda attr, old, new: self._control("law", new))
+        self.w["law"] = law
+        return self._with_error("law", law)
+
+    def _alpha_slider(self, value):
+        """The amplitude's slider (``self.w["alpha_slider"]``), taken when it is let go."""
+        slider = Slider(title="α (amplitude A/R)", start=0.0, end=1.5, step=0.001, value=value,
+                        width=210, css_classes=["rj-alpha-slider"])
+        slider.on_change("value_throttled",
+                         lambda attr, old, new: self._control("alpha", new, source="slider"))
+        self.w["alpha_slider"] = slider
+        return slider
+
+    @staticmethod
+    def _download_source():
+        """A data source whose new data the browser saves as a file (the views' exports)."""
+        download = ColumnDataSource(data=dict(name=[], b64=[], mime=[]))
+        download.js_on_change("data", CustomJS(args=dict(src=download), code="""
+            const d = src.data;
+            if (!d.name || d.name.length == 0) return;
+            const bin = atob(d.b64[0]);
+            const bytes = new Uint8Array(bin.length);
+            for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
+            const a = document.createElement('a');
+            a.href = URL.createObjectURL(new Blob([bytes], {type: d.mime[0]}));
+            a.download = d.name[0];
+            document.body.appendChild(a);
+            a.click();
+            setTimeout(() => { URL.revokeObjectURL(a.href); a.remove(); }, 2000);
+        """))
+        return download
+
+    def _log_timings(self):
+        """The page's own timing log, window.rockjitLog: [what, value, time in ms], stamped
+        when the user changes alpha and after the frame that shows a new basin or diagram
+        (benchmarks/bench_explore.py reads it; nothing polls the page's DOM)."""
         stamp = ("(window.rockjitLog = window.rockjitLog || []);"
                  "const v = {value}; requestAnimationFrame(() => "
                  "window.rockjitLog.push(['{what}', v, performance.now()]));")
@@ -227,7 +249,6 @@ class ExplorerApp(BasinPanel, RunPanel, SweepPanel, ComparePanel, Exports):
             what="basin", value="cb_obj.text")))
         self.sweep_state.js_on_change("text", CustomJS(code=stamp.format(
             what="sweep", value="cb_obj.text")))
-        self.doc.title = "rockjit explore"
 
     def _limits_html(self):
         p = self.params
