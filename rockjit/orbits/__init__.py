@@ -29,6 +29,9 @@ What lives where
     :func:`continue_branches` (the branches of a sweep's periodic attractors) and the entry
     point :func:`orbits_of_sweep` (the sweep and its branches; its ``.plan`` validates, and
     :func:`rockjit.orbits.arclength.run` executes a plan).
+:mod:`.sweep_seeds`
+    The seeds a sweep gives a continuation (one per periodic attractor), the section the
+    sweep fixes, and the sweep run first when neither seeds nor a sweep are given.
 :mod:`.curve_types`
     What the curves in the forcing plane ``(alpha, omega)`` are: :data:`CURVE_TYPES`, the
     codimension-two points met (:class:`Codim2Point`, :data:`CODIM2_TYPES`), the ends

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -37,11 +37,12 @@ from ..grids.cycles import cycle_distance
 from ..entry import entry_point
 from ..grids import plan as gp
 from ..grids import sweep_grid
-from ..settings import Execution, Integration
+from ..settings import Execution
 from ..validate import integer, pair, real
 from .bifurcations import BranchPoint, Locator, unit
 from .shooting import (N_ORBIT, Flow, Solver, check_block, check_forcing, check_n_steps,
                        check_shooting, check_state, shoot)
+from .sweep_seeds import seeding_sweep, sweep_section, sweep_seeds
 from .types import (Branch, Continuation, ContinuationSettings, OrbitRefused, PeriodicOrbit,
                     Shooting, settings_record)
 
@@ -61,6 +62,19 @@ def _settings(settings):
         raise ValueError(f"settings must be a rockjit.orbits.ContinuationSettings "
                          f"(got {type(settings).__name__})")
     return settings
+
+
+@dataclass
+class _Leg:
+    """One direction of a branch as it is followed: its start, form (``"full"`` or ``"sym"``)
+    and period, the points kept, and the bifurcations and branch switches met on the way."""
+
+    start: BranchPoint
+    form: str
+    p: int
+    bifs: list
+    requests: list
+    pts: list = field(default_factory=list)
 
 
 class Continuer(Locator):
@@ -135,81 +149,35 @@ class Continuer(Locator):
     # -- one direction ------------------------------------------------------------------------
     def march(self, start, t, form, p, bifs, requests):
         """Follow the branch from ``start`` along ``t``; returns ``(points, end reason)``."""
-        s = self.s
-        pts = []
+        leg = _Leg(start, form, p, bifs, requests)
+        pts = leg.pts
         a = BranchPoint(start.y.copy(), start.j, start.jt, start.info)
         ds = self.ds0
         t = unit(np.asarray(t, float))
-        e_lam = np.array([0.0, 0.0, 1.0])
-        fail_ds = None
-        why = None
         while True:
             if len(pts) >= self.max_points:
                 return pts, "max_points"
             if self.flow.calls > self.max_calls:
                 return pts, "budget"
-            y_pred = a.y + ds * t
-            n = t
-            at_end = False
-            if not self.lo <= y_pred[2] <= self.hi and abs(t[2]) > 1e-12:
-                bound = self.hi if y_pred[2] > self.hi else self.lo
-                sb = (bound - a.y[2]) / t[2]
-                if 0 <= sb <= ds:
-                    y_pred = a.y + sb * t
-                    y_pred[2] = bound
-                    n = e_lam
-                    at_end = True
-            ok, y, ev, iters, why = s.correct(y_pred, n, form, p, a.j)
+            y_pred, n, at_end = self.predict(a, t, ds)
+            ok, y, ev, iters, why = self.s.correct(y_pred, n, form, p, a.j)
             b = self.point(y, a.j, form, p, ev) if ok else None
             if b is None:
                 why = why or "passes_through_rest"
                 fail_ds = ds
                 ds *= 0.5
                 if ds < self.ds_min:
-                    if why in ("overturn", "rest", "passes_through_rest", "max_impacts"):
-                        last = self.locate_end(a, t, fail_ds, form, p, why, bifs)
-                        if last is not None:
-                            pts.append(last)
-                    elif min(a.info.near_miss, a.info.min_speed) < self.end_graze:
-                        # the corrector fails next to a grazing (the map's derivative is
-                        # singular there): follow the orbit to where it ends
-                        last = self.graze_at(a, t, p, bifs)
-                        if last is not None:
-                            pts.append(last)
-                        return pts, "grazing"
-                    return pts, why
+                    return pts, self.end_after_failure(a, t, fail_ds, why, leg)
                 continue
             b.iters = iters
-            if b.info.nimp != a.info.nimp:
-                last = self.locate_grazing(a, b, form, p, bifs)
-                if last is not None:
-                    pts.append(last)
-                return pts, "grazing"
-            if form == "full":
-                # a doubled (or asymmetric) branch folding back onto its parent orbit
-                da = self.defect(a, p, a.j)
-                db = self.defect(b, p, a.j)
-                if float(da @ db) < 0 or float(np.abs(db).max()) <= \
-                        10 * s.sym_tol * b.info.scale:
-                    return pts, "branch_point"
-            joined = self.known(b.info, b.y[2], p, form == "sym")
-            self.detect(a, b, form, p, bifs, requests)
-            pts.append(b)
-            if joined is not None:
-                return pts, "joins"
-            if at_end:
-                return pts, "range"
-            if len(pts) > 10 and abs(b.y[2] - start.y[2]) < ds and cycle_distance(
-                    b.info.cycle, start.info.cycle) <= self.join_tol * b.info.scale:
-                return pts, "closed"
+            end = self.end_before(a, b, leg)
+            if end is None:
+                end = self.end_after(a, b, ds, at_end, leg)
+            if end is not None:
+                return pts, end
             if iters <= 3:
                 ds = min(1.3 * ds, self.ds_max)
-            # the section: move it when an impact comes near the sampling instant
-            cur, best, mbest = s.margins(b.info, b.j)
-            if cur < 0.3 * mbest:
-                for P in (a, b):
-                    P.y[:2] = s.shifted(P.info, (best - P.jt) % self.N)
-                    P.j = best
+            self.keep_section(a, b)
             sec = b.y - a.y
             if np.linalg.norm(sec) > 0:
                 t = unit(sec)
@@ -217,6 +185,79 @@ class Continuer(Locator):
                 a.info.traj = None  # keep memory bounded: only the last two are needed
                 a.info.run = None
             a = b
+
+    def predict(self, a, t, ds):
+        """The secant predictor from ``a``, cut at the range's end: ``(y, the corrector's
+        normal, whether it is at the end)``."""
+        y_pred = a.y + ds * t
+        if not self.lo <= y_pred[2] <= self.hi and abs(t[2]) > 1e-12:
+            bound = self.hi if y_pred[2] > self.hi else self.lo
+            sb = (bound - a.y[2]) / t[2]
+            if 0 <= sb <= ds:
+                y_pred = a.y + sb * t
+                y_pred[2] = bound
+                return y_pred, np.array([0.0, 0.0, 1.0]), True
+        return y_pred, t, False
+
+    def end_after_failure(self, a, t, fail_ds, why, leg):
+        """Why a branch ends where the corrector fails at the smallest step from ``a``; the
+        point where it ends, when located, is kept."""
+        form, p, bifs, pts = leg.form, leg.p, leg.bifs, leg.pts
+        if why in ("overturn", "rest", "passes_through_rest", "max_impacts"):
+            last = self.locate_end(a, t, fail_ds, form, p, why, bifs)
+            if last is not None:
+                pts.append(last)
+        elif min(a.info.near_miss, a.info.min_speed) < self.end_graze:
+            # the corrector fails next to a grazing (the map's derivative is singular
+            # there): follow the orbit to where it ends
+            last = self.graze_at(a, t, p, bifs)
+            if last is not None:
+                pts.append(last)
+            return "grazing"
+        return why
+
+    def end_before(self, a, b, leg):
+        """The end of a branch found on the step from ``a`` to ``b``, ``b`` not kept: a
+        grazing (the point where it ends kept) or a branch point; else ``None``."""
+        form, p = leg.form, leg.p
+        if b.info.nimp != a.info.nimp:
+            last = self.locate_grazing(a, b, form, p, leg.bifs)
+            if last is not None:
+                leg.pts.append(last)
+            return "grazing"
+        if form == "full":
+            # a doubled (or asymmetric) branch folding back onto its parent orbit
+            da = self.defect(a, p, a.j)
+            db = self.defect(b, p, a.j)
+            if float(da @ db) < 0 or float(np.abs(db).max()) <= \
+                    10 * self.s.sym_tol * b.info.scale:
+                return "branch_point"
+        return None
+
+    def end_after(self, a, b, ds, at_end, leg):
+        """Keep ``b`` (the bifurcations between ``a`` and it detected); the branch's end there
+        (it joins a known branch, reaches the range's end or closes), else ``None``."""
+        start, pts = leg.start, leg.pts
+        joined = self.known(b.info, b.y[2], leg.p, leg.form == "sym")
+        self.detect(a, b, leg.form, leg.p, leg.bifs, leg.requests)
+        pts.append(b)
+        if joined is not None:
+            return "joins"
+        if at_end:
+            return "range"
+        if len(pts) > 10 and abs(b.y[2] - start.y[2]) < ds and cycle_distance(
+                b.info.cycle, start.info.cycle) <= self.join_tol * b.info.scale:
+            return "closed"
+        return None
+
+    def keep_section(self, a, b):
+        """Move the section of ``a`` and ``b`` when an impact comes near the sampling
+        instant."""
+        cur, best, mbest = self.s.margins(b.info, b.j)
+        if cur < 0.3 * mbest:
+            for P in (a, b):
+                P.y[:2] = self.s.shifted(P.info, (best - P.jt) % self.N)
+                P.j = best
 
     # -- branches -----------------------------------------------------------------------------
     def finish(self, pts, ends, form, p, origin, parent, bifs):
@@ -369,7 +410,6 @@ class Continuer(Locator):
         return idx
 
 
-
 # ---------------------------------------------------------------------------------------------
 # seeds, and one continuation from them
 # ---------------------------------------------------------------------------------------------
@@ -439,9 +479,6 @@ def _within(branches, bifs, bounds):
                         ends=ends, origin=br.origin, parent=br.parent, **arrays)
         kept.append(br)
     return kept, [b for b in bifs if lo - tol <= b.value <= hi + tol]
-
-
-
 
 
 def continuation(block, forcing, seeds, *, parameter="alpha", bounds, n_steps=N_ORBIT,
@@ -521,36 +558,6 @@ def continuation(block, forcing, seeds, *, parameter="alpha", bounds, n_steps=N_
 # the branches of a sweep's attractors
 # ---------------------------------------------------------------------------------------------
 
-def _sweep_seeds(sw, max_period):
-    """One seed per periodic cell of a sweep: ``(alpha, cycle (p, 2), p)``, by period."""
-    names = [str(n) for n in sw.names]
-    periodic = {names.index(n) for n in ("symmetric", "asymmetric", "multiperiodic")}
-    out = []
-    for i, a in enumerate(np.asarray(sw.alpha)):
-        p = int(sw.period[i])
-        if int(sw.label[i]) not in periodic or not 1 <= p <= max_period:
-            continue
-        pts = np.asarray(sw.strobe[i])
-        pts = pts[np.all(np.isfinite(pts), axis=1)]
-        if pts.shape[0] < p:
-            continue
-        out.append((float(a), pts[-p:].copy(), p, None))
-    out.sort(key=lambda s: (s[2], s[0]))
-    return out
-
-
-
-def _same_system(sweep, block, forcing):
-    """Refuse a sweep of another block or frequency."""
-    sb, sf = sweep.block, sweep.forcing
-    if not (math.isclose(sb.hb, block.hb) and math.isclose(sf.omega, forcing.omega)
-            and sb.law == block.law and math.isclose(sb.restitution, block.restitution)
-            and math.isclose(sb.xi, block.xi)):
-        raise ValueError(f"sweep must be of the same block (hb={block.hb}, "
-                         f"omega={forcing.omega}, law={block.law}, xi={block.xi}); got "
-                         f"hb={sb.hb}, omega={sf.omega}, law={sb.law}, xi={sb.xi}")
-
-
 def continue_branches(block, forcing, alpha_range, seeds=None, sweep=None, *, n_steps=N_ORBIT,
                       shooting=None, settings=None, sweep_step=0.002) -> Continuation:
     """Every periodic branch of a sweep's attractors over ``alpha_range``, with bifurcations.
@@ -622,23 +629,10 @@ def continue_branches(block, forcing, alpha_range, seeds=None, sweep=None, *, n_
     settings = _settings(settings)
     sl = [] if seeds is None else _seed_list(seeds, "seeds")
     if seeds is None and sweep is None:
-        step = real("sweep_step", sweep_step, 0.0, None, lo_open=True)
-        runs = Shooting() if shooting is None else shooting
-        sweep = sweep_grid.sweep(block, forcing, gp.alpha_grid((a0, a1), step),
-                                 integration=Integration(theta_over=runs.theta_over,
-                                                         rest_speed=runs.rest_speed))
+        sweep = seeding_sweep(block, forcing, (a0, a1), sweep_step, shooting)
     if sweep is not None:
-        _same_system(sweep, block, forcing)
-        z = sweep.settings.get("z0")
-        sphase = math.atan2(z[2], z[3]) if z is not None else 0.0
-        if forcing.phase_given and not math.isclose(phase, sphase, abs_tol=1e-12):
-            raise ValueError(f"the forcing's phase must be the sweep's forcing phase "
-                             f"{sphase!r} (got {phase!r})")
-        phase = sphase
-        if shooting is None:
-            shooting = Shooting(theta_over=sweep.settings.get("theta_over", 0.5 * math.pi),
-                                rest_speed=sweep.settings.get("rest_speed", 1e-6))
-        sl += _sweep_seeds(sweep, settings.max_period)
+        phase, shooting = sweep_section(sweep, block, forcing, phase, shooting)
+        sl += sweep_seeds(sweep, settings.max_period)
     shooting = Shooting() if shooting is None else shooting
     forcing = forcing.replace(phase=phase, r0=None, s0=None)
     return _run(block, forcing, "alpha", (a0, a1), sl, n_steps, shooting, settings,
