@@ -216,13 +216,19 @@ def continue_curve(block, seed, *, phase, alpha_range, omega_range, n_steps=N_OR
                   shooting=shooting)
 
 
-def _chart_box(seed, alpha_range, omega_range):
-    """The chart ``(a0, a1, w0, w1)``, checked, with the seed inside it."""
+def chart_ranges(alpha_range, omega_range):
+    """A chart's ``(a0, a1, w0, w1)`` in the forcing plane, checked (``start < end``)."""
     a0, a1 = pair("alpha_range", alpha_range, 0.0, ALPHA_MAX)
     w0, w1 = pair("omega_range", omega_range, *OMEGA_RANGE)
     if a1 <= a0 or w1 <= w0:
         raise ValueError(f"alpha_range and omega_range must have start < end (got "
                          f"({a0:g}, {a1:g}), ({w0:g}, {w1:g}))")
+    return a0, a1, w0, w1
+
+
+def _chart_box(seed, alpha_range, omega_range):
+    """The chart ``(a0, a1, w0, w1)``, checked, with the seed inside it."""
+    a0, a1, w0, w1 = chart_ranges(alpha_range, omega_range)
     alpha, omega = float(seed.alpha), float(seed.omega)
     if not (a0 <= alpha <= a1 and w0 <= omega <= w1):
         raise ValueError(f"the seed's {seed.type} at (alpha, omega) = ({alpha:.6g}, "

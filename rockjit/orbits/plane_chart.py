@@ -34,15 +34,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..entry import entry_point
-from ..excitation import ALPHA_MAX, OMEGA_RANGE, Harmonic
+from ..excitation import Harmonic
 from ..grids import plan as gp
 from ..grids import plane_grid, sweep_grid
 from ..result import BEHAVIOURS
 from ..settings import Classification, Execution
-from ..validate import boolean, choice, integer, pair, real, real_array
+from ..validate import boolean, choice, integer, real, real_array
 from .arclength import continue_branches
 from .curve_types import CURVE_TYPES, CurveSettings
-from .curves import continue_curve
+from .curves import chart_ranges, continue_curve
 from .shooting import N_ORBIT, check_block, check_n_steps, check_shooting
 from .types import ContinuationSettings, OrbitRefused, Shooting
 
@@ -316,26 +316,53 @@ def run(plan: ChartPlan, execution=None) -> ChartResult:
     t0 = time.perf_counter()
     pl = gp.run(plan.plane_plan, execution)
     timing["chart_s"] = time.perf_counter() - t0
-    block = plan.block
     a0, a1 = plan.alpha_range
     t0 = time.perf_counter()
-    conts = []
-    seed_ex = Execution(threads=execution.threads, progress=False)
-    cs = ContinuationSettings(max_period=plan.max_period)
-    for w in plan.seed_omegas:
-        forcing = plan.forcing.replace(omega=w)
-        sw = sweep_grid.sweep(block, forcing, gp.alpha_grid((a0, a1), plan.sweep_step),
-                              plan.state, integration=plan.integration,
-                              classification=Classification(attractors=False), lyapunov=False,
-                              execution=seed_ex)
-        conts.append(continue_branches(block, Harmonic(omega=w), (a0, a1), sweep=sw,
-                                       n_steps=plan.n_steps, shooting=plan.shooting,
-                                       settings=cs))
+    conts = [_seed_line(plan, w, execution.threads) for w in plan.seed_omegas]
     timing["seeds_s"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    curves, seeds, refused = [], [], []
-    phase = conts[0].phase if conts else 0.0
+    found = _CurveSeeds(plan)
     for w, cont in zip(plan.seed_omegas, conts):
+        found.line(w, cont)
+    timing["curves_s"] = time.perf_counter() - t0
+    if not found.seeds:
+        raise ValueError(
+            f"no bifurcation of period <= {plan.max_period} ({', '.join(plan.types)}) is "
+            f"located along alpha in [{a0:g}, {a1:g}] at omega = "
+            f"{', '.join(f'{w:g}' for w in plan.seed_omegas)}: the chart's ranges contain no "
+            f"seed for a curve")
+    return ChartResult(block=plan.block, plane=pl, alpha_range=(a0, a1),
+                       omega_range=plan.omega_range, seed_omegas=plan.seed_omegas,
+                       curves=found.curves, seeds=found.seeds, refused=found.refused,
+                       overturn_onset=_overturn_onset(pl),
+                       phase=conts[0].phase if conts else 0.0, timing=timing)
+
+
+def _seed_line(plan, w, threads):
+    """The branches and bifurcations along ``alpha`` on the seed line ``omega = w``: a sweep
+    over the chart's ``alpha_range`` seeds :func:`continue_branches`."""
+    a0, a1 = plan.alpha_range
+    forcing = plan.forcing.replace(omega=w)
+    sw = sweep_grid.sweep(plan.block, forcing, gp.alpha_grid((a0, a1), plan.sweep_step),
+                          plan.state, integration=plan.integration,
+                          classification=Classification(attractors=False), lyapunov=False,
+                          execution=Execution(threads=threads, progress=False))
+    return continue_branches(plan.block, Harmonic(omega=w), (a0, a1), sweep=sw,
+                             n_steps=plan.n_steps, shooting=plan.shooting,
+                             settings=ContinuationSettings(max_period=plan.max_period))
+
+
+class _CurveSeeds:
+    """The curves followed from the bifurcations located on the seed lines, a record of
+    every such seed (``seeds``), and those that could not be followed (``refused``)."""
+
+    def __init__(self, plan):
+        self.plan = plan
+        self.curves, self.seeds, self.refused = [], [], []
+
+    def line(self, w, cont):
+        """Seed curves from the bifurcations of ``cont``, the continuation on ``omega = w``."""
+        plan = self.plan
         shooting = Shooting(**{k: cont.settings[k] for k in
                                ("tol", "max_iter", "sym_tol", "graze_tol", "over_tol",
                                 "max_impacts_per_period", "theta_over", "rest_speed")})
@@ -344,42 +371,43 @@ def run(plan: ChartPlan, execution=None) -> ChartResult:
                 continue
             rec = dict(omega=float(w), type=bf.type, period=int(bf.period),
                        alpha=float(bf.alpha))
-            seeds.append(rec)
-            if not bf.located:
-                rec["skipped"] = "not located (its bracketing solve failed)"
-                continue
-            on = next((i for i, c in enumerate(curves) if c.type == bf.type and
-                       c.period == bf.period and c.through(w, bf.alpha, bf.cycle)), None)
-            if on is not None:
-                rec["curve"] = on
-                rec["skipped"] = f"on curve {on}"
-                continue
-            try:
-                c = continue_curve(block, bf, phase=cont.phase, alpha_range=(a0, a1),
-                                   omega_range=plan.omega_range, n_steps=plan.n_steps,
-                                   shooting=shooting, settings=plan.settings)
-            except (OrbitRefused, ValueError) as exc:
-                rec["skipped"] = "refused"
-                refused.append(dict(rec, reason=str(exc)))
-                continue
-            rec["curve"] = len(curves)
-            curves.append(c)
-    timing["curves_s"] = time.perf_counter() - t0
-    if not seeds:
-        raise ValueError(
-            f"no bifurcation of period <= {plan.max_period} ({', '.join(plan.types)}) is "
-            f"located along alpha in [{a0:g}, {a1:g}] at omega = "
-            f"{', '.join(f'{w:g}' for w in plan.seed_omegas)}: the chart's ranges contain no "
-            f"seed for a curve")
+            self.seeds.append(rec)
+            self.follow(w, cont, bf, shooting, rec)
+
+    def follow(self, w, cont, bf, shooting, rec):
+        """Follow the curve through ``bf`` unless it was not located or a curve found before
+        crosses ``omega = w`` there; ``rec`` gets the curve's index, or why there is none."""
+        if not bf.located:
+            rec["skipped"] = "not located (its bracketing solve failed)"
+            return
+        on = next((i for i, c in enumerate(self.curves) if c.type == bf.type and
+                   c.period == bf.period and c.through(w, bf.alpha, bf.cycle)), None)
+        if on is not None:
+            rec["curve"] = on
+            rec["skipped"] = f"on curve {on}"
+            return
+        plan = self.plan
+        try:
+            c = continue_curve(plan.block, bf, phase=cont.phase,
+                               alpha_range=tuple(plan.alpha_range),
+                               omega_range=plan.omega_range, n_steps=plan.n_steps,
+                               shooting=shooting, settings=plan.settings)
+        except (OrbitRefused, ValueError) as exc:
+            rec["skipped"] = "refused"
+            self.refused.append(dict(rec, reason=str(exc)))
+            return
+        rec["curve"] = len(self.curves)
+        self.curves.append(c)
+
+
+def _overturn_onset(pl):
+    """Per ``omega`` column of the chart ``pl``, the smallest ``alpha`` whose cell overturns
+    (``nan`` where none does)."""
     lab = np.asarray(pl.label)[0]
     over = lab == BEHAVIOURS.index("overturn")
     alphas = np.asarray(pl.alpha)
-    onset = np.array([alphas[np.argmax(over[:, k])] if over[:, k].any() else math.nan
-                      for k in range(over.shape[1])])
-    return ChartResult(block=block, plane=pl, alpha_range=(a0, a1),
-                       omega_range=plan.omega_range, seed_omegas=plan.seed_omegas,
-                       curves=curves, seeds=seeds, refused=refused, overturn_onset=onset,
-                       phase=phase, timing=timing)
+    return np.array([alphas[np.argmax(over[:, k])] if over[:, k].any() else math.nan
+                     for k in range(over.shape[1])])
 
 
 @entry_point(run)
@@ -441,11 +469,7 @@ def chart(block, alpha_range, omega_range, *, grid=CHART_GRID, curves=None, stat
 chart starts no curve on it
     """
     block = check_block(block)
-    a0, a1 = pair("alpha_range", alpha_range, 0.0, ALPHA_MAX)
-    w0, w1 = pair("omega_range", omega_range, *OMEGA_RANGE)
-    if a1 <= a0 or w1 <= w0:
-        raise ValueError(f"alpha_range and omega_range must have start < end (got ({a0:g}, "
-                         f"{a1:g}), ({w0:g}, {w1:g}))")
+    a0, a1, w0, w1 = chart_ranges(alpha_range, omega_range)
     curves = ChartCurves() if curves is None else curves
     if not isinstance(curves, ChartCurves):
         raise ValueError(f"curves must be a rockjit.orbits.ChartCurves (got "
