@@ -183,55 +183,11 @@ def fig_trajectory(result, behaviour, *, exponent=None, title=None, first=8, las
     """
     _need_traj(result)
     colour = LINE_COLOURS[behaviour[0]]
-    lam = result.lyapunov_running
     fig = S.figure("double", 0.52, pad=PAD)
     gs = fig.add_gridspec(2, 3, width_ratios=(1.5, 1.0, 1.25))
-    wins = _windows(result, first, last)
-    axes_t = []
-    if len(wins) == 1:
-        axes_t.append(fig.add_subplot(gs[0, :2]))
-    else:
-        axes_t.append(fig.add_subplot(gs[0, 0]))
-        axes_t.append(fig.add_subplot(gs[0, 1], sharey=axes_t[0]))
-    for i, (ax, (t0, t1, what)) in enumerate(zip(axes_t, wins)):
-        _time_panel(ax, result, t0, t1, colour)
-        _mark_end(ax, result)
-        ax.set_xlabel(SYMBOLS["t_unit"])
-        S.letter(ax, i, what)
-    axes_t[0].set_ylabel(SYMBOLS["theta_unit"])
+    axes_t = _time_windows(fig, gs, result, colour, first, last)
     ax_l = fig.add_subplot(gs[1, :2])
-    fig_legend = None
-    if lam is not None and lam.shape[0] > 1:
-        k = np.arange(1, lam.shape[0])
-        ax_l.plot(k * result.period, lam[1:, 0], color="k", lw=1.0,
-                  label=r"running $\lambda_1(t)$ from $t = 0$")
-        ax_l.axhline(0, color="0.6", lw=0.6)
-        t_w = _window_start(result)
-        if result.t > t_w:
-            ax_l.axvspan(t_w, result.t, color="0.88", lw=0, zorder=0)
-        if result.lyapunov is not None and np.isfinite(result.lyapunov[0]):
-            ax_l.axhline(result.lyapunov[0], color=colour, lw=1.0, ls="--",
-                         label=f"$\\lambda_\\mathrm{{max}}$ over the window "
-                               f"$= {result.lyapunov[0]:.4f}$")
-        if exponent is not None and np.isfinite(exponent):
-            ax_l.axhline(exponent, color=colour, lw=1.0, ls=":",
-                         label=f"Floquet exponent of the orbit $= {exponent:.4f}$")
-        fin = lam[1:, 0][np.isfinite(lam[1:, 0])]
-        if fin.size:  # the estimate's range, with room for the legend above it
-            lo, hi = float(fin.min()), float(fin.max())
-            span = max(hi - lo, 0.05 * max(abs(lo), abs(hi), 1e-3))
-            ax_l.set_ylim(lo - 0.1 * span, hi + 0.1 * span)
-        hs, ls_ = ax_l.get_legend_handles_labels()
-        if result.t > t_w:
-            from matplotlib.patches import Patch
-            hs.append(Patch(facecolor="0.88", edgecolor="0.6", lw=0.5))
-            ls_.append("asymptotic window")
-        fig_legend = (hs, ls_)
-        ax_l.set_ylabel(r"$\lambda_1$")
-        ax_l.set_xlim(0, result.t)
-    else:
-        ax_l.text(0.5, 0.5, "Lyapunov exponents not computed", ha="center", va="center",
-                  transform=ax_l.transAxes, color="0.4")
+    fig_legend = _running_exponent(ax_l, result, colour, exponent)
     ax_l.set_xlabel(SYMBOLS["t_unit"])
     S.letter(ax_l, len(axes_t), "running largest Lyapunov exponent")
     ax_p = fig.add_subplot(gs[:, 2])
@@ -246,6 +202,63 @@ def fig_trajectory(result, behaviour, *, exponent=None, title=None, first=8, las
         fig.legend(hp, lp, loc="outside lower center")
     S.suptitle(fig, title or f"{_params(result)}: {_behaviour_words(behaviour)}")
     return fig
+
+
+def _time_windows(fig, gs, result, colour, first, last):
+    """Figure 2's top row: ``theta(t)`` over the first and the last periods (one panel for the
+    whole run when it is short), sharing their vertical axis; returns the axes."""
+    wins = _windows(result, first, last)
+    axes_t = []
+    if len(wins) == 1:
+        axes_t.append(fig.add_subplot(gs[0, :2]))
+    else:
+        axes_t.append(fig.add_subplot(gs[0, 0]))
+        axes_t.append(fig.add_subplot(gs[0, 1], sharey=axes_t[0]))
+    for i, (ax, (t0, t1, what)) in enumerate(zip(axes_t, wins)):
+        _time_panel(ax, result, t0, t1, colour)
+        _mark_end(ax, result)
+        ax.set_xlabel(SYMBOLS["t_unit"])
+        S.letter(ax, i, what)
+    axes_t[0].set_ylabel(SYMBOLS["theta_unit"])
+    return axes_t
+
+
+def _running_exponent(ax_l, result, colour, exponent):
+    """The running exponent ``lambda_1(t)`` with the window's estimate and the orbit's Floquet
+    exponent, the asymptotic window shaded; returns the legend's ``(handles, labels)``, or
+    ``None`` (with a note in the panel) when the run computed no exponents."""
+    lam = result.lyapunov_running
+    if lam is None or lam.shape[0] <= 1:
+        ax_l.text(0.5, 0.5, "Lyapunov exponents not computed", ha="center", va="center",
+                  transform=ax_l.transAxes, color="0.4")
+        return None
+    k = np.arange(1, lam.shape[0])
+    ax_l.plot(k * result.period, lam[1:, 0], color="k", lw=1.0,
+              label=r"running $\lambda_1(t)$ from $t = 0$")
+    ax_l.axhline(0, color="0.6", lw=0.6)
+    t_w = _window_start(result)
+    if result.t > t_w:
+        ax_l.axvspan(t_w, result.t, color="0.88", lw=0, zorder=0)
+    if result.lyapunov is not None and np.isfinite(result.lyapunov[0]):
+        ax_l.axhline(result.lyapunov[0], color=colour, lw=1.0, ls="--",
+                     label=f"$\\lambda_\\mathrm{{max}}$ over the window "
+                           f"$= {result.lyapunov[0]:.4f}$")
+    if exponent is not None and np.isfinite(exponent):
+        ax_l.axhline(exponent, color=colour, lw=1.0, ls=":",
+                     label=f"Floquet exponent of the orbit $= {exponent:.4f}$")
+    fin = lam[1:, 0][np.isfinite(lam[1:, 0])]
+    if fin.size:  # the estimate's range, with room for the legend above it
+        lo, hi = float(fin.min()), float(fin.max())
+        span = max(hi - lo, 0.05 * max(abs(lo), abs(hi), 1e-3))
+        ax_l.set_ylim(lo - 0.1 * span, hi + 0.1 * span)
+    hs, ls_ = ax_l.get_legend_handles_labels()
+    if result.t > t_w:
+        from matplotlib.patches import Patch
+        hs.append(Patch(facecolor="0.88", edgecolor="0.6", lw=0.5))
+        ls_.append("asymptotic window")
+    ax_l.set_ylabel(r"$\lambda_1$")
+    ax_l.set_xlim(0, result.t)
+    return hs, ls_
 
 
 # ---------------------------------------------------------------------------------------------
