@@ -14,7 +14,8 @@ import numpy as np
 from ..result import BEHAVIOURS, fractions
 
 from .cells import extent
-from .style import BEHAVIOUR_COLOURS, LAW_COLOURS, LAW_NAMES, behaviour_cmap, figure
+from .style import (BEHAVIOUR_COLOURS, LAW_COLOURS, LAW_NAMES, behaviour_cmap, figure, letter,
+                    suptitle)
 from .style import styled as _styled
 
 __all__ = ["CURVE_LABELS", "CURVE_STYLES", "fig_chart"]
@@ -138,7 +139,6 @@ def _overturn_edge(ax, res, colour=OVERTURN_EDGE):
 
 
 def _chart_panel(ax, res, i, show_y=True):
-    from .style import letter
     cmap, norm = behaviour_cmap()
     _map(ax, res.label(), res.plane.omega, res.plane.alpha, cmap=cmap, norm=norm)
     _overturn_edge(ax, res)
@@ -215,68 +215,95 @@ def fig_chart(results, title=None):
     >>> [t.get_text() for t in fig.axes[0].texts]
     ['SB\u2081']
     """
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
-
-    from .style import letter, suptitle
-
     if not isinstance(results, dict):
         results = {results.block.law: results}
     res = list(results.values())
-    first = res[0]
-    legend_kw = dict(handlelength=4.0, frameon=False)
-    if len(res) == 1:
-        fig = figure("double", 0.58)
-        ax = fig.add_subplot(1, 1, 1)
-        placed = _chart_panel(ax, first, 0)
-        fig.legend(handles=_legend_handles(res), loc="outside right center", **legend_kw)
-    else:
-        fig = figure("double", 0.86)
-        gs = fig.add_gridspec(2, 2)
-        axes = [fig.add_subplot(gs[0, 0])]
-        axes.append(fig.add_subplot(gs[0, 1], sharey=axes[0]))
-        axes.append(fig.add_subplot(gs[1, 0], sharey=axes[0]))
-        placed = []
-        for i, r in enumerate(res[:2]):
-            placed += _chart_panel(axes[i], r, i, show_y=i == 0)
-        ax = axes[-1]
-        laws = [r.block.law for r in res]
-        labs = [r.label() for r in res]
-        differ = np.zeros(labs[0].shape, bool)
-        for lab in labs[1:]:
-            differ |= lab != labs[0]
-        # hatched where the behaviours differ (grey would read as the rest behaviour's)
-        x, y = np.asarray(first.plane.omega, float), np.asarray(first.plane.alpha, float)
-        if differ.any() and min(differ.shape) > 1:
-            _, sh = _shares(differ.astype(int), x, y)
-            share = sh[-1] if differ.all() or not differ.any() else sh[1]
-            cs = ax.contourf(_fine(x), _fine(y), share, levels=[0.5, 1.01], colors="none",
-                             hatches=[DIFFER_HATCH])
-            cs.set_edgecolor("0.55")
-            cs.set_linewidth(0)
-            if hasattr(cs, "set_hatchcolor"):
-                cs.set_hatchcolor("0.55")
-        for r in res:
-            colour = LAW_COLOURS.get(r.block.law, "k")
-            _overturn_edge(ax, r, colour=colour)
-            placed += _curves(ax, r, colour, "w", labels=True)
-        ax.set_xlim(*first.omega_range)
-        ax.set_ylim(*first.alpha_range)
-        ax.set_xlabel("$\\omega$")
-        ax.set_ylabel("$\\alpha$")
-        letter(ax, 2, f"both laws' curves; hatched: the behaviours differ "
-                      f"({_share_words(100.0 * differ.mean())} of cells)")
-        h = _legend_handles(res)
-        h += [Line2D([], [], color=LAW_COLOURS.get(law, "k"), lw=1.6,
-                     label=f"{LAW_NAMES.get(law, law)}'s curves and overturn boundary")
-              for law in laws]
-        if differ.any() and min(differ.shape) > 1:
-            h.append(Patch(facecolor="white", edgecolor="0.4", lw=0.4, hatch=DIFFER_HATCH,
-                           label="behaviours differ"))
-        # the legend in the fourth cell of the 2 x 2 grid
-        fig.legend(handles=h, loc="center", bbox_to_anchor=(0.76, 0.27), ncols=1, **legend_kw)
-    b = first.block
+    fig, placed = _one_law(res) if len(res) == 1 else _laws_side_by_side(res)
+    b = res[0].block
     suptitle(fig, title or f"The forcing plane, $h/b = {b.hb:g}$: behaviours from $z_0$ and "
                            f"the bifurcation curves")
     _unclash(fig, placed)
     return fig
+
+
+_LEGEND_KW = dict(handlelength=4.0, frameon=False)
+
+
+def _one_law(res):
+    """One law's chart with its legend at the right; returns the figure and the curves'
+    labels."""
+    fig = figure("double", 0.58)
+    ax = fig.add_subplot(1, 1, 1)
+    placed = _chart_panel(ax, res[0], 0)
+    fig.legend(handles=_legend_handles(res), loc="outside right center", **_LEGEND_KW)
+    return fig, placed
+
+
+def _laws_side_by_side(res):
+    """Two laws' charts side by side, both laws' curves overlaid below them and the legend in
+    the fourth cell of the 2 x 2 grid; returns the figure and the curves' labels."""
+    fig = figure("double", 0.86)
+    gs = fig.add_gridspec(2, 2)
+    axes = [fig.add_subplot(gs[0, 0])]
+    axes.append(fig.add_subplot(gs[0, 1], sharey=axes[0]))
+    axes.append(fig.add_subplot(gs[1, 0], sharey=axes[0]))
+    placed = []
+    for i, r in enumerate(res[:2]):
+        placed += _chart_panel(axes[i], r, i, show_y=i == 0)
+    labs = [r.label() for r in res]
+    differ = np.zeros(labs[0].shape, bool)
+    for lab in labs[1:]:
+        differ |= lab != labs[0]
+    placed += _overlay_panel(axes[-1], res, differ)
+    fig.legend(handles=_overlay_legend(res, differ), loc="center", bbox_to_anchor=(0.76, 0.27),
+               ncols=1, **_LEGEND_KW)
+    return fig, placed
+
+
+def _hatched(differ):
+    """Whether the overlay hatches the cells where the laws differ (some do, on a grid of
+    more than one row and column)."""
+    return differ.any() and min(differ.shape) > 1
+
+
+def _overlay_panel(ax, res, differ):
+    """Every law's curves and overturn boundary on one chart, in the law's colour, over the
+    cells where their behaviours differ (hatched); returns the curves' labels."""
+    first = res[0]
+    # hatched where the behaviours differ (grey would read as the rest behaviour's)
+    x, y = np.asarray(first.plane.omega, float), np.asarray(first.plane.alpha, float)
+    if _hatched(differ):
+        _, sh = _shares(differ.astype(int), x, y)
+        share = sh[-1] if differ.all() or not differ.any() else sh[1]
+        cs = ax.contourf(_fine(x), _fine(y), share, levels=[0.5, 1.01], colors="none",
+                         hatches=[DIFFER_HATCH])
+        cs.set_edgecolor("0.55")
+        cs.set_linewidth(0)
+        if hasattr(cs, "set_hatchcolor"):
+            cs.set_hatchcolor("0.55")
+    placed = []
+    for r in res:
+        colour = LAW_COLOURS.get(r.block.law, "k")
+        _overturn_edge(ax, r, colour=colour)
+        placed += _curves(ax, r, colour, "w", labels=True)
+    ax.set_xlim(*first.omega_range)
+    ax.set_ylim(*first.alpha_range)
+    ax.set_xlabel("$\\omega$")
+    ax.set_ylabel("$\\alpha$")
+    letter(ax, 2, f"both laws' curves; hatched: the behaviours differ "
+                  f"({_share_words(100.0 * differ.mean())} of cells)")
+    return placed
+
+
+def _overlay_legend(res, differ):
+    """The overlay's legend: the chart's entries, each law's colour, and the hatching."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+    h = _legend_handles(res)
+    h += [Line2D([], [], color=LAW_COLOURS.get(law, "k"), lw=1.6,
+                 label=f"{LAW_NAMES.get(law, law)}'s curves and overturn boundary")
+          for law in (r.block.law for r in res)]
+    if _hatched(differ):
+        h.append(Patch(facecolor="white", edgecolor="0.4", lw=0.4, hatch=DIFFER_HATCH,
+                       label="behaviours differ"))
+    return h
