@@ -129,42 +129,105 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
     sampled ``theta'`` jumps by the factor ``e``. The list of bifurcations with their
     multipliers is :func:`branch_caption`'s.
     """
-    from matplotlib.lines import Line2D
-
     c = continuation
     comp = int(component)
     if comp not in (0, 1):
         raise ValueError(f"component must be 0 (theta) or 1 (theta') (got {component!r})")
-    pname = c.parameter
-    sym = SYMBOLS.get(pname, pname)
     fig = S.figure("double", 0.66, pad=PAD)
     ax = fig.add_subplot()
-    # legend entry -> (handle, artists it names): an entry is kept when one of its artists
-    # draws within the view
-    entries = {}
-
-    def entry(key, handle, artist):
-        entries.setdefault(key, (handle, []))[1].append(artist)
-
+    legend = _Legend()
     if sweep is not None:
-        alpha = np.asarray(sweep.alpha)
-        label = np.asarray(sweep.label)
-        pts = np.asarray(sweep.strobe)[:, :, comp]
-        names = [str(n) for n in sweep.names]
-        for code, name in enumerate(names):
-            m = label == code
-            if not m.any():
-                continue
-            a = np.repeat(alpha[m], pts.shape[1])
-            yv = pts[m].ravel()
-            ok = np.isfinite(yv)
-            if not ok.any():
-                continue
-            dots = ax.scatter(a[ok], yv[ok], s=2.0, color=S.tint(BEHAVIOUR_COLOURS[name], 0.35),
-                              lw=0, rasterized=True, zorder=2)
-            entry(f"sweep {name}", Line2D([], [], ls="", marker="o", ms=3.5,
-                                          color=S.tint(BEHAVIOUR_COLOURS[name], 0.35),
-                                          label=f"sweep: {name}"), dots)
+        _sweep_dots(ax, sweep, comp, legend)
+    groups = _branch_lines(ax, c, comp, mirrors, legend)
+    _bifurcation_marks(ax, c, comp, mirrors, legend)
+    ends = _branch_ends(c, comp, mirrors)
+    view = _set_view(ax, c, comp, limits)
+    _end_marks(ax, ends, view, legend)
+    fig.legend(handles=legend.handles(groups, view), loc="outside lower center", ncols=3)
+    b, f = c.block, c.forcing
+    fixed = (f"$\\omega = {f.omega:g}$" if c.parameter == "alpha" else
+             f"$\\alpha = {f.alpha:g}$")
+    S.suptitle(fig, title or f"Periodic orbits, {S.law_name(b)}, $h/b = {b.hb:g}$, {fixed}; "
+                             f"sampled at $t = kT$ at the forcing phase "
+                             f"$\\varphi = {c.phase:.4g}$ of the study's $z_0$")
+    return fig
+
+
+def _in_view(artist, view):
+    """Whether any point of a line or a scatter lies within ``view``, ``((x0, x1), (y0, y1))``."""
+    (x0, x1), (y0, y1) = view
+    if hasattr(artist, "get_offsets"):
+        xy = np.asarray(artist.get_offsets(), float).reshape(-1, 2)
+    else:
+        xy = np.column_stack([np.asarray(v, float) for v in artist.get_data()])
+    return bool(np.any((xy[:, 0] >= min(x0, x1)) & (xy[:, 0] <= max(x0, x1))
+                       & (xy[:, 1] >= min(y0, y1)) & (xy[:, 1] <= max(y0, y1))))
+
+
+class _Legend:
+    """The legend of :func:`fig_branches`: each entry's handle with the artists it names; an
+    entry is kept when one of its artists draws within the view."""
+
+    def __init__(self):
+        self.entries = {}   # key -> (handle, artists)
+
+    def add(self, key, handle, artist):
+        """Name ``artist`` by the entry ``key`` (whose handle is the first one given)."""
+        self.entries.setdefault(key, (handle, []))[1].append(artist)
+
+    def handles(self, groups, view):
+        """The handles of the entries drawn within ``view``: the sweep's behaviours, the
+        branches' groups (in ``groups``' order), solid and dashed where such lines show, then
+        bifurcations and branch ends."""
+        from matplotlib.lines import Line2D
+        entries = self.entries
+        stab = [(Line2D([], [], color="0.3", lw=1.1, ls="-", label="stable orbits: solid"),
+                 True),
+                (Line2D([], [], color="0.3", lw=0.8, ls=(0, (3.0, 1.5)),
+                        label="unstable orbits: dashed"), False)]
+        shown = [key for key, (_, arts) in entries.items()
+                 if any(_in_view(a, view) for a in arts)]
+        handles = [entries[key][0] for key in shown
+                   if isinstance(key, str) and key.startswith("sweep ")]
+        branch_lines = [ln for key in shown if isinstance(key, tuple) for ln in entries[key][1]
+                        if _in_view(ln, view)]
+        handles += [entries[key][0] for key in groups if key in shown]
+        for h, stable in stab:
+            if any((ln.get_linestyle() == "-") == stable for ln in branch_lines):
+                handles.append(h)
+        handles += [entries[key][0] for key in shown if isinstance(key, str)
+                    and not key.startswith("sweep ")]
+        return handles
+
+
+def _sweep_dots(ax, sweep, comp, legend):
+    """The sweep's stroboscopic points beneath the branches, small dots tinted by behaviour."""
+    from matplotlib.lines import Line2D
+    alpha = np.asarray(sweep.alpha)
+    label = np.asarray(sweep.label)
+    pts = np.asarray(sweep.strobe)[:, :, comp]
+    names = [str(n) for n in sweep.names]
+    for code, name in enumerate(names):
+        m = label == code
+        if not m.any():
+            continue
+        a = np.repeat(alpha[m], pts.shape[1])
+        yv = pts[m].ravel()
+        ok = np.isfinite(yv)
+        if not ok.any():
+            continue
+        dots = ax.scatter(a[ok], yv[ok], s=2.0, color=S.tint(BEHAVIOUR_COLOURS[name], 0.35),
+                          lw=0, rasterized=True, zorder=2)
+        legend.add(f"sweep {name}", Line2D([], [], ls="", marker="o", ms=3.5,
+                                           color=S.tint(BEHAVIOUR_COLOURS[name], 0.35),
+                                           label=f"sweep: {name}"), dots)
+
+
+def _branch_lines(ax, c, comp, mirrors, legend):
+    """Every branch's line through each of its cycle points (and its mirror orbit's), solid
+    where stable and dashed where not, in its group's colour and marker; returns the groups
+    in the legend's order (by period, symmetric first)."""
+    from matplotlib.lines import Line2D
     groups = {}
     for br in sorted(c.branches, key=lambda b: (b.period, not b.symmetric)):
         groups.setdefault(_branch_group(br), None)
@@ -185,17 +248,19 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
                                     lw=1.1 if st else 0.8, color=colour, zorder=4,
                                     marker=mk or "", ms=3.2, markevery=0.07, mew=0.7,
                                     mfc=colour if st else "white")
-                    entry(group, None, line)
+                    legend.add(group, None, line)
     for group in groups:
         lab, colour, mk = group
-        if group in entries:
-            entries[group] = (Line2D([], [], color=colour, lw=1.4, marker=mk or "", ms=3.5,
-                                     label=lab), entries[group][1])
-    stab = [(Line2D([], [], color="0.3", lw=1.1, ls="-", label="stable orbits: solid"), True),
-            (Line2D([], [], color="0.3", lw=0.8, ls=(0, (3.0, 1.5)),
-                    label="unstable orbits: dashed"), False)]
-    bifs = sorted(c.bifurcations, key=lambda b: b.value)
-    for bf in bifs:
+        if group in legend.entries:
+            legend.entries[group] = (Line2D([], [], color=colour, lw=1.4, marker=mk or "",
+                                            ms=3.5, label=lab), legend.entries[group][1])
+    return groups
+
+
+def _bifurcation_marks(ax, c, comp, mirrors, legend):
+    """Each located bifurcation's cycle points (and its mirror's), in its type's marker."""
+    from matplotlib.lines import Line2D
+    for bf in sorted(c.bifurcations, key=lambda b: b.value):
         mk = BIFURCATION_MARKERS.get(bf.type, "o")
         pts_b = [np.asarray(bf.cycle)]
         if mirrors and bf.has_mirror and getattr(bf, "cycle_half", None) is not None:
@@ -204,11 +269,14 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
             dots = ax.scatter(np.full(cy.shape[0], bf.value), cy[:, comp], marker=mk,
                               s=22 if bf.period <= 2 else 11, facecolor="white", edgecolor="k",
                               lw=0.8, zorder=5)
-            entry(f"bif {bf.type}", Line2D([], [], ls="", marker=mk, ms=4.5,
-                                           markerfacecolor="white", markeredgecolor="k",
-                                           label=_BIF_WORDS.get(bf.type, bf.type)), dots)
-    # where a branch stops inside the range, and why: each point once (branches that stop at
-    # one point, each cycle point of a period-p orbit, pile up otherwise)
+            legend.add(f"bif {bf.type}", Line2D([], [], ls="", marker=mk, ms=4.5,
+                                                markerfacecolor="white", markeredgecolor="k",
+                                                label=_BIF_WORDS.get(bf.type, bf.type)), dots)
+
+
+def _branch_ends(c, comp, mirrors):
+    """Where branches stop inside the range, and why: ``{(marker, words): {"points": [(x, y)],
+    "branches": n}}``, every cycle point of each stopping end."""
     ends = {}
     for br in c.branches:
         cycles = [br.cycle] + ([br.mirror_cycle] if mirrors and br.mirror_cycle is not None
@@ -221,7 +289,13 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
             got["branches"] += 1
             for cyc in cycles:
                 got["points"] += [(float(br.value[side]), float(v)) for v in cyc[side, :, comp]]
-    ax.set_xlabel(sym)
+    return ends
+
+
+def _set_view(ax, c, comp, limits):
+    """The axes' labels and range: the continuation's bounds, or ``limits`` with the vertical
+    range fitted to what is drawn within them; returns the view ``((x0, x1), (y0, y1))``."""
+    ax.set_xlabel(SYMBOLS.get(c.parameter, c.parameter))
     ax.set_ylabel(SYMBOLS["strobe"] if comp == 1 else SYMBOLS["strobe_theta"])
     xlim = tuple(float(v) for v in (limits if limits is not None else c.bounds))
     ax.set_xlim(*xlim)
@@ -239,7 +313,14 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
             lo, hi = float(ys.min()), float(ys.max())
             pad = 0.05 * max(hi - lo, 1e-3)
             ax.set_ylim(lo - pad, hi + pad)
-    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    return ax.get_xlim(), ax.get_ylim()
+
+
+def _end_marks(ax, ends, view, legend):
+    """The branch ends' markers, each point once at the view's resolution (branches that stop
+    at one point, each cycle point of a period-p orbit, pile up otherwise)."""
+    from matplotlib.lines import Line2D
+    (x0, x1), (y0, y1) = view
     for (mk, words), got in ends.items():
         p = np.unique(np.round(np.asarray(got["points"]) /
                                [(x1 - x0) * 2e-3, (y1 - y0) * 2e-3]), axis=0) * \
@@ -247,38 +328,9 @@ def fig_branches(continuation, sweep=None, *, component=1, title=None, limits=No
         line, = ax.plot(p[:, 0], p[:, 1], ls="", marker=mk, ms=4.5, color="k", mew=1.0,
                         zorder=6)
         n = got["branches"]
-        entry(f"end {words}", Line2D([], [], ls="", marker=mk, ms=4.5, color="k", mew=1.0,
-                                     label=f"{words} ({n} branch{'es' if n > 1 else ''})"),
-              line)
-
-    def in_view(artist):
-        if hasattr(artist, "get_offsets"):
-            xy = np.asarray(artist.get_offsets(), float).reshape(-1, 2)
-        else:
-            xy = np.column_stack([np.asarray(v, float) for v in artist.get_data()])
-        return bool(np.any((xy[:, 0] >= min(x0, x1)) & (xy[:, 0] <= max(x0, x1))
-                           & (xy[:, 1] >= min(y0, y1)) & (xy[:, 1] <= max(y0, y1))))
-
-    handles = []
-    shown = [key for key, (_, arts) in entries.items() if any(in_view(a) for a in arts)]
-    for key in shown:
-        if isinstance(key, str) and key.startswith("sweep "):
-            handles.append(entries[key][0])
-    branch_lines = [ln for key in shown if isinstance(key, tuple) for ln in entries[key][1]
-                    if in_view(ln)]
-    handles += [entries[key][0] for key in groups if key in shown]
-    for h, stable in stab:
-        if any((ln.get_linestyle() == "-") == stable for ln in branch_lines):
-            handles.append(h)
-    handles += [entries[key][0] for key in shown if isinstance(key, str)
-                and not key.startswith("sweep ")]
-    fig.legend(handles=handles, loc="outside lower center", ncols=3)
-    b, f = c.block, c.forcing
-    fixed = (f"$\\omega = {f.omega:g}$" if pname == "alpha" else f"$\\alpha = {f.alpha:g}$")
-    S.suptitle(fig, title or f"Periodic orbits, {S.law_name(b)}, $h/b = {b.hb:g}$, {fixed}; "
-                             f"sampled at $t = kT$ at the forcing phase "
-                             f"$\\varphi = {c.phase:.4g}$ of the study's $z_0$")
-    return fig
+        legend.add(f"end {words}", Line2D([], [], ls="", marker=mk, ms=4.5, color="k", mew=1.0,
+                                          label=f"{words} ({n} branch{'es' if n > 1 else ''})"),
+                   line)
 
 
 def branch_caption(continuation, name=None):
