@@ -435,11 +435,13 @@ def call_in(rj, fn: str, kw: dict):
     ----------
     rj : module
         A rockjit package (it may be imported under another name).
-    fn : {"simulate", "basin", "sweep"}
+    fn : {"simulate", "basin", "sweep", "spectrum", "fragility"}
     kw : dict
-        The case's flat keywords.
+        The case's flat keywords (:func:`_ground_call`'s for the last two).
     """
     kw = dict(kw)
+    if fn in ("spectrum", "fragility"):
+        return _ground_call(rj, fn, kw)
     if api_of(rj) == "flat":
         f = rj.simulate if fn == "simulate" else getattr(_flat_grids(rj), fn)
         known = inspect.signature(f).parameters
@@ -447,6 +449,27 @@ def call_in(rj, fn: str, kw: dict):
         return lambda: f(**kw)
     entry, args, settings = _objects_call(rj, fn, kw)
     return lambda: entry(*args, **settings)
+
+
+def _ground_call(rj, fn, kw):
+    """A transient grid on the compiled path: the overturning spectrum of a pulse (``pulse``,
+    ``grid`` x ``grid`` geometric ratios in [0.5, 8] and amplitudes in [1.02, 25], no
+    bisection), or an incremental dynamic analysis of a block of R = 1 m under ``records``
+    synthetic records (20 s at 100 Hz) at ``levels`` intensities in [1.25, 10], both laws."""
+    import numpy as np
+    block = rj.Block(hb=kw.pop("hb", 4.0), law=kw.pop("law", "housner"))
+    if fn == "spectrum":
+        pulse, n = rj.Pulse(kw.pop("pulse", "sine")), kw.pop("grid", 80)
+        ratios, amplitudes = np.geomspace(0.5, 8.0, n), np.geomspace(1.02, 25.0, n)
+        return lambda: rj.spectrum(block, pulse, ratios, amplitudes, locate=False)
+    rng = np.random.default_rng(1)
+    t = np.arange(0.0, 20.0, 0.01)
+    recs = []
+    for k in range(kw.pop("records", 6)):
+        a = sum(np.sin(2 * np.pi * fi * t + rng.uniform(0, 6)) for fi in rng.uniform(0.5, 3, 3))
+        recs.append(rj.Record(0.1 * a * np.sin(np.pi * t / 20.0) ** 2, 0.01, name=f"s{k}"))
+    levels = np.linspace(1.25, 10.0, kw.pop("levels", 30))
+    return lambda: rj.fragility(block, recs, [1.0], levels, laws=("housner", "mao"))
 
 
 def _objects_call(rj, fn, kw):

@@ -17,10 +17,14 @@ medians is taken side by side on one noisy machine:
   program measured twice) at full length over 100 periods (500 would take a minute a call),
   the yardstick of the full-length basin: the report compares their throughputs in
   cell-periods per second, each version's own in the same run;
-- ``sweep``: hb=1 Housner over alpha in [0.5, 1.0] every 0.005 with exponents.
+- ``sweep``: hb=1 Housner over alpha in [0.5, 1.0] every 0.005 with exponents;
+- ``spectrum-sine``, ``spectrum-ricker``: the transient kernel on an 80 x 80 overturning
+  spectrum of a pulse (h/b = 4, no bisection); ``ida``: on an incremental dynamic analysis of
+  six synthetic 20 s records at 30 intensities under both laws (``_common.call_in``).
 
 Each case also reports whether both versions returned the same numbers, bit for bit (the final
-state and impact count of a run; the labels, periods, exponents and strobe points of a grid).
+state and impact count of a run; the labels, periods, exponents and strobe points of a grid;
+the outcomes and largest rotations of a transient grid).
 
 Each version is called in its own API. A case is written once, in flat keywords (the API of the
 versions before rockjit's settings objects); each worker looks at the rockjit it imported
@@ -67,10 +71,15 @@ CASES = {
                                    r0=0.0, s0=1.0, periods=100)),
     "sweep": ("sweep", dict(hb=1.0, omega=1.3, law="housner", alpha_range=(0.5, 1.0),
                             alpha_step=0.005, lyapunov=True, attractors=False)),
+    "spectrum-sine": ("spectrum", dict(hb=4.0, pulse="sine", grid=80)),
+    "spectrum-ricker": ("spectrum", dict(hb=4.0, pulse="ricker", grid=80)),
+    "ida": ("fragility", dict(hb=4.0, records=6, levels=30)),
 }
 QUICK = {"run": dict(periods=50), "run+lyapunov": dict(periods=50), "basin": dict(grid=20,
          periods=50), "basin-full": dict(grid=12, periods=50),
-         "rk4-basin": dict(grid=12, periods=20), "sweep": dict(alpha_step=0.05, periods=50)}
+         "rk4-basin": dict(grid=12, periods=20), "sweep": dict(alpha_step=0.05, periods=50),
+         "spectrum-sine": dict(grid=12), "spectrum-ricker": dict(grid=12),
+         "ida": dict(records=2, levels=4)}
 #: The cases a plain run measures (``--cases`` names others): the two long ones are asked for.
 DEFAULT_CASES = ("run", "run+lyapunov", "basin", "sweep")
 
@@ -95,7 +104,7 @@ _WORKER = textwrap.dedent("""
     def digest(res):
         h = hashlib.sha256()
         names = ("state", "n_impacts") if hasattr(res, "state") else (
-            "label", "period", "lambda_max", "strobe")
+            "label", "period", "lambda_max", "strobe", "outcome", "max_rotation")
         for name in names:
             v = getattr(res, name, None)
             if v is not None:

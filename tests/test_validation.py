@@ -488,7 +488,7 @@ def test_closed_forms_at_the_smallest_ratio_take_their_quasi_static_limit():
     # at beta = 1e-3 (the range's end) the root lies within e^(-3 pi / (2 beta)) = e^-4712 of
     # sqrt(1 + beta^2), the one-cosine boundary within e^(-2 pi / beta) of 1 + beta^2
     from rockjit.ground.closed_forms import cosine_no_impact, sine_no_impact
-    from rockjit.ground.pulses import RATIO_RANGE
+    from rockjit.plugs.pulse import RATIO_RANGE
     beta = RATIO_RANGE[0]
     assert sine_no_impact(beta) == pytest.approx(math.sqrt(1 + beta * beta), rel=1e-15)
     assert cosine_no_impact(beta) == pytest.approx(1 + beta * beta, rel=1e-15)
@@ -499,7 +499,7 @@ def test_closed_forms_hold_over_the_whole_ratio_range(beta):
     # exp(2 pi / beta) overflowed below beta ~ 0.009 (OverflowError after a spectrum's work),
     # and cosh - sinh cancelled into a false "strikes the ground" at beta = 0.01 and 0.1
     from rockjit.ground.closed_forms import cosine_no_impact, sine_no_impact
-    from rockjit.ground.pulses import RATIO_RANGE
+    from rockjit.plugs.pulse import RATIO_RANGE
     assert RATIO_RANGE[0] <= beta <= RATIO_RANGE[1]
     a_ref, applies = _sine_reference(beta)
     if applies:

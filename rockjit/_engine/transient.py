@@ -6,15 +6,14 @@ index, so the results do not depend on the number of threads. A cell follows the
 scipy reference path (:mod:`rockjit.ground.reference`, the specification):
 
 - **rest**: the block leaves rest at the first instant after which ``|f| > cot(thc)``, on the
-  corner ``sign f``: the excitation's windows are found here as the reference path finds them
-  (in closed form for the sine and cosine pulses, by bisection to rounding on the Ricker
-  wavelet's lobes, on their linear pieces for a record), and the instant nudged by the same
-  units in the last place until :func:`rockjit.model.accel` on that corner is outward;
+  corner ``sign f``: the excitation's windows come from its plug
+  (:func:`rockjit.plugs.plug_window`), and the instant is nudged by the same units in the last
+  place as on the reference path until :func:`rockjit.model.accel` on that corner is outward;
 - **flight**: fixed steps of the Dormand–Prince 5(4) tableau of the harmonic engine
-  (:mod:`rockjit._engine.integrate`), on a grid that puts every kink of the forcing on a step
-  boundary: a pulse's duration is cut into equal steps, a record's sample step into ``k``
-  equal steps, free rocking after the excitation into steps of its own length. A step that
-  crosses ``theta = 0`` (an impact), ``|theta| = theta_over`` (overturning) or ``theta' = 0``
+  (:mod:`rockjit._engine.integrate`), on the grid the excitation's plug gives, which puts
+  every kink of the forcing on a step boundary (a pulse's duration cut into equal steps, a
+  record's sample step into ``k`` equal steps), then free rocking after the excitation in
+  steps of its own length. A step that crosses ``theta = 0`` (an impact), ``|theta| = theta_over`` (overturning) or ``theta' = 0``
   (a turning point: a crest gives ``max |theta|`` and, after the excitation, may decide the
   run; a trough below ``theta = 0`` is a dip through an impact and back) is cut there: the
   instant is the root of the event function of a genuine step of variable length from the
@@ -31,19 +30,11 @@ it), and free rocking starts from the still base, its first stage included.
 
 Every equation of the block comes from :mod:`rockjit.model` (:func:`~rockjit.model.corner`,
 :func:`~rockjit.model.accel_pq`, :func:`~rockjit.model.sincos`, :func:`~rockjit.model.jump`,
-:func:`~rockjit.model.accel`, :func:`~rockjit.model.free_rocking_decided`); this module writes
-none. The excitations are the one thing it writes again: :func:`forcing` and the uplift
-windows are the compiled twins of ``Pulse.scalar``/``Pulse.windows`` and
-``Record.scalar``/``Record.windows``, held to them by the tests that compare every cell with
-the scipy path, which evaluates those.
-
-The forcing of a cell is described by a row of ``xpar`` (columns ``X_*``): the kind (0, 1, 2:
-the pulses of :data:`rockjit.ground.pulses.KINDS`; 3: a record; from
-:data:`rockjit.plugs.FIRST_KIND` on, an excitation plug), its amplitude in ``g`` (a gain, for a
-plug), the pulse's ``omega_p``, the end, the Ricker wavelet's delay, the record's model time
-step, the offset and length of its samples (a plug's numbers) in one flat array, and the steps
-of the grid (per pulse or plug, or per record sample). A plug's value and windows are its own
-compiled functions (:func:`rockjit.plugs.plug_value`, :func:`rockjit.plugs.plug_window`).
+:func:`~rockjit.model.accel`, :func:`~rockjit.model.free_rocking_decided`), and every
+excitation from its plug (:mod:`rockjit.plugs`: the pulses, records, sums of harmonics): this
+module writes neither. The forcing of a cell is described by a row of ``xpar`` (columns
+``X_*``): its plug's code, its amplitude, the excitation's end, its grid, and where its
+coefficients lie in one flat array.
 """
 
 from __future__ import annotations
@@ -56,14 +47,16 @@ from numba import prange
 from .._jit import jit
 from ..laws.impact import restitution_at
 from ..model import accel, accel_pq, corner, free_rocking_decided, jump, sincos
-from ..plugs import FIRST_KIND, plug_value, plug_window
+from ..plugs import plug_value, plug_window
 from .stages import chain, compile_step, node
 
 # ---- codes --------------------------------------------------------------------------------------
-K_SINE, K_COSINE, K_RICKER, K_RECORD = 0, 1, 2, 3
-#: columns of a cell's forcing row ``xpar``
-X_KIND, X_AMP, X_OMEGA, X_END, X_DELAY, X_DT, X_OFF, X_N, X_STEPS = range(9)
-N_X = 9
+#: columns of a cell's forcing row ``xpar``: its plug's code, its amplitude (the plug's ``a``),
+#: the end of the excitation, the step between the grid's kinks (0: none), the offset and
+#: number of its coefficients in the flat array ``rec``, the grid's steps (over the excitation,
+#: or between kinks)
+X_CODE, X_AMP, X_END, X_DT, X_OFF, X_N, X_STEPS = range(7)
+N_X = 7
 #: columns of a block's row ``bpar``: thc, xi, e, cot (uplift threshold), th_top (the tipping
 #: angle, or theta_over below it), alpha_s, the law's kind and shape at an impact
 #: (rockjit.laws.impact.restitution_at)
@@ -86,33 +79,11 @@ ROOT_ITERS = 60
 
 @jit(nrt=False, inline=True)
 def forcing(t, x, rec):
-    """The base acceleration (``g``) of the forcing row ``x`` at model time ``t``: the formulas
-    of ``Pulse.scalar`` and ``Record.scalar``, zero outside ``[0, end]``."""
-    end = x[X_END]
-    if not (0.0 <= t <= end):
+    """The base acceleration (``g``) of the forcing row ``x`` at model time ``t``: its plug's
+    value (:func:`rockjit.plugs.plug_value`), zero outside ``[0, end]``."""
+    if not (0.0 <= t <= x[X_END]):
         return 0.0
-    kind = int(x[X_KIND])
-    a = x[X_AMP]
-    if kind == K_SINE:
-        return a * math.sin(x[X_OMEGA] * t)
-    if kind == K_COSINE:
-        return a * math.cos(x[X_OMEGA] * t)
-    if kind == K_RICKER:
-        u = 0.5 * x[X_OMEGA] * (t - x[X_DELAY])
-        u2 = u * u
-        return a * (1.0 - 2.0 * u2) * math.exp(-u2)
-    if kind >= FIRST_KIND:
-        return a * plug_value(kind, t, rec, int(x[X_OFF]), int(x[X_N]))
-    off = int(x[X_OFF])
-    last = int(x[X_N]) - 1
-    q = t / x[X_DT]
-    k = int(q)
-    if k >= last:
-        return a * rec[off + last]
-    w = q - k
-    y0 = a * rec[off + k]
-    y1 = a * rec[off + k + 1]
-    return y0 + w * (y1 - y0)
+    return plug_value(int(x[X_CODE]), t, x[X_AMP], rec, int(x[X_OFF]), int(x[X_N]))
 
 
 @jit(nrt=False, inline=True)
@@ -195,128 +166,17 @@ def _ulp(x):
 
 
 @jit(nrt=False)
-def _ricker_root(r, lo, hi, lobe):
-    """The ``u`` in ``[lo, hi]`` where the Ricker shape ``g(u) = (1 - 2u^2) exp(-u^2)`` meets
-    ``r`` (``lobe`` 1: the main lobe, ``g = r``; -1: a side lobe, ``-g = r``), by bisection to
-    adjacent floats."""
-    glo = lobe * (1.0 - 2.0 * lo * lo) * math.exp(-lo * lo) - r
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if mid <= lo or mid >= hi:
-            break
-        g = lobe * (1.0 - 2.0 * mid * mid) * math.exp(-mid * mid) - r
-        if g == 0.0:
-            return mid
-        if (g > 0.0) == (glo > 0.0):
-            lo, glo = mid, g
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
-
-
-@jit(nrt=False)
-def pulse_windows(x, thr, win):
-    """The rows ``(t_start, t_end, sign f)`` where a pulse's ``|f| > thr``, in order, written
-    to ``win`` (3 x 3); returns their number (``Pulse.windows``)."""
-    a, w = x[X_AMP], x[X_OMEGA]
-    if not a > thr:
-        return 0
-    r = thr / a
-    kind = int(x[X_KIND])
-    if kind == K_SINE:
-        s = math.asin(r)
-        win[0, 0], win[0, 1], win[0, 2] = s / w, (math.pi - s) / w, 1.0
-        win[1, 0], win[1, 1], win[1, 2] = (math.pi + s) / w, (2.0 * math.pi - s) / w, -1.0
-        return 2
-    if kind == K_COSINE:
-        c = math.acos(r)
-        win[0, 0], win[0, 1], win[0, 2] = 0.0, c / w, 1.0
-        win[1, 0], win[1, 1], win[1, 2] = (math.pi - c) / w, (math.pi + c) / w, -1.0
-        win[2, 0], win[2, 1], win[2, 2] = (2.0 * math.pi - c) / w, 2.0 * math.pi / w, 1.0
-        return 3
-    t0 = x[X_DELAY]
-    um = _ricker_root(r, 0.0, math.sqrt(0.5), 1.0)
-    if r < 2.0 * math.exp(-1.5):  # deeper than the side lobes
-        ui = _ricker_root(r, math.sqrt(0.5), math.sqrt(1.5), -1.0)
-        uo = _ricker_root(r, math.sqrt(1.5), 10.0, -1.0)
-        win[0, 0], win[0, 1], win[0, 2] = t0 + 2.0 * -uo / w, t0 + 2.0 * -ui / w, -1.0
-        win[1, 0], win[1, 1], win[1, 2] = t0 + 2.0 * -um / w, t0 + 2.0 * um / w, 1.0
-        win[2, 0], win[2, 1], win[2, 2] = t0 + 2.0 * ui / w, t0 + 2.0 * uo / w, -1.0
-        return 3
-    win[0, 0], win[0, 1], win[0, 2] = t0 + 2.0 * -um / w, t0 + 2.0 * um / w, 1.0
-    return 1
-
-
-@jit(nrt=False)
-def _excess(x, rec, j, sg, thr):
-    return sg * (x[X_AMP] * rec[int(x[X_OFF]) + j]) - thr
-
-
-@jit(nrt=False)
-def record_window(tq, x, rec, thr):
-    """The first window ``(t_start, t_end, sign f)`` of a record with ``t_end > tq``
-    (``Record.windows``: runs of samples with ``|f| > thr``, their ends on the linear pieces);
-    ``sign`` 0 when there is none."""
-    n = int(x[X_N])
-    dt = x[X_DT]
-    j = max(0, int(tq / dt) - 1)
-    while j < n:
-        sg = 0.0
-        if _excess(x, rec, j, 1.0, thr) > 0.0:
-            sg = 1.0
-        elif _excess(x, rec, j, -1.0, thr) > 0.0:
-            sg = -1.0
-        if sg == 0.0:
-            j += 1
-            continue
-        i = j
-        while i > 0 and _excess(x, rec, i - 1, sg, thr) > 0.0:
-            i -= 1
-        if i == 0:
-            start = 0.0
-        else:
-            s0, s1 = _excess(x, rec, i - 1, sg, thr), _excess(x, rec, i, sg, thr)
-            start = (i - 1) * dt + (-s0) / (s1 - s0) * dt
-        m = j
-        while m + 1 < n and _excess(x, rec, m + 1, sg, thr) > 0.0:
-            m += 1
-        if m == n - 1:
-            stop = (n - 1) * dt
-        else:
-            s0, s1 = _excess(x, rec, m, sg, thr), _excess(x, rec, m + 1, sg, thr)
-            stop = m * dt + s0 / (s0 - s1) * dt
-        if stop > tq:
-            return start, stop, sg
-        j = m + 1
-    return 0.0, 0.0, 0.0
-
-
-@jit(nrt=False)
-def next_uplift(t, x, rec, win, nwin, thc, xi, thr):
+def next_uplift(t, x, rec, thc, xi, thr):
     """``(t_up, side)``: the first instant ``>= t`` at which the block at rest accelerates away
-    from it, ``side`` 0 when there is none (the reference path's ``next_uplift``)."""
-    kind = int(x[X_KIND])
-    k = 0
+    from it, ``side`` 0 when there is none (the reference path's ``next_uplift``): through the
+    windows where ``|f| > thr`` (:func:`rockjit.plugs.plug_window`), in order."""
+    code = int(x[X_CODE])
     tq = t
     while True:
-        if kind == K_RECORD:
-            t0, t1, sg = record_window(tq, x, rec, thr)
-            if sg == 0.0:
-                return 0.0, 0
-        elif kind >= FIRST_KIND:
-            a = x[X_AMP]
-            if not a > 0.0:
-                return 0.0, 0
-            t0, t1, sg = plug_window(kind, tq, x[X_END], rec, int(x[X_OFF]), int(x[X_N]),
-                                     thr / a)
-            if sg == 0.0:
-                return 0.0, 0
-        else:
-            while k < nwin and not win[k, 1] > t:
-                k += 1
-            if k >= nwin:
-                return 0.0, 0
-            t0, t1, sg = win[k, 0], win[k, 1], win[k, 2]
+        t0, t1, sg = plug_window(code, tq, x[X_END], x[X_AMP], rec, int(x[X_OFF]), int(x[X_N]),
+                                 thr)
+        if sg == 0.0:
+            return 0.0, 0
         side = int(sg)
         base = max(t, t0)
         tt = base
@@ -326,7 +186,6 @@ def next_uplift(t, x, rec, win, nwin, thc, xi, thr):
                 return tt, side
             step = max(2.0 * step, _ulp(max(tt, 1.0)))
             tt = base + step
-        k += 1
         tq = t1
 
 
@@ -334,9 +193,10 @@ def next_uplift(t, x, rec, win, nwin, thc, xi, thr):
 
 @jit(nrt=False, inline=True)
 def grid_next(t, end, h_exc, nsub, dt, h_free, t_lim):
-    """The first grid instant after ``t``: during a pulse, multiples of ``h_exc`` up to
-    ``end``; during a record, ``nsub`` equal steps per sample (``dt``), the samples exact; after
-    the excitation, ``end`` plus multiples of ``h_free``; never beyond ``t_lim``."""
+    """The first grid instant after ``t``: during the excitation, multiples of ``h_exc`` up to
+    ``end`` or, for a grid with kinks (``nsub > 0``: a record), ``nsub`` equal steps between
+    consecutive multiples of ``dt``, the kinks exact; after the excitation, ``end`` plus
+    multiples of ``h_free``; never beyond ``t_lim``."""
     if t < end:
         j = int(t / h_exc) + 1
         if nsub > 0:
@@ -382,8 +242,7 @@ def _keep(traj, n, t, th, v):
 
 
 @jit(nrt=False)
-def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp, traj, out_f,
-             out_i):
+def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj, out_f, out_i):
     """One run from ``(th0, v0)`` on corner ``side0`` (0: at rest): writes ``out_f`` and
     ``out_i`` (``F_*``, ``I_*``). ``imp`` (rows ``t, theta'-, theta'+``) and ``traj`` (rows
     ``t, theta, theta'`` at the grid points and the events) keep what their lengths hold:
@@ -393,19 +252,16 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp,
     sthc, cthc = math.sin(thc), math.cos(thc)
     thover, rest_speed = s[S_THOVER], s[S_REST]
     end = x[X_END]
-    kind = int(x[X_KIND])
-    # the grid: a pulse in X_STEPS equal steps, a record in X_STEPS steps per sample, free
-    # rocking in steps of S_HFREE
+    # the grid: the excitation in X_STEPS equal steps, or X_STEPS steps between its kinks
+    # (multiples of X_DT), free rocking in steps of S_HFREE
     nsub = 0
-    dt = 0.0
-    if kind == K_RECORD:
+    dt = x[X_DT]
+    if dt > 0.0:
         nsub = int(x[X_STEPS])
-        dt = x[X_DT]
         h_exc = dt / nsub
     else:
         h_exc = end / x[X_STEPS]
     h_free = s[S_HFREE]
-    nwin = pulse_windows(x, thr, win) if kind < K_RECORD else 0  # the others: found as needed
     n_imp_buf = imp.shape[0]
 
     t = 0.0
@@ -426,7 +282,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, win, imp,
             status = ST_TIME_LIMIT
             break
         if side == 0:  # ---- at rest ------------------------------------------------------------
-            t_up, up = next_uplift(t, x, rec, win, nwin, thc, xi, thr)
+            t_up, up = next_uplift(t, x, rec, thc, xi, thr)
             if up == 0:
                 status = ST_REST
                 break
@@ -559,11 +415,10 @@ def run_cells(xpar, rec, bpar, block_of, spar, t_lim, max_impacts, decide, strid
     cells (a spectrum's long pulses, say) cost alike and are spread over the threads."""
     n = xpar.shape[0]
     per = (n + stride - 1) // stride
-    none = np.empty((0, 3))  # no windows given: read only, shared
+    none = np.empty((0, 3))  # no impacts or trajectory kept: read only, shared
     for k in prange(per * stride):
         i = (k % per) * stride + k // per
         if i >= n:
             continue
-        win = np.empty((3, 3))  # each cell's own scratch
         run_cell(xpar[i], rec, bpar[block_of[i]], spar, t_lim[i], max_impacts, decide, 0.0,
-                 0.0, 0, win, none, none, out_f[i], out_i[i])
+                 0.0, 0, none, none, out_f[i], out_i[i])

@@ -32,7 +32,7 @@ def _transient(args):
 
 
 def _spectrum_plan(args):
-    from ..ground.pulses import RATIO_RANGE, Pulse
+    from ..plugs.pulse import RATIO_RANGE, Pulse
     from ..ground.spectrum import spectrum
     from ..validate import integer, pair
     nr, nk = (integer("grid", v, 1, 10**4) for v in args.grid)

@@ -20,7 +20,7 @@ def _tables():
     """``(RANGES, RANGES_BY_COMMAND)``, from the library's constants (a moved bound moves the
     table)."""
     from ..excitation import ALPHA_MAX, OMEGA_RANGE
-    from ..ground.pulses import AMPLITUDE_MAX, RATIO_RANGE
+    from ..plugs.pulse import AMPLITUDE_MAX, RATIO_RANGE
     from ..ground.records import SIZE_RANGE
     from ..ground.settings import TIME_MAX
     from ..integrity.chart import MAX_LATTICE, MAX_SIDE

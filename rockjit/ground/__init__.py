@@ -2,10 +2,8 @@
 
 One concept per module:
 
-- :mod:`~rockjit.ground.pulses`: :class:`Pulse`, the one-sine, one-cosine and Ricker pulses in
-  the literature's ratios;
-- :mod:`~rockjit.ground.records`: :class:`Record`, a recorded motion, and its readers
-  (arrays, PEER ``.AT2``, two-column text or CSV);
+- :mod:`~rockjit.ground.records`: the readers of recorded motions (arrays, PEER ``.AT2``,
+  two-column text or CSV);
 - :mod:`~rockjit.ground.fema`: the FEMA P695 record sets (the ``records`` extra);
 - :mod:`~rockjit.ground.settings`: :class:`Transient`, how a transient run is integrated;
 - :mod:`~rockjit.ground.response`: :class:`TransientResult` and the outcome codes;
@@ -26,8 +24,7 @@ docs/theory/ground-motions.md has the theory, docs/guide/earthquakes.md the guid
 from .fema import fema_set
 from .fitting import LognormalFit, fit_capacities, fit_lognormal
 from .fragility import FragilityResult, fragility
-from .pulses import Pulse
-from .records import Record, read_at2, read_record, read_table
+from .records import read_at2, read_record, read_table
 from .response import OUTCOMES, TransientResult
 from .settings import Transient
 from .spectrum import SpectrumResult, spectrum
@@ -37,11 +34,10 @@ __all__ = ["FragilityResult", "HarmonicSum", "LognormalFit", "OUTCOMES", "Pulse"
            "fragility", "read_at2", "read_record", "read_table", "spectrum"]
 
 from .plan import plan_run  # noqa: E402
-from ..plugs import HarmonicSum, TransientPlug  # noqa: E402
+from ..plugs import HarmonicSum, Pulse, Record, TransientPlug  # noqa: E402
 
-# A single run under a pulse or a record takes the transient path: rockjit.simulate asks the
-# excitation for its plan (Excitation.plan_run), and the transient excitations answer here,
-# above both the excitations and their runs (a Pulse or a Record is only made through this
-# package, so the answer is always in place; an excitation plug, rockjit.plugs, answers here
-# too, and rockjit.HarmonicSum comes through this package).
-Pulse.plan_run = Record.plan_run = TransientPlug.plan_run = plan_run
+# A single run under a transient excitation (an excitation plug, rockjit.plugs: a pulse, a
+# record, a sum of harmonics) takes the transient path: rockjit.simulate asks the excitation
+# for its plan (Excitation.plan_run), and the plugs answer here, above both the excitations and
+# their runs (importing rockjit imports this package, so the answer is always in place).
+TransientPlug.plan_run = plan_run

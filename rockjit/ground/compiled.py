@@ -10,11 +10,12 @@ step lengths below they agree with scipy's DOP853 at ``rtol = 1e-13`` to about 1
 ``max |theta| / alpha_s`` and 4e-11 in the overturning time of a pulse run
 (tests/ground/test_ground_compiled.py, benchmarks/bench_ground.py).
 
-Step lengths, in model time (``1/sqrt(g/R)``, about 0.32 s for a 1 m block): a pulse is cut
-into equal steps of at most :data:`H_PULSE` and at least :data:`MIN_PULSE_STEPS` of them; a
-record's sample step into the fewest equal steps of at most :data:`H_RECORD`, so that its
-samples (the kinks of the linear interpolation) are step boundaries; free rocking after the
-excitation takes steps of :data:`H_FREE`.
+Step lengths, in model time (``1/sqrt(g/R)``, about 0.32 s for a 1 m block): each excitation's
+plug gives its grid (:meth:`rockjit.plugs.TransientPlug.grid`: a pulse in equal steps of at most
+:data:`H_PULSE` and at least :data:`MIN_PULSE_STEPS` of them; a record's sample step in the
+fewest equal steps of at most :data:`H_RECORD`, so that its samples, the kinks of the linear
+interpolation, are step boundaries); free rocking after the excitation takes steps of
+:data:`H_FREE`.
 """
 
 from __future__ import annotations
@@ -26,20 +27,14 @@ import numpy as np
 
 from .._engine import transient as T
 from ..model import damping_rate, initial_side
-from ..plugs import TransientPlug
+from ..plugs.pulse import H_PULSE, MIN_PULSE_STEPS
+from ..plugs.record import H_RECORD
 from ..validate import memory
-from .pulses import KINDS, Pulse
 from .response import STATUS_CODES, TransientResult, alpha_s, empty_outputs
 
 __all__ = ["H_FREE", "H_PULSE", "H_RECORD", "MIN_PULSE_STEPS", "compiled_kernel",
            "run_compiled"]
 
-#: The longest step during a pulse.
-H_PULSE = 0.01
-#: The fewest steps per pulse (a short pulse still has its shape resolved).
-MIN_PULSE_STEPS = 256
-#: The longest step during a record.
-H_RECORD = 0.005
 #: The step of free rocking after the excitation.
 H_FREE = 0.01
 #: The largest ``h 3/4 xi`` of a step: a heavily damped block (``xi`` up to 1e4) gets shorter
@@ -57,38 +52,24 @@ def _block_row(block, theta_over):
 
 
 def _sources(sources, shrink):
-    """``(rows, samples)``: each source's forcing row at unit gain and the records' samples;
-    the step lengths multiplied by ``shrink``."""
+    """``(rows, coefficients)``: each source's forcing row (its plug's code, end and grid, with
+    the step lengths multiplied by ``shrink``) and every source's coefficients in one flat
+    array, where the rows point."""
     rows = np.zeros((len(sources), T.N_X))
     chunks = []
     off = 0
     for k, src in enumerate(sources):
-        row = rows[k]
-        row[T.X_END] = src.end
-        if isinstance(src, Pulse):
-            row[T.X_KIND] = KINDS.index(src.kind)
-            row[T.X_OMEGA] = src.omega_p
-            row[T.X_DELAY] = src.delay
-            row[T.X_STEPS] = max(MIN_PULSE_STEPS, math.ceil(src.end / (shrink * H_PULSE)))
-        elif isinstance(src, TransientPlug):
-            coef = np.asarray(src.coefficients(), dtype=float)
-            row[T.X_KIND] = src.kind
-            row[T.X_OFF] = off
-            row[T.X_N] = coef.size
-            row[T.X_STEPS] = src.steps(shrink)
-            chunks.append(coef)
-            off += coef.size
-        else:
-            dt = src.dt_model
-            row[T.X_KIND] = T.K_RECORD
-            row[T.X_DT] = dt
-            row[T.X_OFF] = off
-            row[T.X_N] = src.n
-            row[T.X_STEPS] = max(1, math.ceil(dt / (shrink * H_RECORD)))
-            chunks.append(np.asarray(src.accel, dtype=float))
-            off += src.n
-    samples = np.concatenate(chunks) if chunks else np.zeros(1)
-    return rows, samples
+        coef = np.asarray(src.coefficients(), dtype=float)
+        steps, kink = src.grid(shrink)
+        rows[k, T.X_CODE] = src.code
+        rows[k, T.X_END] = src.end
+        rows[k, T.X_DT] = kink
+        rows[k, T.X_OFF] = off
+        rows[k, T.X_N] = coef.size
+        rows[k, T.X_STEPS] = steps
+        chunks.append(coef)
+        off += coef.size
+    return rows, np.concatenate(chunks) if chunks else np.zeros(1)
 
 
 def _shrink(blocks):
@@ -130,14 +111,14 @@ def compiled_kernel(blocks, sources, block_of, source_of, gain, settings, method
 
 
 def _amplitudes(sources, source_of, gain):
-    """Every cell's amplitude in ``g`` as the reference path forms it: ``src.scaled(gain)``'s
-    ``accel`` for a pulse (``amplitude * gain / hb``), its ``scale`` for a record."""
-    is_pulse = np.array([isinstance(s, Pulse) for s in sources])
-    base = np.array([s.amplitude if isinstance(s, Pulse) else s.scale for s in sources])
-    hb = np.array([s.hb if isinstance(s, Pulse) else 1.0 for s in sources])
-    p = is_pulse[source_of]
-    a = base[source_of] * gain
-    return np.where(p, a / hb[source_of], a)
+    """Every cell's amplitude, its source's :meth:`~rockjit.plugs.TransientPlug.amplitude_at` at
+    the cell's gain (a pulse's ``accel`` once scaled, ``amplitude * gain / hb``, as the
+    reference path forms it; a record's ``scale * gain``)."""
+    out = np.empty(len(gain))
+    for k, src in enumerate(sources):
+        cells = np.flatnonzero(source_of == k)
+        out[cells] = src.amplitude_at(gain[cells])
+    return out
 
 
 def run_compiled(block, excitation, state, settings) -> TransientResult:
@@ -147,7 +128,7 @@ def run_compiled(block, excitation, state, settings) -> TransientResult:
     impact."""
     shrink = _shrink((block,))
     rows, samples = _sources((excitation,), shrink)
-    rows[0, T.X_AMP] = excitation.accel if isinstance(excitation, Pulse) else excitation.scale
+    rows[0, T.X_AMP] = excitation.amplitude_at(np.ones(1))[0]
     bpar = np.array(_block_row(block, settings.theta_over), dtype=float)
     spar = np.array([settings.theta_over, settings.rest_speed, shrink * H_FREE])
     end = float(excitation.end)
@@ -160,8 +141,8 @@ def run_compiled(block, excitation, state, settings) -> TransientResult:
     n_imp = min(max_imp, 1024)
     n_traj = 0
     if settings.record:
-        steps = rows[0, T.X_STEPS] * (excitation.n - 1 if rows[0, T.X_KIND] == T.K_RECORD
-                                      else 1)
+        kink = rows[0, T.X_DT]
+        steps = rows[0, T.X_STEPS] * (round(end / kink) if kink > 0.0 else 1)
         n_traj = int(steps + (t_lim - min(end, t_lim)) / (shrink * H_FREE)) + 2 * n_imp + 16
     memory(f"a run recorded over {t_lim:.4g} time units (the Transient's free_time or "
            f"duration)", 24.0 * (float(n_traj) + float(n_imp)))
@@ -171,8 +152,7 @@ def run_compiled(block, excitation, state, settings) -> TransientResult:
         imp = np.empty((n_imp, 3))
         traj = np.empty((n_traj, 3))
         T.run_cell(rows[0], samples, bpar, spar, t_lim, max_imp,
-                   bool(settings.stop_when_decided), th0, v0, side0, np.empty((3, 3)), imp, traj,
-                   out_f, out_i)
+                   bool(settings.stop_when_decided), th0, v0, side0, imp, traj, out_f, out_i)
         got_imp, got_traj = int(out_i[T.TI_IMPACTS]), int(out_i[T.TI_TRAJ])
         if got_imp <= n_imp and (not settings.record or got_traj <= n_traj):
             break

@@ -50,7 +50,7 @@ def grid_settings(integration):
 
 def bind(excitation, block):
     """``excitation`` bound to ``block``, with what a single run needs checked."""
-    from .pulses import Pulse
+    from ..plugs.pulse import Pulse
     if isinstance(excitation, Pulse):
         excitation.require("ratio", "amplitude", why="a run under a pulse")
     return excitation.bind(block)

@@ -33,7 +33,7 @@ from ..model import Block
 from ..validate import memory, real, real_array
 from .batch import Batch, grid_method, run_batch
 from .plan import grid_settings
-from .pulses import AMPLITUDE_MAX, RATIO_RANGE, Pulse
+from ..plugs.pulse import AMPLITUDE_MAX, RATIO_RANGE, Pulse
 from .response import (MODE_NAMES, OUTCOMES, OVERTURN_IMPACT, OVERTURN_NO_IMPACT, SAFE,
                        UNRESOLVED)
 

@@ -1,12 +1,13 @@
-"""Excitations as plugs: transient excitations that the compiled kernel of pulses and records runs
-through functions of their own, one module each.
+"""Excitations as plugs: the transient excitations, each one module that the compiled transient
+kernel runs through functions of its own.
 
 Every module of this package defines and registers one plug (:mod:`rockjit.plugs.base` says what
-a plug gives): :class:`rockjit.HarmonicSum`, a sum of harmonics over a given duration. When the package is
-imported, the kernel's two entry points are rendered over the registered plugs:
-``plug_value`` and ``plug_window`` dispatch on the plug's kind (``FIRST_KIND``, the next,
-...) to its compiled functions. A new excitation of this kind is one more module here
-(docs/guide/extending.md), and nothing else changes.
+a plug gives): :class:`rockjit.HarmonicSum`, a sum of harmonics over a given duration;
+:class:`rockjit.Pulse`, the one-sine, one-cosine and Ricker pulses; :class:`rockjit.Record`, a
+recorded ground motion. When the package is imported, the kernel's two entry points are rendered
+over the registered plugs: ``plug_value`` and ``plug_window`` dispatch on the plug's code (0, 1,
+..., in the order of registration) to its compiled functions. A new excitation that ends is one
+more module here (docs/guide/extending.md), and nothing else changes.
 """
 
 from __future__ import annotations
@@ -17,11 +18,8 @@ import pkgutil
 from .._jit import jit
 from .base import TransientPlug, register, registered
 
-__all__ = ["FIRST_KIND", "HarmonicSum", "TransientPlug", "plug_value", "plug_window", "register",
-           "registered"]
-
-#: The kind of the first plug: the kernel's own kinds (the three pulses, a record) come before.
-FIRST_KIND = 4
+__all__ = ["HarmonicSum", "Pulse", "Record", "TransientPlug", "plug_value", "plug_window",
+           "register", "registered"]
 
 for _m in sorted(m.name for m in pkgutil.iter_modules(__path__)):
     if _m != "base":
@@ -30,19 +28,19 @@ for _m in sorted(m.name for m in pkgutil.iter_modules(__path__)):
 
 def _render():
     """Compile the dispatch of ``plug_value`` and ``plug_window`` over the registered
-    plugs, giving each its kind."""
-    value = ['def plug_value(kind, t, rec, off, n):',
-             '    """The registered plug of kind ``kind``: its ``value(t, rec, off, n)``."""']
-    window = ['def plug_window(kind, tq, end, rec, off, n, thr):',
-              '    """The registered plug of kind ``kind``: its ``window(tq, end, rec, off, n,',
-              '    thr)``; ``(0, 0, 0)`` for an unknown kind."""']
+    plugs, giving each its code."""
+    value = ['def plug_value(code, t, a, c, off, n):',
+             '    """The registered plug of code ``code``: its ``value(t, a, c, off, n)``."""']
+    window = ['def plug_window(code, tq, end, a, c, off, n, thr):',
+              '    """The registered plug of code ``code``: its ``window(tq, end, a, c, off, n,',
+              '    thr)``; ``(0, 0, 0)`` for an unknown code."""']
     for i, cls in enumerate(registered()):
-        cls.kind = FIRST_KIND + i
+        cls.code = i
         globals()[f"_value_{i}"] = cls.value
         globals()[f"_window_{i}"] = cls.window
-        value += [f"    if kind == {cls.kind}:", f"        return _value_{i}(t, rec, off, n)"]
-        window += [f"    if kind == {cls.kind}:",
-                   f"        return _window_{i}(tq, end, rec, off, n, thr)"]
+        value += [f"    if code == {i}:", f"        return _value_{i}(t, a, c, off, n)"]
+        window += [f"    if code == {i}:",
+                   f"        return _window_{i}(tq, end, a, c, off, n, thr)"]
     value.append("    return 0.0")
     window.append("    return 0.0, 0.0, 0.0")
     src = "\n".join(value) + "\n\n\n" + "\n".join(window) + "\n"
@@ -53,3 +51,5 @@ def _render():
 plug_value, plug_window = _render()
 
 from .harmonic_sum import HarmonicSum  # noqa: E402
+from .pulse import Pulse  # noqa: E402
+from .record import Record  # noqa: E402

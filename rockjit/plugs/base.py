@@ -2,20 +2,22 @@
 two compiled functions of its own.
 
 A plug is an :class:`rockjit.Excitation` that ends (``transient = True``), written in one module
-of :mod:`rockjit.plugs`. The compiled kernel of pulses and records
-(:mod:`rockjit._engine.transient`) keeps a plug's numbers, :meth:`TransientPlug.coefficients`,
-in its array of samples and calls the plug's two compiled functions:
+of :mod:`rockjit.plugs`: the pulses, recorded motions and sums of harmonics are plugs. The compiled
+kernel of transient runs (:mod:`rockjit._engine.transient`) keeps a plug's numbers,
+:meth:`TransientPlug.coefficients`, in one flat array and calls the plug's two compiled
+functions, with ``a`` the cell's amplitude (:meth:`TransientPlug.amplitude_at`):
 
-- ``value(t, rec, off, n)``: the base acceleration (``g``, at unit gain) at model time
-  ``0 <= t <= end``, from the ``n`` numbers ``rec[off:off + n]``;
-- ``window(tq, end, rec, off, n, thr)``: the first interval ``(t0, t1, sign)`` of
+- ``value(t, a, c, off, n)``: the base acceleration (``g``) at model time ``0 <= t <= end``,
+  from the ``n`` numbers ``c[off:off + n]``;
+- ``window(tq, end, a, c, off, n, thr)``: the first interval ``(t0, t1, sign)`` of
   ``[0, end]`` with ``t1 > tq`` where ``|f| > thr`` (``sign`` of ``f`` there, 0 if none):
   where a block at rest may lift off.
 
-The kernel steps a plug in :meth:`TransientPlug.steps` equal steps over ``[0, end]`` and adds
-its own steps at every event. The scipy reference path uses the plug's Python side
-(:meth:`scalar`, :meth:`windows`, ``breaks``, ``max_step``), which each plug writes
-independently of its compiled functions.
+The kernel steps a plug on the grid :meth:`TransientPlug.grid` gives (equal steps over
+``[0, end]``, or equal steps between the kinks of a sampled motion) and adds its own steps at
+every event. The scipy reference path uses the plug's Python side (:meth:`scalar`,
+:meth:`windows`, ``breaks``, ``max_step``), which each plug writes independently of its compiled
+functions.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from ..excitation import Excitation
 
 __all__ = ["TransientPlug", "register", "registered"]
 
-#: The registered plugs' classes, in the order of their kinds.
+#: The registered plugs' classes, in the order of their codes.
 _PLUGS = []
 
 
@@ -47,22 +49,24 @@ class TransientPlug(Excitation):
     value = None
     window = None
     #: The kernel's code of the plug (set when :mod:`rockjit.plugs` is imported).
-    kind = -1
+    code = -1
 
     # ---- what the compiled kernel needs ----------------------------------------------------
     def coefficients(self):
         """The numbers ``value`` and ``window`` read (a 1-d float array)."""
         raise NotImplementedError
 
-    def steps(self, shrink):
-        """How many equal steps the kernel takes over ``[0, end]`` (``shrink`` <= 1: the step
-        of a heavily damped block is that much shorter)."""
+    def grid(self, shrink):
+        """The kernel's step grid over ``[0, end]``: ``(steps, 0.0)`` for ``steps`` equal
+        steps, or ``(steps, kink_step)`` for ``steps`` equal steps between consecutive multiples
+        of ``kink_step`` (the samples of a record, where its slope jumps). ``shrink`` <= 1: the
+        steps of a heavily damped block are that much shorter."""
         raise NotImplementedError
 
-    @property
-    def scale(self):
-        """The factor the kernel multiplies ``value`` by (a grid's gain multiplies it)."""
-        return 1.0
+    def amplitude_at(self, gains):
+        """The amplitude ``a`` the compiled functions get for each of ``gains``: this
+        excitation ``gain`` times stronger (an array)."""
+        raise NotImplementedError
 
     # ---- what every transient excitation gives ---------------------------------------------
     def bind(self, block):
@@ -79,7 +83,7 @@ class TransientPlug(Excitation):
 def register(plug):
     """Register the plug class ``cls``: a class decorator for the plugs of this package (the
     kernel is compiled with their functions when :mod:`rockjit.plugs` is imported, which
-    gives each its ``kind``).
+    gives each its ``code``).
 
     Parameters
     ----------
@@ -94,8 +98,8 @@ def register(plug):
     Examples
     --------
     >>> from rockjit.plugs import HarmonicSum, registered
-    >>> HarmonicSum in registered(), HarmonicSum.kind
-    (True, 4)
+    >>> HarmonicSum in registered(), HarmonicSum.code >= 0
+    (True, True)
     """
     if not (isinstance(plug, type) and issubclass(plug, TransientPlug)) or plug.value is None \
             or plug.window is None:
@@ -107,12 +111,12 @@ def register(plug):
 
 
 def registered():
-    """The registered plug classes, in the order their kinds are given.
+    """The registered plug classes, in the order their codes are given.
 
     Examples
     --------
     >>> from rockjit import plugs
     >>> [cls.__name__ for cls in plugs.registered()]
-    ['HarmonicSum']
+    ['HarmonicSum', 'Pulse', 'Record']
     """
     return list(_PLUGS)

@@ -2,7 +2,8 @@
 
 A common test signal for rocking blocks (a few tones at once, e.g. a shake-table sweep's
 components), written as one excitation plug (:mod:`rockjit.plugs.base`). The compiled side,
-:func:`harmonics_value` and :func:`harmonics_window`, is what the compiled transient kernel runs;
+:func:`sum_value` and :func:`sum_window` (over :func:`harmonics_value` and
+:func:`harmonics_window`, at unit gain), is what the compiled transient kernel runs;
 the Python side (:meth:`HarmonicSum.f`, :meth:`HarmonicSum.windows`) is what the scipy reference path
 runs, written apart from it: the windows by a dense scan of ``|f|`` and Brent's method, the
 compiled ones by a scan whose steps the largest slope ``sum_k |a_k omega_k|`` bounds.
@@ -20,7 +21,8 @@ from ..excitation import ACCEL_MAX, OMEGA_RANGE
 from ..validate import real, real_array
 from .base import TransientPlug, register
 
-__all__ = ["DURATION_MAX", "HarmonicSum", "MAX_TONES", "harmonics_value", "harmonics_window"]
+__all__ = ["DURATION_MAX", "HarmonicSum", "MAX_TONES", "harmonics_value", "harmonics_window",
+           "sum_value", "sum_window"]
 
 #: At most this many tones.
 MAX_TONES = 64
@@ -126,6 +128,21 @@ def harmonics_window(tq, end, rec, off, n, thr):
     return 0.0, 0.0, 0.0
 
 
+@jit(nrt=False)
+def sum_value(t, a, rec, off, n):
+    """The plug's value: ``a`` times :func:`harmonics_value`."""
+    return a * harmonics_value(t, rec, off, n)
+
+
+@jit(nrt=False)
+def sum_window(tq, end, a, rec, off, n, thr):
+    """The plug's window: :func:`harmonics_window` of the tones at unit gain, above
+    ``thr / a``; none for ``a <= 0``."""
+    if not a > 0.0:
+        return 0.0, 0.0, 0.0
+    return harmonics_window(tq, end, rec, off, n, thr / a)
+
+
 @register
 @dataclass(frozen=True)
 class HarmonicSum(TransientPlug):
@@ -191,8 +208,8 @@ class HarmonicSum(TransientPlug):
         set_(self, "duration", real("duration", self.duration, 0.0, DURATION_MAX, lo_open=True))
         set_(self, "gain", real("gain", self.gain, 0.0, ACCEL_MAX))
 
-    value = staticmethod(harmonics_value)
-    window = staticmethod(harmonics_window)
+    value = staticmethod(sum_value)
+    window = staticmethod(sum_window)
 
     # ---- the compiled kernel's side ------------------------------------------------------
     def coefficients(self):
@@ -200,15 +217,14 @@ class HarmonicSum(TransientPlug):
         return np.array([v for k in range(len(self.amplitudes)) for v in
                          (self.amplitudes[k], self.frequencies[k], self.phases[k])], dtype=float)
 
-    def steps(self, shrink):
-        """A 32nd of the shortest tone's period, at most (and at least 8 steps)."""
+    def grid(self, shrink):
+        """Equal steps of a 32nd of the shortest tone's period, at most (and at least 8)."""
         h = 2.0 * math.pi / max(self.frequencies) / 32.0 * shrink
-        return max(8, math.ceil(self.duration / h))
+        return max(8, math.ceil(self.duration / h)), 0.0
 
-    @property
-    def scale(self):
-        """``gain``: the factor on every tone (a grid's gain multiplies it)."""
-        return self.gain
+    def amplitude_at(self, gains):
+        """``gain`` times each of ``gains``: the factor on every tone."""
+        return self.gain * np.asarray(gains, dtype=float)
 
     # ---- every transient excitation's side -----------------------------------------------
     @property

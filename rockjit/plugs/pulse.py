@@ -1,4 +1,5 @@
-"""Acceleration pulses: the one-sine, the one-cosine and the symmetric Ricker wavelet.
+"""Acceleration pulses: the one-sine, the one-cosine and the symmetric Ricker wavelet, as one
+excitation plug (:mod:`rockjit.plugs.base`).
 
 A pulse is given, as in the rocking literature (Zhang & Makris 2001; Dimitrakopoulos & DeJong
 2012), by two dimensionless ratios: its frequency against the block's frequency parameter,
@@ -8,6 +9,11 @@ A pulse is given, as in the rocking literature (Zhang & Makris 2001; Dimitrakopo
 acceleration in ``g`` is ``a_p / g = amplitude / hb``: the pulse needs the block's slenderness to
 become a base acceleration. :meth:`Pulse.bind` gives it the block's; the forms of
 docs/theory/ground-motions.md then hold.
+
+The compiled side, :func:`pulse_value` and :func:`pulse_window`, is what the compiled transient
+kernel runs (the windows in closed form for the sine and cosine, by bisection to adjacent floats
+on the Ricker wavelet's lobes); the Python side (:meth:`Pulse.scalar`, :meth:`Pulse.windows`,
+the lobes by Brent's method) is what the scipy reference path runs, written apart from it.
 """
 
 from __future__ import annotations
@@ -17,14 +23,18 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..excitation import ACCEL_MAX, Excitation
+from .._jit import jit
+from ..excitation import ACCEL_MAX
 from ..model import HB_RANGE
 from ..validate import choice, real
+from .base import TransientPlug, register
 
-__all__ = ["KINDS", "P_MODEL", "Pulse", "RATIO_RANGE", "AMPLITUDE_MAX"]
+__all__ = ["AMPLITUDE_MAX", "H_PULSE", "KINDS", "MIN_PULSE_STEPS", "P_MODEL", "Pulse",
+           "RATIO_RANGE", "pulse_value", "pulse_window"]
 
-#: The pulses, in the order of their codes (the compiled kernel's ``kind``).
+#: The pulses' shapes, in the order of their codes among the plug's coefficients.
 KINDS = ("sine", "cosine", "ricker")
+SINE, COSINE, RICKER = range(3)
 #: Housner's frequency parameter ``p = sqrt(3 g / 4 R)`` in model units (``1/sqrt(R/g)``).
 P_MODEL = math.sqrt(0.75)
 #: Allowed ranges of the ratios: wide, and keeping the model-unit frequency within the range
@@ -35,10 +45,99 @@ AMPLITUDE_MAX = 1e6
 #: value at ``t = 0`` below ``1e-8 a_p`` (docs/theory/ground-motions.md); the wavelet is cut at
 #: ``2 t0``, where it is as small again.
 RICKER_DELAY = 3.0
+#: The compiled kernel's longest step during a pulse (model time).
+H_PULSE = 0.01
+#: The fewest steps the compiled kernel takes per pulse (a short pulse still has its shape
+#: resolved).
+MIN_PULSE_STEPS = 256
 
 
+# ---- the compiled side --------------------------------------------------------------------------
+
+@jit(nrt=False)
+def pulse_value(t, a, c, off, n):
+    """The pulse of peak ``a`` (``g``) at model time ``t`` inside it, from its coefficients
+    ``c[off:off + 3]``: the shape's code, ``omega_p`` and the Ricker wavelet's delay."""
+    shape = int(c[off])
+    w = c[off + 1]
+    if shape == SINE:
+        return a * math.sin(w * t)
+    if shape == COSINE:
+        return a * math.cos(w * t)
+    u = 0.5 * w * (t - c[off + 2])
+    u2 = u * u
+    return a * (1.0 - 2.0 * u2) * math.exp(-u2)
+
+
+@jit(nrt=False)
+def _ricker_root(r, lo, hi, lobe):
+    """The ``u`` in ``[lo, hi]`` where the Ricker shape ``g(u) = (1 - 2u^2) exp(-u^2)`` meets
+    ``r`` (``lobe`` 1: the main lobe, ``g = r``; -1: a side lobe, ``-g = r``), by bisection to
+    adjacent floats."""
+    glo = lobe * (1.0 - 2.0 * lo * lo) * math.exp(-lo * lo) - r
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
+        g = lobe * (1.0 - 2.0 * mid * mid) * math.exp(-mid * mid) - r
+        if g == 0.0:
+            return mid
+        if (g > 0.0) == (glo > 0.0):
+            lo, glo = mid, g
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+@jit(nrt=False, inline=True)
+def _first_after(tq, a0, a1, sa, b0, b1, sb, c0, c1, sc):
+    """The first of the windows ``(a0, a1, sa)``, ``(b0, b1, sb)``, ``(c0, c1, sc)`` (in order;
+    a sign 0 for none) that ends after ``tq``; ``(0, 0, 0)`` if none does."""
+    if sa != 0.0 and a1 > tq:
+        return a0, a1, sa
+    if sb != 0.0 and b1 > tq:
+        return b0, b1, sb
+    if sc != 0.0 and c1 > tq:
+        return c0, c1, sc
+    return 0.0, 0.0, 0.0
+
+
+@jit(nrt=False)
+def pulse_window(tq, end, a, c, off, n, thr):
+    """The first interval ``(t0, t1, sign f)`` where the pulse of peak ``a`` has
+    ``|f| > thr`` and ``t1 > tq`` (``sign`` 0 if none): of the sine's two and the cosine's three
+    half-waves in closed form, of the Ricker wavelet's main lobe and side lobes by bisection."""
+    if not a > thr:
+        return 0.0, 0.0, 0.0
+    r = thr / a
+    shape = int(c[off])
+    w = c[off + 1]
+    if shape == SINE:
+        s = math.asin(r)
+        return _first_after(tq, s / w, (math.pi - s) / w, 1.0,
+                            (math.pi + s) / w, (2.0 * math.pi - s) / w, -1.0, 0.0, 0.0, 0.0)
+    if shape == COSINE:
+        q = math.acos(r)
+        return _first_after(tq, 0.0, q / w, 1.0, (math.pi - q) / w, (math.pi + q) / w, -1.0,
+                            (2.0 * math.pi - q) / w, 2.0 * math.pi / w, 1.0)
+    t0 = c[off + 2]
+    um = _ricker_root(r, 0.0, math.sqrt(0.5), 1.0)
+    if r < 2.0 * math.exp(-1.5):  # deeper than the side lobes
+        ui = _ricker_root(r, math.sqrt(0.5), math.sqrt(1.5), -1.0)
+        uo = _ricker_root(r, math.sqrt(1.5), 10.0, -1.0)
+        return _first_after(tq, t0 + 2.0 * -uo / w, t0 + 2.0 * -ui / w, -1.0,
+                            t0 + 2.0 * -um / w, t0 + 2.0 * um / w, 1.0,
+                            t0 + 2.0 * ui / w, t0 + 2.0 * uo / w, -1.0)
+    return _first_after(tq, t0 + 2.0 * -um / w, t0 + 2.0 * um / w, 1.0,
+                        0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+# ---- the excitation -----------------------------------------------------------------------------
+
+
+@register
 @dataclass(frozen=True)
-class Pulse(Excitation):
+class Pulse(TransientPlug):
     """An acceleration pulse on the base, in the literature's ratios.
 
     Parameters
@@ -84,9 +183,26 @@ class Pulse(Excitation):
             raise ValueError(f"the pulse's peak acceleration amplitude / hb must be <= "
                              f"{ACCEL_MAX:g} g (got {self.amplitude:g} / {self.hb:g})")
 
-    # ---- what every excitation says -----------------------------------------------------
-    transient = True
+    value = staticmethod(pulse_value)
+    window = staticmethod(pulse_window)
 
+    # ---- the compiled kernel's side ------------------------------------------------------
+    def coefficients(self):
+        """The shape's code, ``omega_p`` and the Ricker wavelet's delay."""
+        return np.array([KINDS.index(self.kind), self.omega_p, self.delay], dtype=float)
+
+    def grid(self, shrink):
+        """Equal steps of at most ``H_PULSE`` (times ``shrink``) over the pulse, at least
+        ``MIN_PULSE_STEPS`` of them."""
+        return max(MIN_PULSE_STEPS, math.ceil(self.end / (shrink * H_PULSE))), 0.0
+
+    def amplitude_at(self, gains):
+        """The peak acceleration in ``g`` of this pulse ``gains`` times stronger, as
+        :meth:`scaled` then :attr:`accel` form it: ``amplitude * gain / hb``."""
+        self._need("amplitude", "hb")
+        return self.amplitude * np.asarray(gains, dtype=float) / self.hb
+
+    # ---- what every transient excitation says --------------------------------------------
     def bind(self, block):
         """This pulse on ``block``: its slenderness set (refused if another was given)."""
         if self.hb is not None and self.hb != block.hb:

@@ -36,12 +36,13 @@ PUBLIC_MODULES = [
     "rockjit.orbits.shooting", "rockjit.orbits.arclength",
     "rockjit.orbits.types", "rockjit.grids.identity", "rockjit.grids.cycles",
     "rockjit.orbits.curves", "rockjit.orbits.curve_types", "rockjit.orbits.bifurcation_curve",
-    "rockjit.orbits.plane_chart", "rockjit.ground.pulses",
+    "rockjit.orbits.plane_chart",
     "rockjit.ground.records", "rockjit.ground.fema", "rockjit.ground.settings",
     "rockjit.ground.response", "rockjit.ground.spectrum", "rockjit.ground.fitting",
     "rockjit.ground.fragility", "rockjit.reprs", "rockjit.laws", "rockjit.laws.base",
     "rockjit.laws.housner", "rockjit.laws.mao", "rockjit.laws.constant", "rockjit.laws.speed",
     "rockjit.plugs", "rockjit.plugs.base", "rockjit.plugs.harmonic_sum",
+    "rockjit.plugs.pulse", "rockjit.plugs.record",
 ]
 if importlib.util.find_spec("bokeh") is not None:  # the explorer's example starts its server
     PUBLIC_MODULES.append("rockjit.explorer")

@@ -351,10 +351,11 @@ def test_transient_figure():
     np.testing.assert_allclose(line.get_ydata(), r.trajectory[:, 1] / r.alpha_s)
 
 
-@pytest.mark.parametrize("module", ["pulses", "records", "settings", "spectrum", "fitting"])
+@pytest.mark.parametrize("module", ["plugs.pulse", "plugs.record", "ground.records",
+                                    "ground.settings", "ground.spectrum", "ground.fitting"])
 def test_the_examples_in_the_docstrings_run(module):
     import doctest
     import importlib
-    mod = importlib.import_module(f"rockjit.ground.{module}")
+    mod = importlib.import_module(f"rockjit.{module}")
     result = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert result.attempted > 0 and result.failed == 0
