@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -33,6 +34,7 @@ from ..result import BEHAVIOURS
 from ..settings import Execution, Integration
 from ..single import DEFAULT_N, classify_result, simulate
 from ..validate import integer, memory, pair, real
+from .runs import drawn_arrays, exponents, floquet_of_run, laws_captions, outcome_words
 from .settings import (  # noqa: F401  (the study's settings, by their names here too)
     Z0, STUDY, ALPHA_STEP, PERIODS, WINDOW, ZOOM, REFERENCE_RUN, GALLERY, TRANSIENT_CHAOS,
     FATE_ENSEMBLE, LAWS_RUN, LAWS_IC, BASIN_CASES, BASIN_GRID, EROSION, EROSION_STEP,
@@ -209,122 +211,9 @@ def after_the_fall(sw):
                                        for a in found])
 
 
-
 # ---------------------------------------------------------------------------------------------
 # the pipeline
 # ---------------------------------------------------------------------------------------------
-
-
-
-def _describe(out, name, holds):
-    if hasattr(out, "describe"):
-        out.describe(name, holds)
-
-
-def _figure(out, name, fig, holds):
-    """Write a figure (in ``out``'s format), describe it; returns the name written."""
-    written = out.figure(name, fig)
-    written = written if isinstance(written, str) else name
-    _describe(out, written, holds)
-    return written
-
-
-def _npz(out, name, holds, **arrays):
-    out.npz(name, **arrays)
-    _describe(out, name, holds)
-    return name
-
-
-def _table(out, stem, header, rows, fmt, holds):
-    out.table(stem, header, rows, fmt)
-    for ext in ("csv", "md"):
-        _describe(out, f"{stem}.{ext}", holds)
-
-
-def _phase_of(res):
-    """The forcing phase of a run (its stroboscopic samples carry ``r, s`` at ``t = 0``)."""
-    return math.atan2(float(res.strobe[0, 2]), float(res.strobe[0, 3]))
-
-
-def floquet_of_run(res, behaviour):
-    """The Floquet exponent ``ln|mu1| / (pT)`` of the periodic orbit a run settled on (its
-    last cycle point), or ``nan`` when it did not settle on one."""
-    from ..grids.identity import floquet
-    name, p = behaviour
-    if name not in ("symmetric", "asymmetric", "multiperiodic") or p < 1 or \
-            res.strobe.shape[0] <= p:
-        return math.nan
-    f = res.forcing
-    _, lam = floquet(res.block, Harmonic(alpha=f.alpha, omega=f.omega), _phase_of(res),
-                     res.integration, res.n_steps, res.strobe[-1, :2], p)
-    return float(lam[0])
-
-
-def _exponents(res, behaviour, exact=None):
-    """A run's ``lambda_max`` as the grids report it: the Floquet exponent of the periodic orbit
-    it settled on (exact), else the window's estimate, kept as ``lambda_window``."""
-    exact = floquet_of_run(res, behaviour) if exact is None else exact
-    return dict(lambda_max=exact if math.isfinite(exact) or exact == -math.inf
-                else res.lambda_max, lambda_window=res.lambda_max)
-
-
-def _drawn(res, prefix, first=FIRST_PERIODS, last=LAST_PERIODS):
-    """The arrays a time-series figure draws of one run: ``theta(t)`` over its first and last
-    periods and the phase portrait's stretch, impacts inserted (``t, theta, dtheta``), and its
-    stroboscopic samples."""
-    from ..plotting.timeseries import with_impacts
-    T = res.period
-    t_w = res.window[0] if res.window is not None else 0.8 * res.periods * T
-    out = {}
-    for what, (t0, t1) in (("first", (0.0, first * T)), ("last", (res.t - last * T, res.t)),
-                           ("phase", (t_w if res.t > t_w + T else 0.0, res.t))):
-        t, th, dth = with_impacts(res, t0, t1)
-        out.update({f"{prefix}{what}_t": t, f"{prefix}{what}_theta": th,
-                    f"{prefix}{what}_dtheta": dth})
-    out[f"{prefix}strobe"] = res.strobe[:, :2]
-    out[f"{prefix}impacts"] = res.impacts
-    return out
-
-
-def _outcome_words(probabilities):
-    from ..plotting.fates import _outcome_names
-    words, _ = _outcome_names(list(probabilities))
-    return ", ".join(f"{words[k]} {v:.0%}" for k, v in probabilities.items())
-
-
-def _same_orbit(a, b, behaviour_a, behaviour_b, tol=1e-4):
-    """Two runs of one system that settled on the same periodic orbit (cycles within ``tol``
-    of their size, any shift)."""
-    from ..grids.cycles import cycle_distance, cycle_size
-    if behaviour_a != behaviour_b or behaviour_a[0] not in ("symmetric", "asymmetric",
-                                                            "multiperiodic"):
-        return False
-    p = behaviour_a[1]
-    ca, cb = a.strobe[-p:, :2], b.strobe[-p:, :2]
-    return bool(cycle_distance(ca, cb) <= tol * max(cycle_size(ca), cycle_size(cb), 1e-12))
-
-
-def laws_captions(rows, behaviours):
-    """The line under each row of figure 4: what each law's run does, and which rows reach the
-    same orbit."""
-    from ..plotting.style import law_name
-    letters = "abcdefgh"
-    caps = []
-    for i, row in enumerate(rows):
-        parts = []
-        for law, res in row.items():
-            beh = behaviours[i][law]
-            name, p = beh
-            what = (f"overturns at $t = {res.t:.3g}$" if res.status == "overturned" else
-                    f"comes to rest at $t = {res.t:.3g}$" if res.status == "rest" else
-                    f"settles on a {name} period-{p} orbit" if p else f"is {name}")
-            same = [letters[j] for j, other in enumerate(rows) if j != i and
-                    law in other and _same_orbit(res, other[law], beh, behaviours[j][law])]
-            if same:
-                what += f" (the one of row{'s' if len(same) > 1 else ''} {', '.join(same)})"
-            parts.append(f"{law_name(res.block)} {what}")
-        caps.append("; ".join(parts) + ".")
-    return caps
 
 
 def paper(out, plan=None, *, execution=None, say=None):
@@ -348,350 +237,475 @@ def paper(out, plan=None, *, execution=None, say=None):
     say : callable, optional
         ``say(message)`` for one line of progress per part.
     """
-    from ..grids.identity import agreement, attractor_agreement
-    from ..orbits import continue_branches
-    from ..plotting.basins import fig_attractors, fig_basin_compare, fig_erosion
-    from ..plotting.branches import branch_caption, fig_branches
-    from ..plotting.forcing import fig_bifurcation
-    from ..plotting.timeseries import fig_gallery, fig_laws_timeseries, fig_trajectory
-    from ..plotting.style import attractor_names
     from . import report
 
-    p = plan_paper() if plan is None else plan
-    execution = Execution() if execution is None else execution
-    say = say or (lambda msg: None)
-    walls = {}
-    results = {}
-    figures = {}  # figure number -> names written, for the report
-    n_parts = 8
-    basins_done = {}
-    integration = Integration(periods=p.periods, n_steps=p.n_steps)
-    run_kw = dict(integration=integration, record_stride=p.stride, lyapunov=True)
+    pp = _Paper(out, plan_paper() if plan is None else plan,
+                Execution() if execution is None else execution, say or (lambda msg: None))
     t_all = time.perf_counter()
+    for part in (_fig1_restitution, _fig2_reference, _fig3_gallery, _fig4_laws,
+                 _fig5_diagrams, _fig6_basins, _fig7_attractors, _fig8_erosion, _fig9_plane):
+        part(pp)
+    p, results = pp.plan, pp.results
+    results.update(wall_s_parts=pp.walls, zoom_step=p.zoom_step, record_stride=p.stride,
+                   grid=p.grid, erosion_grid=p.erosion_grid, erosion_step=p.erosion_step,
+                   total_s=time.perf_counter() - t_all)
+    results["published"] = report.published_beside(results)
+    report.write_index(out, results, pp.figures, p)
+    return results
 
-    def within(name):
+
+class _Paper:
+    """One paper in the making: its plan, where its files go and how it says its progress, and
+    what it has made so far (the results, each figure's names as written, each part's wall
+    time, the basins that figure 7 maps again)."""
+
+    N_PARTS = 8
+
+    def __init__(self, out, plan, execution, say):
+        self.out, self.plan, self.execution, self.say = out, plan, execution, say
+        self.walls, self.results, self.basins = {}, {}, {}
+        self.figures = {}  # figure number -> names written, for the report
+        self.integration = Integration(periods=plan.periods, n_steps=plan.n_steps)
+        self.run_kw = dict(integration=self.integration, record_stride=plan.stride,
+                           lyapunov=True)
+        self.every_step = dict(self.run_kw, record_stride=1)  # short windows are drawn
+
+    def within(self, name):
         """The execution of one grid: its own chunk store beneath the paper's."""
-        store = execution.store
-        return execution.replace(store=None if store is None else Path(store) / name)
+        store = self.execution.store
+        return self.execution.replace(store=None if store is None else Path(store) / name)
 
-    def grid(gp, name):
-        return run_grid(gp, within(name))
+    def grid(self, gp, name):
+        """Run one planned grid in its own chunk store."""
+        return run_grid(gp, self.within(name))
 
-    def part(i, name, what):
-        say(f"paper [{i}/{n_parts}] {name}: {what}")
-        return time.perf_counter()
+    @contextmanager
+    def part(self, i, name, what):
+        """One part of the paper: its progress line, and its wall time once it is done."""
+        self.say(f"paper [{i}/{self.N_PARTS}] {name}: {what}")
+        t0 = time.perf_counter()
+        yield
+        self.walls[name] = time.perf_counter() - t0
+        self.say(f"paper: {name} done in {self.walls[name]:.1f} s")
 
-    def done(name, t0):
-        walls[name] = time.perf_counter() - t0
-        say(f"paper: {name} done in {walls[name]:.1f} s")
+    def describe(self, name, holds):
+        """Say what a file holds (the summary's manifest), where ``out`` keeps one."""
+        if hasattr(self.out, "describe"):
+            self.out.describe(name, holds)
 
-    t0 = part(1, "fig1", "restitution laws and the e-table")
-    results["e_table"] = write_e_table(out, E_TABLE_HB, E_FIGURE_HB_MAX, "fig1_restitution.png",
-                                       "e_table")
-    figures[1] = [n for n in out.written if n.startswith("fig1_") and not n.endswith(".npz")]
-    done("fig1", t0)
+    def figure(self, name, fig, holds):
+        """Write a figure (in ``out``'s format), describe it; returns the name written."""
+        written = self.out.figure(name, fig)
+        written = written if isinstance(written, str) else name
+        self.describe(written, holds)
+        return written
 
-    t0 = part(2, "fig2", "reference run alpha=0.6, omega=1.3, hb=1, Housner")
-    ref = simulate(Block(hb=REFERENCE_RUN["hb"], law=REFERENCE_RUN["law"]),
-                   Harmonic(alpha=REFERENCE_RUN["alpha"], omega=REFERENCE_RUN["omega"]),
-                   **run_kw)
-    beh = classify_result(ref)
-    exact = floquet_of_run(ref, beh)
-    tr = ref.trajectory
-    _npz(out, "fig2_reference.npz", "figure 2's run: t, theta, dtheta (recorded trajectory), "
-         "strobe (theta, theta', r, s at kT), impacts (t, theta'-, theta'+), lyapunov_running "
-         "(lambda1, lambda2 at kT)", t=tr[:, 0], theta=tr[:, 1], dtheta=tr[:, 2],
-         strobe=ref.strobe, impacts=ref.impacts, lyapunov_running=ref.lyapunov_running)
-    figures[2] = [_figure(out, "fig2_reference.png",
-                          fig_trajectory(ref, beh, exponent=exact, first=FIRST_PERIODS,
-                                         last=LAST_PERIODS),
-                          "figure 2: the reference run's theta(t) (first and last periods), "
-                          "running exponent and phase portrait (data: fig2_reference.npz)")]
-    results["fig2"] = dict(status=ref.status, behaviour=beh[0], period=beh[1],
-                           **_exponents(ref, beh, exact), lyapunov=ref.lyapunov)
-    done("fig2", t0)
+    def npz(self, name, holds, **arrays):
+        """Write a figure's data, describe it; returns its name."""
+        self.out.npz(name, **arrays)
+        self.describe(name, holds)
+        return name
 
-    t0 = part(3, "fig3", "behaviour gallery")
-    one = dict(run_kw, record_stride=1)  # short windows are drawn: every step
-    gal = {k: simulate(Block(hb=hb), Harmonic(alpha=alpha, omega=omega, r0=pt[0], s0=pt[1]),
-                       state, **one)
-           for k, (hb, alpha, omega, state, pt) in GALLERY.items()}
-    gal_beh = {k: classify_result(r) for k, r in gal.items()}
-    # the study's "multiperiodic" example is transient chaos: its fate, with either forcing,
-    # is a probability over initial states within round-off of z0
+    def table(self, stem, header, rows, fmt, holds):
+        """Write a table as CSV and Markdown, describe both."""
+        self.out.table(stem, header, rows, fmt)
+        for ext in ("csv", "md"):
+            self.describe(f"{stem}.{ext}", holds)
+
+
+def _fig1_restitution(pp):
+    """Figure 1 and the restitution table."""
+    with pp.part(1, "fig1", "restitution laws and the e-table"):
+        pp.results["e_table"] = write_e_table(pp.out, E_TABLE_HB, E_FIGURE_HB_MAX,
+                                              "fig1_restitution.png", "e_table")
+        pp.figures[1] = [n for n in pp.out.written if n.startswith("fig1_") and
+                         not n.endswith(".npz")]
+
+
+def _fig2_reference(pp):
+    """Figure 2: the reference run with its data, behaviour and exponents."""
+    from ..plotting.timeseries import fig_trajectory
+    with pp.part(2, "fig2", "reference run alpha=0.6, omega=1.3, hb=1, Housner"):
+        ref = simulate(Block(hb=REFERENCE_RUN["hb"], law=REFERENCE_RUN["law"]),
+                       Harmonic(alpha=REFERENCE_RUN["alpha"], omega=REFERENCE_RUN["omega"]),
+                       **pp.run_kw)
+        beh = classify_result(ref)
+        exact = floquet_of_run(ref, beh)
+        tr = ref.trajectory
+        pp.npz("fig2_reference.npz", "figure 2's run: t, theta, dtheta (recorded trajectory), "
+               "strobe (theta, theta', r, s at kT), impacts (t, theta'-, theta'+), "
+               "lyapunov_running (lambda1, lambda2 at kT)", t=tr[:, 0], theta=tr[:, 1],
+               dtheta=tr[:, 2], strobe=ref.strobe, impacts=ref.impacts,
+               lyapunov_running=ref.lyapunov_running)
+        pp.figures[2] = [pp.figure("fig2_reference.png",
+                                   fig_trajectory(ref, beh, exponent=exact, first=FIRST_PERIODS,
+                                                  last=LAST_PERIODS),
+                                   "figure 2: the reference run's theta(t) (first and last "
+                                   "periods), running exponent and phase portrait (data: "
+                                   "fig2_reference.npz)")]
+        pp.results["fig2"] = dict(status=ref.status, behaviour=beh[0], period=beh[1],
+                                  **exponents(ref, beh, exact), lyapunov=ref.lyapunov)
+
+
+def _fig3_gallery(pp):
+    """Figure 3: the behaviour gallery with its data, and the fates of its transient chaos."""
+    from ..plotting.timeseries import fig_gallery
+    with pp.part(3, "fig3", "behaviour gallery"):
+        gal = {k: simulate(Block(hb=hb), Harmonic(alpha=alpha, omega=omega, r0=pt[0],
+                                                  s0=pt[1]), state, **pp.every_step)
+               for k, (hb, alpha, omega, state, pt) in GALLERY.items()}
+        gal_beh = {k: classify_result(r) for k, r in gal.items()}
+        fates = _transient_chaos_fates(pp)
+        note = (f"over {FATE_ENSEMBLE} runs within $10^{{-10}}$ of $z_0$: closed form: "
+                f"{outcome_words(fates['closed'].probabilities)}; embedded: "
+                f"{outcome_words(fates['embedded'].probabilities)}")
+        arrays = {}
+        for i, (k, r) in enumerate(gal.items()):
+            arrays.update(drawn_arrays(r, f"c{i}_"))
+        arrays["cases"] = np.array(list(gal), dtype=str)
+        arrays["params"] = np.array([[hb, a, w] for hb, a, w, _, _ in GALLERY.values()])
+        pp.npz("fig3_gallery.npz", "figure 3's runs, case i = cases[i] (hb, alpha, omega in "
+               "params[i]): c{i}_first_*, c{i}_last_*, c{i}_phase_* (t, theta, dtheta with "
+               "impacts inserted) as drawn, c{i}_strobe, c{i}_impacts", **arrays)
+        pp.figures[3] = [pp.figure("fig3_gallery.png",
+                                   fig_gallery(gal, gal_beh, notes={TRANSIENT_CHAOS: note},
+                                               first=FIRST_PERIODS, last=LAST_PERIODS),
+                                   "figure 3: the behaviour gallery, one row per case: "
+                                   "theta(t) over the first and last periods and the phase "
+                                   "portrait (data: fig3_gallery.npz)")]
+        pp.results["fig3_fates"] = {forcing: f.to_summary() for forcing, f in fates.items()}
+        pp.results["fig3"] = {k: dict(behaviour=gal_beh[k][0], period=gal_beh[k][1],
+                                      status=r.status, t_end=r.t, **exponents(r, gal_beh[k]),
+                                      state0=list(r.trajectory[0, 1:3]))
+                              for k, r in gal.items()}
+
+
+def _transient_chaos_fates(pp):
+    """The fates of the study's "multiperiodic" example, which is transient chaos: with either
+    forcing (closed form, embedded), a probability over initial states within round-off of
+    z0."""
     hb, alpha, omega, state, pt = GALLERY[TRANSIENT_CHAOS]
-    fates = {forcing: fate(Block(hb=hb), Harmonic(alpha=alpha, omega=omega, r0=pt[0], s0=pt[1],
-                                                  embedded=forcing == "embedded"),
-                           state, integration=integration, ensemble=FATE_ENSEMBLE,
-                           execution=within("fate").replace(store=None))
-             for forcing in ("closed", "embedded")}
-    note = (f"over {FATE_ENSEMBLE} runs within $10^{{-10}}$ of $z_0$: closed form: "
-            f"{_outcome_words(fates['closed'].probabilities)}; embedded: "
-            f"{_outcome_words(fates['embedded'].probabilities)}")
-    arrays = {}
-    for i, (k, r) in enumerate(gal.items()):
-        arrays.update(_drawn(r, f"c{i}_"))
-    arrays["cases"] = np.array(list(gal), dtype=str)
-    arrays["params"] = np.array([[hb, a, w] for hb, a, w, _, _ in GALLERY.values()])
-    _npz(out, "fig3_gallery.npz", "figure 3's runs, case i = cases[i] (hb, alpha, omega in "
-         "params[i]): c{i}_first_*, c{i}_last_*, c{i}_phase_* (t, theta, dtheta with impacts "
-         "inserted) as drawn, c{i}_strobe, c{i}_impacts", **arrays)
-    figures[3] = [_figure(out, "fig3_gallery.png",
-                          fig_gallery(gal, gal_beh, notes={TRANSIENT_CHAOS: note},
-                                      first=FIRST_PERIODS, last=LAST_PERIODS),
-                          "figure 3: the behaviour gallery, one row per case: theta(t) over "
-                          "the first and last periods and the phase portrait "
-                          "(data: fig3_gallery.npz)")]
-    results["fig3_fates"] = {forcing: f.to_summary() for forcing, f in fates.items()}
-    results["fig3"] = {k: dict(behaviour=gal_beh[k][0], period=gal_beh[k][1], status=r.status,
-                               t_end=r.t, **_exponents(r, gal_beh[k]),
-                               state0=list(r.trajectory[0, 1:3]))
-                       for k, r in gal.items()}
-    done("fig3", t0)
+    return {forcing: fate(Block(hb=hb), Harmonic(alpha=alpha, omega=omega, r0=pt[0], s0=pt[1],
+                                                 embedded=forcing == "embedded"),
+                          state, integration=pp.integration, ensemble=FATE_ENSEMBLE,
+                          execution=pp.within("fate").replace(store=None))
+            for forcing in ("closed", "embedded")}
 
-    t0 = part(4, "fig4", "Housner vs Mao time series, alpha=0.2, omega=1.6, hb=2")
-    rows = [{law: simulate(Block(hb=LAWS_RUN["hb"], law=law),
-                           Harmonic(alpha=LAWS_RUN["alpha"], omega=LAWS_RUN["omega"], r0=0.0,
-                                    s0=1.0), (th0, dth0), **one)
-             for law in ("housner", "mao")} for th0, dth0 in LAWS_IC]
-    row_beh = [{law: classify_result(r) for law, r in row.items()} for row in rows]
-    captions = laws_captions(rows, row_beh)
-    arrays = {}
-    for i, row in enumerate(rows):
-        for law, r in row.items():
-            arrays.update(_drawn(r, f"r{i}_{law}_"))
-    arrays["initial_states"] = np.array(LAWS_IC)
-    _npz(out, "fig4_laws_timeseries.npz", "figure 4's runs, row i from initial_states[i], law "
-         "housner or mao: r{i}_{law}_first_*, _last_*, _phase_* (t, theta, dtheta with impacts "
-         "inserted) as drawn, _strobe, _impacts", **arrays)
-    figures[4] = [_figure(out, "fig4_laws_timeseries.png",
-                          fig_laws_timeseries(rows, row_beh, periods=LAWS_PERIODS),
-                          "figure 4: Housner against Mao et al. from three initial states "
-                          "(data: fig4_laws_timeseries.npz)")]
-    results["fig4"] = [{law: dict(behaviour=row_beh[i][law][0], period=row_beh[i][law][1],
-                                  status=r.status, t_end=r.t,
-                                  t_overturn=r.t if r.status == "overturned" else math.nan)
-                        for law, r in row.items()} | {"caption": captions[i]}
-                       for i, row in enumerate(rows)]
-    done("fig4", t0)
 
-    t0 = part(5, "fig5", "bifurcation sweeps (4 + zoom)")
-    sweeps = {}
-    sweep_rows = []
-    figures[5] = []
-    sweep_words = ("the sweep: alpha, label (codes into names), period, lambda_max (exact "
-                   "Floquet exponent where periodic), lambda_window (the study's finite-window "
-                   "estimate), strobe (theta, theta' at kT over the classified stretch), "
-                   "impact_section, t_end, attractor")
-    for (hb, law), gp in p.sweeps.items():
+def _fig4_laws(pp):
+    """Figure 4: both laws in time from each initial state, with their data and each row's
+    caption."""
+    from ..plotting.timeseries import fig_laws_timeseries
+    with pp.part(4, "fig4", "Housner vs Mao time series, alpha=0.2, omega=1.6, hb=2"):
+        rows = [{law: simulate(Block(hb=LAWS_RUN["hb"], law=law),
+                               Harmonic(alpha=LAWS_RUN["alpha"], omega=LAWS_RUN["omega"],
+                                        r0=0.0, s0=1.0), (th0, dth0), **pp.every_step)
+                 for law in ("housner", "mao")} for th0, dth0 in LAWS_IC]
+        row_beh = [{law: classify_result(r) for law, r in row.items()} for row in rows]
+        captions = laws_captions(rows, row_beh)
+        arrays = {}
+        for i, row in enumerate(rows):
+            for law, r in row.items():
+                arrays.update(drawn_arrays(r, f"r{i}_{law}_"))
+        arrays["initial_states"] = np.array(LAWS_IC)
+        pp.npz("fig4_laws_timeseries.npz", "figure 4's runs, row i from initial_states[i], "
+               "law housner or mao: r{i}_{law}_first_*, _last_*, _phase_* (t, theta, dtheta "
+               "with impacts inserted) as drawn, _strobe, _impacts", **arrays)
+        pp.figures[4] = [pp.figure("fig4_laws_timeseries.png",
+                                   fig_laws_timeseries(rows, row_beh, periods=LAWS_PERIODS),
+                                   "figure 4: Housner against Mao et al. from three initial "
+                                   "states (data: fig4_laws_timeseries.npz)")]
+        pp.results["fig4"] = [
+            {law: dict(behaviour=row_beh[i][law][0], period=row_beh[i][law][1],
+                       status=r.status, t_end=r.t,
+                       t_overturn=r.t if r.status == "overturned" else math.nan)
+             for law, r in row.items()} | {"caption": captions[i]}
+            for i, row in enumerate(rows)]
+
+
+#: What a sweep's data file holds (figure 5's files).
+_SWEEP_WORDS = ("the sweep: alpha, label (codes into names), period, lambda_max (exact "
+                "Floquet exponent where periodic), lambda_window (the study's finite-window "
+                "estimate), strobe (theta, theta' at kT over the classified stretch), "
+                "impact_section, t_end, attractor")
+
+
+def _fig5_diagrams(pp):
+    """Figure 5: the bifurcation sweeps and the zoom with their table, the branches of
+    periodic orbits over them, and (when planned) the diagrams as the study computed them."""
+    with pp.part(5, "fig5", "bifurcation sweeps (4 + zoom)"):
+        pp.figures[5] = []
+        sweeps, rows = _fig5_sweeps(pp)
+        zsw = _fig5_zoom(pp, rows)
+        _fig5_table(pp, sweeps, rows)
+        _fig5_branches(pp, sweeps, zsw)
+        if pp.plan.published:
+            _fig5_as_published(pp, sweeps)
+
+
+def _sweep_row(hb, law, alphas, sw):
+    """A sweep's row of the sweep table: its settings and the percent of each behaviour."""
+    fr = sw.fractions()
+    return [hb, law, STUDY[hb]["omega"], float(alphas[0]), float(alphas[-1]),
+            int(alphas.size)] + [fr[n] for n in BEHAVIOURS]
+
+
+def _fig5_sweeps(pp):
+    """Both laws' sweeps at each slenderness with their data, and figure 5's diagrams of them;
+    returns the sweeps and their rows of the sweep table."""
+    sweeps, rows = {}, []
+    for (hb, law), gp in pp.plan.sweeps.items():
         alphas = gp.axes["alpha"]
-        say(f"paper: sweep {law} hb={hb:g}, {alphas.size} amplitudes")
-        sw = sweeps[(hb, law)] = grid(gp, f"sweep_hb{hb}_{law}")
-        _npz(out, f"fig5_sweep_hb{hb}_{law}.npz", f"figure 5, {law} h/b = {hb}: " + sweep_words,
-             **sw.arrays())
-        fr = sw.fractions()
-        sweep_rows.append([hb, law, STUDY[hb]["omega"], float(alphas[0]), float(alphas[-1]),
-                           int(alphas.size)] + [fr[n] for n in BEHAVIOURS])
+        pp.say(f"paper: sweep {law} hb={hb:g}, {alphas.size} amplitudes")
+        sw = sweeps[(hb, law)] = pp.grid(gp, f"sweep_hb{hb}_{law}")
+        pp.npz(f"fig5_sweep_hb{hb}_{law}.npz", f"figure 5, {law} h/b = {hb}: " + _SWEEP_WORDS,
+               **sw.arrays())
+        rows.append(_sweep_row(hb, law, alphas, sw))
     for hb in STUDY:
-        figures[5].append(_figure(
-            out, f"fig5_bifurcation_hb{hb}.png",
+        pp.figures[5].append(pp.figure(
+            f"fig5_bifurcation_hb{hb}.png",
             draw_fig5({law: sweeps[(hb, law)] for law in ("housner", "mao")}, hb),
             f"figure 5: bifurcation diagrams of both laws at h/b = {hb} with lambda_max (data: "
             f"fig5_sweep_hb{hb}_housner.npz, fig5_sweep_hb{hb}_mao.npz)"))
+    return sweeps, rows
+
+
+def _fig5_zoom(pp, rows):
+    """Figure 5's zoom of the Housner h/b = 1 diagram with its data, its row appended to
+    ``rows``; returns its sweep."""
+    from ..plotting.forcing import fig_bifurcation
+    p = pp.plan
     zoom = p.zoom_sweep.axes["alpha"]
-    say(f"paper: zoom sweep Housner hb=1, {zoom.size} amplitudes")
-    zsw = grid(p.zoom_sweep, "sweep_zoom")
-    _npz(out, "fig5_sweep_zoom_hb1_housner.npz", "figure 5's zoom, Housner h/b = 1: "
-         + sweep_words, **zsw.arrays())
-    figures[5].append(_figure(
-        out, "fig5_bifurcation_zoom.png", fig_bifurcation(
+    pp.say(f"paper: zoom sweep Housner hb=1, {zoom.size} amplitudes")
+    zsw = pp.grid(p.zoom_sweep, "sweep_zoom")
+    pp.npz("fig5_sweep_zoom_hb1_housner.npz", "figure 5's zoom, Housner h/b = 1: "
+           + _SWEEP_WORDS, **zsw.arrays())
+    pp.figures[5].append(pp.figure(
+        "fig5_bifurcation_zoom.png", fig_bifurcation(
             zsw, alpha_limits=tuple(p.zoom),
             title=f"Zoom: Housner, $h/b = 1$, $\\omega = 1.3$, $\\alpha \\in "
                   f"[{p.zoom[0]:g}, {p.zoom[1]:g}]$"),
         "figure 5's zoom of the Housner h/b = 1 diagram (data: "
         "fig5_sweep_zoom_hb1_housner.npz)"))
-    fr = zsw.fractions()
-    sweep_rows.append([1, "housner (zoom)", STUDY[1]["omega"], float(zoom[0]),
-                       float(zoom[-1]), int(zoom.size)] + [fr[n] for n in BEHAVIOURS])
-    sweep_header = ["hb", "law", "omega", "alpha_start", "alpha_end", "n_alpha"] + \
+    rows.append(_sweep_row(1, "housner (zoom)", zoom, zsw))
+    return zsw
+
+
+def _fig5_table(pp, sweeps, rows):
+    """The sweep table (the percent of amplitudes of each behaviour) and the range of each
+    sweep's exponents, exact and of the window."""
+    header = ["hb", "law", "omega", "alpha_start", "alpha_end", "n_alpha"] + \
         [f"{n}_percent" for n in BEHAVIOURS]
-    _table(out, "sweep_table", sweep_header, sweep_rows,
-           {h: ".1f" for h in sweep_header[6:]} | {"omega": "g", "alpha_start": "g",
-                                                   "alpha_end": "g"},
-           "figure 5's sweeps: the percent of amplitudes of each behaviour")
-    results["fig5"] = [dict(zip(sweep_header, r)) for r in sweep_rows]
-    results["fig5_lambda"] = {
+    pp.table("sweep_table", header, rows,
+             {h: ".1f" for h in header[6:]} | {"omega": "g", "alpha_start": "g",
+                                               "alpha_end": "g"},
+             "figure 5's sweeps: the percent of amplitudes of each behaviour")
+    pp.results["fig5"] = [dict(zip(header, r)) for r in rows]
+    pp.results["fig5_lambda"] = {
         f"hb{hb}_{law}": dict(exact_min=_finite(sw.lambda_max, min),
                               exact_max=_finite(sw.lambda_max, max),
                               window_min=_finite(sw.lambda_window, min),
                               window_max=_finite(sw.lambda_window, max))
         for (hb, law), sw in sweeps.items()}
-    # the branches of periodic orbits over the diagrams, bifurcations located
-    bif_rows = []
-    conts = {}
-    figures["5b"] = []
+
+
+def _fig5_branches(pp, sweeps, zsw):
+    """The branches of periodic orbits over each diagram and over the zoom, and the table of
+    every located bifurcation."""
+    from ..plotting.branches import fig_branches
+    rows, conts = [], {}
+    pp.figures["5b"] = []
     for (hb, law), sw in sweeps.items():
-        say(f"paper: periodic orbits {law} hb={hb:g}, continued from the sweep's attractors")
-        conts[(hb, law)] = cont = continue_branches(Block(hb=float(hb), law=law),
-                                                    Harmonic(omega=STUDY[hb]["omega"]),
-                                                    STUDY[hb]["alpha_range"][law], sweep=sw)
-        stem = f"fig5_branches_hb{hb}_{law}"
-        summary_c, arrays_c = cont.to_summary()
-        _npz(out, f"{stem}.npz", f"the branches of {law} h/b = {hb}: per branch i "
-             f"branch{{i}}_value, _cycle (n, p, 2), _cycle_half, _multipliers, _stable, "
-             f"_impacts; the bifurcations bif_type, bif_value, bif_period, bif_multipliers",
-             **arrays_c)
-        out.text(f"{stem}.md", branch_caption(cont, f"Figure 5, periodic orbits"))
-        _describe(out, f"{stem}.md", f"the caption of {stem}: every bifurcation with its "
-                                     f"multipliers, every branch with where and why it stops")
-        figures["5b"].append(_figure(
-            out, f"{stem}.png", fig_branches(cont, sw),
-            f"periodic orbits of {law} h/b = {hb} continued over the sweep, stable solid and "
-            f"unstable dashed, bifurcations marked (data: {stem}.npz; list: {stem}.md)"))
+        conts[(hb, law)] = cont = _branches_of(pp, hb, law, sw)
         for bf in sorted(cont.bifurcations, key=lambda b: b.alpha):
             mu = sorted(np.abs(bf.multipliers), reverse=True)
-            bif_rows.append([hb, law, bf.type, bf.alpha, bf.period, mu[0], mu[1]])
-    figures["5b"].append(_figure(
-        out, "fig5_branches_zoom.png", fig_branches(conts[(1, "housner")], zsw,
-                                                    limits=tuple(p.zoom)),
+            rows.append([hb, law, bf.type, bf.alpha, bf.period, mu[0], mu[1]])
+    pp.figures["5b"].append(pp.figure(
+        "fig5_branches_zoom.png", fig_branches(conts[(1, "housner")], zsw,
+                                               limits=tuple(pp.plan.zoom)),
         "the Housner h/b = 1 branches over the zoom (data: fig5_branches_hb1_housner.npz, "
         "fig5_sweep_zoom_hb1_housner.npz; list: fig5_branches_hb1_housner.md)"))
-    bif_header = ["hb", "law", "type", "alpha", "period", "abs_mu1", "abs_mu2"]
-    _table(out, "bifurcation_table", bif_header, bif_rows,
-           {"hb": "g", "alpha": ".9f", "abs_mu1": ".4g", "abs_mu2": ".4g"},
-           "every located bifurcation: h/b, law, type, alpha, period, |mu1|, |mu2|")
-    results["bifurcations"] = [dict(zip(bif_header, r)) for r in bif_rows]
-    if p.published:
-        results["fig5_as_published"] = {}
-        for hb in STUDY:
-            cols = {}
+    header = ["hb", "law", "type", "alpha", "period", "abs_mu1", "abs_mu2"]
+    pp.table("bifurcation_table", header, rows,
+             {"hb": "g", "alpha": ".9f", "abs_mu1": ".4g", "abs_mu2": ".4g"},
+             "every located bifurcation: h/b, law, type, alpha, period, |mu1|, |mu2|")
+    pp.results["bifurcations"] = [dict(zip(header, r)) for r in rows]
+
+
+def _branches_of(pp, hb, law, sw):
+    """One diagram's branches of periodic orbits, continued from its sweep's attractors, with
+    their data, caption and figure; returns the continuation."""
+    from ..orbits import continue_branches
+    from ..plotting.branches import branch_caption, fig_branches
+    pp.say(f"paper: periodic orbits {law} hb={hb:g}, continued from the sweep's attractors")
+    cont = continue_branches(Block(hb=float(hb), law=law), Harmonic(omega=STUDY[hb]["omega"]),
+                             STUDY[hb]["alpha_range"][law], sweep=sw)
+    stem = f"fig5_branches_hb{hb}_{law}"
+    _, arrays = cont.to_summary()
+    pp.npz(f"{stem}.npz", f"the branches of {law} h/b = {hb}: per branch i "
+           f"branch{{i}}_value, _cycle (n, p, 2), _cycle_half, _multipliers, _stable, "
+           f"_impacts; the bifurcations bif_type, bif_value, bif_period, bif_multipliers",
+           **arrays)
+    pp.out.text(f"{stem}.md", branch_caption(cont, "Figure 5, periodic orbits"))
+    pp.describe(f"{stem}.md", f"the caption of {stem}: every bifurcation with its "
+                              f"multipliers, every branch with where and why it stops")
+    pp.figures["5b"].append(pp.figure(
+        f"{stem}.png", fig_branches(cont, sw),
+        f"periodic orbits of {law} h/b = {hb} continued over the sweep, stable solid and "
+        f"unstable dashed, bifurcations marked (data: {stem}.npz; list: {stem}.md)"))
+    return cont
+
+
+def _fig5_as_published(pp, sweeps):
+    """Figure 5 as the study computed it (integrated on past overturning) beside each law's
+    diagram, with what its points after the fall are."""
+    from ..plotting.forcing import fig_bifurcation
+    pp.results["fig5_as_published"] = {}
+    for hb in STUDY:
+        cols = {}
+        for law in ("housner", "mao"):
+            pp.say(f"paper: sweep {law} hb={hb:g} as published (past overturning)")
+            pub = pp.grid(pp.plan.published[(hb, law)], f"sweep_hb{hb}_{law}_published")
+            pp.npz(f"fig5_sweep_hb{hb}_{law}_as_published.npz",
+                   f"figure 5 as published, {law} h/b = {hb} (integrated on past "
+                   f"overturning): " + _SWEEP_WORDS + ", t_overturn, motion", **pub.arrays())
+            cols[law] = sweeps[(hb, law)]
+            cols[f"{law}, as published"] = pub
+            pp.results["fig5_as_published"][f"hb{hb}_{law}"] = after_the_fall(pub)
+        pp.figures[5].append(pp.figure(
+            f"fig5_bifurcation_hb{hb}_as_published.png", fig_bifurcation(
+                cols, title=f"$h/b = {hb}$, $\\omega = {STUDY[hb]['omega']}$: the "
+                            f"physical diagrams and the study's (integrated on past "
+                            f"$|\\theta| = \\pi/2$)"),
+            f"figure 5 at h/b = {hb} beside the study's way (integrated past overturning, "
+            f"its finite-window exponent) (data: fig5_sweep_hb{hb}_*_as_published.npz)"))
+
+
+def _basins_of(pp, hb, alpha, omega):
+    """Both laws' basins of one case, kept for figure 7; returns ``{law: BasinResult}``."""
+    bs = {}
+    for law in ("housner", "mao"):
+        pp.say(f"paper: basin {law} hb={hb:g} alpha={alpha:g} omega={omega:g}")
+        bs[law] = pp.grid(pp.plan.basins[(hb, law)], f"basin_hb{hb:g}_{law}")
+    pp.basins[(hb, alpha, omega)] = bs
+    return bs
+
+
+def _fig6_basins(pp):
+    """Figure 6: both laws' basins of each case with their data, where the laws agree, and the
+    basin table."""
+    from ..grids.identity import agreement
+    from ..plotting.basins import fig_basin_compare
+    p = pp.plan
+    with pp.part(6, "fig6", f"basins, {p.grid}x{p.grid} cells, both laws, two cases"):
+        rows = []
+        pp.results["fig6"] = []
+        pp.figures[6] = []
+        for hb, alpha, omega in BASIN_CASES:
+            bs = _basins_of(pp, hb, alpha, omega)
+            agree = agreement(bs["housner"].label, bs["mao"].label)
+            tag = f"hb{hb:g}"
+            pp.npz(f"fig6_basin_{tag}.npz", f"figure 6, h/b = {hb:g}: theta0, dtheta0, "
+                   f"label_housner, label_mao (label[i, j] of theta0[i], dtheta0[j]), names",
+                   theta0=bs["housner"].theta0, dtheta0=bs["housner"].dtheta0,
+                   label_housner=bs["housner"].label, label_mao=bs["mao"].label,
+                   names=np.asarray(bs["housner"].names, dtype=str))
+            pp.figures[6].append(pp.figure(f"fig6_basin_{tag}.png",
+                                           fig_basin_compare(bs["housner"], bs["mao"]),
+                                           f"figure 6: basins of both laws at h/b = {hb:g} and "
+                                           f"where they agree (data: fig6_basin_{tag}.npz)"))
+            entry = dict(hb=hb, alpha=alpha, omega=omega, agreement=agree)
+            for law, b in bs.items():
+                fr = b.fractions()
+                entry[law] = dict(fractions=fr)
+                rows.append([hb, alpha, omega, law] + [fr[n] for n in BEHAVIOURS] + [agree])
+            pp.results["fig6"].append(entry)
+        header = ["hb", "alpha", "omega", "law"] + [f"{n}_percent" for n in BEHAVIOURS] + \
+            ["agreement_percent"]
+        pp.table("basin_table", header, rows,
+                 {h: ".1f" for h in header[4:]} | {"hb": "g", "alpha": "g", "omega": "g"},
+                 "figure 6's basins: percent of each behaviour per law, and the laws' agreement")
+
+
+def _attractor_arrays(bs):
+    """Figure 7's data of one case: the cells' initial states and, per law, each cell's
+    attractor and each attractor's name, behaviour, period and fraction."""
+    from ..plotting.style import attractor_names
+    arrays = dict(theta0=bs["housner"].theta0, dtheta0=bs["housner"].dtheta0)
+    for law, b in bs.items():
+        arrays[f"attractor_{law}"] = b.attractor
+        arrays[f"names_{law}"] = np.array(attractor_names(b.attractors), dtype=str)
+        arrays[f"behaviour_{law}"] = np.array([a.behaviour for a in b.attractors], dtype=str)
+        arrays[f"period_{law}"] = np.array([a.period for a in b.attractors], dtype=np.int64)
+        arrays[f"fraction_{law}"] = np.array([a.fraction for a in b.attractors])
+    return arrays
+
+
+def _fig7_attractors(pp):
+    """Figure 7: the attractor maps of figure 6's basins with their data, entropy and
+    integrity, and the attractor table."""
+    from ..grids.identity import attractor_agreement
+    from ..plotting.basins import fig_attractors
+    from ..plotting.style import attractor_names
+    with pp.part(7, "fig7", "attractor maps of the basins, their entropy and integrity"):
+        rows = []
+        pp.results["fig7"] = []
+        pp.figures[7] = []
+        for hb, alpha, omega in BASIN_CASES:
+            bs = pp.basins[(hb, alpha, omega)]
+            ms = {law: b.measures() for law, b in bs.items()}
+            tag = f"hb{hb:g}"
+            pp.npz(f"fig7_attractors_{tag}.npz", f"figure 7, h/b = {hb:g}: theta0, dtheta0, "
+                   f"per law attractor_<law> (ids: >= 0 the attractor, -1 overturn, -2 "
+                   f"unresolved), names_<law>, behaviour_<law>, period_<law>, fraction_<law> "
+                   f"by id", **_attractor_arrays(bs))
+            pp.figures[7].append(pp.figure(f"fig7_attractors_{tag}.png", fig_attractors(bs, ms),
+                                           f"figure 7: the attractor each initial state reaches "
+                                           f"at h/b = {hb:g}, by name, with basin entropy and "
+                                           f"integrity (data: fig7_attractors_{tag}.npz)"))
+            agree = attractor_agreement(bs["housner"], bs["mao"])
+            entry = dict(hb=hb, alpha=alpha, omega=omega, attractor_agreement=agree)
+            for law, b in bs.items():
+                m = ms[law]
+                entry[law] = dict(attractors=[dict(a.to_dict(), name=n) for a, n in
+                                              zip(b.attractors, attractor_names(b.attractors))],
+                                  **m)
+                rows.append([hb, alpha, omega, law, len(b.attractors), m["basin_entropy"],
+                             m["boundary_basin_entropy"], m["uncertainty_exponent"]["alpha"],
+                             m["integrity"]["GIM"], m["integrity"]["IF"], agree["percent"]])
+            pp.results["fig7"].append(entry)
+        pp.table("attractor_table", ATTRACTOR_HEADER, rows,
+                 {h: ".3f" for h in ATTRACTOR_HEADER[5:]} | {"hb": "g", "alpha": "g",
+                                                             "omega": "g"},
+                 "figure 7's measures: attractors, basin entropy, boundary basin entropy, "
+                 "uncertainty exponent, GIM, IF, the laws' attractor agreement")
+
+
+def _fig8_erosion(pp):
+    """Figure 8: both laws' erosion profiles at each slenderness, with their data."""
+    from ..plotting.basins import fig_erosion
+    from ..plotting.style import attractor_names
+    with pp.part(8, "fig8", "erosion profiles, both laws, hb = 1 and 2"):
+        pp.results["fig8"] = {}
+        pp.figures[8] = []
+        for hb in EROSION:
+            prof = {}
             for law in ("housner", "mao"):
-                say(f"paper: sweep {law} hb={hb:g} as published (past overturning)")
-                pub = grid(p.published[(hb, law)], f"sweep_hb{hb}_{law}_published")
-                _npz(out, f"fig5_sweep_hb{hb}_{law}_as_published.npz",
-                     f"figure 5 as published, {law} h/b = {hb} (integrated on past "
-                     f"overturning): " + sweep_words + ", t_overturn, motion", **pub.arrays())
-                cols[law] = sweeps[(hb, law)]
-                cols[f"{law}, as published"] = pub
-                results["fig5_as_published"][f"hb{hb}_{law}"] = after_the_fall(pub)
-            figures[5].append(_figure(
-                out, f"fig5_bifurcation_hb{hb}_as_published.png", fig_bifurcation(
-                    cols, title=f"$h/b = {hb}$, $\\omega = {STUDY[hb]['omega']}$: the "
-                                f"physical diagrams and the study's (integrated on past "
-                                f"$|\\theta| = \\pi/2$)"),
-                f"figure 5 at h/b = {hb} beside the study's way (integrated past overturning, "
-                f"its finite-window exponent) (data: fig5_sweep_hb{hb}_*_as_published.npz)"))
-    done("fig5", t0)
-
-    t0 = part(6, "fig6", f"basins, {p.grid}x{p.grid} cells, both laws, two cases")
-    basin_rows = []
-    results["fig6"] = []
-    figures[6] = []
-    for hb, alpha, omega in BASIN_CASES:
-        bs = {}
-        for law in ("housner", "mao"):
-            say(f"paper: basin {law} hb={hb:g} alpha={alpha:g} omega={omega:g}")
-            bs[law] = grid(p.basins[(hb, law)], f"basin_hb{hb:g}_{law}")
-        basins_done[(hb, alpha, omega)] = bs
-        agree = agreement(bs["housner"].label, bs["mao"].label)
-        tag = f"hb{hb:g}"
-        _npz(out, f"fig6_basin_{tag}.npz", f"figure 6, h/b = {hb:g}: theta0, dtheta0, "
-             f"label_housner, label_mao (label[i, j] of theta0[i], dtheta0[j]), names",
-             theta0=bs["housner"].theta0, dtheta0=bs["housner"].dtheta0,
-             label_housner=bs["housner"].label, label_mao=bs["mao"].label,
-             names=np.asarray(bs["housner"].names, dtype=str))
-        figures[6].append(_figure(out, f"fig6_basin_{tag}.png",
-                                  fig_basin_compare(bs["housner"], bs["mao"]),
-                                  f"figure 6: basins of both laws at h/b = {hb:g} and where they "
-                                  f"agree (data: fig6_basin_{tag}.npz)"))
-        entry = dict(hb=hb, alpha=alpha, omega=omega, agreement=agree)
-        for law, b in bs.items():
-            fr = b.fractions()
-            entry[law] = dict(fractions=fr)
-            basin_rows.append([hb, alpha, omega, law] + [fr[n] for n in BEHAVIOURS] + [agree])
-        results["fig6"].append(entry)
-    basin_header = ["hb", "alpha", "omega", "law"] + [f"{n}_percent" for n in BEHAVIOURS] + \
-        ["agreement_percent"]
-    _table(out, "basin_table", basin_header, basin_rows,
-           {h: ".1f" for h in basin_header[4:]} | {"hb": "g", "alpha": "g", "omega": "g"},
-           "figure 6's basins: percent of each behaviour per law, and the laws' agreement")
-    done("fig6", t0)
-
-    t0 = part(7, "fig7", "attractor maps of the basins, their entropy and integrity")
-    rows = []
-    results["fig7"] = []
-    figures[7] = []
-    for hb, alpha, omega in BASIN_CASES:
-        bs = basins_done[(hb, alpha, omega)]
-        ms = {law: b.measures() for law, b in bs.items()}
-        tag = f"hb{hb:g}"
-        arrays = dict(theta0=bs["housner"].theta0, dtheta0=bs["housner"].dtheta0)
-        for law, b in bs.items():
-            arrays[f"attractor_{law}"] = b.attractor
-            arrays[f"names_{law}"] = np.array(attractor_names(b.attractors), dtype=str)
-            arrays[f"behaviour_{law}"] = np.array([a.behaviour for a in b.attractors], dtype=str)
-            arrays[f"period_{law}"] = np.array([a.period for a in b.attractors], dtype=np.int64)
-            arrays[f"fraction_{law}"] = np.array([a.fraction for a in b.attractors])
-        _npz(out, f"fig7_attractors_{tag}.npz", f"figure 7, h/b = {hb:g}: theta0, dtheta0, per "
-             f"law attractor_<law> (ids: >= 0 the attractor, -1 overturn, -2 unresolved), "
-             f"names_<law>, behaviour_<law>, period_<law>, fraction_<law> by id", **arrays)
-        figures[7].append(_figure(out, f"fig7_attractors_{tag}.png", fig_attractors(bs, ms),
-                                  f"figure 7: the attractor each initial state reaches at h/b = "
-                                  f"{hb:g}, by name, with basin entropy and integrity (data: "
-                                  f"fig7_attractors_{tag}.npz)"))
-        agree = attractor_agreement(bs["housner"], bs["mao"])
-        entry = dict(hb=hb, alpha=alpha, omega=omega, attractor_agreement=agree)
-        for law, b in bs.items():
-            m = ms[law]
-            entry[law] = dict(attractors=[dict(a.to_dict(), name=n) for a, n in
-                                          zip(b.attractors, attractor_names(b.attractors))],
-                              **m)
-            rows.append([hb, alpha, omega, law, len(b.attractors), m["basin_entropy"],
-                         m["boundary_basin_entropy"], m["uncertainty_exponent"]["alpha"],
-                         m["integrity"]["GIM"], m["integrity"]["IF"], agree["percent"]])
-        results["fig7"].append(entry)
-    _table(out, "attractor_table", ATTRACTOR_HEADER, rows,
-           {h: ".3f" for h in ATTRACTOR_HEADER[5:]} | {"hb": "g", "alpha": "g", "omega": "g"},
-           "figure 7's measures: attractors, basin entropy, boundary basin entropy, "
-           "uncertainty exponent, GIM, IF, the laws' attractor agreement")
-    done("fig7", t0)
-
-    t0 = part(8, "fig8", "erosion profiles, both laws, hb = 1 and 2")
-    results["fig8"] = {}
-    figures[8] = []
-    for hb in EROSION:
-        prof = {}
-        for law in ("housner", "mao"):
-            say(f"paper: erosion {law} hb={hb:g}, {p.erosions[(hb, law)].alpha.size} "
-                f"amplitudes")
-            prof[law] = erosion_run(p.erosions[(hb, law)], within(f"erosion_hb{hb}_{law}"))
-        figures[8].append(_figure(out, f"fig8_erosion_hb{hb}.png", fig_erosion(prof),
-                                  f"figure 8: erosion profiles of both laws at h/b = {hb} "
-                                  f"(data: fig8_erosion_hb{hb}.npz)"))
-        _npz(out, f"fig8_erosion_hb{hb}.npz", f"figure 8, h/b = {hb}: alpha, theta0, dtheta0 "
-             f"and per law (suffix _<law>) GIM, IF, fractions (each attractor's percent at "
-             f"each alpha), overturn, basin_entropy, attractor and label maps of every basin",
-             alpha=prof["housner"].alpha, theta0=prof["housner"].theta0,
-             dtheta0=prof["housner"].dtheta0,
-             **{k: v for law, r in prof.items() for k, v in r.arrays(f"_{law}").items()})
-        results["fig8"][f"hb{hb}"] = {law: r.to_summary() | dict(names=attractor_names(
-            r.branches)) for law, r in prof.items()}
-    done("fig8", t0)
-
-    # ---- extra figure: the forcing plane with exact boundaries (rockjit.chart) --------------
-    t0 = time.perf_counter()
-    say("paper [extra] fig9: the forcing plane with its bifurcation curves, both laws")
-    results["fig9"], figures[9] = _fig9_charts(out, integration, within, say)
-    results["fig9_wall_s"] = time.perf_counter() - t0  # (apart from the study's parts)
-    say(f"paper: fig9 done in {results['fig9_wall_s']:.1f} s")
-    # ---- end of the extra figure ----------------------------------------------------------
-
-    results.update(wall_s_parts=walls, zoom_step=p.zoom_step, record_stride=p.stride,
-                   grid=p.grid, erosion_grid=p.erosion_grid, erosion_step=p.erosion_step,
-                   total_s=time.perf_counter() - t_all)
-    results["published"] = report.published_beside(results)
-    report.write_index(out, results, figures, p)
-    return results
+                pp.say(f"paper: erosion {law} hb={hb:g}, "
+                       f"{pp.plan.erosions[(hb, law)].alpha.size} amplitudes")
+                prof[law] = erosion_run(pp.plan.erosions[(hb, law)],
+                                        pp.within(f"erosion_hb{hb}_{law}"))
+            pp.figures[8].append(pp.figure(f"fig8_erosion_hb{hb}.png", fig_erosion(prof),
+                                           f"figure 8: erosion profiles of both laws at h/b = "
+                                           f"{hb} (data: fig8_erosion_hb{hb}.npz)"))
+            pp.npz(f"fig8_erosion_hb{hb}.npz", f"figure 8, h/b = {hb}: alpha, theta0, dtheta0 "
+                   f"and per law (suffix _<law>) GIM, IF, fractions (each attractor's percent "
+                   f"at each alpha), overturn, basin_entropy, attractor and label maps of every "
+                   f"basin", alpha=prof["housner"].alpha, theta0=prof["housner"].theta0,
+                   dtheta0=prof["housner"].dtheta0,
+                   **{k: v for law, r in prof.items() for k, v in r.arrays(f"_{law}").items()})
+            pp.results["fig8"][f"hb{hb}"] = {law: r.to_summary() | dict(names=attractor_names(
+                r.branches)) for law, r in prof.items()}
 
 
 def _finite(a, fn):
@@ -703,25 +717,35 @@ def _finite(a, fn):
 # ---- extra figure: the forcing plane with exact boundaries (rockjit.chart) ------------------
 
 
-def _fig9_charts(out, integration, within, say):
+def _fig9_plane(pp):
+    """Figure 9, beyond the study's parts and timed apart from them: the forcing plane of both
+    laws with its bifurcation curves."""
+    t0 = time.perf_counter()
+    pp.say("paper [extra] fig9: the forcing plane with its bifurcation curves, both laws")
+    pp.results["fig9"], pp.figures[9] = _fig9_charts(pp)
+    pp.results["fig9_wall_s"] = time.perf_counter() - t0  # (apart from the study's parts)
+    pp.say(f"paper: fig9 done in {pp.results['fig9_wall_s']:.1f} s")
+
+
+def _fig9_charts(pp):
     """Figure 9: per slenderness, both laws' charts with their curves, side by side and
     overlaid; returns the curves (type, period, law, points) per slenderness."""
     from ..orbits.plane_chart import ChartCurves, chart
-    from ..plotting.chart import fig_chart
     from ..outputs import chart as write_chart
     found, names = {}, []
     for hb in STUDY:
         res = {}
         for law in ("housner", "mao"):
-            say(f"paper: chart {law} hb={hb:g}")
+            pp.say(f"paper: chart {law} hb={hb:g}")
             try:
                 kw = dict(CHART, curves=ChartCurves(**CHART["curves"]))
-                res[law] = chart(Block(hb=float(hb), law=law), **kw, integration=integration,
-                                 execution=within(f"chart_hb{hb}_{law}"))
+                res[law] = chart(Block(hb=float(hb), law=law), **kw,
+                                 integration=pp.integration,
+                                 execution=pp.within(f"chart_hb{hb}_{law}"))
             except ValueError as exc:  # no seed on the lines (a quick paper's short runs)
                 found[f"hb{hb}_{law}_refused"] = str(exc)
         if res:
-            written = write_chart(out, res, npz=f"fig9_chart_hb{hb}.npz",
+            written = write_chart(pp.out, res, npz=f"fig9_chart_hb{hb}.npz",
                                   png=f"fig9_chart_hb{hb}.png")
             names.append(written.pop("figure"))
             found[f"hb{hb}"] = written["curves"]

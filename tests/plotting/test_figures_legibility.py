@@ -457,7 +457,7 @@ def test_the_headline_image_is_drawn_by_figure_5s_function(monkeypatch, tmp_path
     dpi = style.STYLES["default"].rc["savefig.dpi"]
     assert (w, h) == (round(fig.get_figwidth() * dpi), round(fig.get_figheight() * dpi))
     # and the paper draws its figure 5 with the same function
-    assert "draw_fig5(" in inspect.getsource(paper.paper)
+    assert "draw_fig5(" in inspect.getsource(paper._fig5_sweeps)
     # the image in the repository is that figure's size: made by the script, not by hand
     with Image.open(mod.HEADLINE) as im:
         assert im.size[0] == round(fig.get_figwidth() * dpi)
