@@ -97,9 +97,9 @@ def _interrupted(exc, sig):
 
 
 def _main(argv, sig):
+    """Run one command (see :func:`main`): parse, plan and claim ``--out``, compute, publish."""
     from .. import outputs
-    from ..storage.output_dir import OutputDir
-    from .signals import interrupted, signal_name
+    from .signals import interrupted
     try:
         args = build_parser().parse_args(argv)
     except UsageError as exc:
@@ -109,32 +109,17 @@ def _main(argv, sig):
     if args.command == "compile":
         return run_compile(args)
     try:
-        check_device(args)
-        plan = args.plan(args)
-        check_run(args)
-        # --out taken for this run (its lock), refused if it holds files rockjit did not write
-        out = sig.out = OutputDir(args.out, command=args.command)
-        out.claim(files=OUTPUTS.get(args.command, ()),
-                  figure_format=getattr(args, "format", None), name="--out")
+        plan, out = _plan(args, sig)
     except (UsageError, ValueError) as exc:
         return error(exc)
-    from .._jit import cached_kernels
-    # spectra and fragility run the pulses' and records' kernel, the others the harmonic ones
-    engine = ("transient",) if args.command in ("spectrum", "fragility") else \
-        ("integrate", "kernel")
-    if args.command != "cor" and not cached_kernels(modules=engine):
-        say(args, "first run here: numba compiles rockjit's kernels into its cache, about "
-                   "10-20 s per kernel variant on two cores, once (`rockjit compile` does it "
-                   "ahead of time)")
-        if args.command == "paper":  # every variant, side by side
-            rc = run_compile(args)
-            if rc:
-                out.discard()
-                return rc
+    rc = _first_run(args)
+    if rc:
+        out.discard()
+        return rc
     import matplotlib
     matplotlib.use("Agg")
     interrupted(sig)  # a signal whose KeyboardInterrupt something swallowed: no work
-    from ..grids.runner import NoWorkers, worker_timeout
+    from ..grids.runner import worker_timeout
     from ..plotting import style
     timeout = getattr(args, "scheduler_timeout", None)
     out.figure_format = getattr(args, "format", None)
@@ -155,23 +140,67 @@ def _main(argv, sig):
         if not out.published:
             raise  # main: --out as it was, 130 or 143
         note = out.warning
-    except NoWorkers as exc:
+    except BaseException as exc:
         out.discard()
-        return error(f"--scheduler {args.scheduler}: {exc} (--scheduler-timeout)")
-    except (UsageError, ValueError) as exc:  # a check made only once running
-        out.discard()
-        return error(exc)
-    except Exception as exc:  # a full disk, a refused write, a bug: one line and a report
-        out.discard()
-        if len(sig.received) > n0:
-            raise  # what a signal became (see main)
-        lost = getattr(args, "scheduler", None) and from_dask(exc)
-        return internal_error(exc, f"--scheduler {args.scheduler}: the connection to the Dask "
-                                    f"scheduler failed: " if lost else "")
-    except BaseException:
-        out.discard()
-        raise
+        status = _failed(exc, args, sig, n0)
+        if status is None:
+            raise  # what a signal became (see main), or not an error of the run's
+        return status
     sig.final = True  # published: from here on a signal changes nothing
+    _after_publication(args, out, note)
+    return _completed(args, out, sig, n)
+
+
+def _plan(args, sig):
+    """The command's plan and ``--out`` claimed for this run, before any work (a UsageError or
+    ValueError for bad input)."""
+    from ..storage.output_dir import OutputDir
+    check_device(args)
+    plan = args.plan(args)
+    check_run(args)
+    # --out taken for this run (its lock), refused if it holds files rockjit did not write
+    out = sig.out = OutputDir(args.out, command=args.command)
+    out.claim(files=OUTPUTS.get(args.command, ()),
+              figure_format=getattr(args, "format", None), name="--out")
+    return plan, out
+
+
+def _first_run(args):
+    """Say so when numba's cache lacks the command's kernels (``paper`` then compiles every
+    variant, side by side); returns that compilation's exit status, else 0."""
+    from .._jit import cached_kernels
+    # spectra and fragility run the pulses' and records' kernel, the others the harmonic ones
+    engine = ("transient",) if args.command in ("spectrum", "fragility") else \
+        ("integrate", "kernel")
+    if args.command != "cor" and not cached_kernels(modules=engine):
+        say(args, "first run here: numba compiles rockjit's kernels into its cache, about "
+                   "10-20 s per kernel variant on two cores, once (`rockjit compile` does it "
+                   "ahead of time)")
+        if args.command == "paper":
+            return run_compile(args)
+    return 0
+
+
+def _failed(exc, args, sig, n0):
+    """The exit status of a run that failed before publication, its one line said; ``None``
+    when ``exc`` goes on up: what a signal became (``n0`` signals were seen before the run),
+    or no ``Exception``."""
+    from ..grids.runner import NoWorkers
+    if isinstance(exc, NoWorkers):
+        return error(f"--scheduler {args.scheduler}: {exc} (--scheduler-timeout)")
+    if isinstance(exc, (UsageError, ValueError)):  # a check made only once running
+        return error(exc)
+    if not isinstance(exc, Exception) or len(sig.received) > n0:
+        return None
+    # a full disk, a refused write, a bug: one line and a report
+    lost = getattr(args, "scheduler", None) and from_dask(exc)
+    return internal_error(exc, f"--scheduler {args.scheduler}: the connection to the Dask "
+                               f"scheduler failed: " if lost else "")
+
+
+def _after_publication(args, out, note):
+    """The lines after publication (the note, each figure not drawn, where the outputs are) and
+    the finished chunks removed; a failure here is a warning (the command has succeeded)."""
     try:
         if note:
             warn(note)
@@ -185,7 +214,13 @@ def _main(argv, sig):
     except Exception as exc:  # the outputs are published: the command has succeeded
         warn(f"{args.out} was written; cleaning up after it failed ({type(exc).__name__}: "
              f"{exc})")
-    status = 3 if out.figure_errors else 0  # published, a figure missing
+
+
+def _completed(args, out, sig, n):
+    """The exit status of a published command, 3 when a figure is missing, else 0; a line for a
+    signal that arrived after the first ``n`` (which came before publication)."""
+    from .signals import signal_name
+    status = 3 if out.figure_errors else 0
     late = ([out.interrupted] if out.interrupted else []) + sig.received[n:]
     if late:
         print(f"{PROG}: {signal_name(late[0])} arrived after {args.out} was written; the "
