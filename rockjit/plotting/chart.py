@@ -43,6 +43,7 @@ FINER = 6
 
 
 def _fine(x, k=FINER):
+    """The axis ``x`` ``k`` times finer, its ends kept."""
     x = np.asarray(x, float)
     if x.size < 2:
         return x
@@ -74,6 +75,7 @@ def _map(ax, lab, x, y, **kw):
 
 
 def _label(curve):
+    """A curve's label on the chart: its type's letters, its period as a subscript."""
     return CURVE_LABELS[curve.type] + str(curve.period).translate(_SUB)
 
 
@@ -139,6 +141,7 @@ def _overturn_edge(ax, res, colour=OVERTURN_EDGE):
 
 
 def _chart_panel(ax, res, i, show_y=True):
+    """One law's chart with its overturn boundary and curves; returns the curves' labels."""
     cmap, norm = behaviour_cmap()
     _map(ax, res.label(), res.plane.omega, res.plane.alpha, cmap=cmap, norm=norm)
     _overturn_edge(ax, res)
@@ -154,10 +157,13 @@ def _chart_panel(ax, res, i, show_y=True):
 
 
 def _share_words(pct):
+    """A percentage in words, a small nonzero share as ``< 1 %``."""
     return "< 1 %" if 0 < pct < 0.5 else f"{pct:.0f} %"
 
 
 def _legend_handles(results):
+    """The charts' legend: the curve types drawn, the overturn boundary, the codimension-two
+    points and each behaviour present with its share."""
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
     types = [t for t in CURVE_STYLES if any(c.type == t for r in results for c in r.curves)]

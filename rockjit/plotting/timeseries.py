@@ -58,11 +58,13 @@ def _wrap(text, fig, fraction=0.95):
 
 
 def _need_traj(result):
+    """Refuse a result recorded without its trajectory."""
     if result.trajectory is None or result.trajectory.shape[0] == 0:
         raise ValueError("the result has no trajectory: simulate with record_stride=...")
 
 
 def _window_start(result):
+    """The start of a run's asymptotic window (its periods' last fifth when it carries none)."""
     if result.window is not None:
         return float(result.window[0])
     return round(0.8 * result.periods) * result.period
@@ -89,6 +91,7 @@ def with_impacts(result, t0=-math.inf, t1=math.inf):
 
 
 def _time_panel(ax, result, t0, t1, colour, **kw):
+    """``theta(t)`` over ``[t0, t1]``, impacts as vertical jumps."""
     t, th, _ = with_impacts(result, t0, t1)
     ax.plot(t, th, color=colour, lw=kw.pop("lw", 1.0), **kw)
     ax.axhline(0, color="0.8", lw=0.5, zorder=0)

@@ -709,6 +709,7 @@ def _fig8_erosion(pp):
 
 
 def _finite(a, fn):
+    """``fn`` (min or max) of the finite values of ``a``, or ``nan`` when there are none."""
     a = np.asarray(a, float) if a is not None else np.zeros(0)
     a = a[np.isfinite(a)]
     return float(fn(a)) if a.size else math.nan

@@ -90,6 +90,7 @@ SHARES_PUBLISHED = {(1, "housner"): 7.0, (1, "mao"): 47.1, (2, "housner"): 10.5,
 
 
 def _num(v, fmt):
+    """``v`` formatted by ``fmt``, or a dash when it is missing or not finite."""
     try:
         v = float(v)
     except (TypeError, ValueError):
@@ -184,6 +185,7 @@ nav ul { columns: 2; } code { font-size: 0.9em; }
 
 
 def _table(header, rows, left=()):
+    """An HTML table, the columns numbered in ``left`` aligned left."""
     h = "".join(f'<th class="l">{html.escape(c)}</th>' if i in left else
                 f"<th>{html.escape(c)}</th>" for i, c in enumerate(header))
     body = []
@@ -195,6 +197,7 @@ def _table(header, rows, left=()):
 
 
 def _img(name, alt):
+    """An image of the page, or a link to it when it is a PDF."""
     if name.endswith(".pdf"):
         return (f'<p><a href="{html.escape(name)}">{html.escape(name)}</a> '
                 f'(PDF)</p>')
@@ -365,6 +368,7 @@ _TITLES = {1: "Figure 1. Restitution laws", 2: "Figure 2. The reference symmetri
 
 
 def _published_html(pub):
+    """The study's published numbers beside this run's, as the page's tables."""
     parts = []
     parts.append("<h3>The restitution table</h3>")
     parts.append(_table(["h/b", "e_H study", "e_H rockjit", "e_M study", "e_M rockjit",
@@ -409,6 +413,7 @@ def _published_html(pub):
 
 
 def _results_tables(results):
+    """The run's tables (restitution, sweeps, basins, attractors, bifurcations) in HTML."""
     from ..result import BEHAVIOURS
     parts = []
     e = results.get("e_table", [])
