@@ -8,15 +8,19 @@ each, eight cells per thread in lockstep where there are no exponents). Cases: t
 basin (h/b = 1, Housner, alpha = 0.66, omega = 1.3, 500 periods) at 100 x 100, 300 x 300 and
 1000 x 1000, full length and early-stopped; the study's sweep (omega = 1.3, 501 amplitudes in
 [0.5, 1], 500 periods, full length, with exponents); a 200 x 200 (alpha, omega) plane with
-exponents (early-stopped); and a balanced yardstick, one source compiled for both devices:
-10^6 cells, each 2000 RK4 steps of a damped linear oscillator in registers (what the devices'
-fp64 arithmetic gives with every cell the same work and no memory traffic). Times are medians
+exponents (early-stopped); the transient kernel (rockjit._engine.gpu_transient) on a 400 x 400
+overturning spectrum of the one-sine pulse (h/b = 4, the grid without the bisections) and on an
+incremental dynamic analysis of 44 synthetic far-field-like records (20 s at 100 Hz, the FEMA
+P695 set where it is installed) at 50 intensities under both laws; and a balanced yardstick,
+one source compiled for both devices: 10^6 cells, each 2000 RK4 steps of a damped linear
+oscillator in registers (what the devices' fp64 arithmetic gives with every cell the same work and no memory traffic). Times are medians
 of repeats, GPU and CPU interleaved, compile excluded (a warm-up call first); the CPU's
 1000 x 1000 full-length basin is extrapolated from its 300 x 300 cells per second (it would
 take minutes). Agreement: the cells whose label or period differ between the devices, and
 of those at 100 x 100 how many the uncertainty test (initial states moved by 1e-9, on the
 CPU) does not flag; the largest difference of the stroboscopic samples of the cells both call
-periodic.
+periodic (for the transient grids: the cells whose outcome differs, and the largest
+difference of max |theta| / alpha_s).
 
     PYTHONPATH=. python benchmarks/bench_gpu.py           # full, on a machine with a GPU
     PYTHONPATH=. python benchmarks/bench_gpu.py --quick   # smoke: small grids, 60 periods
@@ -55,9 +59,11 @@ from rockjit.result import ASYMMETRIC, MULTIPERIODIC, SYMMETRIC
 from rockjit.settings import cuda_missing
 
 FULL = dict(basins=(100, 300, 1000), periods=500, alphas=501, plane=200, repeats=3,
-            cpu_cells_max=100_000, budget_s=220.0, yard_cells=10**6, yard_steps=2000)
+            cpu_cells_max=100_000, budget_s=220.0, yard_cells=10**6, yard_steps=2000,
+            spectrum=400, records=44, levels=50)
 QUICK = dict(basins=(12, 20), periods=60, alphas=21, plane=10, repeats=1,
-             cpu_cells_max=400, budget_s=120.0, yard_cells=1000, yard_steps=100)
+             cpu_cells_max=400, budget_s=120.0, yard_cells=1000, yard_steps=100,
+             spectrum=12, records=2, levels=4)
 #: Relative move of the initial states in the uncertainty test of the agreement.
 EPS = 1e-9
 HEADERS = ("case", "cells", "gpu_s", "cpu_s", "cpu_basis", "speedup", "cells_per_s_gpu",
@@ -86,6 +92,52 @@ def cases(cfg):
     return out
 
 
+def transient_cases(cfg):
+    """``(key, cells, run)`` of the transient grids: ``run(device)`` returns the result."""
+    from bench_ground import records
+    n = cfg["spectrum"]
+    ratios, amplitudes = np.geomspace(0.5, 8.0, n), np.geomspace(1.02, 25.0, n)
+    recs, what = records(cfg["records"])
+    levels = np.linspace(1.25, 10.0, cfg["levels"])
+
+    def ex(device):
+        return Execution(device=device, progress=False)
+
+    def spectrum(device):
+        return rockjit.spectrum(Block(hb=4.0), rockjit.Pulse("sine"), ratios, amplitudes,
+                                locate=False, execution=ex(device))
+
+    def ida(device):
+        return rockjit.fragility(Block(hb=4.0), recs, [1.0], levels, laws=("housner", "mao"),
+                                 execution=ex(device))
+
+    return [(f"spectrum {n}x{n}, one-sine pulse, no bisection", n * n, spectrum),
+            (f"fragility, {len(recs)} {what.split(' (')[0]}, {len(levels)} intensities, both "
+             f"laws", 2 * len(recs) * len(levels), ida)]
+
+
+def measure_transient(cfg, t0):
+    """The transient grids on both devices: rows as :func:`measure` gives them; for
+    agreement, the cells whose outcome differs and the largest difference of
+    ``max |theta| / alpha_s`` over the cells with the same outcome."""
+    rows, raw = [], {}
+    for key, _, run in transient_cases(cfg):
+        reps = cfg["repeats"] if time.monotonic() - t0 < 0.5 * cfg["budget_s"] else 1
+        t = H.side_by_side({"gpu": lambda run=run: run("cuda"),
+                            "cpu": lambda run=run: run("cpu")}, reps)
+        g, c = t.result["gpu"], t.result["cpu"]
+        n = int(np.asarray(c.outcome).size)
+        same = np.asarray(g.outcome) == np.asarray(c.outcome)
+        d = np.abs(np.asarray(g.max_rotation) - np.asarray(c.max_rotation))[same]
+        d = d[np.isfinite(d)]
+        gpu_s, cpu_s = t.median("gpu"), t.median("cpu")
+        rows.append((key, n, gpu_s, cpu_s, f"median of {reps}", cpu_s / gpu_s, n / gpu_s,
+                     int((~same).sum()), "", float(d.max()) if d.size else math.nan, "yes"))
+        raw[key] = dict(gpu=t.wall["gpu"], cpu=t.wall["cpu"])
+        print(f"{key}: GPU {gpu_s:.3f} s, CPU {cpu_s:.3f} s", flush=True)
+    return rows, raw
+
+
 def cells(p, device):
     """The grid's cells through the runner on ``device``: its outputs by name."""
     return runner.run_grid(p.y0s, p.pars, p.ipar, p.cpar, tangent=p.tangent, n_pts=p.n_pts,
@@ -112,10 +164,14 @@ def unflagged(p, differ):
 
 def warm_up(cfg):
     """Compile (or load) every kernel either device runs, on tiny grids."""
-    small = dict(cfg, basins=(3,), periods=12, alphas=3, plane=2)
+    small = dict(cfg, basins=(3,), periods=12, alphas=3, plane=2, spectrum=2, records=1,
+                 levels=2)
     for _, p in cases(small):
         for device in ("cuda", "cpu"):
             cells(p, device)
+    for _, _, run in transient_cases(small):
+        for device in ("cuda", "cpu"):
+            run(device)
 
 
 def measure(cfg, t0):
@@ -245,6 +301,8 @@ def main(argv=None):
     if missing is not None:
         rows = [(key, p.y0s.shape[0], "", "", "", "", "", "", "", "", "no")
                 for key, p in cases(cfg)]
+        rows += [(key, n, "", "", "", "", "", "", "", "", "no")
+                 for key, n, _ in transient_cases(cfg)]
         rows.append((f"yardstick: {cfg['yard_cells']} cells of {cfg['yard_steps']} RK4 steps "
                      f"in registers", cfg["yard_cells"], "", "", "", "", "", "", "", "", "no"))
         md = (head + "Not measured on a GPU yet: this machine has none (" + missing + "). "
@@ -259,6 +317,9 @@ def main(argv=None):
     warm_up(cfg)
     warm = time.monotonic() - warm
     rows, raw = measure(cfg, t0)
+    more, more_raw = measure_transient(cfg, t0)
+    rows += more
+    raw.update(more_raw)
     more, more_raw = registers(cfg, t0)
     rows += more
     raw.update(more_raw)
@@ -276,7 +337,9 @@ def main(argv=None):
             f"differ between the devices; differ, not flagged: of those, at the smallest "
             f"basin, the cells the uncertainty test (initial states moved by {EPS:g}, on the "
             f"CPU) does not flag. max strobe diff: the largest difference of the "
-            f"stroboscopic samples of the cells both devices call periodic. The rows 'one "
+            f"stroboscopic samples of the cells both devices call periodic (for the spectrum "
+            f"and the fragility analysis: the cells whose outcome differs, and the largest "
+            f"difference of max |theta| / alpha_s where it does not). The rows 'one "
             f"call': the largest basin in one call of the driver (no chunks), with the "
             f"compiler's choice of registers a thread and with a cap (more threads resident, "
             f"more spilled); labels_differ there counts the cells whose label differs from "

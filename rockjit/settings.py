@@ -26,7 +26,7 @@ from .validate import boolean, integer, pair, real
 
 __all__ = ["DEVICES", "Classification", "Execution", "Integration", "Lattice", "MAX_IMPACTS",
            "MAX_N", "MAX_PERIODS", "REST_SPEED_RANGE", "cuda_missing", "cuda_refusal",
-           "cuda_unsupported", "default_max_impacts"]
+           "default_max_impacts"]
 
 #: Largest number of periods, and of steps per period, a run may ask for: bounds that keep the
 #: kernels' step counter in 64 bits. The memory check refuses most large requests first, with
@@ -280,16 +280,6 @@ def cuda_refusal(what='device="cuda"', instead='device="cpu"'):
             f'(pip install "rockjit[cuda]"); {missing}: use {instead}')
 
 
-#: What runs on the GPU with ``device="cuda"``: the grids of the harmonic kernels.
-CUDA_COVERS = ("the cells of sweeps, basins, planes, erosion profiles, fates, safety and chart "
-               "grids")
-
-
-def cuda_unsupported(what, name='device="cuda"', instead='device="cpu"'):
-    """The one line that refuses ``name`` for ``what``, a computation the GPU does not run."""
-    return f"{name} runs {CUDA_COVERS}; {what} run on the CPU only: use {instead}"
-
-
 @dataclass(frozen=True)
 class Execution(_Replace):
     """Where and how a grid runs. Nothing here changes a result: every cell is computed the
@@ -301,10 +291,10 @@ class Execution(_Replace):
         Where the cells run: the CPU's cores (default), or an NVIDIA GPU through numba's CUDA
         target, which needs a CUDA-capable GPU with its driver and ``numba-cuda``
         (``pip install "rockjit[cuda]"``): the cells of sweeps, basins, planes, erosion
-        profiles, fates and the safety and chart grids run one per GPU thread
-        (docs/guide/gpu.md); spectra and fragility refuse it. Where this machine lacks the
-        GPU, its driver or ``numba-cuda``, ``device="cuda"`` is refused with a ``ValueError``
-        saying what is missing.
+        profiles, fates, the safety and chart grids, spectra and fragility curves run one
+        per GPU thread (docs/guide/gpu.md; the scipy reference path stays on the CPU). Where
+        this machine lacks the GPU, its driver or ``numba-cuda``, ``device="cuda"`` is refused
+        with a ``ValueError`` saying what is missing.
     threads : int, optional
         numba threads (default: all).
     chunk : int, optional

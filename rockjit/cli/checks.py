@@ -28,18 +28,14 @@ CHUNKED = ("sweep", "basin", "plane", "erosion", "safety", "orbits", "chart", "p
            "spectrum", "fragility")
 
 
-#: Commands whose cells run on the CPU only (the pulses' and records' kernel), by what they run.
-CPU_ONLY = {"spectrum": "spectra", "fragility": "fragility curves"}
-
-
 def check_device(args):
-    """``--device cuda`` is refused in one line, before any work, where it cannot run: for the
-    commands whose cells run on the CPU only, and on a machine without a usable GPU."""
+    """``--device cuda`` is refused in one line, before any work, with the scipy reference path
+    (``--method scipy``, which runs on the CPU only) and on a machine without a usable GPU."""
     if getattr(args, "device", "cpu") == "cuda":
-        from ..settings import cuda_refusal, cuda_unsupported
-        if args.command in CPU_ONLY:
-            raise UsageError(cuda_unsupported(CPU_ONLY[args.command], "--device cuda",
-                                              "--device cpu"))
+        from ..settings import cuda_refusal
+        if getattr(args, "method", "rockjit") != "rockjit":
+            raise UsageError("--device cuda runs the compiled path (--method rockjit); the "
+                             "scipy reference path runs on the CPU only: use --device cpu")
         refusal = cuda_refusal("--device cuda", "--device cpu")
         if refusal is not None:
             raise UsageError(refusal)

@@ -25,8 +25,9 @@ returning one array per name of :data:`OUTPUTS`, each of the chunk's length:
 
 Two kernels: :func:`scipy_kernel` runs the cells one after another on the scipy reference path;
 the compiled kernel (:func:`rockjit.ground.compiled.compiled_kernel`, the default) runs a
-chunk's cells in parallel threads; :func:`kernel_for` registers it in :data:`KERNELS` under
-``"rockjit"`` when first asked for it. :func:`run_batch`
+chunk's cells in parallel threads, or one per GPU thread with ``Execution(device="cuda")``
+(:func:`~rockjit.ground.compiled.cuda_kernel`); :func:`kernel_for` registers them in
+:data:`KERNELS` when first asked for them. :func:`run_batch`
 cuts a batch into chunks and runs them through a kernel, in this process or on a Dask cluster
 (``Execution.client`` or ``Execution.scheduler``), with progress, resumable from a chunk store
 (``Execution.store``).
@@ -97,16 +98,24 @@ def scipy_kernel(blocks, sources, block_of, source_of, gain, settings, method):
 
 
 #: The kernels by method: ``"scipy"`` (any :class:`rockjit.Scipy`) and, once
-#: :func:`kernel_for` has been asked for it, ``"rockjit"``.
+#: :func:`kernel_for` has been asked for them, ``"rockjit"`` and ``"rockjit-cuda"`` (the
+#: compiled path on the GPU).
 KERNELS = {"scipy": scipy_kernel}
 
 
-def kernel_for(method):
-    """The kernel of ``method`` (``"rockjit"`` or a :class:`rockjit.Scipy`)."""
-    name = "rockjit" if method == "rockjit" else "scipy"
-    if name == "rockjit" and name not in KERNELS:
-        from .compiled import compiled_kernel  # numba only when asked for
-        KERNELS[name] = compiled_kernel
+def kernel_for(method, device="cpu"):
+    """The kernel of ``method`` (``"rockjit"`` or a :class:`rockjit.Scipy`) on ``device``
+    (``"cpu"``, or ``"cuda"`` for the compiled path on the GPU; the scipy path runs on the CPU
+    only: ``ValueError``)."""
+    if method != "rockjit":
+        if device == "cuda":
+            raise ValueError('device="cuda" runs the compiled path (method="rockjit"); the '
+                             'scipy reference path runs on the CPU only: use device="cpu"')
+        return KERNELS["scipy"]
+    name = "rockjit-cuda" if device == "cuda" else "rockjit"
+    if name not in KERNELS:
+        from .compiled import compiled_kernel, cuda_kernel  # numba only when asked for
+        KERNELS.update({"rockjit": compiled_kernel, "rockjit-cuda": cuda_kernel})
     return KERNELS[name]
 
 
@@ -175,10 +184,7 @@ def run_batch(batch, settings, method, execution=None, label="cells"):
     from ..settings import Execution
     from ..storage import chunkstore
     ex = Execution() if execution is None else execution
-    if ex.device == "cuda":
-        from ..settings import cuda_unsupported
-        raise ValueError(cuda_unsupported("spectra and fragility curves"))
-    kernel = kernel_for(method)
+    kernel = kernel_for(method, ex.device)
     n = len(batch)
     outputs = empty_outputs(n)
     if n == 0:
@@ -187,7 +193,13 @@ def run_batch(batch, settings, method, execution=None, label="cells"):
     prefix = f"rockjit-{label.replace(' ', '-')}-{uuid.uuid4().hex[:12]}"
     with _client(ex) as client, _threads(ex.threads if client is None else None):
         local = client is None and method == "rockjit"
-        chunk = default_chunk(n, local) if ex.chunk is None else ex.chunk
+        if ex.chunk is not None:
+            chunk = ex.chunk
+        elif ex.device == "cuda":  # few, large launches (rockjit._engine.gpu.default_chunk)
+            from .._engine.gpu import default_chunk as gpu_chunk
+            chunk = gpu_chunk(n)
+        else:
+            chunk = default_chunk(n, local)
         store = None
         if ex.store is not None:  # every input of every cell, and the kernel's outputs
             key = chunkstore.fingerprint_of("transient batch", batch.blocks, batch.sources,

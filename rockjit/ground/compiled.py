@@ -1,10 +1,11 @@
 """The compiled kernel of the transient batches: pulses and records on the compiled path.
 
-:func:`compiled_kernel` packs a chunk of a :class:`rockjit.ground.batch.Batch` into arrays
-(one row per block, one per cell's forcing, every record's samples in one flat array) and runs
-its cells in parallel in :func:`rockjit._engine.transient.run_cells`; it is
-``KERNELS["rockjit"]`` of :mod:`rockjit.ground.batch`, registered when a batch first asks for
-it. :func:`run_compiled` is a single run (:func:`rockjit.simulate`) on the same code. The
+:func:`pack` turns a chunk of a :class:`rockjit.ground.batch.Batch` into arrays (one row per
+block, one per cell's forcing, every excitation's coefficients in one flat array);
+:func:`compiled_kernel` runs its cells in parallel in :func:`rockjit._engine.transient.run_cells`
+and :func:`cuda_kernel` one per GPU thread (:mod:`rockjit._engine.gpu_transient`); they are
+``KERNELS["rockjit"]`` and ``KERNELS["rockjit-cuda"]`` of :mod:`rockjit.ground.batch`, registered
+when a batch first asks for them. :func:`run_compiled` is a single run (:func:`rockjit.simulate`) on the same code. The
 cells follow the scipy reference path (:mod:`rockjit.ground.reference`) phase by phase; at the
 step lengths below they agree with scipy's DOP853 at ``rtol = 1e-13`` to about 1e-11 in
 ``max |theta| / alpha_s`` and 4e-11 in the overturning time of a pulse run
@@ -32,8 +33,8 @@ from ..plugs.record import H_RECORD
 from ..validate import memory
 from .response import STATUS_CODES, TransientResult, alpha_s, empty_outputs
 
-__all__ = ["H_FREE", "H_PULSE", "H_RECORD", "MIN_PULSE_STEPS", "compiled_kernel",
-           "run_compiled"]
+__all__ = ["H_FREE", "H_PULSE", "H_RECORD", "MIN_PULSE_STEPS", "compiled_kernel", "cuda_kernel",
+           "pack", "run_compiled"]
 
 #: The step of free rocking after the excitation.
 H_FREE = 0.01
@@ -80,13 +81,10 @@ def _shrink(blocks):
     return min(1.0, DAMPED_STEP / (damping_rate(xi) * max(H_PULSE, H_RECORD, H_FREE)))
 
 
-def compiled_kernel(blocks, sources, block_of, source_of, gain, settings, method):
-    """The compiled path on a chunk of cells (the kernel interface of
-    :mod:`rockjit.ground.batch`): every cell from rest, in parallel."""
-    n = len(gain)
-    out = empty_outputs(n)
-    if n == 0:
-        return out
+def pack(blocks, sources, block_of, source_of, gain, settings):
+    """A chunk of cells as the transient kernel reads them: the arguments of
+    :func:`rockjit._engine.transient.run_cells` before the thread stride and outputs
+    (``xpar, coefficients, bpar, block_of, spar, t_lim, max_impacts, decide``)."""
     bpar = np.array([_block_row(b, settings.theta_over) for b in blocks], dtype=float)
     shrink = _shrink(blocks)
     rows, samples = _sources(sources, shrink)
@@ -96,11 +94,40 @@ def compiled_kernel(blocks, sources, block_of, source_of, gain, settings, method
     xpar[:, T.X_AMP] = _amplitudes(sources, source_of, gain)
     t_lim = np.array([settings.limit(float(src.end)) for src in sources])[source_of]
     spar = np.array([settings.theta_over, settings.rest_speed, shrink * H_FREE])
+    return (xpar, samples, bpar, np.asarray(block_of, dtype=np.int64), spar, t_lim,
+            int(settings.impact_bound()), bool(settings.stop_when_decided))
+
+
+def compiled_kernel(blocks, sources, block_of, source_of, gain, settings, method):
+    """The compiled path on a chunk of cells (the kernel interface of
+    :mod:`rockjit.ground.batch`): every cell from rest, in parallel on the CPU's threads."""
+    n = len(gain)
+    if n == 0:
+        return empty_outputs(n)
     out_f = np.empty((n, T.N_TF))
     out_i = np.empty((n, T.N_TI), dtype=np.int64)
-    T.run_cells(xpar, samples, bpar, np.asarray(block_of, dtype=np.int64), spar, t_lim,
-                int(settings.impact_bound()), bool(settings.stop_when_decided),
+    T.run_cells(*pack(blocks, sources, block_of, source_of, gain, settings),
                 numba.get_num_threads(), out_f, out_i)
+    return _outputs(out_f, out_i)
+
+
+def cuda_kernel(blocks, sources, block_of, source_of, gain, settings, method):
+    """:func:`compiled_kernel` on the GPU, one cell per thread
+    (:mod:`rockjit._engine.gpu_transient`): the same inputs and outputs."""
+    from .._engine import gpu_transient
+    n = len(gain)
+    if n == 0:
+        return empty_outputs(n)
+    out_f = np.empty((n, T.N_TF))
+    out_i = np.empty((n, T.N_TI), dtype=np.int64)
+    gpu_transient.run_cells(*pack(blocks, sources, block_of, source_of, gain, settings),
+                            out_f, out_i)
+    return _outputs(out_f, out_i)
+
+
+def _outputs(out_f, out_i):
+    """The kernel's output arrays as the batch's outputs by name."""
+    out = empty_outputs(out_f.shape[0])
     out["max_rotation"][:] = out_f[:, T.TF_MAXROT]
     out["t_overturn"][:] = out_f[:, T.TF_TOVER]
     out["t_end"][:] = out_f[:, T.TF_T]

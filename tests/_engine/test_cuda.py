@@ -37,17 +37,20 @@ def _nvvm():
 
 @pytest.mark.skipif(not _nvvm(), reason="numba-cuda finds no NVVM (pip install \"rockjit[cuda]\" "
                     "brings the CUDA 12 one)")
-@pytest.mark.parametrize("name", ["tables", "cells", "cells+tangent"])
+@pytest.mark.parametrize("name", ["tables", "cells", "cells+tangent", "transient"])
 def test_kernels_compile_to_ptx_for_sm90(sm90, name):
-    from rockjit._engine import gpu
-    kern = gpu.kernels()[name]
-    ptx, _ = cuda.compile_ptx(kern, gpu.signatures()[name], cc=(9, 0))
+    from rockjit._engine import gpu, gpu_transient
+    driver = gpu_transient if name == "transient" else gpu
+    kern = driver.kernels()[name]
+    ptx, _ = cuda.compile_ptx(kern, driver.signatures()[name], cc=(9, 0))
     assert ".target sm_90" in ptx
     assert ptx.count(".entry ") == 1
-    # the stage chain's and the polynomials' explicit fused multiply-adds, as on the CPU
-    assert "fma.rn.f64" in ptx
-    entry = {"tables": "_tables", "cells": "_cells_plain", "cells+tangent": "_cells_tangent"}
+    entry = {"tables": "_tables", "cells": "_cells_plain", "cells+tangent": "_cells_tangent",
+             "transient": "_cells"}
     assert entry[name] in ptx.split(".entry ")[1].split("(")[0]
+    if name != "transient":
+        # the stage chain's and the polynomials' explicit fused multiply-adds, as on the CPU
+        assert "fma.rn.f64" in ptx
 
 
 #: The cases run under the simulator: a grid plan's constructor and its arguments (small: the
@@ -77,6 +80,15 @@ _PLANS = textwrap.dedent('''
                                       n_impact_points=8)
         return rockjit.plane.plan(block, (0.3, 0.9), (1.0, 2.0), grid=(3, 3), integration=integ,
                                   classification=cl, lyapunov=True)
+
+    def transient_spectrum():
+        return (Block(hb=3, law="mao"), rockjit.Pulse("ricker"), np.geomspace(0.7, 5.0, 4),
+                np.geomspace(1.1, 8.0, 4))
+
+    def transient_ida():
+        t = np.arange(0.0, 3.0, 0.01)
+        rec = rockjit.Record(0.3 * np.sin(2 * np.pi * 1.2 * t) * np.sin(np.pi * t / 3.0), 0.01)
+        return Block(hb=3), [rec], [0.5], [0.5, 1.05, 1.2, 1.5]
 ''')
 
 _SIMULATED = _PLANS + textwrap.dedent('''
@@ -99,6 +111,12 @@ _SIMULATED = _PLANS + textwrap.dedent('''
                       classification=Classification(attractors=False),
                       execution=Execution(device="cuda"))
     got["api/label"] = b.label
+    # the transient kernel: a spectrum of the Ricker wavelet and an IDA over a short record
+    sp = rockjit.spectrum(*transient_spectrum(), locate=False,
+                          execution=Execution(device="cuda"))
+    fr = rockjit.fragility(*transient_ida(), execution=Execution(device="cuda"))
+    for k, r in (("spectrum", sp), ("ida", fr)):
+        got[f"{k}/outcome"], got[f"{k}/max_rotation"] = r.outcome, r.max_rotation
     np.savez(path, **got)
 ''')
 
@@ -145,6 +163,15 @@ def test_simulated_gpu_gives_the_cpu_kernels_results(tmp_path):
     assert len(labels) >= 3  # the cases reach several behaviours, not one
     cpu_basin = _cpu("basin", "housner", True)
     np.testing.assert_array_equal(got["api/label"].ravel(), cpu_basin["res"][:, R_LABEL])
+    namespace = {}
+    exec(_PLANS, namespace)  # noqa: S102 - the same cases as the simulated run's
+    import rockjit
+    sp = rockjit.spectrum(*namespace["transient_spectrum"](), locate=False)
+    fr = rockjit.fragility(*namespace["transient_ida"]())
+    for k, r in (("spectrum", sp), ("ida", fr)):
+        assert len(set(r.outcome.ravel())) >= 2, k  # safe and overturned cells both
+        np.testing.assert_array_equal(got[f"{k}/outcome"], r.outcome, err_msg=k)
+        np.testing.assert_array_equal(got[f"{k}/max_rotation"], r.max_rotation, err_msg=k)
 
 
 def test_cuda_without_a_gpu_is_refused(monkeypatch):
@@ -158,31 +185,58 @@ def test_cuda_without_a_gpu_is_refused(monkeypatch):
     assert "\n" not in text and "GPU" in text and 'device="cpu"' in text
 
 
-def test_cuda_with_a_gpu_is_taken_and_cpu_only_work_refuses_it(monkeypatch):
-    """Where a GPU is usable, Execution(device="cuda") is accepted; the spectra's and
-    fragility's batches, which have no GPU kernel, refuse it in one line naming what runs."""
+def test_cuda_with_a_gpu_is_taken_and_the_scipy_path_refuses_it(monkeypatch):
+    """Where a GPU is usable, Execution(device="cuda") is accepted; a batch on the scipy
+    reference path, which runs on the CPU only, refuses it in one line."""
     import rockjit.settings as st
+    from rockjit import Scipy
     monkeypatch.setattr(st, "cuda_missing", lambda: None)
     ex = Execution(device="cuda", progress=False)
     assert ex.device == "cuda"
     from rockjit.ground.batch import run_batch
     with pytest.raises(ValueError) as exc:
-        run_batch([None], None, "rockjit", ex)
+        run_batch([None], None, Scipy("DOP853"), ex)
     text = str(exc.value)
-    assert "\n" not in text and "basins" in text and "spectra" in text
-    assert 'device="cpu"' in text
+    assert "\n" not in text and "scipy" in text and 'device="cpu"' in text
 
 
-def test_cli_refuses_cuda_for_spectra_in_one_line(tmp_path, capsys, monkeypatch):
+def test_cli_refuses_cuda_for_the_scipy_path_in_one_line(tmp_path, capsys, monkeypatch):
     import rockjit.settings as st
     from rockjit.cli.main import main
     monkeypatch.setattr(st, "cuda_missing", lambda: None)
     code = main(["spectrum", "--hb", "1", "--ratio-range", "1", "2", "--amplitude-range", "1",
                  "2", "--grid", "2", "2", "--out", str(tmp_path / "s"), "--device", "cuda",
-                 "--quiet"])
+                 "--method", "scipy", "--quiet"])
     err = capsys.readouterr().err.strip()
-    assert code == 2 and "\n" not in err and "--device cuda runs" in err
+    assert code == 2 and "\n" not in err and "--device cuda runs the compiled path" in err
     assert "--device cpu" in err and not (tmp_path / "s").exists()
+
+
+def test_cli_spectrum_on_cuda_runs_its_cells_on_the_gpu_driver(tmp_path, monkeypatch):
+    """``rockjit spectrum --device cuda`` hands every cell to the transient GPU driver
+    (here replaced by the CPU kernel on one thread, which records the cells it gets): the
+    outputs are the CPU run's."""
+    import rockjit.settings as st
+    from rockjit._engine import gpu_transient
+    from rockjit._engine import transient as T
+    from rockjit.cli.main import main
+    monkeypatch.setattr(st, "cuda_missing", lambda: None)
+    seen = []
+
+    def on_the_cpu(xpar, rec, bpar, block_of, spar, t_lim, max_impacts, decide, out_f, out_i):
+        seen.append(xpar.shape[0])
+        T.run_cells(xpar, rec, bpar, block_of, spar, t_lim, max_impacts, decide, 1, out_f,
+                    out_i)
+    monkeypatch.setattr(gpu_transient, "run_cells", on_the_cpu)
+    args = ["spectrum", "--hb", "3", "--ratio-range", "1", "4", "--amplitude-range", "1.2",
+            "6", "--grid", "3", "3", "--quiet", "--tol", "1e-3"]
+    assert main(args + ["--out", str(tmp_path / "g"), "--device", "cuda"]) == 0
+    assert sum(seen) >= 9
+    assert main(args + ["--out", str(tmp_path / "c")]) == 0
+    for name in sorted(p.name for p in (tmp_path / "c").iterdir() if p.suffix == ".npz"):
+        a, b = np.load(tmp_path / "g" / name), np.load(tmp_path / "c" / name)
+        for k in a.files:
+            np.testing.assert_array_equal(a[k], b[k], err_msg=f"{name} {k}")
 
 
 def test_chunks_on_the_gpu_fill_it():
