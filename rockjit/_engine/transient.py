@@ -13,9 +13,10 @@ scipy reference path (:mod:`rockjit.ground.reference`, the specification):
   (:mod:`rockjit._engine.integrate`), on the grid the excitation's plug gives, which puts
   every kink of the forcing on a step boundary (a pulse's duration cut into equal steps, a
   record's sample step into ``k`` equal steps), then free rocking after the excitation in
-  steps of its own length. A step that crosses ``theta = 0`` (an impact), ``|theta| = theta_over`` (overturning) or ``theta' = 0``
-  (a turning point: a crest gives ``max |theta|`` and, after the excitation, may decide the
-  run; a trough below ``theta = 0`` is a dip through an impact and back) is cut there: the
+  steps of its own length. A step that crosses ``theta = 0`` (an impact),
+  ``|theta| = theta_over`` (overturning) or ``theta' = 0`` (a turning point: a crest gives
+  ``max |theta|`` and, after the excitation, may decide the run; a trough below ``theta = 0``
+  is a dip through an impact and back) is cut there: the
   instant is the root of the event function of a genuine step of variable length from the
   step's start, found by Newton's iteration kept inside its bracket by bisection, so the
   event's state has the step's own order of accuracy;
@@ -78,20 +79,28 @@ ROOT_ITERS = 60
 # ---- the forcing --------------------------------------------------------------------------------
 
 @jit(nrt=False, inline=True)
-def forcing(t, x, rec):
-    """The base acceleration (``g``) of the forcing row ``x`` at model time ``t``: its plug's
-    value (:func:`rockjit.plugs.plug_value`), zero outside ``[0, end]``."""
-    if not (0.0 <= t <= x[X_END]):
-        return 0.0
-    return plug_value(int(x[X_CODE]), t, x[X_AMP], rec, int(x[X_OFF]), int(x[X_N]))
+def forcing_of(x):
+    """A cell's forcing row ``x`` as the tuple the step reads, taken once per cell:
+    ``(end, plug code, amplitude, offset and number of its coefficients)``."""
+    return x[X_END], int(x[X_CODE]), x[X_AMP], int(x[X_OFF]), int(x[X_N])
 
 
 @jit(nrt=False, inline=True)
-def acc(th, v, t, side, sthc, cthc, xi, x, rec):
+def forcing(t, fx, rec):
+    """The base acceleration (``g``) of the forcing ``fx`` (:func:`forcing_of`) at model time
+    ``t``: its plug's value (:func:`rockjit.plugs.plug_value`), zero outside ``[0, end]``."""
+    end, code, a, off, n = fx
+    if not (0.0 <= t <= end):
+        return 0.0
+    return plug_value(code, t, a, rec, off, n)
+
+
+@jit(nrt=False, inline=True)
+def acc(th, v, t, side, sthc, cthc, xi, fx, rec):
     """``theta''`` on corner ``side`` at ``(t, th, v)``: :func:`rockjit.model.corner` and
     :func:`rockjit.model.accel_pq` (what :func:`rockjit.model.accel` computes, with the
     block's ``sin(thc), cos(thc)`` taken once)."""
-    P, Q = corner(forcing(t, x, rec), side, sthc, cthc)
+    P, Q = corner(forcing(t, fx, rec), side, sthc, cthc)
     s, c = sincos(th)
     return accel_pq(P, Q, s, c, v, xi)
 
@@ -108,11 +117,11 @@ def _stage(i):
     """Stage ``i``'s ``theta''``, its instant kept at or below ``cap``."""
     c = node(i)
     at = "t + hh" if c == "1.0" else f"t + {c} * hh"
-    return f"k{i} = acc(x{i}, v{i}, min({at}, cap), side, sthc, cthc, xi, x, rec)"
+    return f"k{i} = acc(x{i}, v{i}, min({at}, cap), side, sthc, cthc, xi, fx, rec)"
 
 
 dp_step = compile_step(
-    "dp_step", "t, x0, v0, k0, hh, cap, side, sthc, cthc, xi, x, rec",
+    "dp_step", "t, x0, v0, k0, hh, cap, side, sthc, cthc, xi, fx, rec",
     chain(_stage, arith="plain", form="first", h="hh") + ["return x6, v6, k6"],
     globals(), jit(nrt=False, inline=True), doc="""One Dormand–Prince step of length ``hh``
     from ``(t, theta, theta')`` (``k0``: ``theta''`` there): ``(theta, theta', theta'')`` at
@@ -123,7 +132,7 @@ dp_step = compile_step(
 
 
 @jit(nrt=False)
-def locate(kind, target, t, th, v, a0, lo, hi, glo, cap, side, sthc, cthc, xi, x, rec):
+def locate(kind, target, t, th, v, a0, lo, hi, glo, cap, side, sthc, cthc, xi, fx, rec):
     """The root in ``(lo, hi)`` of an event function along genuine steps from ``(t, th, v)``:
     ``kind`` 0, ``side * theta - target`` (slope ``side * theta'``); ``kind`` 1,
     ``side * theta'`` (slope ``side * theta''``). ``glo`` has its sign just after ``lo``, and
@@ -134,7 +143,7 @@ def locate(kind, target, t, th, v, a0, lo, hi, glo, cap, side, sthc, cthc, xi, x
     steps = 1
     for _ in range(ROOT_ITERS):
         steps += 1
-        th1, v1, a1 = dp_step(t, th, v, a0, z, cap, side, sthc, cthc, xi, x, rec)
+        th1, v1, a1 = dp_step(t, th, v, a0, z, cap, side, sthc, cthc, xi, fx, rec)
         if kind == 0:
             g, dg = side * th1 - target, side * v1
         else:
@@ -152,7 +161,7 @@ def locate(kind, target, t, th, v, a0, lo, hi, glo, cap, side, sthc, cthc, xi, x
             z = zn
             break
         z = zn
-    th1, v1, a1 = dp_step(t, th, v, a0, z, cap, side, sthc, cthc, xi, x, rec)
+    th1, v1, a1 = dp_step(t, th, v, a0, z, cap, side, sthc, cthc, xi, fx, rec)
     return z, th1, v1, a1, steps
 
 
@@ -166,15 +175,14 @@ def _ulp(x):
 
 
 @jit(nrt=False)
-def next_uplift(t, x, rec, thc, xi, thr):
+def next_uplift(t, fx, rec, thc, xi, thr):
     """``(t_up, side)``: the first instant ``>= t`` at which the block at rest accelerates away
     from it, ``side`` 0 when there is none (the reference path's ``next_uplift``): through the
     windows where ``|f| > thr`` (:func:`rockjit.plugs.plug_window`), in order."""
-    code = int(x[X_CODE])
+    end, code, a, off, n = fx
     tq = t
     while True:
-        t0, t1, sg = plug_window(code, tq, x[X_END], x[X_AMP], rec, int(x[X_OFF]), int(x[X_N]),
-                                 thr)
+        t0, t1, sg = plug_window(code, tq, end, a, rec, off, n, thr)
         if sg == 0.0:
             return 0.0, 0
         side = int(sg)
@@ -182,7 +190,7 @@ def next_uplift(t, x, rec, thc, xi, thr):
         tt = base
         step = 0.0
         while tt <= t1:
-            if side * accel(side * _TINY, 0.0, forcing(tt, x, rec), side, thc, xi) > 0.0:
+            if side * accel(side * _TINY, 0.0, forcing(tt, fx, rec), side, thc, xi) > 0.0:
                 return tt, side
             step = max(2.0 * step, _ulp(max(tt, 1.0)))
             tt = base + step
@@ -251,6 +259,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
     th_top = b[B_THTOP]
     sthc, cthc = math.sin(thc), math.cos(thc)
     thover, rest_speed = s[S_THOVER], s[S_REST]
+    fx = forcing_of(x)
     end = x[X_END]
     # the grid: the excitation in X_STEPS equal steps, or X_STEPS steps between its kinks
     # (multiples of X_DT), free rocking in steps of S_HFREE
@@ -268,7 +277,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
     th = th0
     v = v0
     side = side0
-    a = acc(th, v, t, side, sthc, cthc, xi, x, rec) if side != 0 else 0.0
+    a = acc(th, v, t, side, sthc, cthc, xi, fx, rec) if side != 0 else 0.0
     n_imp = 0
     n_rest = 0
     n_step = 0
@@ -282,7 +291,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
             status = ST_TIME_LIMIT
             break
         if side == 0:  # ---- at rest ------------------------------------------------------------
-            t_up, up = next_uplift(t, x, rec, thc, xi, thr)
+            t_up, up = next_uplift(t, fx, rec, thc, xi, thr)
             if up == 0:
                 status = ST_REST
                 break
@@ -299,7 +308,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
             side = up
             th = side * _TINY
             v = 0.0
-            a = acc(th, v, t, side, sthc, cthc, xi, x, rec)
+            a = acc(th, v, t, side, sthc, cthc, xi, fx, rec)
             continue
         if decide and t >= end and free_rocking_decided(th, v, max_th, thc, th_top):
             status = ST_DECIDED
@@ -307,7 +316,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
         # ---- one step on corner `side` --------------------------------------------------------
         tn = grid_next(t, end, h_exc, nsub, dt, h_free, t_lim)
         hh = tn - t
-        th1, v1, a1 = dp_step(t, th, v, a, hh, tn, side, sthc, cthc, xi, x, rec)
+        th1, v1, a1 = dp_step(t, th, v, a, hh, tn, side, sthc, cthc, xi, fx, rec)
         n_step += 1
         if not (math.isfinite(th1) and math.isfinite(v1) and math.isfinite(a1)):
             status = ST_NONFINITE
@@ -318,7 +327,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
         crest = (side * v > 0.0 or (v == 0.0 and side * a > 0.0)) and side * v1 < 0.0
         if crest:  # a maximum of side * theta inside the step
             tau, th_c, vc, ac, ns = locate(1, 0.0, t, th, v, a, 0.0, hh, 1.0, tn, side,
-                                           sthc, cthc, xi, x, rec)
+                                           sthc, cthc, xi, fx, rec)
             n_step += ns
             max_th = max(max_th, abs(th_c))
             if decide and t + tau >= end and free_rocking_decided(th_c, 0.0, max_th, thc,
@@ -332,7 +341,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
         impact_at = -1.0
         if side * th1 >= thover:  # overturning
             tau, th2, v2, a2, ns = locate(0, thover, t, th, v, a, 0.0, hh,
-                                          side * th - thover, tn, side, sthc, cthc, xi, x, rec)
+                                          side * th - thover, tn, side, sthc, cthc, xi, fx, rec)
             n_step += ns
             t = t_over = t + tau
             th, v = th2, v2
@@ -345,7 +354,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
         elif not crest and side * v < 0.0 and side * v1 > 0.0:
             # a minimum of side * theta: below 0, the block went through an impact and back
             tau, th2, v2, a2, ns = locate(1, 0.0, t, th, v, a, 0.0, hh, side * v, tn, side,
-                                          sthc, cthc, xi, x, rec)
+                                          sthc, cthc, xi, fx, rec)
             n_step += ns
             if side * th2 < 0.0:
                 impact_at = tau
@@ -360,7 +369,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
         # ---- impact --------------------------------------------------------------------------
         g_lo = side * th if lo == 0.0 else side * th_c
         tau, th2, v2, a2, ns = locate(0, 0.0, t, th, v, a, lo, impact_at, g_lo, tn, side,
-                                      sthc, cthc, xi, x, rec)
+                                      sthc, cthc, xi, fx, rec)
         n_step += ns
         t = t + tau
         n_tr = _keep(traj, n_tr, t, 0.0, v2)
@@ -379,7 +388,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
             side = 0
             n_rest += 1
         else:
-            a = acc(th, v, t, side, sthc, cthc, xi, x, rec)
+            a = acc(th, v, t, side, sthc, cthc, xi, fx, rec)
         if n_imp >= max_impacts:
             status = ST_MAX_IMPACTS
             break

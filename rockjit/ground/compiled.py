@@ -1,15 +1,15 @@
 """The compiled kernel of the transient batches: pulses and records on the compiled path.
 
-:func:`pack` turns a chunk of a :class:`rockjit.ground.batch.Batch` into arrays (one row per
-block, one per cell's forcing, every excitation's coefficients in one flat array);
-:func:`compiled_kernel` runs its cells in parallel in :func:`rockjit._engine.transient.run_cells`
-and :func:`cuda_kernel` one per GPU thread (:mod:`rockjit._engine.gpu_transient`); they are
-``KERNELS["rockjit"]`` and ``KERNELS["rockjit-cuda"]`` of :mod:`rockjit.ground.batch`, registered
-when a batch first asks for them. :func:`run_compiled` is a single run (:func:`rockjit.simulate`) on the same code. The
-cells follow the scipy reference path (:mod:`rockjit.ground.reference`) phase by phase; at the
-step lengths below they agree with scipy's DOP853 at ``rtol = 1e-13`` to about 1e-11 in
-``max |theta| / alpha_s`` and 4e-11 in the overturning time of a pulse run
-(tests/ground/test_ground_compiled.py, benchmarks/bench_ground.py).
+:func:`pack` turns a chunk of a :class:`rockjit.ground.batch.Batch` into arrays (one row per block,
+one per cell's forcing, every excitation's coefficients in one flat array); :func:`compiled_kernel`
+runs its cells in parallel in :func:`rockjit._engine.transient.run_cells` and :func:`cuda_kernel`
+one per GPU thread (:mod:`rockjit._engine.gpu_transient`); they are ``KERNELS["rockjit"]`` and
+``KERNELS["rockjit-cuda"]`` of :mod:`rockjit.ground.batch`, registered when a batch first asks for
+them. :func:`run_compiled` is a single run (:func:`rockjit.simulate`) on the same code. The cells
+follow the scipy reference path (:mod:`rockjit.ground.reference`) phase by phase; at the step
+lengths below they agree with scipy's DOP853 at ``rtol = 1e-13`` to about 1e-11 in ``max |theta| /
+alpha_s`` and 4e-11 in the overturning time of a pulse run (tests/ground/test_ground_compiled.py,
+benchmarks/bench_ground.py).
 
 Step lengths, in model time (``1/sqrt(g/R)``, about 0.32 s for a 1 m block): each excitation's
 plug gives its grid (:meth:`rockjit.plugs.TransientPlug.grid`: a pulse in equal steps of at most

@@ -45,7 +45,9 @@ def _render():
     window.append("    return 0.0, 0.0, 0.0")
     src = "\n".join(value) + "\n\n\n" + "\n".join(window) + "\n"
     exec(compile(src, __file__, "exec"), globals())  # noqa: S102 - our own template
-    return (jit(globals()["plug_value"], nrt=False), jit(globals()["plug_window"], nrt=False))
+    # the value is called at every stage of every step: inlined, as the kernel's own code
+    return (jit(globals()["plug_value"], nrt=False, inline=True),
+            jit(globals()["plug_window"], nrt=False))
 
 
 plug_value, plug_window = _render()

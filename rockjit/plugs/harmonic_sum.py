@@ -3,10 +3,10 @@
 A common test signal for rocking blocks (a few tones at once, e.g. a shake-table sweep's
 components), written as one excitation plug (:mod:`rockjit.plugs.base`). The compiled side,
 :func:`sum_value` and :func:`sum_window` (over :func:`harmonics_value` and
-:func:`harmonics_window`, at unit gain), is what the compiled transient kernel runs;
-the Python side (:meth:`HarmonicSum.f`, :meth:`HarmonicSum.windows`) is what the scipy reference path
-runs, written apart from it: the windows by a dense scan of ``|f|`` and Brent's method, the
-compiled ones by a scan whose steps the largest slope ``sum_k |a_k omega_k|`` bounds.
+:func:`harmonics_window`, at unit gain), is what the compiled transient kernel runs; the Python
+side (:meth:`HarmonicSum.f`, :meth:`HarmonicSum.windows`) is what the scipy reference path runs,
+written apart from it: the windows by a dense scan of ``|f|`` and Brent's method, the compiled ones
+by a scan whose steps the largest slope ``sum_k |a_k omega_k|`` bounds.
 """
 
 from __future__ import annotations

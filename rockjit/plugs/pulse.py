@@ -54,7 +54,7 @@ MIN_PULSE_STEPS = 256
 
 # ---- the compiled side --------------------------------------------------------------------------
 
-@jit(nrt=False)
+@jit(nrt=False, inline=True)
 def pulse_value(t, a, c, off, n):
     """The pulse of peak ``a`` (``g``) at model time ``t`` inside it, from its coefficients
     ``c[off:off + 3]``: the shape's code, ``omega_p`` and the Ricker wavelet's delay."""

@@ -45,7 +45,7 @@ H_RECORD = 0.005
 
 # ---- the compiled side --------------------------------------------------------------------------
 
-@jit(nrt=False)
+@jit(nrt=False, inline=True)
 def record_value(t, a, c, off, n):
     """The record at gain ``a`` at model time ``t`` inside it, from its coefficients
     ``c[off:off + n]``: the model time step, then the ``n - 1`` samples; linear between
