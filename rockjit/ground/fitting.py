@@ -314,6 +314,25 @@ def fit_lognormal(x, overturned, runs, *, confidence=CONFIDENCE) -> LognormalFit
     >>> fit_lognormal([1, 2, 3], [0, 5, 5], [5, 5, 5]).reason       # a clean cut
     'complete separation between 1 and 2: beta -> 0 and any median in between fits'
     """
+    x, k, n = _checked_counts(x, overturned, runs, confidence)
+    N, K = int(n.sum()), int(k.sum())
+    if N == 0:
+        return _no_estimate("no_data", N, K, confidence)
+    if K == 0:
+        return _no_estimate("all_survive", N, K, confidence, bound=float(x.max()))
+    if K == N:
+        return _no_estimate("all_overturn", N, K, confidence, bound=float(x.min()))
+    levels = _Levels(x, k, n, confidence)
+    for rule in (_one_level, _separation):
+        fit = rule(levels)
+        if fit is not None:
+            return fit
+    return _maximum(levels)
+
+
+def _checked_counts(x, overturned, runs, confidence):
+    """``(x, k, n)`` as float arrays over the levels with runs; a ``ValueError`` where the data
+    or ``confidence`` are out of range."""
     x = np.asarray(x, dtype=float).ravel()
     k = np.asarray(overturned, dtype=float).ravel()
     n = np.asarray(runs, dtype=float).ravel()
@@ -327,93 +346,131 @@ def fit_lognormal(x, overturned, runs, *, confidence=CONFIDENCE) -> LognormalFit
         raise ValueError("the intensities must be finite and positive")
     if np.any(k < 0) or np.any(k > n):
         raise ValueError("overturned counts must lie in [0, runs]")
-    N, K = int(n.sum()), int(k.sum())
+    return x, k, n
+
+
+def _no_estimate(status, N, K, confidence, bound=math.nan):
+    """A fit without median, dispersion or intervals: ``status``, and the median's ``bound``."""
     nan = math.nan
+    return LognormalFit(nan, nan, nan, nan, nan, status, bound, N, K, nan,
+                        confidence=confidence)
 
-    def bare(status, bound=nan):
-        return LognormalFit(nan, nan, nan, nan, nan, status, bound, N, K, nan,
-                            confidence=confidence)
 
-    if N == 0:
-        return bare("no_data")
-    if K == 0:
-        return bare("all_survive", bound=float(x.max()))
-    if K == N:
-        return bare("all_overturn", bound=float(x.min()))
-    lx = np.log(x)
-    c = float(np.sum(n * lx) / N)
-    pr = _Probit(lx - c, k, n)
-    q = float(_chi2_1(confidence))
-    ll_flat = _ll_binomial(np.array([K], float), np.array([N], float))
-    spread = float(np.ptp(lx))
-    s_max = 1e8 / max(spread, 1e-3)
+class _Levels:
+    """Counts with both outcomes among them, in log intensity (``c`` their mean), with what the
+    rules of :func:`fit_lognormal` share: the probit likelihood, the supremum of a constant
+    probability ``ll_flat``, the interval threshold ``q`` and the reach ``s_max`` of ``s``."""
 
-    def unidentified(reason, ll_sup, m0=None, s0=None, beta_to_zero=False):
+    def __init__(self, x, k, n, confidence):
+        self.k, self.n, self.confidence = k, n, confidence
+        self.N, self.K = int(n.sum()), int(k.sum())
+        self.lx = np.log(x)
+        self.c = float(np.sum(n * self.lx) / self.N)
+        self.pr = _Probit(self.lx - self.c, k, n)
+        self.q = float(_chi2_1(confidence))
+        self.ll_flat = _ll_binomial(np.array([self.K], float), np.array([self.N], float))
+        spread = float(np.ptp(self.lx))
+        self.s_max = 1e8 / max(spread, 1e-3)
+
+    def intervals(self, ll_sup, m0, s0, beta_to_zero=False):
+        """The profile-likelihood intervals of the median (in intensity) and ``beta``."""
+        (m_lo, m_hi), bci = _intervals(self.pr, ll_sup, self.ll_flat, m0, s0, self.s_max,
+                                       self.q, beta_to_zero)
+        return (math.exp(m_lo + self.c), math.exp(m_hi + self.c)), bci
+
+    def unidentified(self, reason, ll_sup, m0=None, s0=None, beta_to_zero=False):
+        """No estimate, for ``reason``; the intervals where the data bound something (searched
+        from ``(m0, s0)`` where given)."""
         mci = bci = _NAN2
         if m0 is not None:
             try:
-                (m_lo, m_hi), bci = _intervals(pr, ll_sup, ll_flat, m0, s0, s_max, q,
-                                               beta_to_zero)
-                mci = (math.exp(m_lo + c), math.exp(m_hi + c))
+                mci, bci = self.intervals(ll_sup, m0, s0, beta_to_zero)
             except (ValueError, OverflowError, FloatingPointError):
                 mci = bci = _NAN2
-        return LognormalFit(nan, nan, nan, nan, nan, "unidentified", nan, N, K, ll_sup,
-                            reason, tuple(map(float, mci)), tuple(map(float, bci)), confidence)
+        nan = math.nan
+        return LognormalFit(nan, nan, nan, nan, nan, "unidentified", nan, self.N, self.K,
+                            ll_sup, reason, tuple(map(float, mci)), tuple(map(float, bci)),
+                            self.confidence)
 
-    if np.unique(lx).size == 1:
-        return unidentified("one intensity level: the likelihood is flat along a line of "
-                            "(median, beta)", ll_flat, 0.0, 1.0 / max(abs(c), 1.0), True)
-    # a cut: every run below survives, every run above overturns (one level may be mixed)
+
+def _one_level(d):
+    """Unidentified where every run is at one intensity, else ``None``."""
+    if np.unique(d.lx).size == 1:
+        return d.unidentified("one intensity level: the likelihood is flat along a line of "
+                              "(median, beta)", d.ll_flat, 0.0, 1.0 / max(abs(d.c), 1.0), True)
+    return None
+
+
+def _separation(d):
+    """Unidentified where a cut separates the outcomes (every run below survives, every run
+    above overturns, one level at most mixed), else ``None``."""
+    lx, k, n = d.lx, d.k, d.n
     survive_max = lx[k < n].max()   # the highest level with a survival
     over_min = lx[k > 0].min()      # the lowest level with an overturning
-    if survive_max <= over_min:
-        s0 = s_max * 1e-3
-        if survive_max < over_min:
-            return unidentified(
-                f"complete separation between {math.exp(survive_max):.6g} and "
-                f"{math.exp(over_min):.6g}: beta -> 0 and any median in between fits", 0.0,
-                0.5 * (survive_max + over_min) - c, s0, True)
-        mixed = lx == survive_max
-        km, nm = k[mixed].sum(), n[mixed].sum()
-        m0 = survive_max - c - float(ndtri(km / nm)) / s0
-        return unidentified(
-            f"quasi-complete separation at {math.exp(survive_max):.6g}: every run below "
-            f"survives and every run above overturns, the likelihood grows as beta -> 0",
-            _ll_binomial(k[mixed], n[mixed]), m0, s0, True)
-    # a start: the median where the empirical fraction crosses 1/2, beta from the spread
-    frac = k / n
+    if survive_max > over_min:
+        return None
+    s0 = d.s_max * 1e-3
+    if survive_max < over_min:
+        return d.unidentified(
+            f"complete separation between {math.exp(survive_max):.6g} and "
+            f"{math.exp(over_min):.6g}: beta -> 0 and any median in between fits", 0.0,
+            0.5 * (survive_max + over_min) - d.c, s0, True)
+    mixed = lx == survive_max
+    km, nm = k[mixed].sum(), n[mixed].sum()
+    m0 = survive_max - d.c - float(ndtri(km / nm)) / s0
+    return d.unidentified(
+        f"quasi-complete separation at {math.exp(survive_max):.6g}: every run below "
+        f"survives and every run above overturns, the likelihood grows as beta -> 0",
+        _ll_binomial(k[mixed], n[mixed]), m0, s0, True)
+
+
+def _start(d):
+    """A start ``(m0, s0)``: the median where the empirical fraction crosses 1/2, ``s0`` from
+    the spread of the log intensities."""
+    lx = d.lx
     order = np.argsort(lx)
-    m0 = float(np.interp(0.5, np.maximum.accumulate(frac[order]), lx[order])) - c
-    s0 = 1.0 / max(0.1, float(np.sqrt(np.sum(n * (lx - c) ** 2) / N)))
-    a, s, ll, d, w = pr.fit(s0 * m0, s0)
-    a, s = float(a), float(s)
-    if not (s > 0 and math.isfinite(s)):
-        return unidentified("the fraction overturned does not rise with the intensity",
-                            ll_flat)
-    m = a / s
-    if 2.0 * (ll - ll_flat) < q:
-        return unidentified(
-            f"nearly flat likelihood: a probability that does not change with the intensity "
-            f"fits about as well (likelihood ratio {2 * (ll - ll_flat):.3g} < {q:.3g}), so "
-            f"the data set no upper end to beta", ll, m, s)
-    # observed information in (a, s), then in (ln theta_m, beta) by the change of variables
+    m0 = float(np.interp(0.5, np.maximum.accumulate((d.k / d.n)[order]), lx[order])) - d.c
+    s0 = 1.0 / max(0.1, float(np.sqrt(np.sum(d.n * (lx - d.c) ** 2) / d.N)))
+    return m0, s0
+
+
+def _standard_errors(pr, w, a, s):
+    """``(se(ln theta_m), se(beta))`` from the observed information in ``(a, s)`` (``w``: the
+    second derivatives in ``z``), by the change of variables."""
     H = pr.hessian(w)
     J = np.array([[1.0 / s, -a / s ** 2], [0.0, -1.0 / s ** 2]])   # d(m, beta)/d(a, s)
     try:
         cov = J @ np.linalg.inv(-H) @ J.T
-        se_mu, se_beta = (math.sqrt(v) if v > 0 else nan for v in np.diag(cov))
+        return tuple(math.sqrt(v) if v > 0 else math.nan for v in np.diag(cov))
     except np.linalg.LinAlgError:
-        se_mu = se_beta = nan
-    (m_lo, m_hi), bci = _intervals(pr, ll, ll_flat, m, s, s_max, q)
-    mci = (math.exp(m_lo + c), math.exp(m_hi + c))
+        return math.nan, math.nan
+
+
+def _maximum(d):
+    """The maximum-likelihood fit with its intervals, or unidentified where the likelihood is
+    too flat to bound ``beta`` or the median."""
+    m0, s0 = _start(d)
+    a, s, ll, _, w = d.pr.fit(s0 * m0, s0)
+    a, s = float(a), float(s)
+    if not (s > 0 and math.isfinite(s)):
+        return d.unidentified("the fraction overturned does not rise with the intensity",
+                              d.ll_flat)
+    m = a / s
+    if 2.0 * (ll - d.ll_flat) < d.q:
+        return d.unidentified(
+            f"nearly flat likelihood: a probability that does not change with the intensity "
+            f"fits about as well (likelihood ratio {2 * (ll - d.ll_flat):.3g} < {d.q:.3g}), "
+            f"so the data set no upper end to beta", ll, m, s)
+    se_mu, se_beta = _standard_errors(d.pr, w, a, s)
+    mci, bci = d.intervals(ll, m, s)
     if not (mci[0] > 0.0 and mci[1] < math.inf):
         # the profile of the median falls too slowly: it is not bounded within reach
         side = "lower" if mci[0] == 0.0 else "upper"
-        return unidentified(f"nearly flat likelihood: the data set no {side} end to the "
-                            f"median", ll, m, s)
-    median = math.exp(m + c)
-    return LognormalFit(median, 1.0 / s, median * se_mu, se_beta, se_mu, "ok", nan, N, K, ll,
-                        "", mci, tuple(map(float, bci)), confidence)
+        return d.unidentified(f"nearly flat likelihood: the data set no {side} end to the "
+                              f"median", ll, m, s)
+    median = math.exp(m + d.c)
+    return LognormalFit(median, 1.0 / s, median * se_mu, se_beta, se_mu, "ok", math.nan, d.N,
+                        d.K, ll, "", mci, tuple(map(float, bci)), d.confidence)
 
 
 def _chi2_1(p):
