@@ -261,6 +261,8 @@ def run(p: FragilityPlan, execution=None) -> FragilityResult:
 
 
 def _records(records):
+    """The records, checked: a record set's name or a sequence of records, each with some
+    motion to scale."""
     if isinstance(records, str):
         from .fema import fema_set
         return fema_set(records)
@@ -275,7 +277,49 @@ def _records(records):
         if not isinstance(r, Record):
             raise ValueError(f"records must be rockjit.Record objects (got "
                              f"{type(r).__name__})")
+    for r in recs:
+        if r.pga == 0.0:
+            raise ValueError(f"record {r.name!r} has no motion (PGA 0): it cannot be scaled")
     return recs
+
+
+def _sizes(sizes):
+    """The block's sizes, checked: one or more distinct half-diagonals in metres."""
+    sz = np.atleast_1d(real_array("sizes", sizes, "one or more sizes in metres")).astype(float)
+    if sz.ndim != 1 or sz.size == 0:
+        raise ValueError(f"sizes must be one or more numbers (got {sizes!r})")
+    for s in sz:
+        real("size", float(s), *SIZE_RANGE)
+    if np.unique(sz).size != sz.size:
+        raise ValueError(f"sizes must be distinct (got {sz.tolist()})")
+    return sz
+
+
+def _intensities(intensities):
+    """The intensities, checked: one or more, positive and increasing."""
+    x = np.atleast_1d(real_array("intensities", intensities, "increasing positive numbers"))
+    x = x.astype(float)
+    if x.ndim != 1 or x.size == 0:
+        raise ValueError(f"intensities must be one or more numbers (got {intensities!r})")
+    for v in x:
+        real("intensity", float(v), 0.0, 1e6, lo_open=True)
+    if x.size > 1 and not np.all(np.diff(x) > 0):
+        raise ValueError(f"intensities must be increasing (got {x.tolist()})")
+    return x
+
+
+def _blocks(block, laws):
+    """One block per restitution law of ``laws`` (distinct names), or ``block`` alone."""
+    if laws is None:
+        return (block,)
+    names = (laws,) if isinstance(laws, str) else tuple(laws)
+    if not names:
+        raise ValueError("laws must name at least one restitution law")
+    for name in names:
+        choice("law", name, LAWS)
+    if len(set(names)) != len(names):
+        raise ValueError(f"laws must be distinct (got {names})")
+    return tuple(block if name == block.law else block.replace(law=name) for name in names)
 
 
 @entry_point(run)
@@ -336,37 +380,9 @@ def fragility(block, records, sizes, intensities, *, measure="pga", laws=None,
     if not isinstance(block, Block):
         raise ValueError(f"block must be a rockjit.Block (got {type(block).__name__})")
     recs = _records(records)
-    for r in recs:
-        if r.pga == 0.0:
-            raise ValueError(f"record {r.name!r} has no motion (PGA 0): it cannot be scaled")
-    sz = np.atleast_1d(real_array("sizes", sizes, "one or more sizes in metres")).astype(float)
-    if sz.ndim != 1 or sz.size == 0:
-        raise ValueError(f"sizes must be one or more numbers (got {sizes!r})")
-    for s in sz:
-        real("size", float(s), *SIZE_RANGE)
-    if np.unique(sz).size != sz.size:
-        raise ValueError(f"sizes must be distinct (got {sz.tolist()})")
-    x = np.atleast_1d(real_array("intensities", intensities, "increasing positive numbers"))
-    x = x.astype(float)
-    if x.ndim != 1 or x.size == 0:
-        raise ValueError(f"intensities must be one or more numbers (got {intensities!r})")
-    for v in x:
-        real("intensity", float(v), 0.0, 1e6, lo_open=True)
-    if x.size > 1 and not np.all(np.diff(x) > 0):
-        raise ValueError(f"intensities must be increasing (got {x.tolist()})")
+    sz, x = _sizes(sizes), _intensities(intensities)
     choice("measure", measure, tuple(MEASURES))
-    if laws is None:
-        blocks = (block,)
-    else:
-        names = (laws,) if isinstance(laws, str) else tuple(laws)
-        if not names:
-            raise ValueError("laws must name at least one restitution law")
-        for name in names:
-            choice("law", name, LAWS)
-        if len(set(names)) != len(names):
-            raise ValueError(f"laws must be distinct (got {names})")
-        blocks = tuple(block if name == block.law else block.replace(law=name)
-                       for name in names)
+    blocks = _blocks(block, laws)
     n = float(len(blocks)) * sz.size * len(recs) * x.size
     if n > MAX_RUNS:
         raise ValueError(f"an analysis may have at most {MAX_RUNS:.0e} runs (got {n:.3g})")
