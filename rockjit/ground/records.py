@@ -182,45 +182,8 @@ def read_at2(path, *, size=None, p=None, name=None) -> Record:
     path = _path_of(path)
     src = str(path)
     stream = _lines(path)
-    lines = [text.rstrip("\r\n") for _, (_, text) in zip(range(4), stream)]
-    if len(lines) < 4:
-        _refuse(src, "not a PEER .AT2 file (fewer than four header lines)")
-    units = lines[2].upper()
-    if "UNITS OF" in units or "UNITS" in units:
-        m = re.search(r"UNITS\s+(?:OF\s+)?([A-Z/0-9*^. ]+)", units)
-        unit = m.group(1).strip().split()[0] if m and m.group(1).strip() else ""
-        if unit != "G":
-            _refuse(src, f"the accelerations are in {unit or 'unstated units'}, not g "
-                         f"(header line 3: {lines[2].strip()!r})")
-    else:
-        _refuse(src, f"the header does not state the units (line 3: {lines[2].strip()!r}); "
-                     f"an .AT2 record must be in units of g")
-    head = lines[3].upper()
-    m_n = re.search(r"NPTS\s*=\s*(\d+)", head)
-    m_dt = re.search(r"DT\s*=\s*(" + _FLOAT + ")", head)
-    if m_n and m_dt:
-        npts, dt = int(m_n.group(1)), float(m_dt.group(1).replace("D", "E"))
-    else:  # the older layout: "  2999   0.0100   NPTS, DT"
-        nums = re.findall(_FLOAT, head)
-        if len(nums) >= 2 and "NPTS" in head:
-            try:
-                npts, dt = int(float(nums[0])), float(nums[1].replace("D", "E"))
-            except ValueError:
-                npts = dt = None
-        else:
-            npts = dt = None
-        if npts is None:
-            _refuse(src, f"line 4 does not give NPTS and DT ({lines[3].strip()!r})")
-    got = array("d")
-    for _, text in stream:
-        for token in text.split():
-            v = _number(token, _NUMBER_D)
-            if v is None:
-                _refuse(src, f"{token!r} among the accelerations is not a number")
-            if len(got) >= MAX_SAMPLES:
-                _too_many(src)
-            got.append(v)
-    values = np.frombuffer(got, dtype=float) if got else np.zeros(0)
+    npts, dt = _at2_header(src, stream)
+    values = _at2_samples(src, stream)
     if values.size == 0:
         _refuse(src, "it holds no samples")
     if values.size != npts:
@@ -233,6 +196,62 @@ def read_at2(path, *, size=None, p=None, name=None) -> Record:
         _refuse(src, f"sample {k} is not finite ({values[k]})")
     name = name or Path(path).stem
     return _named(src, name, lambda: Record(values, dt, size=size, p=p, name=name))
+
+
+def _at2_header(src, stream):
+    """``(NPTS, DT)`` from the four header lines of an ``.AT2`` file (taken from ``stream``,
+    :func:`_lines`), its units checked."""
+    lines = [text.rstrip("\r\n") for _, (_, text) in zip(range(4), stream)]
+    if len(lines) < 4:
+        _refuse(src, "not a PEER .AT2 file (fewer than four header lines)")
+    _at2_units(src, lines[2])
+    return _at2_npts_dt(src, lines[3])
+
+
+def _at2_units(src, line):
+    """Refuse an ``.AT2`` header's units line ``line`` unless it states ``g``."""
+    units = line.upper()
+    if "UNITS OF" in units or "UNITS" in units:
+        m = re.search(r"UNITS\s+(?:OF\s+)?([A-Z/0-9*^. ]+)", units)
+        unit = m.group(1).strip().split()[0] if m and m.group(1).strip() else ""
+        if unit != "G":
+            _refuse(src, f"the accelerations are in {unit or 'unstated units'}, not g "
+                         f"(header line 3: {line.strip()!r})")
+    else:
+        _refuse(src, f"the header does not state the units (line 3: {line.strip()!r}); "
+                     f"an .AT2 record must be in units of g")
+
+
+def _at2_npts_dt(src, line):
+    """``(NPTS, DT)`` from an ``.AT2`` header's fourth line, in either of the database's two
+    layouts (``NPTS= 2999, DT= .0100 SEC`` or ``2999   0.0100   NPTS, DT``)."""
+    head = line.upper()
+    m_n = re.search(r"NPTS\s*=\s*(\d+)", head)
+    m_dt = re.search(r"DT\s*=\s*(" + _FLOAT + ")", head)
+    if m_n and m_dt:
+        return int(m_n.group(1)), float(m_dt.group(1).replace("D", "E"))
+    nums = re.findall(_FLOAT, head)
+    if len(nums) >= 2 and "NPTS" in head:
+        try:
+            return int(float(nums[0])), float(nums[1].replace("D", "E"))
+        except ValueError:
+            pass
+    _refuse(src, f"line 4 does not give NPTS and DT ({line.strip()!r})")
+
+
+def _at2_samples(src, stream):
+    """The accelerations of an ``.AT2`` file, the rest of ``stream`` (:func:`_lines`) after its
+    header: numbers (Fortran's ``D`` exponents allowed), at most ``MAX_SAMPLES``."""
+    got = array("d")
+    for _, text in stream:
+        for token in text.split():
+            v = _number(token, _NUMBER_D)
+            if v is None:
+                _refuse(src, f"{token!r} among the accelerations is not a number")
+            if len(got) >= MAX_SAMPLES:
+                _too_many(src)
+            got.append(v)
+    return np.frombuffer(got, dtype=float) if got else np.zeros(0)
 
 
 _UNIT = re.compile(r"[\(\[]\s*([^\)\]]*?)\s*[\)\]]")
@@ -310,51 +329,22 @@ def read_table(path, *, size=None, p=None, name=None) -> Record:
     path = _path_of(path)
     src = str(path)
     times, accels = array("d"), array("d")
-    header = None
-    units_col = None
+    header = units_col = None
     row = _ROW.fullmatch
     for lineno, line in _lines(path):
         m = row(line) if units_col is None else None
         if m is not None:  # the common row, two plain numbers: no more checks to make
-            if len(times) >= MAX_SAMPLES:
-                _too_many(src)
-            times.append(float(m.group(1)))
-            accels.append(float(m.group(2)))
-            continue
-        line = line.split("#", 1)[0].strip()
-        if not line:
-            continue
-        fields = [x for x in _SEPARATORS.split(line) if x]
-        # a header names its columns: words, no number; a first line of numbers, one of them
-        # written in a way refused here ('1_0', other scripts' digits), is a row, refused
-        # below, not a header to skip
-        if not times and header is None and any(c.isalpha() for c in line) and \
-                not any(_number(x) is not None for x in fields[:2]):
-            header = line
-            cols = _header_units(src, header)
-            for k, col in enumerate(cols):
-                if re.fullmatch(r"units?", col.strip().lower()):
-                    units_col = k
-            continue
-        if units_col is not None:
-            if len(fields) <= units_col:
-                _refuse(src, f"line {lineno} has no value in its units column")
-            unit = fields[units_col].lower()
-            if unit not in _ACCEL_UNITS:
-                _refuse(src, f"line {lineno} gives the acceleration in {fields[units_col]!r}, "
-                             f"not g")
-            fields = fields[:units_col] + fields[units_col + 1:]
-        if len(fields) < 2:
-            _refuse(src, f"line {lineno} has {len(fields)} column: two are needed "
-                         f"(time in s, acceleration in g)")
-        if len(fields) > 2:
-            _refuse(src, f"line {lineno} has {len(fields)} columns: two are expected "
-                         f"(time in s, acceleration in g)")
-        t, a = _number(fields[0]), _number(fields[1])
-        if t is None or a is None:
-            bad = fields[0] if t is None else fields[1]
-            _refuse(src, f"line {lineno}: {bad!r} is not a number (ASCII digits, '.', "
-                         f"'e' and a sign)")
+            t, a = float(m.group(1)), float(m.group(2))
+        else:
+            line = line.split("#", 1)[0].strip()
+            if not line:
+                continue
+            fields = [x for x in _SEPARATORS.split(line) if x]
+            if not times and header is None and _is_header(line, fields):
+                header = line
+                units_col = _units_column(_header_units(src, header))
+                continue
+            t, a = _row_numbers(src, lineno, _without_units(src, lineno, fields, units_col))
         if len(times) >= MAX_SAMPLES:
             _too_many(src)
         times.append(t)
@@ -364,6 +354,52 @@ def read_table(path, *, size=None, p=None, name=None) -> Record:
     return Record.from_arrays(np.frombuffer(times, dtype=float),
                               np.frombuffer(accels, dtype=float), size=size, p=p,
                               name=name or Path(path).stem, source=src)
+
+
+def _is_header(line, fields):
+    """Whether a table's first line names its columns: words, no number. A first line of
+    numbers, one of them written in a way refused here ('1_0', other scripts' digits), is a
+    row, refused as such, not a header to skip."""
+    return any(c.isalpha() for c in line) and \
+        not any(_number(x) is not None for x in fields[:2])
+
+
+def _units_column(cols):
+    """The index of the column named ``unit`` or ``units`` (the last), or ``None``."""
+    units_col = None
+    for k, col in enumerate(cols):
+        if re.fullmatch(r"units?", col.strip().lower()):
+            units_col = k
+    return units_col
+
+
+def _without_units(src, lineno, fields, units_col):
+    """A row's ``fields`` less its units column (if the table has one), which must say ``g``."""
+    if units_col is None:
+        return fields
+    if len(fields) <= units_col:
+        _refuse(src, f"line {lineno} has no value in its units column")
+    unit = fields[units_col].lower()
+    if unit not in _ACCEL_UNITS:
+        _refuse(src, f"line {lineno} gives the acceleration in {fields[units_col]!r}, "
+                     f"not g")
+    return fields[:units_col] + fields[units_col + 1:]
+
+
+def _row_numbers(src, lineno, fields):
+    """``(time, acceleration)`` from a row's two ``fields``, or a refusal naming the line."""
+    if len(fields) < 2:
+        _refuse(src, f"line {lineno} has {len(fields)} column: two are needed "
+                     f"(time in s, acceleration in g)")
+    if len(fields) > 2:
+        _refuse(src, f"line {lineno} has {len(fields)} columns: two are expected "
+                     f"(time in s, acceleration in g)")
+    t, a = _number(fields[0]), _number(fields[1])
+    if t is None or a is None:
+        bad = fields[0] if t is None else fields[1]
+        _refuse(src, f"line {lineno}: {bad!r} is not a number (ASCII digits, '.', "
+                     f"'e' and a sign)")
+    return t, a
 
 
 def read_record(path, *, size=None, p=None, name=None) -> Record:
