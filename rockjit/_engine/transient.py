@@ -249,69 +249,163 @@ def _keep(traj, n, t, th, v):
     return n + 1
 
 
-@jit(nrt=False)
-def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj, out_f, out_i):
-    """One run from ``(th0, v0)`` on corner ``side0`` (0: at rest): writes ``out_f`` and
-    ``out_i`` (``F_*``, ``I_*``). ``imp`` (rows ``t, theta'-, theta'+``) and ``traj`` (rows
-    ``t, theta, theta'`` at the grid points and the events) keep what their lengths hold:
-    buffers of no rows for a grid, which needs neither."""
-    thc, xi, e, thr = b[B_THC], b[B_XI], b[B_E], b[B_COT]
-    th_top = b[B_THTOP]
-    sthc, cthc = math.sin(thc), math.cos(thc)
-    thover, rest_speed = s[S_THOVER], s[S_REST]
-    fx = forcing_of(x)
-    end = x[X_END]
-    # the grid: the excitation in X_STEPS equal steps, or X_STEPS steps between its kinks
-    # (multiples of X_DT), free rocking in steps of S_HFREE
-    nsub = 0
+@jit(nrt=False, inline=True)
+def _start(out_f, out_i):
+    """A cell's outputs before its run: the counts at zero, no status, no overturning or
+    uplift yet."""
+    for k in range(N_TI):
+        out_i[k] = 0
+    out_i[TI_STATUS] = -1
+    out_f[TF_TOVER] = math.nan
+    out_f[TF_TUP] = math.nan
+
+
+@jit(nrt=False, inline=True)
+def _grid(x, s):
+    """The step grid of the forcing row ``x`` (``grid_next``'s ``h_exc, nsub, dt, h_free``):
+    the excitation in ``X_STEPS`` equal steps, or ``X_STEPS`` steps between its kinks
+    (multiples of ``X_DT``), free rocking in steps of ``S_HFREE``."""
     dt = x[X_DT]
     if dt > 0.0:
         nsub = int(x[X_STEPS])
-        h_exc = dt / nsub
-    else:
-        h_exc = end / x[X_STEPS]
-    h_free = s[S_HFREE]
-    n_imp_buf = imp.shape[0]
+        return dt / nsub, nsub, dt, s[S_HFREE]
+    return x[X_END] / x[X_STEPS], 0, dt, s[S_HFREE]
 
-    t = 0.0
-    th = th0
-    v = v0
-    side = side0
+
+@jit(nrt=False, inline=True)
+def _leave_rest(t, fx, rec, thc, xi, thr, t_lim, traj, n_tr, out_f, out_i):
+    """The block at rest at ``t``: ``(t, side, trajectory rows)`` where it lifts off, the
+    corner ``side``; or ``side`` 0 with the status set (rest for good, or the time limit
+    first)."""
+    t_up, up = next_uplift(t, fx, rec, thc, xi, thr)
+    if up == 0:
+        out_i[TI_STATUS] = ST_REST
+        return t, 0, n_tr
+    if t_up >= t_lim:
+        out_i[TI_STATUS] = ST_TIME_LIMIT
+        return t_lim, 0, _keep(traj, n_tr, t_lim, 0.0, 0.0)
+    if t_up > t:
+        n_tr = _keep(traj, n_tr, t_up, 0.0, 0.0)
+    if math.isnan(out_f[TF_TUP]):
+        out_f[TF_TUP] = t_up
+    return t_up, up, n_tr
+
+
+@jit(nrt=False, inline=True)
+def _crest(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec):
+    """A maximum of ``side * theta`` inside the step (rising at its start, or about to: the
+    instant of an uplift, and falling at its end): ``(found, its instant, theta and theta'
+    there, the steps its location took)``; ``(False, 0, 0, 0, 0)`` if none."""
+    if not ((side * v > 0.0 or (v == 0.0 and side * a > 0.0)) and side * v1 < 0.0):
+        return False, 0.0, 0.0, 0.0, 0
+    tau, th_c, vc, ac, ns = locate(1, 0.0, t, th, v, a, 0.0, hh, 1.0, tn, side, sthc, cthc,
+                                   xi, fx, rec)
+    return True, tau, th_c, vc, ns
+
+
+@jit(nrt=False, inline=True)
+def _reach(kind, target, glo, t, th, v, a, lo, hi, tn, side, sthc, cthc, xi, fx, rec):
+    """Where in the step ``side * theta`` reaches ``target`` (``kind`` 0) between ``lo`` and
+    ``hi`` (:func:`locate`; ``glo``, the event function's sign just after ``lo``): ``(the
+    instant, theta and theta' there, the steps its location took)``."""
+    tau, th2, v2, a2, ns = locate(kind, target, t, th, v, a, lo, hi, glo, tn, side, sthc, cthc,
+                                  xi, fx, rec)
+    return tau, th2, v2, ns
+
+
+@jit(nrt=False, inline=True)
+def _impact_in(crest, t, th, v, a, hh, tn, th1, v1, side, sthc, cthc, xi, fx, rec):
+    """Whether the step went through an impact: ``(where it ends, or -1, the steps its search
+    took)``; the step's end if it ends beyond ``theta = 0``, else a dip's minimum
+    (:func:`_dip`) in a step without a crest."""
+    if side * th1 < 0.0:
+        return hh, 0
+    if crest:
+        return -1.0, 0
+    return _dip(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec)
+
+
+@jit(nrt=False, inline=True)
+def _dip(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec):
+    """Where a step whose ``side * theta`` falls then rises (a minimum inside it) goes through
+    an impact and back: ``(the minimum's instant if side * theta is negative there, else -1;
+    the steps its location took)``."""
+    if not (side * v < 0.0 and side * v1 > 0.0):
+        return -1.0, 0
+    tau, th2, v2, a2, ns = locate(1, 0.0, t, th, v, a, 0.0, hh, side * v, tn, side, sthc,
+                                  cthc, xi, fx, rec)
+    return (tau if side * th2 < 0.0 else -1.0), ns
+
+
+@jit(nrt=False, inline=True)
+def _land(t, v2, side, b, rest_speed, imp, out_i):
+    """The impact at ``t`` with ``theta'(-) = v2`` on corner ``side``: the jump of the
+    block's law (:func:`rockjit.model.jump`), kept in ``imp`` if it holds it; ``(theta,
+    theta', side)`` after it on the other corner, or at rest below ``rest_speed``."""
+    dth_p = jump(v2, restitution_at(int(b[B_LAW]), abs(v2), b[B_E], b[B_LAW_SHAPE])[0])
+    n_imp = out_i[TI_IMPACTS]
+    if n_imp < imp.shape[0]:
+        imp[n_imp, 0] = t
+        imp[n_imp, 1] = v2
+        imp[n_imp, 2] = dth_p
+    out_i[TI_IMPACTS] = n_imp + 1
+    if abs(dth_p) < rest_speed or dth_p == 0.0:
+        out_i[TI_REST] += 1
+        return 0.0, 0.0, 0
+    return -side * _TINY, dth_p, -side
+
+
+@jit(nrt=False, inline=True)
+def _finish(t, th, v, max_th, n_step, n_tr, end, alpha, out_f, out_i):
+    """A finished cell's outcome from its status, its last state, ``max |theta|``, the steps
+    it took and its trajectory's rows."""
+    out_f[TF_MAXTH] = max_th
+    out_i[TI_STEPS] = n_step
+    out_i[TI_TRAJ] = n_tr
+    status = out_i[TI_STATUS]
+    if status == ST_OVERTURNED:
+        outcome = OC_OVER_IMPACT if out_i[TI_IMPACTS] > 0 else OC_OVER_NO_IMPACT
+    elif status == ST_REST or status == ST_DECIDED or (status == ST_TIME_LIMIT and t >= end):
+        outcome = OC_SAFE
+    else:
+        outcome = OC_UNRESOLVED
+    out_i[TI_OUTCOME] = outcome
+    out_f[TF_MAXROT] = out_f[TF_MAXTH] / alpha
+    out_f[TF_T] = t
+    out_f[TF_TH] = th
+    out_f[TF_DTH] = v
+
+
+@jit(nrt=False)
+def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj, out_f, out_i):
+    """One run from ``(th0, v0)`` on corner ``side0`` (0: at rest): writes ``out_f`` and
+    ``out_i`` (``TF_*``, ``TI_*``; they hold the run's status and counts as it goes).
+    ``imp`` (rows ``t, theta'-, theta'+``) and ``traj`` (rows ``t, theta, theta'`` at the grid
+    points and the events) keep what their lengths hold: buffers of no rows for a grid, which
+    needs neither."""
+    thc, xi, thr, th_top = b[B_THC], b[B_XI], b[B_COT], b[B_THTOP]
+    sthc, cthc, thover = math.sin(thc), math.cos(thc), s[S_THOVER]
+    fx = forcing_of(x)
+    end = x[X_END]
+    h_exc, nsub, dt, h_free = _grid(x, s)
+    _start(out_f, out_i)
+    t, th, v, side, max_th, n_step = 0.0, th0, v0, side0, abs(th0), 0
     a = acc(th, v, t, side, sthc, cthc, xi, fx, rec) if side != 0 else 0.0
-    n_imp = 0
-    n_rest = 0
-    n_step = 0
     n_tr = _keep(traj, 0, t, th, v)
-    max_th = abs(th0)
-    t_over = math.nan
-    t_up_first = math.nan
-    status = -1
-    while status < 0:
+    while out_i[TI_STATUS] < 0:
         if t >= t_lim:
-            status = ST_TIME_LIMIT
+            out_i[TI_STATUS] = ST_TIME_LIMIT
             break
         if side == 0:  # ---- at rest ------------------------------------------------------------
-            t_up, up = next_uplift(t, fx, rec, thc, xi, thr)
-            if up == 0:
-                status = ST_REST
+            t, side, n_tr = _leave_rest(t, fx, rec, thc, xi, thr, t_lim, traj, n_tr, out_f,
+                                        out_i)
+            if side == 0:
                 break
-            if t_up >= t_lim:
-                n_tr = _keep(traj, n_tr, t_lim, 0.0, 0.0)
-                t = t_lim
-                status = ST_TIME_LIMIT
-                break
-            if t_up > t:
-                n_tr = _keep(traj, n_tr, t_up, 0.0, 0.0)
-            t = t_up
-            if math.isnan(t_up_first):
-                t_up_first = t
-            side = up
-            th = side * _TINY
-            v = 0.0
+            th, v = side * _TINY, 0.0
             a = acc(th, v, t, side, sthc, cthc, xi, fx, rec)
             continue
         if decide and t >= end and free_rocking_decided(th, v, max_th, thc, th_top):
-            status = ST_DECIDED
+            out_i[TI_STATUS] = ST_DECIDED
             break
         # ---- one step on corner `side` --------------------------------------------------------
         tn = grid_next(t, end, h_exc, nsub, dt, h_free, t_lim)
@@ -319,99 +413,50 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
         th1, v1, a1 = dp_step(t, th, v, a, hh, tn, side, sthc, cthc, xi, fx, rec)
         n_step += 1
         if not (math.isfinite(th1) and math.isfinite(v1) and math.isfinite(a1)):
-            status = ST_NONFINITE
+            out_i[TI_STATUS] = ST_NONFINITE
             break
-        lo = 0.0
-        th_c = 0.0
-        # rising at the start (or about to: the instant of an uplift) and falling at the end
-        crest = (side * v > 0.0 or (v == 0.0 and side * a > 0.0)) and side * v1 < 0.0
-        if crest:  # a maximum of side * theta inside the step
-            tau, th_c, vc, ac, ns = locate(1, 0.0, t, th, v, a, 0.0, hh, 1.0, tn, side,
-                                           sthc, cthc, xi, fx, rec)
-            n_step += ns
+        crest, lo, th_c, vc, ns = _crest(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec)
+        n_step += ns
+        if crest:
             max_th = max(max_th, abs(th_c))
-            if decide and t + tau >= end and free_rocking_decided(th_c, 0.0, max_th, thc,
-                                                                  th_top):
-                t = t + tau
-                th, v = th_c, vc
+            if decide and t + lo >= end and free_rocking_decided(th_c, 0.0, max_th, thc,
+                                                                 th_top):
+                t, th, v = t + lo, th_c, vc
                 n_tr = _keep(traj, n_tr, t, th, v)
-                status = ST_DECIDED
+                out_i[TI_STATUS] = ST_DECIDED
                 break
-            lo = tau
-        impact_at = -1.0
         if side * th1 >= thover:  # overturning
-            tau, th2, v2, a2, ns = locate(0, thover, t, th, v, a, 0.0, hh,
-                                          side * th - thover, tn, side, sthc, cthc, xi, fx, rec)
+            tau, th, v, ns = _reach(0, thover, side * th - thover, t, th, v, a, 0.0, hh, tn,
+                                    side, sthc, cthc, xi, fx, rec)
             n_step += ns
-            t = t_over = t + tau
-            th, v = th2, v2
+            t = out_f[TF_TOVER] = t + tau
             n_tr = _keep(traj, n_tr, t, th, v)
             max_th = max(max_th, thover)
-            status = ST_OVERTURNED
+            out_i[TI_STATUS] = ST_OVERTURNED
             break
-        if side * th1 < 0.0:  # an impact inside the step
-            impact_at = hh
-        elif not crest and side * v < 0.0 and side * v1 > 0.0:
-            # a minimum of side * theta: below 0, the block went through an impact and back
-            tau, th2, v2, a2, ns = locate(1, 0.0, t, th, v, a, 0.0, hh, side * v, tn, side,
-                                          sthc, cthc, xi, fx, rec)
-            n_step += ns
-            if side * th2 < 0.0:
-                impact_at = tau
+        impact_at, ns = _impact_in(crest, t, th, v, a, hh, tn, th1, v1, side, sthc, cthc, xi,
+                                   fx, rec)
+        n_step += ns
         if impact_at < 0.0:
             if t < end <= tn:  # the excitation ends here: free rocking from f = 0 on
                 a1 = acc_free(th1, v1, side, sthc, cthc, xi)
-            t = tn
-            th, v, a = th1, v1, a1
+            t, th, v, a = tn, th1, v1, a1
             n_tr = _keep(traj, n_tr, t, th, v)
             max_th = max(max_th, abs(th))
             continue
         # ---- impact --------------------------------------------------------------------------
-        g_lo = side * th if lo == 0.0 else side * th_c
-        tau, th2, v2, a2, ns = locate(0, 0.0, t, th, v, a, lo, impact_at, g_lo, tn, side,
-                                      sthc, cthc, xi, fx, rec)
+        tau, th2, v2, ns = _reach(0, 0.0, side * th if lo == 0.0 else side * th_c, t, th, v, a,
+                                  lo, impact_at, tn, side, sthc, cthc, xi, fx, rec)
         n_step += ns
         t = t + tau
         n_tr = _keep(traj, n_tr, t, 0.0, v2)
-        dth_p = jump(v2, restitution_at(int(b[B_LAW]), abs(v2), e, b[B_LAW_SHAPE])[0])
-        if n_imp < n_imp_buf:
-            imp[n_imp, 0] = t
-            imp[n_imp, 1] = v2
-            imp[n_imp, 2] = dth_p
-        n_imp += 1
-        side = -side
-        th = side * _TINY
-        v = dth_p
-        if abs(dth_p) < rest_speed or dth_p == 0.0:
-            th = 0.0
-            v = 0.0
-            side = 0
-            n_rest += 1
-        else:
+        th, v, side = _land(t, v2, side, b, s[S_REST], imp, out_i)
+        if side != 0:
             a = acc(th, v, t, side, sthc, cthc, xi, fx, rec)
-        if n_imp >= max_impacts:
-            status = ST_MAX_IMPACTS
+        if out_i[TI_IMPACTS] >= max_impacts:
+            out_i[TI_STATUS] = ST_MAX_IMPACTS
             break
-
-    if status == ST_OVERTURNED:
-        outcome = OC_OVER_IMPACT if n_imp > 0 else OC_OVER_NO_IMPACT
-    elif status == ST_REST or status == ST_DECIDED or (status == ST_TIME_LIMIT and t >= end):
-        outcome = OC_SAFE
-    else:
-        outcome = OC_UNRESOLVED
-    out_f[TF_MAXROT] = max_th / b[B_ALPHA]
-    out_f[TF_TOVER] = t_over
-    out_f[TF_T] = t
-    out_f[TF_TUP] = t_up_first
-    out_f[TF_TH] = th
-    out_f[TF_DTH] = v
-    out_f[TF_MAXTH] = max_th
-    out_i[TI_OUTCOME] = outcome
-    out_i[TI_IMPACTS] = n_imp
-    out_i[TI_STATUS] = status
-    out_i[TI_REST] = n_rest
-    out_i[TI_TRAJ] = n_tr
-    out_i[TI_STEPS] = n_step
+    _finish(t, th, v, max_th, n_step, n_tr, end, b[B_ALPHA], out_f, out_i)
 
 
 @jit(parallel=True)
