@@ -495,43 +495,154 @@ def tock(PROF, counts, k, c0):
         counts[k] += cycles() - c0
 
 
+@jit(ir_inline=True)
+def substep(EMBED4, TANGENT, PROF, fresh, pre, j, t, t_grid, sp, cp, side, par, out, w,
+            counts):
+    """The Runge–Kutta step from ``t`` to the grid point ``t_grid``: a whole grid step
+    (``fresh``; with ``pre``, already taken) on the grid step's table, its forcing from the
+    period's table row ``j``; or the rest of one after an event, on a table of its own length,
+    the forcing rotated from its phase's sine and cosine ``sp, cp`` at ``t``. Returns
+    ``(hh, sp, cp, f0, df0, f1)``: its length, the forcing's phase at its start, the forcing and
+    its derivative there and the forcing at its end (for :func:`locate`)."""
+    ftab = w.ftab
+    if fresh:
+        # a whole grid step: the forcing phase there is phi + 2 pi j / N exactly
+        hh = par[P_H]
+        if not pre:
+            c0 = tick(PROF)
+            rk_step(EMBED4, TANGENT, EMBED4 is None, 0.0, 0.0, w.y, w.K, side, par, w.ytmp,
+                    w.ynew, w.tab_h, w.fr if EMBED4 is not None else ftab[j], w.jac, w.trig)
+            tock(PROF, counts, np.int64(11), c0)
+        sp = ftab[j, FT_SIN]
+        cp = ftab[j, FT_COS]
+        f0 = ftab[j, 0]
+        df0 = ftab[j, FT_DF0]
+        f1 = ftab[j, N_STAGES]
+    else:
+        c0 = tick(PROF)
+        hh = t_grid - t
+        step_table(par[P_OMEGA], hh, w.tab)
+        rk_step(EMBED4, TANGENT, OFF_GRID, sp, cp, w.y, w.K, side, par, w.ytmp, w.ynew, w.tab,
+                w.fr, w.jac, w.trig)
+        tock(PROF, counts, np.int64(7), c0)
+        f0 = w.fr[0]
+        df0 = par[P_AW2] * par[P_OMEGA] * cp
+        f1 = w.fr[N_STAGES]
+    out.iout[O_RHS] += N_STAGES
+    out.iout[O_SUBSTEPS] += 1
+    return hh, sp, cp, f0, df0, f1
+
+
+@jit(ir_inline=True)
+def move_to_event(EMBED4, TANGENT, kind, lo, hi, hh, j, side, par, out, w, sp, cp, f0, df0,
+                  f1):
+    """The state at the event ``kind`` detected in ``(lo, hi)`` of the step of length ``hh``
+    (:func:`locate`) taken into ``w.y``; an unresolvably small flight (``hi <= lo``) ends at
+    rest where it started. Returns the event's time in the step."""
+    NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
+    NY = NS + (4 if TANGENT is not None else 0)  # plus the tangent matrix, column-major
+    y = w.y
+    if hi > lo:
+        tau = locate(EMBED4, TANGENT, kind, y, w.ynew, hh, lo, hi, w.K, side, par, w.ytmp,
+                     w.yev, out.iout, w.tab, w.fr, w.jac, w.trig, sp, cp, f0, df0, f1,
+                     w.ftab[j, FT_DF1])
+    else:
+        tau = 0.0
+        for m in range(NY):
+            w.yev[m] = y[m]
+        w.yev[1] = 0.0
+    for m in range(NY):
+        y[m] = w.yev[m]
+    return tau
+
+
+@jit(ir_inline=True)
+def pass_event(EMBED4, kind, t, side, par, out, w):
+    """Go on from an event that does not end the step's flight: overturning in the study's
+    way (the first crossing noted, then integrated on in the same field, the threshold lifted
+    so that the crossing is not found again), or an uplift from rest (the block on the corner
+    its forcing pushes it to). Returns the corner; the field at ``t`` is in ``w.K[0]``."""
+    y = w.y
+    if kind == EV_OVERTURN:
+        out.fout[F_TOVER] = t
+        par[P_THOVER] = math.inf
+    else:
+        y[0] = 0.0
+        y[1] = 0.0
+        side = 1 if y[2] > 0.0 else -1
+    rhs(EMBED4, forcing_at(t, par), y, side, par, w.K, w.jac, w.trig)
+    out.iout[O_RHS] += 1
+    return side
+
+
+@jit(ir_inline=True)
+def rest_collapse(EMBED4, TANGENT, in_window, y, n_col, n_col_win):
+    """The tangent vectors after an impact that brings the block to rest: ``(n_col,
+    n_col_win)``, the collapses counted (and those in the exponents' window).
+
+    A rest phase ends every perturbation: a nearby state reaches rest too (its Zeno cascade
+    ends a little earlier or later), and the block leaves rest when the forcing alone says.
+    The flow's Jacobian across it is zero, and the exponents of a stretch holding one are
+    -inf (docs/theory/exponents.md): the vectors start afresh (:func:`reset_tangent`)."""
+    if TANGENT is not None:
+        reset_tangent(EMBED4, y)
+        n_col += 1
+        if in_window:
+            n_col_win += 1
+    return n_col, n_col_win
+
+
+@jit(ir_inline=True)
+def end_of_grid_step(EMBED4, TANGENT, PROF, record, t, step, side, n_imp, n_col, n_col_win,
+                     in_window, ipar, par, out, w, counts, j_per, k_per, j_qr, j_rec):
+    """The grid point reached without an end: the step counted, the state checked finite and
+    the grid point's work done (:func:`grid_point`). Returns ``(status, step, j_per, k_per,
+    j_qr, j_rec, n_col, n_col_win)``."""
+    step += 1
+    if not (math.isfinite(w.y[0]) and math.isfinite(w.y[1])):
+        return NONFINITE, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win
+    c0 = tick(PROF)
+    status, j_per, k_per, j_qr, j_rec, collapsed = grid_point(
+        EMBED4, TANGENT, record, t, step, side, n_imp, n_col, in_window, ipar, par, out, w,
+        j_per, k_per, j_qr, j_rec)
+    tock(PROF, counts, np.int64(12), c0)
+    if collapsed:
+        n_col += 1
+        if in_window:
+            n_col_win += 1
+    return status, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win
+
+
 @jit(nrt=False, inline=True)
 def grid_step(EMBED4, TANGENT, record, PROF, pre, s, par, ipar, out, w, counts):
     """One grid step, from ``t`` (the grid point ``step h``, or the block still at rest) to the
-    next grid point (docs/theory/integrator.md): a step of the current corner, or of rest; an event in it is
-    located, the state taken there (impact: :func:`impact`; uplift; overturning ends the run),
-    and the step finished from the event to the grid point; then :func:`grid_point`.
+    next grid point (docs/theory/integrator.md): a step of the current corner, or of rest
+    (:func:`leave_rest`; ``hold``: held at rest until the grid point, where a flight that
+    began at an uplift ended at rest within rounding of that instant, lest the uplift be found
+    again forever); an event in it is located (:func:`move_to_event`), the state taken there
+    (impact: :func:`impact`; uplift; overturning ends the run or is passed,
+    :func:`pass_event`), and the step finished from the event to the grid point
+    (:func:`substep`); then :func:`grid_point` (:func:`end_of_grid_step`).
 
     The loop's state ``s`` (a :data:`~rockjit._engine.layout.Loop`) goes in and the next comes
-    back out. The one step of the single-lane loop
-    (:func:`drive`) and of a lane taken out of the lanes' lockstep (:mod:`rockjit._engine.lanes`): with
-    ``pre`` the grid step's first Runge–Kutta step is already in ``K``, ``w.ynew``, ``w.jac``
-    and ``w.trig``. With ``PROF``, ``counts[6:13]`` receive the cycles spent in rest phases,
-    in the steps after an event, in locating, in impacts, in detection, in the first step and
-    at the grid point (the lanes' accounting, a run-time bool; the single-lane loop passes
-    ``PROF = None``: :func:`tick`).
+    back out. The one step of the single-lane loop (:func:`drive`) and of a lane taken out of
+    the lanes' lockstep (:mod:`rockjit._engine.lanes`): with ``pre`` the grid step's first
+    Runge–Kutta step is already in ``K``, ``w.ynew``, ``w.jac`` and ``w.trig``. With ``PROF``,
+    ``counts[6:13]`` receive the cycles spent in rest phases, in the steps after an event, in
+    locating, in impacts, in detection, in the first step and at the grid point (the lanes'
+    accounting, a run-time bool; the single-lane loop passes ``PROF = None``: :func:`tick`).
     """
-    NS = 4 if EMBED4 is not None else 2  # state: theta, theta' (, r, s)
-    NY = NS + (4 if TANGENT is not None else 0)  # plus the tangent matrix, column-major
     t, side, n_imp, step, j_per, k_per, j_qr, j_rec = (s.t, s.side, s.n_imp, s.step, s.j_per,
                                                        s.k_per, s.j_qr, s.j_rec)
     n_col, n_col_win, t_lift, max_err = s.n_col, s.n_col_win, s.t_lift, s.max_err
-    h = par[P_H]
     y = w.y
-    K = w.K
     status = RUNNING
     j = j_per
-    t_grid = (step + 1) * h
+    t_grid = (step + 1) * par[P_H]
     in_window = step >= ipar[I_WINDOW] * ipar[I_N]
     fresh = True  # no event yet in this grid step
-    ftab = w.ftab
     jn = j + 1 if j + 1 < ipar[I_N] else 0  # the grid point's row of the forcing table
-    sp = 0.0  # sine and cosine of the forcing phase at t, off the grid point (phase_before)
-    cp = 0.0
-    # Held at rest until the grid point: set when a flight that began at an uplift ends at
-    # rest within rounding of that instant (forcing a hair above the uplift threshold, where
-    # the acceleration rounds to zero); otherwise the uplift would be found again at the
-    # same instant forever.
+    sp, cp = 0.0, 0.0  # sine and cosine of the forcing phase at t, off the grid (phase_before)
     hold = step < 0  # False, typed bool rather than the literal (one compilation of leave_rest)
     while True:
         if side == 0:
@@ -546,80 +657,33 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, s, par, ipar, out, w, counts):
             if action == REST_LIFT:
                 t_lift = t
                 fresh = EMBED4 is not None and fresh
-                sp, cp = phase_before(EMBED4, ftab, jn, par[P_OMEGA] * (t_grid - t))
+                sp, cp = phase_before(EMBED4, w.ftab, jn, par[P_OMEGA] * (t_grid - t))
                 continue
-        if fresh:
-            # a whole grid step: the forcing phase there is phi + 2 pi j / N exactly
-            hh = h
-            if not pre:
-                c0 = tick(PROF)
-                rk_step(EMBED4, TANGENT, EMBED4 is None, 0.0, 0.0, y, K, side, par, w.ytmp, w.ynew,
-                        w.tab_h, w.fr if EMBED4 is not None else ftab[j], w.jac, w.trig)
-                tock(PROF, counts, np.int64(11), c0)
-            pre = False
-            # the forcing's phase at the start, its value and derivative at the ends (locate)
-            sp = ftab[j, FT_SIN]
-            cp = ftab[j, FT_COS]
-            f0 = ftab[j, 0]
-            df0 = ftab[j, FT_DF0]
-            f1 = ftab[j, N_STAGES]
-        else:
-            c0 = tick(PROF)
-            hh = t_grid - t
-            step_table(par[P_OMEGA], hh, w.tab)
-            rk_step(EMBED4, TANGENT, OFF_GRID, sp, cp, y, K, side, par, w.ytmp, w.ynew, w.tab,
-                    w.fr, w.jac, w.trig)
-            tock(PROF, counts, np.int64(7), c0)
-            f0 = w.fr[0]
-            df0 = par[P_AW2] * par[P_OMEGA] * cp
-            f1 = w.fr[N_STAGES]
-        out.iout[O_RHS] += N_STAGES
-        out.iout[O_SUBSTEPS] += 1
+        hh, sp, cp, f0, df0, f1 = substep(EMBED4, TANGENT, PROF, fresh, pre, j, t, t_grid, sp,
+                                          cp, side, par, out, w, counts)
+        pre = False
         c0 = tick(PROF)
-        kind, lo, hi = detect(y, w.ynew, hh, K, side, par)
+        kind, lo, hi = detect(y, w.ynew, hh, w.K, side, par)
         tock(PROF, counts, np.int64(10), c0)
-        if hold and kind == EV_UPLIFT:
-            kind = EV_NONE
-        if kind == EV_NONE:
+        if kind == EV_NONE or (hold and kind == EV_UPLIFT):
             max_err = accept(EMBED4, TANGENT, side, hh, max_err, w)
             t = t_grid
             break
         c0 = tick(PROF)
-        if hi > lo:
-            tau = locate(EMBED4, TANGENT, kind, y, w.ynew, hh, lo, hi, K, side, par, w.ytmp,
-                         w.yev, out.iout, w.tab, w.fr, w.jac, w.trig, sp, cp, f0, df0, f1,
-                         ftab[j, FT_DF1])
-        else:
-            # an unresolvably small flight: take it as ending at rest where it started
-            tau = 0.0
-            for m in range(NY):
-                w.yev[m] = y[m]
-            w.yev[1] = 0.0
+        tau = move_to_event(EMBED4, TANGENT, kind, lo, hi, hh, j, side, par, out, w, sp, cp, f0,
+                            df0, f1)
         tock(PROF, counts, np.int64(8), c0)
         t = t + tau
         fresh = False
-        for m in range(NY):
-            y[m] = w.yev[m]
         # the forcing phase at the event, for the rest of the step (and its forcing)
-        sp, cp = phase_before(EMBED4, ftab, jn, par[P_OMEGA] * (t_grid - t))
-        if kind == EV_OVERTURN:
-            if ipar[I_CONTINUE] == 0:
-                status = OVERTURNED
-                break
-            # the study's way: note the first crossing and integrate on (the same field;
-            # the threshold is lifted so that the crossing is not found again)
-            out.fout[F_TOVER] = t
-            par[P_THOVER] = math.inf
-            rhs(EMBED4, forcing_at(t, par), y, side, par, K, w.jac, w.trig)
-            out.iout[O_RHS] += 1
-            continue
-        if kind == EV_UPLIFT:
-            y[0] = 0.0
-            y[1] = 0.0
-            side = 1 if y[2] > 0.0 else -1
-            t_lift = t
-            rhs(EMBED4, forcing_at(t, par), y, side, par, K, w.jac, w.trig)
-            out.iout[O_RHS] += 1
+        sp, cp = phase_before(EMBED4, w.ftab, jn, par[P_OMEGA] * (t_grid - t))
+        if kind == EV_OVERTURN and ipar[I_CONTINUE] == 0:
+            status = OVERTURNED
+            break
+        if kind == EV_OVERTURN or kind == EV_UPLIFT:
+            if kind == EV_UPLIFT:
+                t_lift = t
+            side = pass_event(EMBED4, kind, t, side, par, out, w)
             continue
         c0 = tick(PROF)
         side, n_imp, rests, held = impact(EMBED4, TANGENT, t, sp, t_lift, side, n_imp,
@@ -627,34 +691,14 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, s, par, ipar, out, w, counts):
         tock(PROF, counts, np.int64(9), c0)
         if rests:
             hold = hold or held
-            if TANGENT is not None:
-                # A rest phase ends every perturbation: a nearby state reaches rest too (its
-                # Zeno cascade ends a little earlier or later), and the block leaves rest
-                # when the forcing alone says. The flow's Jacobian across it is zero, and
-                # the exponents of a stretch holding one are -inf (docs/theory/exponents.md). (Banking the
-                # vectors' growth instead counted the cascade's saltation entries, ~1/theta'
-                # at the last impacts, as growth: exponents that depended on rest_speed.)
-                reset_tangent(EMBED4, y)
-                n_col += 1
-                if in_window:
-                    n_col_win += 1
+            n_col, n_col_win = rest_collapse(EMBED4, TANGENT, in_window, y, n_col, n_col_win)
         if n_imp >= ipar[I_MAXIMP]:
             status = MAX_IMPACTS
             break
     if status == RUNNING:
-        step += 1
-        if not (math.isfinite(y[0]) and math.isfinite(y[1])):
-            status = NONFINITE
-        else:
-            c0 = tick(PROF)
-            status, j_per, k_per, j_qr, j_rec, collapsed = grid_point(
-                EMBED4, TANGENT, record, t, step, side, n_imp, n_col, in_window, ipar, par,
-                out, w, j_per, k_per, j_qr, j_rec)
-            tock(PROF, counts, np.int64(12), c0)
-            if collapsed:
-                n_col += 1
-                if in_window:
-                    n_col_win += 1
+        status, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win = end_of_grid_step(
+            EMBED4, TANGENT, PROF, record, t, step, side, n_imp, n_col, n_col_win, in_window,
+            ipar, par, out, w, counts, j_per, k_per, j_qr, j_rec)
     return Loop(status, t, side, n_imp, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win,
                 t_lift, max_err)
 
