@@ -249,7 +249,7 @@ def _keep(traj, n, t, th, v):
     return n + 1
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def _start(out_f, out_i):
     """A cell's outputs before its run: the counts at zero, no status, no overturning or
     uplift yet."""
@@ -260,7 +260,7 @@ def _start(out_f, out_i):
     out_f[TF_TUP] = math.nan
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def _grid(x, s):
     """The step grid of the forcing row ``x`` (``grid_next``'s ``h_exc, nsub, dt, h_free``):
     the excitation in ``X_STEPS`` equal steps, or ``X_STEPS`` steps between its kinks
@@ -272,7 +272,7 @@ def _grid(x, s):
     return x[X_END] / x[X_STEPS], 0, dt, s[S_HFREE]
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def _leave_rest(t, fx, rec, thc, xi, thr, t_lim, traj, n_tr, out_f, out_i):
     """The block at rest at ``t``: ``(t, side, trajectory rows)`` where it lifts off, the
     corner ``side``; or ``side`` 0 with the status set (rest for good, or the time limit
@@ -291,7 +291,7 @@ def _leave_rest(t, fx, rec, thc, xi, thr, t_lim, traj, n_tr, out_f, out_i):
     return t_up, up, n_tr
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def _crest(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec):
     """A maximum of ``side * theta`` inside the step (rising at its start, or about to: the
     instant of an uplift, and falling at its end): ``(found, its instant, theta and theta'
@@ -303,7 +303,7 @@ def _crest(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec):
     return True, tau, th_c, vc, ns
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def _reach(kind, target, glo, t, th, v, a, lo, hi, tn, side, sthc, cthc, xi, fx, rec):
     """Where in the step ``side * theta`` reaches ``target`` (``kind`` 0) between ``lo`` and
     ``hi`` (:func:`locate`; ``glo``, the event function's sign just after ``lo``): ``(the
@@ -313,7 +313,7 @@ def _reach(kind, target, glo, t, th, v, a, lo, hi, tn, side, sthc, cthc, xi, fx,
     return tau, th2, v2, ns
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def _impact_in(crest, t, th, v, a, hh, tn, th1, v1, side, sthc, cthc, xi, fx, rec):
     """Whether the step went through an impact: ``(where it ends, or -1, the steps its search
     took)``; the step's end if it ends beyond ``theta = 0``, else a dip's minimum
@@ -325,7 +325,7 @@ def _impact_in(crest, t, th, v, a, hh, tn, th1, v1, side, sthc, cthc, xi, fx, re
     return _dip(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec)
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def _dip(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec):
     """Where a step whose ``side * theta`` falls then rises (a minimum inside it) goes through
     an impact and back: ``(the minimum's instant if side * theta is negative there, else -1;
@@ -337,7 +337,7 @@ def _dip(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec):
     return (tau if side * th2 < 0.0 else -1.0), ns
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def _land(t, v2, side, b, rest_speed, imp, out_i):
     """The impact at ``t`` with ``theta'(-) = v2`` on corner ``side``: the jump of the
     block's law (:func:`rockjit.model.jump`), kept in ``imp`` if it holds it; ``(theta,
@@ -355,7 +355,7 @@ def _land(t, v2, side, b, rest_speed, imp, out_i):
     return -side * _TINY, dth_p, -side
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def _finish(t, th, v, max_th, n_step, n_tr, end, alpha, out_f, out_i):
     """A finished cell's outcome from its status, its last state, ``max |theta|``, the steps
     it took and its trajectory's rows."""
