@@ -251,11 +251,10 @@ def _keep(traj, n, t, th, v):
 
 @jit(ir_inline=True)
 def _start(out_f, out_i):
-    """A cell's outputs before its run: the counts at zero, no status, no overturning or
+    """A cell's outputs before its run: the impacts and rests at zero, no overturning or
     uplift yet."""
-    for k in range(N_TI):
-        out_i[k] = 0
-    out_i[TI_STATUS] = -1
+    out_i[TI_IMPACTS] = 0
+    out_i[TI_REST] = 0
     out_f[TF_TOVER] = math.nan
     out_f[TF_TUP] = math.nan
 
@@ -273,22 +272,20 @@ def _grid(x, s):
 
 
 @jit(ir_inline=True)
-def _leave_rest(t, fx, rec, thc, xi, thr, t_lim, traj, n_tr, out_f, out_i):
-    """The block at rest at ``t``: ``(t, side, trajectory rows)`` where it lifts off, the
-    corner ``side``; or ``side`` 0 with the status set (rest for good, or the time limit
+def _leave_rest(t, fx, rec, thc, xi, thr, t_lim, traj, n_tr, out_f):
+    """The block at rest at ``t``: ``(t, side, trajectory rows, -1)`` where it lifts off, the
+    corner ``side``; or ``side`` 0 and the run's status (rest for good, or the time limit
     first)."""
     t_up, up = next_uplift(t, fx, rec, thc, xi, thr)
     if up == 0:
-        out_i[TI_STATUS] = ST_REST
-        return t, 0, n_tr
+        return t, 0, n_tr, ST_REST
     if t_up >= t_lim:
-        out_i[TI_STATUS] = ST_TIME_LIMIT
-        return t_lim, 0, _keep(traj, n_tr, t_lim, 0.0, 0.0)
+        return t_lim, 0, _keep(traj, n_tr, t_lim, 0.0, 0.0), ST_TIME_LIMIT
     if t_up > t:
         n_tr = _keep(traj, n_tr, t_up, 0.0, 0.0)
     if math.isnan(out_f[TF_TUP]):
         out_f[TF_TUP] = t_up
-    return t_up, up, n_tr
+    return t_up, up, n_tr, -1
 
 
 @jit(ir_inline=True)
@@ -356,13 +353,13 @@ def _land(t, v2, side, b, rest_speed, imp, out_i):
 
 
 @jit(ir_inline=True)
-def _finish(t, th, v, max_th, n_step, n_tr, end, alpha, out_f, out_i):
-    """A finished cell's outcome from its status, its last state, ``max |theta|``, the steps
-    it took and its trajectory's rows."""
+def _finish(status, t, th, v, max_th, n_step, n_tr, end, alpha, out_f, out_i):
+    """A finished cell's status and outcome, its last state, ``max |theta|``, the steps it
+    took and its trajectory's rows."""
     out_f[TF_MAXTH] = max_th
     out_i[TI_STEPS] = n_step
     out_i[TI_TRAJ] = n_tr
-    status = out_i[TI_STATUS]
+    out_i[TI_STATUS] = status
     if status == ST_OVERTURNED:
         outcome = OC_OVER_IMPACT if out_i[TI_IMPACTS] > 0 else OC_OVER_NO_IMPACT
     elif status == ST_REST or status == ST_DECIDED or (status == ST_TIME_LIMIT and t >= end):
@@ -379,7 +376,7 @@ def _finish(t, th, v, max_th, n_step, n_tr, end, alpha, out_f, out_i):
 @jit(nrt=False)
 def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj, out_f, out_i):
     """One run from ``(th0, v0)`` on corner ``side0`` (0: at rest): writes ``out_f`` and
-    ``out_i`` (``TF_*``, ``TI_*``; they hold the run's status and counts as it goes).
+    ``out_i`` (``TF_*``, ``TI_*``; they hold the run's impact and rest counts as it goes).
     ``imp`` (rows ``t, theta'-, theta'+``) and ``traj`` (rows ``t, theta, theta'`` at the grid
     points and the events) keep what their lengths hold: buffers of no rows for a grid, which
     needs neither."""
@@ -389,23 +386,23 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
     end = x[X_END]
     h_exc, nsub, dt, h_free = _grid(x, s)
     _start(out_f, out_i)
-    t, th, v, side, max_th, n_step = 0.0, th0, v0, side0, abs(th0), 0
+    t, th, v, side, max_th, n_step, status = 0.0, th0, v0, side0, abs(th0), 0, -1
     a = acc(th, v, t, side, sthc, cthc, xi, fx, rec) if side != 0 else 0.0
     n_tr = _keep(traj, 0, t, th, v)
-    while out_i[TI_STATUS] < 0:
+    while status < 0:
         if t >= t_lim:
-            out_i[TI_STATUS] = ST_TIME_LIMIT
+            status = ST_TIME_LIMIT
             break
         if side == 0:  # ---- at rest ------------------------------------------------------------
-            t, side, n_tr = _leave_rest(t, fx, rec, thc, xi, thr, t_lim, traj, n_tr, out_f,
-                                        out_i)
+            t, side, n_tr, status = _leave_rest(t, fx, rec, thc, xi, thr, t_lim, traj, n_tr,
+                                                out_f)
             if side == 0:
                 break
             th, v = side * _TINY, 0.0
             a = acc(th, v, t, side, sthc, cthc, xi, fx, rec)
             continue
         if decide and t >= end and free_rocking_decided(th, v, max_th, thc, th_top):
-            out_i[TI_STATUS] = ST_DECIDED
+            status = ST_DECIDED
             break
         # ---- one step on corner `side` --------------------------------------------------------
         tn = grid_next(t, end, h_exc, nsub, dt, h_free, t_lim)
@@ -413,7 +410,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
         th1, v1, a1 = dp_step(t, th, v, a, hh, tn, side, sthc, cthc, xi, fx, rec)
         n_step += 1
         if not (math.isfinite(th1) and math.isfinite(v1) and math.isfinite(a1)):
-            out_i[TI_STATUS] = ST_NONFINITE
+            status = ST_NONFINITE
             break
         crest, lo, th_c, vc, ns = _crest(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec)
         n_step += ns
@@ -423,7 +420,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
                                                                  th_top):
                 t, th, v = t + lo, th_c, vc
                 n_tr = _keep(traj, n_tr, t, th, v)
-                out_i[TI_STATUS] = ST_DECIDED
+                status = ST_DECIDED
                 break
         if side * th1 >= thover:  # overturning
             tau, th, v, ns = _reach(0, thover, side * th - thover, t, th, v, a, 0.0, hh, tn,
@@ -432,7 +429,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
             t = out_f[TF_TOVER] = t + tau
             n_tr = _keep(traj, n_tr, t, th, v)
             max_th = max(max_th, thover)
-            out_i[TI_STATUS] = ST_OVERTURNED
+            status = ST_OVERTURNED
             break
         impact_at, ns = _impact_in(crest, t, th, v, a, hh, tn, th1, v1, side, sthc, cthc, xi,
                                    fx, rec)
@@ -454,9 +451,9 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
         if side != 0:
             a = acc(th, v, t, side, sthc, cthc, xi, fx, rec)
         if out_i[TI_IMPACTS] >= max_impacts:
-            out_i[TI_STATUS] = ST_MAX_IMPACTS
+            status = ST_MAX_IMPACTS
             break
-    _finish(t, th, v, max_th, n_step, n_tr, end, b[B_ALPHA], out_f, out_i)
+    _finish(status, t, th, v, max_th, n_step, n_tr, end, b[B_ALPHA], out_f, out_i)
 
 
 @jit(parallel=True)
