@@ -130,14 +130,14 @@ def harmonics_window(tq, end, rec, off, n, thr):
 
 @jit(nrt=False)
 def sum_value(t, a, rec, off, n):
-    """The plug's value: ``a`` times :func:`harmonics_value`."""
+    """The plug's value: ``a`` times ``harmonics_value`` (this module's sum of sines)."""
     return a * harmonics_value(t, rec, off, n)
 
 
 @jit(nrt=False)
 def sum_window(tq, end, a, rec, off, n, thr):
-    """The plug's window: :func:`harmonics_window` of the tones at unit gain, above
-    ``thr / a``; none for ``a <= 0``."""
+    """The plug's window: ``harmonics_window`` (this module's scan) of the tones at unit gain,
+    above ``thr / a``; none for ``a <= 0``."""
     if not a > 0.0:
         return 0.0, 0.0, 0.0
     return harmonics_window(tq, end, rec, off, n, thr / a)
