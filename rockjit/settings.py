@@ -26,7 +26,7 @@ from .validate import boolean, integer, pair, real
 
 __all__ = ["DEVICES", "Classification", "Execution", "Integration", "Lattice", "MAX_IMPACTS",
            "MAX_N", "MAX_PERIODS", "REST_SPEED_RANGE", "cuda_missing", "cuda_refusal",
-           "default_max_impacts"]
+           "default_max_impacts", "scipy_on_cuda"]
 
 #: Largest number of periods, and of steps per period, a run may ask for: bounds that keep the
 #: kernels' step counter in 64 bits. The memory check refuses most large requests first, with
@@ -278,6 +278,13 @@ def cuda_refusal(what='device="cuda"', instead='device="cpu"'):
         return None
     return (f'{what} needs a CUDA-capable NVIDIA GPU with its driver and numba-cuda '
             f'(pip install "rockjit[cuda]"); {missing}: use {instead}')
+
+
+def scipy_on_cuda(name='device="cuda"', instead='device="cpu"', compiled='method="rockjit"'):
+    """The one line that refuses ``name`` for the scipy reference path, which runs on the CPU
+    only."""
+    return (f"{name} runs the compiled path ({compiled}); the scipy reference path runs on the "
+            f"CPU only: use {instead}")
 
 
 @dataclass(frozen=True)

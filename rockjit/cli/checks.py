@@ -32,10 +32,9 @@ def check_device(args):
     """``--device cuda`` is refused in one line, before any work, with the scipy reference path
     (``--method scipy``, which runs on the CPU only) and on a machine without a usable GPU."""
     if getattr(args, "device", "cpu") == "cuda":
-        from ..settings import cuda_refusal
+        from ..settings import cuda_refusal, scipy_on_cuda
         if getattr(args, "method", "rockjit") != "rockjit":
-            raise UsageError("--device cuda runs the compiled path (--method rockjit); the "
-                             "scipy reference path runs on the CPU only: use --device cpu")
+            raise UsageError(scipy_on_cuda("--device cuda", "--device cpu", "--method rockjit"))
         refusal = cuda_refusal("--device cuda", "--device cpu")
         if refusal is not None:
             raise UsageError(refusal)

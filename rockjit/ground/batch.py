@@ -109,8 +109,8 @@ def kernel_for(method, device="cpu"):
     only: ``ValueError``)."""
     if method != "rockjit":
         if device == "cuda":
-            raise ValueError('device="cuda" runs the compiled path (method="rockjit"); the '
-                             'scipy reference path runs on the CPU only: use device="cpu"')
+            from ..settings import scipy_on_cuda
+            raise ValueError(scipy_on_cuda())
         return KERNELS["scipy"]
     name = "rockjit-cuda" if device == "cuda" else "rockjit"
     if name not in KERNELS:

@@ -101,27 +101,30 @@ def pack(blocks, sources, block_of, source_of, gain, settings):
 def compiled_kernel(blocks, sources, block_of, source_of, gain, settings, method):
     """The compiled path on a chunk of cells (the kernel interface of
     :mod:`rockjit.ground.batch`): every cell from rest, in parallel on the CPU's threads."""
-    n = len(gain)
-    if n == 0:
-        return empty_outputs(n)
-    out_f = np.empty((n, T.N_TF))
-    out_i = np.empty((n, T.N_TI), dtype=np.int64)
-    T.run_cells(*pack(blocks, sources, block_of, source_of, gain, settings),
-                numba.get_num_threads(), out_f, out_i)
-    return _outputs(out_f, out_i)
+    def on_threads(cells, out_f, out_i):
+        T.run_cells(*cells, numba.get_num_threads(), out_f, out_i)
+    return _run_chunk(on_threads, blocks, sources, block_of, source_of, gain, settings)
 
 
 def cuda_kernel(blocks, sources, block_of, source_of, gain, settings, method):
     """:func:`compiled_kernel` on the GPU, one cell per thread
     (:mod:`rockjit._engine.gpu_transient`): the same inputs and outputs."""
     from .._engine import gpu_transient
+
+    def on_gpu(cells, out_f, out_i):
+        gpu_transient.run_cells(*cells, out_f, out_i)
+    return _run_chunk(on_gpu, blocks, sources, block_of, source_of, gain, settings)
+
+
+def _run_chunk(run, blocks, sources, block_of, source_of, gain, settings):
+    """A chunk packed (:func:`pack`) and run by ``run(cells, out_f, out_i)``: the batch's
+    outputs by name."""
     n = len(gain)
     if n == 0:
         return empty_outputs(n)
     out_f = np.empty((n, T.N_TF))
     out_i = np.empty((n, T.N_TI), dtype=np.int64)
-    gpu_transient.run_cells(*pack(blocks, sources, block_of, source_of, gain, settings),
-                            out_f, out_i)
+    run(pack(blocks, sources, block_of, source_of, gain, settings), out_f, out_i)
     return _outputs(out_f, out_i)
 
 
