@@ -17,7 +17,7 @@ against something other than itself. It is deliberately plain, not deliberately 
   concave side); then the jump ``theta' <- e theta'``, the corner switched, and the rest of the
   step taken from the impact;
 - rest when the speed after an impact is below the block's ``rest_speed``, lifted at
-  :func:`rockjit.model.uplift_time`; overturning when ``|theta|`` reaches ``theta_over`` at a
+  :func:`rockjit.plugs.harmonic.uplift_time`; overturning when ``|theta|`` reaches ``theta_over`` at a
   step's end (the run stops, as the study's basins do);
 - labels by rockjit's own classifier on the samples at ``kT`` and ``kT + T/2`` over the window.
 
@@ -36,7 +36,7 @@ import numpy as np
 
 from rockjit._engine import integrate as ig
 from rockjit._engine.classify import classify
-from rockjit.model import uplift_time
+from rockjit.plugs.harmonic import uplift_time
 from rockjit.result import OVERTURN, REST
 
 RUNNING, DONE, OVERTURNED, RESTED = 0, 1, 2, 3

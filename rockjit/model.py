@@ -1,9 +1,11 @@
 """The rocking block: the one place where its physics is written.
 
-Everything that knows the equations of motion lives here: the restitution laws, the angular
-acceleration on either corner and its Jacobian, the forcing oscillator, the impact (jump) map and
-the saltation matrix. The compiled integrator (:mod:`rockjit._engine.integrate`) and the scipy reference
-path call these same functions; nothing else writes an equation of motion.
+Everything that knows the equations of motion lives here: the angular acceleration on either
+corner and its Jacobian, the impact (jump) map and the saltation matrix, with the restitution laws
+of :mod:`rockjit.laws`. The excitations are plugs (:mod:`rockjit.plugs`): the harmonic forcing
+and its oscillator in :mod:`rockjit.plugs.harmonic`. The compiled integrator
+(:mod:`rockjit._engine.integrate`) and the scipy reference path call these same functions;
+nothing else writes an equation of motion.
 
 Conventions (docs/theory/model.md, impacts.md). State ``(theta, dtheta)``; ``side = +1`` rocks on the corner reached
 for ``theta > 0`` and ``side = -1`` on the other one; ``side = 0`` is the block at rest. The
@@ -44,13 +46,10 @@ __all__ = [
     "e_housner",
     "e_mao",
     "energy",
-    "forcing_closed",
     "free_rocking_decided",
     "initial_side",
     "jump",
     "near_poly",
-    "oscillator",
-    "oscillator_jac",
     "rotate",
     "saltation",
     "saltation_at",
@@ -58,7 +57,6 @@ __all__ = [
     "sincos_poly",
     "slope_pq",
     "thc_from_hb",
-    "uplift_time",
 ]
 
 #: The names of the package's restitution laws (:mod:`rockjit.laws`, where they are defined).
@@ -306,12 +304,6 @@ def sincos(x):
 
 
 @jit
-def forcing_closed(t, omega, phi):
-    """``r = sin(omega t + phi)``, the closed form of the forcing oscillator on its circle."""
-    return math.sin(omega * t + phi)
-
-
-@jit
 def corner(f, side, sthc, cthc):
     """``(P, Q)`` with ``theta'' = P cos(theta) + Q sin(theta) - 3/4 xi theta'`` on corner ``side``.
 
@@ -417,40 +409,6 @@ def accel_jac(theta, dtheta, f, side, thc, xi):
     s, c = sincos(theta)
     # d/df of P cos + Q sin is 3/4 (sin(thc) cos(theta) + side cos(thc) sin(theta))
     return slope_pq(P, Q, s, c), -damping_rate(xi), 0.75 * fma(sthc, c, side * cthc * s)
-
-
-@jit
-def uplift_time(t, aw2, cot, omega, phi):
-    """First time ``>= t`` at which the closed-form forcing lifts a block at rest.
-
-    The block at rest leaves it when ``|aw2 sin(omega t + phi)| > cot`` (docs/theory/impacts.md). Returns
-    ``t`` itself if that already holds, and ``inf`` if ``aw2 <= cot`` (it never leaves).
-    """
-    if aw2 <= cot:
-        return math.inf
-    a = math.asin(cot / aw2)
-    psi = omega * t + phi
-    u = psi - math.pi * math.floor(psi / math.pi)  # phase modulo pi: |sin| has period pi
-    if a < u < math.pi - a:
-        return t
-    if u <= a:
-        return t + (a - u) / omega
-    return t + (math.pi - u + a) / omega
-
-
-@jit
-def oscillator(r, s, omega):
-    """Right-hand side ``(r', s')`` of the autonomous forcing oscillator (docs/theory/model.md)."""
-    q = r * r + s * s
-    return r + omega * s - r * q, s - omega * r - s * q
-
-
-@jit
-def oscillator_jac(r, s, omega):
-    """Jacobian ``[[dr'/dr, dr'/ds], [ds'/dr, ds'/ds]]`` of :func:`oscillator`."""
-    q = r * r + s * s
-    return (1.0 - q - 2.0 * r * r, omega - 2.0 * r * s,
-            -omega - 2.0 * r * s, 1.0 - q - 2.0 * s * s)
 
 
 @jit

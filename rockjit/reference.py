@@ -4,8 +4,8 @@ This is how the study computed its trajectories (docs/theory/integrator.md): ``s
 atol 1e-9) on the 4-D embedding, with terminal events at ``theta = 0`` and ``|theta| = theta_over``
 and a restart after each impact. Any ``solve_ivp`` method and tolerance may be chosen; the rest and
 overturning rules, the jump and the Zeno cut-off are those of the compiled path, and every
-equation comes from :mod:`rockjit.model`. It is slow by design: it is the independent reference
-the compiled integrator is checked against.
+equation comes from :mod:`rockjit.model` (the forcing from :mod:`rockjit.plugs.harmonic`). It is
+slow by design: it is the independent reference the compiled integrator is checked against.
 """
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from .model import (Block, accel, accel_jac, forcing_closed, initial_side, jump, oscillator,
-                    oscillator_jac, uplift_time)
+from .model import Block, accel, accel_jac, initial_side, jump
+from .plugs.harmonic import forcing_closed, oscillator, oscillator_jac, uplift_time
 from .result import Result
 
 # A point just off theta = 0 on the new corner after an impact, so that the impact event of the

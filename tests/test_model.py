@@ -3,9 +3,10 @@
 - restitution laws: the values docs/theory/impacts.md quotes from the paper, and the papers' formulas typed in
   again in conftest;
 - ``accel``: the two corner equations of docs/theory/model.md written out separately (conftest);
-- ``accel_jac``, ``oscillator_jac``: central finite differences of ``accel``, ``oscillator``;
-- ``saltation``: the closed form of docs/theory/exponents.md written out here;
-- ``uplift_time``: a brute-force scan of the forcing, and the closed form in conftest.
+- ``accel_jac``: central finite differences of ``accel``;
+- ``saltation``: the closed form of docs/theory/exponents.md written out here.
+
+The harmonic forcing's functions are checked in tests/plugs/test_harmonic.py.
 """
 
 import math
@@ -147,31 +148,6 @@ def test_accel_jac_matches_finite_differences(side, hb):
         np.testing.assert_allclose(jac, fd, rtol=1e-7, atol=1e-9)
 
 
-def test_oscillator_jac_matches_finite_differences():
-    eps = 1e-6
-    rng = np.random.default_rng(RNG_SEED)
-    for r, s, omega in zip(rng.uniform(-1.5, 1.5, 8), rng.uniform(-1.5, 1.5, 8),
-                           rng.uniform(0.5, 3.0, 8)):
-        jac = np.array(model.oscillator_jac(r, s, omega)).reshape(2, 2)
-        fd = np.empty((2, 2))
-        fd[:, 0] = (np.array(model.oscillator(r + eps, s, omega))
-                    - np.array(model.oscillator(r - eps, s, omega))) / (2 * eps)
-        fd[:, 1] = (np.array(model.oscillator(r, s + eps, omega))
-                    - np.array(model.oscillator(r, s - eps, omega))) / (2 * eps)
-        np.testing.assert_allclose(jac, fd, rtol=1e-7, atol=1e-9)
-
-
-def test_oscillator_on_the_circle_is_the_closed_form():
-    # r = sin(omega t + phi), s = cos(omega t + phi) solves r' = omega s, s' = -omega r there
-    omega, phi = 1.3, 0.7
-    for t in np.linspace(0.0, 5.0, 11):
-        r, s = math.sin(omega * t + phi), math.cos(omega * t + phi)
-        dr, ds = model.oscillator(r, s, omega)
-        assert dr == pytest.approx(omega * s, abs=1e-14)
-        assert ds == pytest.approx(-omega * r, abs=1e-14)
-        assert model.forcing_closed(t, omega, phi) == pytest.approx(r, abs=1e-15)
-
-
 # ---- the impact (docs/theory/impacts.md, §5) --------------------------------------------------------------
 
 def test_jump_map():
@@ -194,26 +170,3 @@ def test_saltation_matches_spec_closed_form(hb, xi):
                        - np.sign(dm) * (1 + e) * math.cos(thc)) / dm
         got = model.saltation(dm, f, side_old, thc, xi, e)
         assert got == pytest.approx(want, rel=1e-12, abs=1e-12 / abs(dm))
-
-
-# ---- rest and uplift (docs/theory/impacts.md) -------------------------------------------------------------
-
-@pytest.mark.parametrize("t0, aw2, cot, omega, phi", [
-    (0.0, 0.6, 0.5, 3.0, 0.0),
-    (0.0, 0.6, 0.5, 3.0, math.pi),
-    (0.0, 0.6, 0.5, 3.0, 4.0),
-    (1.234, 1.2, 1.0, 1.3, 0.2),
-    (7.5, 0.9, 0.5, 2.0, -2.0),
-    (0.0, 0.6, 0.5, 3.0, 1.5),   # already lifting at t0
-])
-def test_uplift_time(spec, t0, aw2, cot, omega, phi):
-    got = model.uplift_time(t0, aw2, cot, omega, phi)
-    want, _ = spec.first_uplift(t0, aw2, cot, omega, phi)
-    assert got == pytest.approx(want, rel=0, abs=1e-12)
-    # brute force: scan one forcing period on a fine grid
-    ts = t0 + np.linspace(0.0, 2 * math.pi / omega, 400_001)
-    lifted = np.abs(aw2 * np.sin(omega * ts + phi)) > cot
-    t_scan = ts[np.argmax(lifted)]
-    assert abs(got - t_scan) <= (ts[1] - ts[0])
-    # a block that can never be lifted
-    assert model.uplift_time(t0, cot, cot, omega, phi) == math.inf

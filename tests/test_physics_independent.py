@@ -28,6 +28,7 @@ import physics as ph  # tests/physics.py: the independent statement
 import rockjit
 from rockjit import Block, Harmonic, Integration, Scipy, model
 from rockjit.grids.identity import floquet
+from rockjit.plugs import harmonic
 from rockjit.orbits import periodic_orbit
 
 #: The study's initial state (theta, theta', r, s) of its single runs and sweeps.
@@ -188,7 +189,7 @@ def test_saltation_of_a_law_that_depends_on_the_impact_matches_muellers_formula(
 
 
 def test_uplift_time_matches_a_brute_force_scan():
-    """``model.uplift_time`` against a scan of |f(t)| > cot (step T/400, then bisection to
+    """``harmonic.uplift_time`` against a scan of |f(t)| > cot (step T/400, then bisection to
     rounding), at 300 random starts: measured 5.2e-15 of T. Edge cases: lifted already (t
     itself), a forcing that reaches the threshold but never exceeds it, and one below it
     (inf)."""
@@ -200,18 +201,18 @@ def test_uplift_time_matches_a_brute_force_scan():
         aw2 = cot * rng.uniform(1.001, 4.0)
         phi = rng.uniform(-math.pi, math.pi)
         t0 = rng.uniform(0.0, 50.0)
-        got = model.uplift_time(t0, aw2, cot, omega, phi)
+        got = harmonic.uplift_time(t0, aw2, cot, omega, phi)
         ref = ph.first_uplift(t0, aw2, omega, phi, cot)
         worst = max(worst, abs(got - ref) / (2 * math.pi / omega))
         assert got >= t0
     assert worst <= 5e-14, worst
     # already above the threshold: leaves at once
     t0 = 0.5 * math.pi / 1.3  # f at its crest
-    assert model.uplift_time(t0, 1.5, 1.0, 1.3, 0.0) == t0 == ph.first_uplift(t0, 1.5, 1.3,
+    assert harmonic.uplift_time(t0, 1.5, 1.0, 1.3, 0.0) == t0 == ph.first_uplift(t0, 1.5, 1.3,
                                                                               0.0, 1.0)
     # |f| reaches cot at its crests but never exceeds it, or stays below: never lifted
     for aw2 in (1.0, 0.999):
-        assert model.uplift_time(0.3, aw2, 1.0, 1.0, 0.0) == math.inf
+        assert harmonic.uplift_time(0.3, aw2, 1.0, 1.0, 0.0) == math.inf
         assert ph.first_uplift(0.3, aw2, 1.0, 0.0, 1.0) == math.inf
 
 

@@ -10,7 +10,8 @@ import math
 import numpy as np
 
 from .._jit import fma, jit
-from ..model import jerk_snap, oscillator
+from ..model import jerk_snap
+from ..plugs.harmonic import curvature, oscillator
 from .layout import (BISECT_ITERS, DELTA_EULER, EV_IMPACT, EV_NONE, EV_OVERTURN, EV_UPLIFT,
                      LOCATE_TOL, NEWTON_ITERS, OFF_GRID, O_RESTEP, O_RHS, O_UNCONVERGED, P_AW2,
                      P_COT, P_CTHC, P_OMEGA, P_STHC, P_THOVER, P_XI)
@@ -107,8 +108,8 @@ def dense_event_slope(kind, y0m, h, q0, q1, q2, q3, side, par, x):
 def end_derivs(f, df, side, s, c, v, a, par):
     """The jerk and snap of theta (:func:`rockjit.model.jerk_snap`) at a point of a step on
     corner ``side``, under the closed-form forcing: ``f`` and its time derivative ``df`` there,
-    and ``f'' = -omega^2 f``."""
-    ddf = -(par[P_OMEGA] * par[P_OMEGA]) * f
+    and its second (:func:`rockjit.plugs.harmonic.curvature`)."""
+    ddf = curvature(par[P_OMEGA], f)
     return jerk_snap(f, df, ddf, side, par[P_STHC], par[P_CTHC], par[P_XI], s, c, v, a)
 
 

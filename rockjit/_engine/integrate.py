@@ -50,10 +50,11 @@ import math
 
 import numpy as np
 
-from .._jit import cycles, fma, jit
+from .._jit import cycles, jit
 from .classify import orbit_scale, repeats
 from ..laws.impact import restitution_at
-from ..model import forcing_closed, jump, saltation_at, sincos, uplift_time
+from ..model import jump, saltation_at
+from ..plugs import harmonic
 # the tableau (scipy's names) and the step's table, the layout, the step and the events: each
 # a module of its own, named here too (the kernels' one entry point)
 from .tableau import A, B, C, E, N_STAGES, N_TAB, P, step_table, tab_entry  # noqa: F401
@@ -118,7 +119,7 @@ def settled_period(strobe, half, per_imp, k, reps, pmax, tol):
 def forcing_now(EMBED4, t, y, par):
     if EMBED4 is not None:
         return y[2]
-    return forcing_closed(t, par[P_OMEGA], par[P_PHI])
+    return harmonic.forcing_closed(t, par[P_OMEGA], par[P_PHI])
 
 
 @jit(nrt=False)
@@ -129,9 +130,7 @@ def sample(EMBED4, t, y, par, out):
         out[2] = y[2]
         out[3] = y[3]
     else:
-        psi = par[P_OMEGA] * t + par[P_PHI]
-        out[2] = math.sin(psi)
-        out[3] = math.cos(psi)
+        out[2], out[3] = harmonic.phase_at(t, par[P_OMEGA], par[P_PHI])
 
 
 @jit(nrt=False)
@@ -223,18 +222,16 @@ def tables(EMBED4, par, ipar, w):
         aw3 = aw2 * par[P_OMEGA]
         ftab = w.ftab
         for j in range(n_per):
-            ph0 = par[P_PHI] + 2.0 * math.pi * j / n_per
-            s0 = math.sin(ph0)
-            c0 = math.cos(ph0)
+            s0, c0 = harmonic.grid_phase(par[P_PHI], j, n_per)
             ftab[j, FT_SIN] = s0
             ftab[j, FT_COS] = c0
-            ftab[j, FT_DF0] = aw3 * c0
+            ftab[j, FT_DF0] = harmonic.slope(aw3, c0)
             for i in range(N_STAGES + 1):
                 c = C[i] if i < N_STAGES else 1.0
-                sd, cd = sincos(2.0 * math.pi * c / n_per)
-                ftab[j, i] = aw2 * fma(s0, cd, c0 * sd)
+                sd, cd = harmonic.grid_advance(c, n_per)
+                ftab[j, i] = aw2 * harmonic.advance(s0, c0, cd, sd)
                 if i == N_STAGES:
-                    ftab[j, FT_DF1] = aw3 * fma(c0, cd, -(s0 * sd))
+                    ftab[j, FT_DF1] = harmonic.slope(aw3, harmonic.advance_slope(s0, c0, cd, sd))
 
 
 @jit(nrt=False, inline=True)
@@ -290,7 +287,7 @@ def leave_rest(EMBED4, t, t_grid, hold, y, side, par, w, iout):
     ``REST_STEP`` (embedding: take a step at rest and watch the forcing).
     """
     if EMBED4 is None:
-        t_up = uplift_time(t, par[P_AW2], par[P_COT], par[P_OMEGA], par[P_PHI])
+        t_up = harmonic.uplift_time(t, par[P_AW2], par[P_COT], par[P_OMEGA], par[P_PHI])
         if t_up == math.inf:
             return REST_END, t, side
         if t_up >= t_grid or hold:
@@ -526,7 +523,7 @@ def substep(EMBED4, TANGENT, PROF, fresh, pre, j, t, t_grid, sp, cp, side, par, 
                 w.fr, w.jac, w.trig)
         tock(PROF, counts, np.int64(7), c0)
         f0 = w.fr[0]
-        df0 = par[P_AW2] * par[P_OMEGA] * cp
+        df0 = harmonic.slope(par[P_AW2] * par[P_OMEGA], cp)
         f1 = w.fr[N_STAGES]
     out.iout[O_RHS] += N_STAGES
     out.iout[O_SUBSTEPS] += 1

@@ -27,7 +27,8 @@ from .._jit import cycles, fma, jit
 from .stages import chain, compile_step
 from .tableau import COLS
 from ..model import (NEAR_RANGE, SINCOS_RANGE, accel_near, corner, initial_side, rotate,
-                    sincos_poly, uplift_time)
+                    sincos_poly)
+from ..plugs.harmonic import uplift_time
 
 __all__ = ["W", "bank", "block_step_lanes", "lane_tables", "run_lanes", "scalar_step"]
 
@@ -175,7 +176,7 @@ block_step_lanes = compile_step("block_step_lanes", "n, j, lin, lout, ftl", _STE
  LS_CELL) = range(11)
 N_ST = 11
 LF_TT, LF_MAXERR, LF_TLIFT, LF_TUP = range(4)
-# LF_TUP: at rest, the instant the forcing lifts the block (rockjit.model.uplift_time)
+# LF_TUP: at rest, the instant the forcing lifts the block (rockjit.plugs.harmonic.uplift_time)
 # the forcing and grid the lane's tables were made for: alpha omega^2, omega, phi, h, N
 LF_KEY = 4
 N_FS = LF_KEY + 5

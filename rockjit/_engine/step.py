@@ -9,8 +9,9 @@ from __future__ import annotations
 
 from .._jit import fma, jit
 from ..model import (NEAR_RANGE, SINCOS_RANGE, accel_near, accel_pq, corner, damping_rate,
-                     forcing_closed, near_poly, oscillator, rotate, sincos, sincos_poly,
-                     slope_pq)
+                     near_poly, rotate, sincos, sincos_poly, slope_pq)
+from ..plugs import harmonic
+from ..plugs.harmonic import oscillator
 from .layout import FT_COS, FT_SIN, P_AW2, P_CTHC, P_OMEGA, P_PHI, P_STHC, P_XI
 from .stages import chain, compile_step
 from .tableau import A, N_STAGES, P, T_HB, T_ROTC, T_ROTS, tab_entry
@@ -158,15 +159,13 @@ def phase_before(EMBED4, ftab, jn, u):
     integrated."""
     if EMBED4 is not None:
         return 0.0, 0.0
-    su, cu = sincos_poly(u)
-    se = ftab[jn, FT_SIN]
-    ce = ftab[jn, FT_COS]
-    return fma(se, cu, -(ce * su)), fma(ce, cu, se * su)
+    return harmonic.phase_before(ftab[jn, FT_SIN], ftab[jn, FT_COS], u)
 
 
 @jit(nrt=False)
 def forcing_at(t, par):
-    return forcing_closed(t, par[P_OMEGA], par[P_PHI])
+    """The closed-form forcing ``r`` at ``t`` (:func:`rockjit.plugs.harmonic.forcing_closed`)."""
+    return harmonic.forcing_closed(t, par[P_OMEGA], par[P_PHI])
 
 
 @jit(nrt=False, inline=True)
@@ -186,7 +185,7 @@ def rk_step(EMBED4, TANGENT, tabulated, sp, cp, y, K, side, par, ytmp, ynew, tab
     elif not tabulated:
         aw2 = par[P_AW2]
         for i in range(N_STAGES + 1):
-            fr[i] = aw2 * fma(sp, tab[T_ROTC, i], cp * tab[T_ROTS, i])
+            fr[i] = aw2 * harmonic.advance(sp, cp, tab[T_ROTC, i], tab[T_ROTS, i])
     if side == 0:
         for i in range(1, N_STAGES + 1):
             K[i, 0] = 0.0

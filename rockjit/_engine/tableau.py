@@ -20,7 +20,7 @@ from fractions import Fraction
 import numpy as np
 
 from .._jit import jit
-from ..model import NEAR_RANGE, near_poly, sincos
+from ..plugs.harmonic import advance_rotation
 
 N_STAGES = 6
 
@@ -116,17 +116,8 @@ def step_table(omega, h, tab):
             tab[T_HAA + i, j] = h2 * _AA[i, j]
         tab[T_HB, i] = h * B[i]
         tab[T_HBA, i] = h2 * _BA[i]
-    # the phase advances: within NEAR_RANGE (omega h = 2 pi / N < 0.3 from N = 21 on) the short
-    # polynomial of a small angle, else the sine's
-    near = abs(omega * h) <= NEAR_RANGE
+    # the nodes, and the harmonic forcing's phase advances to them
     for i in range(N_STAGES + 1):
         c = C[i] if i < N_STAGES else 1.0
         tab[T_HC, i] = h * c
-        u = omega * c * h
-        if near:
-            sn, cs = near_poly(u)
-            sn = sn * u
-        else:
-            sn, cs = sincos(u)
-        tab[T_ROTC, i] = cs
-        tab[T_ROTS, i] = sn
+        tab[T_ROTC, i], tab[T_ROTS, i] = advance_rotation(omega, h, c)

@@ -1,13 +1,17 @@
-"""Excitations as plugs: the transient excitations, each one module that the compiled transient
-kernel runs through functions of its own.
+"""Excitations as plugs: each excitation one module, which the compiled kernels run through
+functions of its own.
 
-Every module of this package defines and registers one plug (:mod:`rockjit.plugs.base` says what
-a plug gives): :class:`rockjit.HarmonicSum`, a sum of harmonics over a given duration;
-:class:`rockjit.Pulse`, the one-sine, one-cosine and Ricker pulses; :class:`rockjit.Record`, a
-recorded ground motion. When the package is imported, the kernel's two entry points are rendered
-over the registered plugs: ``plug_value`` and ``plug_window`` dispatch on the plug's code (0, 1,
-..., in the order of registration) to its compiled functions. A new excitation that ends is one
-more module here (docs/guide/extending.md), and nothing else changes.
+The harmonic forcing of the study, ``rockjit.plugs.harmonic``, is the plug of the periodic
+kernels (single runs, sweeps, basins, the lanes and the GPU's cells): its closed form, the
+rotations of its phase over a step, its derivatives, the instant it lifts a block at rest and
+its oscillator. Every other module of this package defines and registers one transient plug
+(:mod:`rockjit.plugs.base` says what a plug gives): :class:`rockjit.HarmonicSum`, a sum of
+harmonics over a given duration; :class:`rockjit.Pulse`, the one-sine, one-cosine and Ricker
+pulses; :class:`rockjit.Record`, a recorded ground motion. When the package is imported, the
+transient kernel's two entry points are rendered over the registered plugs: ``plug_value`` and
+``plug_window`` dispatch on the plug's code (0, 1, ..., in the order of registration) to its
+compiled functions. A new excitation that ends is one more module here
+(docs/guide/extending.md), and nothing else changes.
 """
 
 from __future__ import annotations
@@ -22,7 +26,7 @@ __all__ = ["HarmonicSum", "Pulse", "Record", "TransientPlug", "plug_value", "plu
            "register", "registered"]
 
 for _m in sorted(m.name for m in pkgutil.iter_modules(__path__)):
-    if _m != "base":
+    if _m not in ("base", "harmonic"):
         importlib.import_module(f"{__name__}.{_m}")
 
 
