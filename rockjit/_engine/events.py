@@ -1,6 +1,8 @@
 """Events within a step: detection, the event functions, the event interpolant and its error,
 and the root finders that locate an impact, an overturning or an uplift on the step's data
-(:func:`locate_interp`) or along genuine steps (:func:`locate_step`).
+(:func:`locate_interp`) or along genuine steps (:func:`locate_step`); for the transient
+kernel, the crests, dips, impacts and overturning inside a step, each located along genuine
+steps of its own (:func:`locate_on_steps`).
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from ..plugs.harmonic import curvature, oscillator
 from .layout import (BISECT_ITERS, DELTA_EULER, EV_IMPACT, EV_NONE, EV_OVERTURN, EV_UPLIFT,
                      LOCATE_TOL, NEWTON_ITERS, OFF_GRID, O_RESTEP, O_RHS, O_UNCONVERGED, P_AW2,
                      P_COT, P_CTHC, P_OMEGA, P_STHC, P_THOVER, P_XI)
-from .step import dense_coeffs, rk_step
+from .step import dense_coeffs, dp_step, rk_step
 from .tableau import N_STAGES, P, step_table
 
 
@@ -462,3 +464,90 @@ def detect(y, ynew, hh, K, side, par):
         if dense_event(np.int64(EV_IMPACT), y[0], hh, q0, q1, q2, q3, side, par, x) < 0.0:
             return EV_IMPACT, 0.0, x * hh
     return EV_NONE, 0.0, 0.0
+
+
+# ---- the transient kernel's events (:mod:`rockjit._engine.transient`), along genuine steps ----
+
+#: Newton's and bisection's iterations at most for an event of the transient kernel.
+ROOT_ITERS = 60
+_EPS = float(np.finfo(float).eps)
+
+
+@jit(nrt=False)
+def locate_on_steps(kind, target, t, th, v, a0, lo, hi, glo, cap, side, sthc, cthc, xi, fx, rec):
+    """The root in ``(lo, hi)`` of an event function along genuine steps from ``(t, th, v)``:
+    ``kind`` 0, ``side * theta - target`` (slope ``side * theta'``); ``kind`` 1,
+    ``side * theta'`` (slope ``side * theta''``). ``glo`` has its sign just after ``lo``, and
+    its value at ``hi`` has the other sign. Newton's iteration, bisection where it would leave the
+    bracket. Returns ``(tau, theta, theta', theta'', steps taken)`` at the root."""
+    tol = 4.0 * _EPS * max(1.0, abs(t) + hi)
+    z = lo + 0.5 * (hi - lo)
+    steps = 1
+    for _ in range(ROOT_ITERS):
+        steps += 1
+        th1, v1, a1 = dp_step(t, th, v, a0, z, cap, side, sthc, cthc, xi, fx, rec)
+        if kind == 0:
+            g, dg = side * th1 - target, side * v1
+        else:
+            g, dg = side * v1, side * a1
+        if g == 0.0:
+            return z, th1, v1, a1, steps
+        if (g > 0.0) == (glo > 0.0):
+            lo, glo = z, g
+        else:
+            hi = z
+        zn = z - g / dg if dg != 0.0 else lo + 0.5 * (hi - lo)
+        if not (lo < zn < hi):
+            zn = lo + 0.5 * (hi - lo)
+        if abs(zn - z) <= tol or hi - lo <= tol:
+            z = zn
+            break
+        z = zn
+    th1, v1, a1 = dp_step(t, th, v, a0, z, cap, side, sthc, cthc, xi, fx, rec)
+    return z, th1, v1, a1, steps
+
+
+@jit(ir_inline=True)
+def crest_in(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec):
+    """A maximum of ``side * theta`` inside the step (rising at its start, or about to: the
+    instant of an uplift, and falling at its end): ``(found, its instant, theta and theta'
+    there, the steps its location took)``; ``(False, 0, 0, 0, 0)`` if none."""
+    if not ((side * v > 0.0 or (v == 0.0 and side * a > 0.0)) and side * v1 < 0.0):
+        return False, 0.0, 0.0, 0.0, 0
+    tau, th_c, vc, ac, ns = locate_on_steps(1, 0.0, t, th, v, a, 0.0, hh, 1.0, tn, side, sthc, cthc,
+                                   xi, fx, rec)
+    return True, tau, th_c, vc, ns
+
+
+@jit(ir_inline=True)
+def reach_in(kind, target, glo, t, th, v, a, lo, hi, tn, side, sthc, cthc, xi, fx, rec):
+    """Where in the step ``side * theta`` reaches ``target`` (``kind`` 0) between ``lo`` and
+    ``hi`` (:func:`locate_on_steps`; ``glo``, the event function's sign just after ``lo``): ``(the
+    instant, theta and theta' there, the steps its location took)``."""
+    tau, th2, v2, a2, ns = locate_on_steps(kind, target, t, th, v, a, lo, hi, glo, tn, side, sthc, cthc,
+                                  xi, fx, rec)
+    return tau, th2, v2, ns
+
+
+@jit(ir_inline=True)
+def impact_in(crest, t, th, v, a, hh, tn, th1, v1, side, sthc, cthc, xi, fx, rec):
+    """Whether the step went through an impact: ``(where it ends, or -1, the steps its search
+    took)``; the step's end if it ends beyond ``theta = 0``, else a dip's minimum
+    (:func:`dip_in`) in a step without a crest."""
+    if side * th1 < 0.0:
+        return hh, 0
+    if crest:
+        return -1.0, 0
+    return dip_in(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec)
+
+
+@jit(ir_inline=True)
+def dip_in(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec):
+    """Where a step whose ``side * theta`` falls then rises (a minimum inside it) goes through
+    an impact and back: ``(the minimum's instant if side * theta is negative there, else -1;
+    the steps its location took)``."""
+    if not (side * v < 0.0 and side * v1 > 0.0):
+        return -1.0, 0
+    tau, th2, v2, a2, ns = locate_on_steps(1, 0.0, t, th, v, a, 0.0, hh, side * v, tn, side, sthc,
+                                  cthc, xi, fx, rec)
+    return (tau if side * th2 < 0.0 else -1.0), ns

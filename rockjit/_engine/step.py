@@ -1,5 +1,6 @@
-"""One step of the harmonic kernels: the block's Dormand–Prince step, the forcing oscillator's
-and the tangent matrix's, and the continuous extension's coefficients.
+"""The steps: the harmonic kernels' Dormand–Prince step of the block, the forcing oscillator's
+and the tangent matrix's, and the continuous extension's coefficients; the transient kernel's
+step of the block under an excitation plug (:func:`dp_step`).
 
 The stage chain itself is :mod:`rockjit._engine.stages`' (rendered here for the block and
 for a tangent column); the tableau and the step's table, :mod:`rockjit._engine.tableau`.
@@ -10,10 +11,10 @@ from __future__ import annotations
 from .._jit import fma, jit
 from ..model import (NEAR_RANGE, SINCOS_RANGE, accel_near, accel_pq, corner, damping_rate,
                      near_poly, rotate, sincos, sincos_poly, slope_pq)
-from ..plugs import harmonic
+from ..plugs import harmonic, plug_value
 from ..plugs.harmonic import oscillator
 from .layout import FT_COS, FT_SIN, P_AW2, P_CTHC, P_OMEGA, P_PHI, P_STHC, P_XI
-from .stages import chain, compile_step
+from .stages import chain, compile_step, node
 from .tableau import A, N_STAGES, P, T_HB, T_ROTC, T_ROTS, tab_entry
 
 
@@ -217,3 +218,52 @@ def dense_coeffs(K, m):
         q2 += k * P[i, 2]
         q3 += k * P[i, 3]
     return q0, q1, q2, q3
+
+
+# ---- the step of the transient kernel (:mod:`rockjit._engine.transient`) -----------------------
+# the forcing of a cell is its excitation plug's value (rockjit.plugs), its instant given
+
+@jit(nrt=False, inline=True)
+def plug_forcing(t, fx, rec):
+    """The base acceleration (``g``) of the forcing ``fx`` (:func:`rockjit._engine.transient.forcing_of`) at model time
+    ``t``: its plug's value (:func:`rockjit.plugs.plug_value`), zero outside ``[0, end]``."""
+    end, code, a, off, n = fx
+    if not (0.0 <= t <= end):
+        return 0.0
+    return plug_value(code, t, a, rec, off, n)
+
+
+@jit(nrt=False, inline=True)
+def plug_acc(th, v, t, side, sthc, cthc, xi, fx, rec):
+    """``theta''`` on corner ``side`` at ``(t, th, v)``: :func:`rockjit.model.corner` and
+    :func:`rockjit.model.accel_pq` (what :func:`rockjit.model.accel` computes, with the
+    block's ``sin(thc), cos(thc)`` taken once)."""
+    P, Q = corner(plug_forcing(t, fx, rec), side, sthc, cthc)
+    s, c = sincos(th)
+    return accel_pq(P, Q, s, c, v, xi)
+
+
+@jit(nrt=False, inline=True)
+def free_acc(th, v, side, sthc, cthc, xi):
+    """``theta''`` on corner ``side`` with the base still (after the excitation)."""
+    P, Q = corner(0.0, side, sthc, cthc)
+    s, c = sincos(th)
+    return accel_pq(P, Q, s, c, v, xi)
+
+
+def _plug_stage(i):
+    """Stage ``i``'s ``theta''``, its instant kept at or below ``cap``."""
+    c = node(i)
+    at = "t + hh" if c == "1.0" else f"t + {c} * hh"
+    return f"k{i} = plug_acc(x{i}, v{i}, min({at}, cap), side, sthc, cthc, xi, fx, rec)"
+
+
+dp_step = compile_step(
+    "dp_step", "t, x0, v0, k0, hh, cap, side, sthc, cthc, xi, fx, rec",
+    chain(_plug_stage, arith="plain", form="first", h="hh") + ["return x6, v6, k6"],
+    globals(), jit(nrt=False, inline=True), doc="""One Dormand–Prince step of length ``hh``
+    from ``(t, theta, theta')`` (``k0``: ``theta''`` there): ``(theta, theta', theta'')`` at
+    ``t + hh``, the stage chain of :mod:`rockjit._engine.stages` in its first-order form with
+    literal coefficients. The stages' instants are kept at or below ``cap``, the grid instant
+    that ends the step: a step that ends on the excitation's end sees the forcing's value there
+    even where ``t + hh`` rounds beyond it (the one-cosine pulse ends on ``a_p``).""")

@@ -9,17 +9,19 @@ scipy reference path (:mod:`rockjit.ground.reference`, the specification):
   corner ``sign f``: the excitation's windows come from its plug
   (:func:`rockjit.plugs.plug_window`), and the instant is nudged by the same units in the last
   place as on the reference path until :func:`rockjit.model.accel` on that corner is outward;
-- **flight**: fixed steps of the Dormand–Prince 5(4) tableau of the harmonic engine
-  (:mod:`rockjit._engine.integrate`), on the grid the excitation's plug gives, which puts
+- **flight**: fixed steps of the Dormand–Prince 5(4) tableau, the stage chain the harmonic
+  engine renders too (:func:`rockjit._engine.step.dp_step`), on the grid the excitation's plug
+  gives, which puts
   every kink of the forcing on a step boundary (a pulse's duration cut into equal steps, a
   record's sample step into ``k`` equal steps), then free rocking after the excitation in
   steps of its own length. A step that crosses ``theta = 0`` (an impact),
   ``|theta| = theta_over`` (overturning) or ``theta' = 0`` (a turning point: a crest gives
   ``max |theta|`` and, after the excitation, may decide the run; a trough below ``theta = 0``
-  is a dip through an impact and back) is cut there: the
+  is a dip through an impact and back) is cut there (:mod:`rockjit._engine.events`): the
   instant is the root of the event function of a genuine step of variable length from the
-  step's start, found by Newton's iteration kept inside its bracket by bisection, so the
-  event's state has the step's own order of accuracy;
+  step's start, found by Newton's iteration kept inside its bracket by bisection
+  (:func:`rockjit._engine.events.locate_on_steps`), so the event's state has the step's own
+  order of accuracy;
 - **impact**: :func:`rockjit.model.jump` on the other corner, or rest below ``rest_speed``;
 - **decided** (``decide``): after the excitation, the run stops at the first grid point, crest
   or impact from which free rocking can neither overturn nor swing wider than the largest
@@ -32,8 +34,9 @@ it), and free rocking starts from the still base, its first stage included.
 Every equation of the block comes from :mod:`rockjit.model` (:func:`~rockjit.model.corner`,
 :func:`~rockjit.model.accel_pq`, :func:`~rockjit.model.sincos`, :func:`~rockjit.model.jump`,
 :func:`~rockjit.model.accel`, :func:`~rockjit.model.free_rocking_decided`), and every
-excitation from its plug (:mod:`rockjit.plugs`: the pulses, records, sums of harmonics): this
-module writes neither. The forcing of a cell is described by a row of ``xpar`` (columns
+excitation from its plug (:mod:`rockjit.plugs`: the pulses, records, sums of harmonics), the
+step from :mod:`rockjit._engine.step` and the events' location from
+:mod:`rockjit._engine.events`: this module writes none of them; it drives them. The forcing of a cell is described by a row of ``xpar`` (columns
 ``X_*``): its plug's code, its amplitude, the excitation's end, its grid, and where its
 coefficients lie in one flat array.
 """
@@ -47,9 +50,10 @@ from numba import prange
 
 from .._jit import jit
 from ..laws.impact import restitution_at
-from ..model import accel, accel_pq, corner, free_rocking_decided, jump, sincos
-from ..plugs import plug_value, plug_window
-from .stages import chain, compile_step, node
+from ..model import accel, free_rocking_decided, jump
+from ..plugs import plug_window
+from .events import crest_in, impact_in, reach_in
+from .step import dp_step, free_acc, plug_acc, plug_forcing
 
 # ---- codes --------------------------------------------------------------------------------------
 #: columns of a cell's forcing row ``xpar``: its plug's code, its amplitude (the plug's ``a``),
@@ -72,8 +76,6 @@ ST_OVERTURNED, ST_REST, ST_DECIDED, ST_TIME_LIMIT, ST_MAX_IMPACTS, ST_NONFINITE 
 OC_SAFE, OC_OVER_IMPACT, OC_OVER_NO_IMPACT, OC_UNRESOLVED = range(4)
 
 _TINY = float(np.finfo(float).tiny)
-_EPS = float(np.finfo(float).eps)
-ROOT_ITERS = 60
 
 
 # ---- the forcing --------------------------------------------------------------------------------
@@ -83,86 +85,6 @@ def forcing_of(x):
     """A cell's forcing row ``x`` as the tuple the step reads, taken once per cell:
     ``(end, plug code, amplitude, offset and number of its coefficients)``."""
     return x[X_END], int(x[X_CODE]), x[X_AMP], int(x[X_OFF]), int(x[X_N])
-
-
-@jit(nrt=False, inline=True)
-def forcing(t, fx, rec):
-    """The base acceleration (``g``) of the forcing ``fx`` (:func:`forcing_of`) at model time
-    ``t``: its plug's value (:func:`rockjit.plugs.plug_value`), zero outside ``[0, end]``."""
-    end, code, a, off, n = fx
-    if not (0.0 <= t <= end):
-        return 0.0
-    return plug_value(code, t, a, rec, off, n)
-
-
-@jit(nrt=False, inline=True)
-def acc(th, v, t, side, sthc, cthc, xi, fx, rec):
-    """``theta''`` on corner ``side`` at ``(t, th, v)``: :func:`rockjit.model.corner` and
-    :func:`rockjit.model.accel_pq` (what :func:`rockjit.model.accel` computes, with the
-    block's ``sin(thc), cos(thc)`` taken once)."""
-    P, Q = corner(forcing(t, fx, rec), side, sthc, cthc)
-    s, c = sincos(th)
-    return accel_pq(P, Q, s, c, v, xi)
-
-
-@jit(nrt=False, inline=True)
-def acc_free(th, v, side, sthc, cthc, xi):
-    """``theta''`` on corner ``side`` with the base still (after the excitation)."""
-    P, Q = corner(0.0, side, sthc, cthc)
-    s, c = sincos(th)
-    return accel_pq(P, Q, s, c, v, xi)
-
-
-def _stage(i):
-    """Stage ``i``'s ``theta''``, its instant kept at or below ``cap``."""
-    c = node(i)
-    at = "t + hh" if c == "1.0" else f"t + {c} * hh"
-    return f"k{i} = acc(x{i}, v{i}, min({at}, cap), side, sthc, cthc, xi, fx, rec)"
-
-
-dp_step = compile_step(
-    "dp_step", "t, x0, v0, k0, hh, cap, side, sthc, cthc, xi, fx, rec",
-    chain(_stage, arith="plain", form="first", h="hh") + ["return x6, v6, k6"],
-    globals(), jit(nrt=False, inline=True), doc="""One Dormand–Prince step of length ``hh``
-    from ``(t, theta, theta')`` (``k0``: ``theta''`` there): ``(theta, theta', theta'')`` at
-    ``t + hh``, the stage chain of :mod:`rockjit._engine.stages` in its first-order form with
-    literal coefficients. The stages' instants are kept at or below ``cap``, the grid instant
-    that ends the step: a step that ends on the excitation's end sees the forcing's value there
-    even where ``t + hh`` rounds beyond it (the one-cosine pulse ends on ``a_p``).""")
-
-
-@jit(nrt=False)
-def locate(kind, target, t, th, v, a0, lo, hi, glo, cap, side, sthc, cthc, xi, fx, rec):
-    """The root in ``(lo, hi)`` of an event function along genuine steps from ``(t, th, v)``:
-    ``kind`` 0, ``side * theta - target`` (slope ``side * theta'``); ``kind`` 1,
-    ``side * theta'`` (slope ``side * theta''``). ``glo`` has its sign just after ``lo``, and
-    its value at ``hi`` has the other sign. Newton's iteration, bisection where it would leave the
-    bracket. Returns ``(tau, theta, theta', theta'', steps taken)`` at the root."""
-    tol = 4.0 * _EPS * max(1.0, abs(t) + hi)
-    z = lo + 0.5 * (hi - lo)
-    steps = 1
-    for _ in range(ROOT_ITERS):
-        steps += 1
-        th1, v1, a1 = dp_step(t, th, v, a0, z, cap, side, sthc, cthc, xi, fx, rec)
-        if kind == 0:
-            g, dg = side * th1 - target, side * v1
-        else:
-            g, dg = side * v1, side * a1
-        if g == 0.0:
-            return z, th1, v1, a1, steps
-        if (g > 0.0) == (glo > 0.0):
-            lo, glo = z, g
-        else:
-            hi = z
-        zn = z - g / dg if dg != 0.0 else lo + 0.5 * (hi - lo)
-        if not (lo < zn < hi):
-            zn = lo + 0.5 * (hi - lo)
-        if abs(zn - z) <= tol or hi - lo <= tol:
-            z = zn
-            break
-        z = zn
-    th1, v1, a1 = dp_step(t, th, v, a0, z, cap, side, sthc, cthc, xi, fx, rec)
-    return z, th1, v1, a1, steps
 
 
 # ---- when the block leaves rest -----------------------------------------------------------------
@@ -190,7 +112,7 @@ def next_uplift(t, fx, rec, thc, xi, thr):
         tt = base
         step = 0.0
         while tt <= t1:
-            if side * accel(side * _TINY, 0.0, forcing(tt, fx, rec), side, thc, xi) > 0.0:
+            if side * accel(side * _TINY, 0.0, plug_forcing(tt, fx, rec), side, thc, xi) > 0.0:
                 return tt, side
             step = max(2.0 * step, _ulp(max(tt, 1.0)))
             tt = base + step
@@ -289,52 +211,6 @@ def _leave_rest(t, fx, rec, thc, xi, thr, t_lim, traj, n_tr, out_f):
 
 
 @jit(ir_inline=True)
-def _crest(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec):
-    """A maximum of ``side * theta`` inside the step (rising at its start, or about to: the
-    instant of an uplift, and falling at its end): ``(found, its instant, theta and theta'
-    there, the steps its location took)``; ``(False, 0, 0, 0, 0)`` if none."""
-    if not ((side * v > 0.0 or (v == 0.0 and side * a > 0.0)) and side * v1 < 0.0):
-        return False, 0.0, 0.0, 0.0, 0
-    tau, th_c, vc, ac, ns = locate(1, 0.0, t, th, v, a, 0.0, hh, 1.0, tn, side, sthc, cthc,
-                                   xi, fx, rec)
-    return True, tau, th_c, vc, ns
-
-
-@jit(ir_inline=True)
-def _reach(kind, target, glo, t, th, v, a, lo, hi, tn, side, sthc, cthc, xi, fx, rec):
-    """Where in the step ``side * theta`` reaches ``target`` (``kind`` 0) between ``lo`` and
-    ``hi`` (:func:`locate`; ``glo``, the event function's sign just after ``lo``): ``(the
-    instant, theta and theta' there, the steps its location took)``."""
-    tau, th2, v2, a2, ns = locate(kind, target, t, th, v, a, lo, hi, glo, tn, side, sthc, cthc,
-                                  xi, fx, rec)
-    return tau, th2, v2, ns
-
-
-@jit(ir_inline=True)
-def _impact_in(crest, t, th, v, a, hh, tn, th1, v1, side, sthc, cthc, xi, fx, rec):
-    """Whether the step went through an impact: ``(where it ends, or -1, the steps its search
-    took)``; the step's end if it ends beyond ``theta = 0``, else a dip's minimum
-    (:func:`_dip`) in a step without a crest."""
-    if side * th1 < 0.0:
-        return hh, 0
-    if crest:
-        return -1.0, 0
-    return _dip(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec)
-
-
-@jit(ir_inline=True)
-def _dip(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec):
-    """Where a step whose ``side * theta`` falls then rises (a minimum inside it) goes through
-    an impact and back: ``(the minimum's instant if side * theta is negative there, else -1;
-    the steps its location took)``."""
-    if not (side * v < 0.0 and side * v1 > 0.0):
-        return -1.0, 0
-    tau, th2, v2, a2, ns = locate(1, 0.0, t, th, v, a, 0.0, hh, side * v, tn, side, sthc,
-                                  cthc, xi, fx, rec)
-    return (tau if side * th2 < 0.0 else -1.0), ns
-
-
-@jit(ir_inline=True)
 def _land(t, v2, side, b, rest_speed, imp, out_i):
     """The impact at ``t`` with ``theta'(-) = v2`` on corner ``side``: the jump of the
     block's law (:func:`rockjit.model.jump`), kept in ``imp`` if it holds it; ``(theta,
@@ -387,7 +263,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
     h_exc, nsub, dt, h_free = _grid(x, s)
     _start(out_f, out_i)
     t, th, v, side, max_th, n_step, status = 0.0, th0, v0, side0, abs(th0), 0, -1
-    a = acc(th, v, t, side, sthc, cthc, xi, fx, rec) if side != 0 else 0.0
+    a = plug_acc(th, v, t, side, sthc, cthc, xi, fx, rec) if side != 0 else 0.0
     n_tr = _keep(traj, 0, t, th, v)
     while status < 0:
         if t >= t_lim:
@@ -399,7 +275,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
             if side == 0:
                 break
             th, v = side * _TINY, 0.0
-            a = acc(th, v, t, side, sthc, cthc, xi, fx, rec)
+            a = plug_acc(th, v, t, side, sthc, cthc, xi, fx, rec)
             continue
         if decide and t >= end and free_rocking_decided(th, v, max_th, thc, th_top):
             status = ST_DECIDED
@@ -412,7 +288,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
         if not (math.isfinite(th1) and math.isfinite(v1) and math.isfinite(a1)):
             status = ST_NONFINITE
             break
-        crest, lo, th_c, vc, ns = _crest(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec)
+        crest, lo, th_c, vc, ns = crest_in(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec)
         n_step += ns
         if crest:
             max_th = max(max_th, abs(th_c))
@@ -423,7 +299,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
                 status = ST_DECIDED
                 break
         if side * th1 >= thover:  # overturning
-            tau, th, v, ns = _reach(0, thover, side * th - thover, t, th, v, a, 0.0, hh, tn,
+            tau, th, v, ns = reach_in(0, thover, side * th - thover, t, th, v, a, 0.0, hh, tn,
                                     side, sthc, cthc, xi, fx, rec)
             n_step += ns
             t = out_f[TF_TOVER] = t + tau
@@ -431,25 +307,25 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
             max_th = max(max_th, thover)
             status = ST_OVERTURNED
             break
-        impact_at, ns = _impact_in(crest, t, th, v, a, hh, tn, th1, v1, side, sthc, cthc, xi,
+        impact_at, ns = impact_in(crest, t, th, v, a, hh, tn, th1, v1, side, sthc, cthc, xi,
                                    fx, rec)
         n_step += ns
         if impact_at < 0.0:
             if t < end <= tn:  # the excitation ends here: free rocking from f = 0 on
-                a1 = acc_free(th1, v1, side, sthc, cthc, xi)
+                a1 = free_acc(th1, v1, side, sthc, cthc, xi)
             t, th, v, a = tn, th1, v1, a1
             n_tr = _keep(traj, n_tr, t, th, v)
             max_th = max(max_th, abs(th))
             continue
         # ---- impact --------------------------------------------------------------------------
-        tau, th2, v2, ns = _reach(0, 0.0, side * th if lo == 0.0 else side * th_c, t, th, v, a,
+        tau, th2, v2, ns = reach_in(0, 0.0, side * th if lo == 0.0 else side * th_c, t, th, v, a,
                                   lo, impact_at, tn, side, sthc, cthc, xi, fx, rec)
         n_step += ns
         t = t + tau
         n_tr = _keep(traj, n_tr, t, 0.0, v2)
         th, v, side = _land(t, v2, side, b, s[S_REST], imp, out_i)
         if side != 0:
-            a = acc(th, v, t, side, sthc, cthc, xi, fx, rec)
+            a = plug_acc(th, v, t, side, sthc, cthc, xi, fx, rec)
         if out_i[TI_IMPACTS] >= max_impacts:
             status = ST_MAX_IMPACTS
             break

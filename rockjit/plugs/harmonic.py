@@ -1,8 +1,8 @@
 """The harmonic forcing ``f = alpha omega^2 sin(omega t + phi)``: the periodic kernels' plug.
 
 The study's excitation, in its two forms, and every rule of it that the compiled kernels of
-periodic runs (:mod:`rockjit._engine.integrate`, the lanes, the GPU driver) and the scipy
-reference path (:mod:`rockjit.reference`) use; the kernels call these functions and write no
+periodic runs (``rockjit._engine.integrate``, the lanes, the GPU driver) and the scipy
+reference path (``rockjit.reference``) use; the kernels call these functions and write no
 sine of the forcing of their own. Its Python side is :class:`rockjit.Harmonic`.
 
 - The closed form ``r = sin(omega t + phi)`` (:func:`forcing_closed`), its phase at a time
@@ -10,8 +10,9 @@ sine of the forcing of their own. Its Python side is :class:`rockjit.Harmonic`.
   (:func:`grid_phase`, and the advance over a fraction of a grid step, :func:`grid_advance`),
   the phase advanced by an angle (:func:`advance`, the stages of a step, and its time
   derivative :func:`advance_slope`) or taken back by one (:func:`phase_before`), the rotation
-  that advance is (:func:`advance_rotation`, within a step); the derivatives the event interpolant needs, ``f' = alpha omega^3 cos`` from the phase
-  (:func:`slope`) and ``f'' = -omega^2 f`` (:func:`curvature`).
+  that advance is (:func:`advance_rotation`, within a step); the derivatives the event
+  interpolant needs, ``f' = alpha omega^3 cos`` from the phase (:func:`slope`) and
+  ``f'' = -omega^2 f`` (:func:`curvature`).
 - When a block at rest is lifted: the first instant ``|f|`` exceeds ``cot(thc)``
   (:func:`uplift_time`, in closed form).
 - The autonomous form: the oscillator ``(r, s)`` whose limit cycle is the closed form
@@ -19,7 +20,7 @@ sine of the forcing of their own. Its Python side is :class:`rockjit.Harmonic`.
   (docs/theory/model.md).
 
 Every function takes numbers, not the kernels' parameter rows: which slot holds ``omega`` is the
-kernels' business (:mod:`rockjit._engine.layout`). An excitation that ends is a transient plug
+kernels' business (``rockjit._engine.layout``). An excitation that ends is a transient plug
 instead (:mod:`rockjit.plugs.base`), run by the transient kernel.
 """
 
