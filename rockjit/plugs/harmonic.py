@@ -19,7 +19,9 @@ sine of the forcing of their own. Its Python side is :class:`rockjit.Harmonic`.
   (:func:`oscillator`, :func:`oscillator_jac`), which the embedding integrates with the block
   (docs/theory/model.md).
 
-Every function takes numbers, not the kernels' parameter rows: which slot holds ``omega`` is the
+The small functions of the phase are inlined in numba's IR where they are called (no compiled
+function of their own: a cold start compiles less). Every function takes numbers, not the
+kernels' parameter rows: which slot holds ``omega`` is the
 kernels' business (``rockjit._engine.layout``). An excitation that ends is a transient plug
 instead (:mod:`rockjit.plugs.base`), run by the transient kernel.
 """
@@ -44,14 +46,14 @@ def forcing_closed(t, omega, phi):
     return math.sin(omega * t + phi)
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def phase_at(t, omega, phi):
     """``(sin, cos)`` of the phase ``omega t + phi`` (libm's)."""
     psi = omega * t + phi
     return math.sin(psi), math.cos(psi)
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def grid_phase(phi, j, n_per):
     """``(sin, cos)`` of the phase ``phi + 2 pi j / N`` at the start of grid step ``j`` of a
     period cut into ``N = n_per`` steps (libm's)."""
@@ -59,26 +61,26 @@ def grid_phase(phi, j, n_per):
     return math.sin(ph0), math.cos(ph0)
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def grid_advance(c, n_per):
     """``(sin, cos)`` of the advance ``2 pi c / N`` of the phase over the fraction ``c`` of a
     grid step."""
     return sincos(2.0 * math.pi * c / n_per)
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def advance(s0, c0, cd, sd):
     """``sin(p + d)`` from ``s0, c0 = sin p, cos p`` and ``cd, sd = cos d, sin d``."""
     return fma(s0, cd, c0 * sd)
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def advance_slope(s0, c0, cd, sd):
     """``cos(p + d)`` from the same four numbers as :func:`advance` (the phase's derivative)."""
     return fma(c0, cd, -(s0 * sd))
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def phase_before(se, ce, u):
     """``(sin, cos)`` of the phase the angle ``u`` (``|u| <= SINCOS_RANGE``) before a phase of
     sine ``se`` and cosine ``ce``: a rotation back by the polynomial's sine and cosine of
@@ -88,7 +90,7 @@ def phase_before(se, ce, u):
     return fma(se, cu, -(ce * su)), fma(ce, cu, se * su)
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def advance_rotation(omega, h, c):
     """``(cos, sin)`` of the phase's advance ``omega c h`` to the node ``c`` of a step of length
     ``h``: while ``omega h`` is within ``NEAR_RANGE`` (0.3: from ``N = 21`` steps a period on)
@@ -101,14 +103,14 @@ def advance_rotation(omega, h, c):
     return cs, sn
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def slope(aw3, c):
     """The forcing's time derivative ``alpha omega^3 cos(phase)``, from ``aw3 = alpha
     omega^3`` and the phase's cosine ``c``."""
     return aw3 * c
 
 
-@jit(nrt=False, inline=True)
+@jit(ir_inline=True)
 def curvature(omega, f):
     """The forcing's second time derivative, ``f'' = -omega^2 f``."""
     return -(omega * omega) * f
