@@ -239,6 +239,47 @@ def newton_bracketed(x, g, dg, a, b, conv):
     return xn, a, b, b - a <= 1e-15
 
 
+@jit(ir_inline=True)
+def event_poly(kind, side, par, tc):
+    """The coefficients ``g0 .. g7`` of the event function ``g`` (positive before the event,
+    :func:`event_g`) on theta's interpolant ``tc`` (:func:`interpolant`), as a polynomial in
+    ``x = tau / hh``: ``sg theta + g_off`` (an impact or an overturning)."""
+    sg = float(side) if kind == EV_IMPACT else -float(side)
+    g0 = fma(sg, tc[0], par[P_THOVER] if kind == EV_OVERTURN else 0.0)
+    g1 = sg * tc[1]
+    g2 = sg * tc[2]
+    g3 = sg * tc[3]
+    g4 = sg * tc[4]
+    g5 = sg * tc[5]
+    g6 = sg * tc[6]
+    g7 = sg * tc[7]
+    return g0, g1, g2, g3, g4, g5, g6, g7
+
+
+@jit(ir_inline=True)
+def newton_start(g0, g1, g2, a, b, ga, gb):
+    """Where Newton's iteration for the root of ``g`` in the bracket ``[a, b]`` (``g`` is ``ga
+    > 0`` at ``a``, ``gb <= 0`` at ``b``) starts: the root in the bracket of the quadratic
+    ``g0 + g1 x + g2 x^2`` (the step's start's Taylor polynomial: it finds the far root of a
+    flight that starts on ``g = 0``), else regula falsi's, else the bracket's middle."""
+    x = -1.0
+    disc = fma(g1, g1, -4.0 * g0 * g2)
+    if disc >= 0.0 and g2 != 0.0:
+        qq = -0.5 * (g1 + math.copysign(math.sqrt(disc), g1))
+        if qq != 0.0:
+            r1 = qq / g2
+            r2 = g0 / qq
+            if a < r2 < b:
+                x = r2
+            elif a < r1 < b:
+                x = r1
+    if x < 0.0:
+        x = a + ga * (b - a) / (ga - gb)
+        if not (a < x < b):
+            x = 0.5 * (a + b)
+    return x
+
+
 @jit(nrt=False, inline=True)
 def locate_interp(kind, y, ynew, hh, lo, hi, K, side, par, trig, f0, df0, f1, df1):
     """The event in ``[lo, hi]`` on the step's own interpolant, without a field evaluation.
@@ -271,17 +312,8 @@ def locate_interp(kind, y, ynew, hh, lo, hi, K, side, par, trig, f0, df0, f1, df
     data did.
     """
     tc, vc, cint, dfc = interpolant(y, ynew, hh, K, side, par, trig, f0, df0, f1, df1)
-    # the event function g (positive before the event) on the interpolant, as a polynomial:
-    # sg theta + g_off, and its derivative's coefficients
-    sg = float(side) if kind == EV_IMPACT else -float(side)
-    g0 = fma(sg, tc[0], par[P_THOVER] if kind == EV_OVERTURN else 0.0)
-    g1 = sg * tc[1]
-    g2 = sg * tc[2]
-    g3 = sg * tc[3]
-    g4 = sg * tc[4]
-    g5 = sg * tc[5]
-    g6 = sg * tc[6]
-    g7 = sg * tc[7]
+    g0, g1, g2, g3, g4, g5, g6, g7 = event_poly(kind, side, par, tc)
+    # the coefficients of g's derivative
     d2 = 2.0 * g2
     d3 = 3.0 * g3
     d4 = 4.0 * g4
@@ -294,25 +326,9 @@ def locate_interp(kind, y, ynew, hh, lo, hi, K, side, par, trig, f0, df0, f1, df
     gb = poly7(g0, g1, g2, g3, g4, g5, g6, g7, b)
     if not (ga > 0.0 and gb <= 0.0):
         return -1, 0.0, 0.0, 0.0
-    # a start: the root in the bracket of the quadratic g0 + g1 x + g2 x^2 (the step's start's
-    # Taylor polynomial: it finds the far root of a flight that starts on g = 0), else regula
-    # falsi; then Newton, stopped once its step is below 1e-9 (the next would be below 1e-17:
-    # it converges quadratically); a step that leaves the bracket bisects it
-    x = -1.0
-    disc = fma(g1, g1, -4.0 * g0 * g2)
-    if disc >= 0.0 and g2 != 0.0:
-        qq = -0.5 * (g1 + math.copysign(math.sqrt(disc), g1))
-        if qq != 0.0:
-            r1 = qq / g2
-            r2 = g0 / qq
-            if a < r2 < b:
-                x = r2
-            elif a < r1 < b:
-                x = r1
-    if x < 0.0:
-        x = a + ga * (b - a) / (ga - gb)
-        if not (a < x < b):
-            x = 0.5 * (a + b)
+    # Newton from its start, stopped once its step is below 1e-9 (the next would be below
+    # 1e-17: it converges quadratically); a step that leaves the bracket bisects it
+    x = newton_start(g0, g1, g2, a, b, ga, gb)
     for _ in range(BISECT_ITERS):
         x, a, b, done = newton_bracketed(x, poly7(g0, g1, g2, g3, g4, g5, g6, g7, x),
                                          poly6(g1, d2, d3, d4, d5, d6, d7, x), a, b, 1e-9)
