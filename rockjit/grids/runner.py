@@ -181,7 +181,9 @@ def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, label, executi
     process the cells run as pieces on one thread each, as many at once as threads
     (:func:`local_plan`, :func:`pieces`). With ``execution.device == "cuda"`` each chunk runs
     on the GPU instead (:func:`rockjit._engine.gpu.run_chunk`, chunks of
-    :func:`rockjit._engine.gpu.default_chunk` cells by default), here or on a Dask worker.
+    :func:`rockjit._engine.gpu.default_chunk` cells by default), here or on a Dask worker;
+    here, the next chunk starts on the GPU while the host places and stores the last
+    (:func:`run_chunks`' ``ahead``).
 
     Returns the outputs by name: ``res`` (the kernels' rows; :func:`rockjit._engine.kernel.
     grid_results` names them), ``pts``, ``imp``, ``n_got``, ``n_imp_got``. With a Dask
@@ -219,7 +221,7 @@ def run_grid(y0s, pars, ipar, cpar, *, tangent, n_pts, n_imp_pts, label, executi
         run_chunks(run_chunk, (bool(tangent), y0s, pars, ipar, cpar, n_pts, n_imp_pts,
                                threads, ex.lanes), n, chunk, outputs_, client=client,
                    store=cs, progress=ex.progress, label=label, message=ex.message,
-                   worker_timeout=ex.worker_timeout, at_once=at_once)
+                   worker_timeout=ex.worker_timeout, at_once=at_once, ahead=cuda)
     return outputs_
 
 
@@ -324,7 +326,7 @@ class _Callback:
 
 def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, progress=False,
                label="cells", task_prefix="rockjit", message=None, worker_timeout=None,
-               at_once=1):
+               at_once=1, ahead=False):
     """Run ``runner`` over chunks of ``n`` cells and fill ``outputs`` in place.
 
     Parameters
@@ -371,6 +373,11 @@ def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, pr
         is placed once all its pieces are done. When a call, the progress callback or an
         interrupt raises, no call starts any more; the calls already running are waited for
         (and their finished chunks kept in the store) before the exception propagates.
+    ahead : bool
+        In this process, with one call at a time: call ``runner`` in a thread of its own, on
+        whole chunks, and start the next chunk's call before the chunk just finished is placed,
+        stored and reported. For a device that computes on its own (the GPU): it runs the next
+        chunk while the host copies and saves the last. Errors as with ``at_once``.
     """
     if message is None and store is not None:
         message = store.message
@@ -379,14 +386,14 @@ def run_chunks(runner, inputs, n, chunk, outputs, *, client=None, store=None, pr
     try:
         return _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, label,
                            task_prefix, message, _timeout(worker_timeout),
-                           max(1, int(at_once)))
+                           max(1, int(at_once)), bool(ahead))
     finally:
         if store is not None:
             store.close()
 
 
 def _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, label,
-                task_prefix, message, timeout, at_once=1):
+                task_prefix, message, timeout, at_once=1, ahead=False):
     bounds = [(a, min(n, a + chunk)) for a in range(0, n, chunk)]
     todo = []
     for a, b in bounds:
@@ -421,11 +428,11 @@ def _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, labe
         bar.update(b - a)
 
     try:
-        if client is None and at_once == 1:
+        if client is None and at_once == 1 and not ahead:
             for a, b in todo:
                 place(a, b, runner(*args(a, b)))
         elif client is None:
-            _at_once(runner, todo, args, place, store, at_once)
+            _at_once(runner, todo, args, place, store, at_once, whole=ahead)
         elif todo:
             _on_dask(client, runner, inputs, n, chunk, todo, args, place, task_prefix, message,
                      timeout)
@@ -434,11 +441,12 @@ def _run_chunks(runner, inputs, n, chunk, outputs, client, store, progress, labe
     return outputs
 
 
-def _at_once(runner, todo, args, place, store, at_once):
+def _at_once(runner, todo, args, place, store, at_once, whole=False):
     """The chunks ``todo`` in this process, ``at_once`` calls running at a time, each in a
-    thread of its own, on the chunks' :func:`pieces`; each chunk placed once all its pieces
-    are done (see :func:`run_chunks`)."""
-    work = pieces(todo, at_once)
+    thread of its own, on the chunks' :func:`pieces` (``whole``: on the chunks themselves);
+    each chunk placed once all its pieces are done, after the next call has started (see
+    :func:`run_chunks`)."""
+    work = ((a, b, k) for k, (a, b) in enumerate(todo)) if whole else pieces(todo, at_once)
     parts = [{} for _ in todo]  # per chunk: its finished pieces' outputs by their start
     left = [b - a for a, b in todo]  # per chunk: cells not yet finished
     pending = {}

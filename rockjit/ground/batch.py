@@ -209,5 +209,5 @@ def run_batch(batch, settings, method, execution=None, label="cells"):
         run_chunks(kernel, (batch.blocks, batch.sources, batch.block_of, batch.source_of,
                             batch.gain, settings, method), n, chunk, outputs, client=client,
                    store=store, progress=ex.progress, label=label, task_prefix=prefix,
-                   message=ex.message)
+                   message=ex.message, ahead=ex.device == "cuda")
     return outputs

@@ -223,6 +223,46 @@ def test_a_failing_chunk_raises_after_the_others_finish():
     assert len(calls) < n // chunk
 
 
+@pytest.mark.parametrize("ahead", [True, False])
+def test_ahead_the_next_chunk_starts_before_the_last_is_placed(ahead):
+    """``ahead`` (the GPU's chunks): whole chunks, one call at a time, and the next chunk's call
+    running before the chunk just finished is placed and reported; without, the next call waits
+    for the placing (the wait below then times out)."""
+    n, chunk = 100, 30
+    calls, state, lock = [], dict(now=0, most=0), threading.Lock()
+    count = _counting(calls, state, lock, delay=0.0)
+    started = [threading.Event() for _ in range(4)]
+
+    def run(x):
+        started[int(x[0]) // chunk].set()
+        return count(x)
+
+    running_next = []
+
+    def progress(done, total):
+        if 0 < done < n:  # chunk done // chunk - 1 placed: has the next one started?
+            running_next.append(started[done // chunk].wait(timeout=2.0 if ahead else 0.2))
+
+    x = np.arange(n, dtype=float)
+    out = {"y": np.zeros(n)}
+    runner.run_chunks(run, (x,), n, chunk, out, ahead=ahead, progress=progress)
+    assert np.array_equal(out["y"], np.sqrt(x) + 1.0)
+    assert calls == [(0, 30), (30, 60), (60, 90), (90, 100)] and state["most"] == 1
+    assert running_next == [ahead] * 3
+
+
+def test_ahead_a_failing_chunk_raises_and_the_chunks_before_it_are_stored(tmp_path):
+    from rockjit.storage import chunkstore
+    n, chunk = 40, 8
+    calls, state, lock = [], dict(now=0, most=0), threading.Lock()
+    store = chunkstore.ChunkStore(tmp_path / "s", "k", n, chunk)
+    with pytest.raises(ZeroDivisionError, match="chunk failed"):
+        runner.run_chunks(_counting(calls, state, lock, fail_at=3), (np.arange(n, dtype=float),),
+                          n, chunk, {"y": np.zeros(n)}, store=store, ahead=True)
+    assert state["now"] == 0 and len(calls) == 4
+    assert [a for a in range(0, n, chunk) if store.has(a, a + chunk)] == [0, 8, 16]
+
+
 def test_a_rerun_without_a_chunk_keeps_the_chunk_the_first_run_gave(tmp_path, monkeypatch):
     p = _plan(grid=6, periods=30)
     first = _chunked(p, chunk=5, threads=1, store=tmp_path / "s")
