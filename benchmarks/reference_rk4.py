@@ -17,8 +17,8 @@ against something other than itself. It is deliberately plain, not deliberately 
   concave side); then the jump ``theta' <- e theta'``, the corner switched, and the rest of the
   step taken from the impact;
 - rest when the speed after an impact is below the block's ``rest_speed``, lifted at
-  :func:`rockjit.plugs.harmonic.uplift_time`; overturning when ``|theta|`` reaches ``theta_over`` at a
-  step's end (the run stops, as the study's basins do);
+  :func:`rockjit.plugs.harmonic.uplift_time`; overturning when ``|theta|`` reaches
+  ``theta_over`` at a step's end (the run stops, as the study's basins do);
 - labels by rockjit's own classifier on the samples at ``kT`` and ``kT + T/2`` over the window.
 
 It reads the packed inputs of a basin plan (:func:`rockjit.basin.plan`: ``y0s``,

@@ -45,7 +45,9 @@ def jit(func=None, *, parallel=False, nrt=True, inline=False, ir_inline=False):
     no compiled function of its own. For a layer with one or two callers above the whole loop
     (``integrate._run``): every compiled function is linked with all it calls and optimised and
     turned into machine code again, so each layer above the loop pays the loop's LLVM time once
-    more (benchmarks/results/compile_code_levers.md).
+    more (benchmarks/results/compile_code_levers.md). For a piece of a loop with one call site,
+    and for a leaf of a few lines (the harmonic forcing's phase rotations): typing it at each call
+    site costs less than compiling it as a function of its own.
     """
     opts = dict(cache=True, fastmath=set(FASTMATH), parallel=parallel, error_model="numpy",
                 forceinline=bool(inline))

@@ -17,7 +17,8 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from .model import Block, accel, accel_jac, initial_side, jump
-from .plugs.harmonic import forcing_closed, oscillator, oscillator_jac, uplift_time
+from .plugs.harmonic import (forcing_closed, oscillator, oscillator_jac, peak_after, phase_at,
+                             uplift_time)
 from .result import Result
 
 # A point just off theta = 0 on the new corner after an impact, so that the impact event of the
@@ -103,8 +104,7 @@ class _Samples:
         """The state ``(theta, theta', r, s)`` at ``tk`` (``r, s`` of the closed form)."""
         if self.embed4:
             return yk
-        psi = self.omega * tk + self.phi
-        return np.array([yk[0], yk[1], math.sin(psi), math.cos(psi)])
+        return np.array([yk[0], yk[1], *phase_at(tk, self.omega, self.phi)])
 
     def sections(self, t_half, periods, t):
         """The stroboscopic samples at ``t_half[0::2]`` and at ``t_half[1::2]``, in order, as
@@ -175,7 +175,7 @@ class _ScipyRun:
     def wait_embedded(self):
         """At rest with the oscillator integrated: wait for ``|f| > cot(thc)``."""
         aw2, cot, omega, z = self.aw2, self.cot, self.omega, self.z
-        if aw2 * max(1.0, math.hypot(z[2], z[3])) <= cot:
+        if aw2 * peak_after(math.hypot(z[2], z[3])) <= cot:
             self.status = "rest"
             return
         if aw2 * abs(z[2]) > cot:

@@ -28,8 +28,8 @@ import physics as ph  # tests/physics.py: the independent statement
 import rockjit
 from rockjit import Block, Harmonic, Integration, Scipy, model
 from rockjit.grids.identity import floquet
-from rockjit.plugs import harmonic
 from rockjit.orbits import periodic_orbit
+from rockjit.plugs import harmonic
 
 #: The study's initial state (theta, theta', r, s) of its single runs and sweeps.
 Z0 = (-0.2254, -0.1597, -0.7778, 0.6284)
@@ -209,7 +209,7 @@ def test_uplift_time_matches_a_brute_force_scan():
     # already above the threshold: leaves at once
     t0 = 0.5 * math.pi / 1.3  # f at its crest
     assert harmonic.uplift_time(t0, 1.5, 1.0, 1.3, 0.0) == t0 == ph.first_uplift(t0, 1.5, 1.3,
-                                                                              0.0, 1.0)
+                                                                                 0.0, 1.0)
     # |f| reaches cot at its crests but never exceeds it, or stays below: never lifted
     for aw2 in (1.0, 0.999):
         assert harmonic.uplift_time(0.3, aw2, 1.0, 1.0, 0.0) == math.inf

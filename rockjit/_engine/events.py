@@ -2,7 +2,7 @@
 and the root finders that locate an impact, an overturning or an uplift on the step's data
 (:func:`locate_interp`) or along genuine steps (:func:`locate_step`); for the transient
 kernel, the crests, dips, impacts and overturning inside a step, each located along genuine
-steps of its own (:func:`locate_on_steps`).
+steps of its own (:func:`locate_transient`).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from ..model import jerk_snap
 from ..plugs.harmonic import curvature, oscillator
 from .layout import (BISECT_ITERS, DELTA_EULER, EV_IMPACT, EV_NONE, EV_OVERTURN, EV_UPLIFT,
                      LOCATE_TOL, NEWTON_ITERS, OFF_GRID, O_RESTEP, O_RHS, O_UNCONVERGED, P_AW2,
-                     P_COT, P_CTHC, P_OMEGA, P_STHC, P_THOVER, P_XI)
+                     P_COT, P_CTHC, P_OMEGA, P_STHC, P_THOVER, P_XI, ROOT_ITERS)
 from .step import dense_coeffs, dp_step, rk_step
 from .tableau import N_STAGES, P, step_table
 
@@ -484,13 +484,12 @@ def detect(y, ynew, hh, K, side, par):
 
 # ---- the transient kernel's events (:mod:`rockjit._engine.transient`), along genuine steps ----
 
-#: Newton's and bisection's iterations at most for an event of the transient kernel.
-ROOT_ITERS = 60
 _EPS = float(np.finfo(float).eps)
 
 
 @jit(nrt=False)
-def locate_on_steps(kind, target, t, th, v, a0, lo, hi, glo, cap, side, sthc, cthc, xi, fx, rec):
+def locate_transient(kind, target, t, th, v, a0, lo, hi, glo, cap, side, sthc, cthc, xi, fx,
+                     rec):
     """The root in ``(lo, hi)`` of an event function along genuine steps from ``(t, th, v)``:
     ``kind`` 0, ``side * theta - target`` (slope ``side * theta'``); ``kind`` 1,
     ``side * theta'`` (slope ``side * theta''``). ``glo`` has its sign just after ``lo``, and
@@ -530,18 +529,18 @@ def crest_in(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec):
     there, the steps its location took)``; ``(False, 0, 0, 0, 0)`` if none."""
     if not ((side * v > 0.0 or (v == 0.0 and side * a > 0.0)) and side * v1 < 0.0):
         return False, 0.0, 0.0, 0.0, 0
-    tau, th_c, vc, ac, ns = locate_on_steps(1, 0.0, t, th, v, a, 0.0, hh, 1.0, tn, side, sthc, cthc,
-                                   xi, fx, rec)
+    tau, th_c, vc, ac, ns = locate_transient(1, 0.0, t, th, v, a, 0.0, hh, 1.0, tn, side,
+                                             sthc, cthc, xi, fx, rec)
     return True, tau, th_c, vc, ns
 
 
 @jit(ir_inline=True)
 def reach_in(kind, target, glo, t, th, v, a, lo, hi, tn, side, sthc, cthc, xi, fx, rec):
     """Where in the step ``side * theta`` reaches ``target`` (``kind`` 0) between ``lo`` and
-    ``hi`` (:func:`locate_on_steps`; ``glo``, the event function's sign just after ``lo``): ``(the
-    instant, theta and theta' there, the steps its location took)``."""
-    tau, th2, v2, a2, ns = locate_on_steps(kind, target, t, th, v, a, lo, hi, glo, tn, side, sthc, cthc,
-                                  xi, fx, rec)
+    ``hi`` (:func:`locate_transient`; ``glo``, the event function's sign just after ``lo``):
+    ``(the instant, theta and theta' there, the steps its location took)``."""
+    tau, th2, v2, a2, ns = locate_transient(kind, target, t, th, v, a, lo, hi, glo, tn, side,
+                                            sthc, cthc, xi, fx, rec)
     return tau, th2, v2, ns
 
 
@@ -564,6 +563,6 @@ def dip_in(t, th, v, a, hh, tn, v1, side, sthc, cthc, xi, fx, rec):
     the steps its location took)``."""
     if not (side * v < 0.0 and side * v1 > 0.0):
         return -1.0, 0
-    tau, th2, v2, a2, ns = locate_on_steps(1, 0.0, t, th, v, a, 0.0, hh, side * v, tn, side, sthc,
-                                  cthc, xi, fx, rec)
+    tau, th2, v2, a2, ns = locate_transient(1, 0.0, t, th, v, a, 0.0, hh, side * v, tn, side,
+                                            sthc, cthc, xi, fx, rec)
     return (tau if side * th2 < 0.0 else -1.0), ns

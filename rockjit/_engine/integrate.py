@@ -69,7 +69,7 @@ from .layout import (RUNNING, DONE, OVERTURNED, REST, MAX_IMPACTS, NONFINITE, SE
                      O_RESTEP, N_IOUT, F_T, F_TH, F_S, F_MAXERR, F_LAM1, F_LAM2, F_WINTIME, F_V,
                      F_TOVER, N_FOUT, FT_DF0, FT_DF1, FT_SIN, FT_COS, N_FTAB, EV_NONE, EV_IMPACT,
                      EV_OVERTURN, EV_UPLIFT, BISECT_ITERS, OFF_GRID)
-from .step import rhs, block_step, phase_before, forcing_at, rk_step  # noqa: F401
+from .step import rhs, block_step, phase_before_grid, forcing_at, rk_step  # noqa: F401
 from .events import (turning_point, interp_at, locate_interp, locate, locate_step,  # noqa: F401
                      detect)
 
@@ -299,7 +299,7 @@ def leave_rest(EMBED4, t, t_grid, hold, y, side, par, w, iout):
         iout[O_RHS] += 1
         return REST_LIFT, t_up, side
     rad = math.sqrt(y[2] * y[2] + y[3] * y[3])
-    if par[P_AW2] * max(1.0, rad) <= par[P_COT]:
+    if par[P_AW2] * harmonic.peak_after(rad) <= par[P_COT]:
         return REST_END, t, side
     if not hold and par[P_AW2] * abs(y[2]) > par[P_COT]:
         side = 1 if y[2] > 0.0 else -1
@@ -623,7 +623,7 @@ def rest_phase(EMBED4, PROF, t, t_grid, hold, side, t_lift, fresh, sp, cp, jn, p
     if action == REST_LIFT:
         t_lift = t
         fresh = EMBED4 is not None and fresh
-        sp, cp = phase_before(EMBED4, w.ftab, jn, par[P_OMEGA] * (t_grid - t))
+        sp, cp = phase_before_grid(EMBED4, w.ftab, jn, par[P_OMEGA] * (t_grid - t))
     return action, t, side, t_lift, fresh, sp, cp
 
 
@@ -639,7 +639,7 @@ def to_event(EMBED4, TANGENT, PROF, kind, lo, hi, hh, j, jn, t, t_grid, side, pa
                         df0, f1)
     tock(PROF, counts, np.int64(8), c0)
     t = t + tau
-    sp, cp = phase_before(EMBED4, w.ftab, jn, par[P_OMEGA] * (t_grid - t))
+    sp, cp = phase_before_grid(EMBED4, w.ftab, jn, par[P_OMEGA] * (t_grid - t))
     return t, sp, cp
 
 
@@ -689,7 +689,7 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, s, par, ipar, out, w, counts):
     in_window = step >= ipar[I_WINDOW] * ipar[I_N]
     fresh = True  # no event yet in this grid step
     jn = j + 1 if j + 1 < ipar[I_N] else 0  # the grid point's row of the forcing table
-    sp, cp = 0.0, 0.0  # sine and cosine of the forcing phase at t, off the grid (phase_before)
+    sp, cp = 0.0, 0.0  # sine and cosine of the forcing phase at t, off the grid (phase_before_grid)
     hold = step < 0  # False, typed bool rather than the literal (one compilation of leave_rest)
     while True:
         if side == 0:

@@ -33,7 +33,7 @@ from ..plugs.harmonic import uplift_time
 __all__ = ["W", "bank", "block_step_lanes", "lane_tables", "run_lanes", "scalar_step"]
 
 # rows of the lane-major step table (:func:`lane_tables`): the entries of integrate's table that
-# the block's step reads (the chain's coefficients not exactly zero, :data:`tableau.COLS`), lane
+# the block's step reads (the chain's coefficients not exactly zero, :data:`rockjit._engine.tableau.COLS`), lane
 # innermost; ``LANE_ROW[kind, i, j]`` is the row of coefficient ``j`` of chain row ``i``
 LANE_ROW = {}
 for _kind in ("A", "AA"):
@@ -415,7 +415,8 @@ def _fill(n_lanes, j, nxt, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
           n_got, n_imp_got, b):
     """At a period's start (``j`` 0), each free lane loaded with the next pending cell from
     ``nxt`` on that runs (a cell that ends before its first step is finished at once). Returns
-    ``(nxt, busy)``: the next pending cell and the lanes with a cell."""
+    ``(nxt, busy)``: the next pending cell and the number of lanes with a cell (counted at
+    every step)."""
     busy = 0
     for l in range(n_lanes):
         while j == 0 and b.st[l, LS_CELL] < 0 and nxt < i1:
@@ -485,7 +486,8 @@ def _scalar_lane(l, st, ipar, b, prof, counts):
     """Lane ``l``'s grid step taken again by :func:`scalar_step`, the single-lane code: its
     single-lane state synced from the step input, the vector step's first Runge–Kutta step
     handed over where it stayed in range, then the step input and the uplift instant
-    refreshed; with ``prof``, its cycles in ``counts[4]``."""
+    refreshed. Counts the scalar step in ``counts[1]`` and, with ``prof``, its cycles in
+    ``counts[4]``."""
     counts[1] += 1
     c0 = cycles() if prof else 0
     _sync(l, b)

@@ -85,7 +85,7 @@ N_FOUT = F_TOVER + 1  # F_TOVER: the first instant |theta| reached theta_over (n
 # FT_DF0, FT_DF1: its time derivative alpha omega^3 cos(phase) at the step's start and end (the
 # jerk and snap of the event interpolant, :func:`end_derivs`); FT_SIN, FT_COS: sin and cos of the
 # phase phi + 2 pi j / N at the step's start (a step from an event instant rotates them,
-# :func:`phase_before`).
+# :func:`~rockjit._engine.step.phase_before_grid`).
 FT_DF0, FT_DF1, FT_SIN, FT_COS = 7, 8, 9, 10
 N_FTAB = 11
 
@@ -94,6 +94,8 @@ EV_NONE, EV_IMPACT, EV_OVERTURN, EV_UPLIFT = 0, 1, 2, 3
 
 BISECT_ITERS = 60
 NEWTON_ITERS = 8
+#: the transient kernel's root finder along genuine steps: Newton's and bisection's iterations
+ROOT_ITERS = 60
 DELTA_EULER = 1e-8  # see locate_step
 LOCATE_TOL = DELTA_EULER  # see locate_interp
 

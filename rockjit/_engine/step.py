@@ -138,7 +138,7 @@ def tangent_step(NS, y, K, ynew, tab, par, jac):
     ``J = [[0, 1], [jac, -3/4 xi]]`` at each stage (:func:`block_stage` left the slopes in
     ``jac``). The tangent never feeds back into the state. ``K[0]`` and ``K[-1]`` receive the
     tangent's derivative at the step's ends (the end's is used to carry an event's state the
-    last Newton correction, :func:`locate`)."""
+    last Newton correction, :func:`rockjit._engine.events.locate_step`)."""
     jb = -damping_rate(par[P_XI])
     for c in range(2):
         a = NS + 2 * c
@@ -152,7 +152,7 @@ def tangent_step(NS, y, K, ynew, tab, par, jac):
 
 
 @jit(nrt=False, inline=True)
-def phase_before(EMBED4, ftab, jn, u):
+def phase_before_grid(EMBED4, ftab, jn, u):
     """Sine and cosine of the closed-form forcing's phase the angle ``u`` (``omega`` times a
     time within a grid step, ``|u| <= 2 pi / N``) before the start of grid step ``jn`` of the
     period: the table's exact values rotated back, instead of a sine of ``omega t + phi`` (no
@@ -225,8 +225,9 @@ def dense_coeffs(K, m):
 
 @jit(nrt=False, inline=True)
 def plug_forcing(t, fx, rec):
-    """The base acceleration (``g``) of the forcing ``fx`` (:func:`rockjit._engine.transient.forcing_of`) at model time
-    ``t``: its plug's value (:func:`rockjit.plugs.plug_value`), zero outside ``[0, end]``."""
+    """The base acceleration (``g``) of the forcing ``fx``
+    (:func:`rockjit._engine.transient.forcing_of`) at model time ``t``: its plug's value
+    (:func:`rockjit.plugs.plug_value`), zero outside ``[0, end]``."""
     end, code, a, off, n = fx
     if not (0.0 <= t <= end):
         return 0.0

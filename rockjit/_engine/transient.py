@@ -20,7 +20,7 @@ scipy reference path (:mod:`rockjit.ground.reference`, the specification):
   is a dip through an impact and back) is cut there (:mod:`rockjit._engine.events`): the
   instant is the root of the event function of a genuine step of variable length from the
   step's start, found by Newton's iteration kept inside its bracket by bisection
-  (:func:`rockjit._engine.events.locate_on_steps`), so the event's state has the step's own
+  (:func:`rockjit._engine.events.locate_transient`), so the event's state has the step's own
   order of accuracy;
 - **impact**: :func:`rockjit.model.jump` on the other corner, or rest below ``rest_speed``;
 - **decided** (``decide``): after the excitation, the run stops at the first grid point, crest
@@ -31,14 +31,14 @@ The forcing may jump where the excitation ends (the one-cosine pulse ends on ``a
 step of the excitation sees its value there (its stages never pass the grid instant that ends
 it), and free rocking starts from the still base, its first stage included.
 
-Every equation of the block comes from :mod:`rockjit.model` (:func:`~rockjit.model.corner`,
-:func:`~rockjit.model.accel_pq`, :func:`~rockjit.model.sincos`, :func:`~rockjit.model.jump`,
-:func:`~rockjit.model.accel`, :func:`~rockjit.model.free_rocking_decided`), and every
+Every equation of the block comes from :mod:`rockjit.model` (here :func:`~rockjit.model.jump`,
+:func:`~rockjit.model.accel`, :func:`~rockjit.model.free_rocking_decided`; in the step,
+:func:`~rockjit.model.corner`, :func:`~rockjit.model.accel_pq`), and every
 excitation from its plug (:mod:`rockjit.plugs`: the pulses, records, sums of harmonics), the
 step from :mod:`rockjit._engine.step` and the events' location from
-:mod:`rockjit._engine.events`: this module writes none of them; it drives them. The forcing of a cell is described by a row of ``xpar`` (columns
-``X_*``): its plug's code, its amplitude, the excitation's end, its grid, and where its
-coefficients lie in one flat array.
+:mod:`rockjit._engine.events`: this module writes none of them; it drives them. The forcing
+of a cell is described by a row of ``xpar`` (columns ``X_*``): its plug's code, its amplitude,
+the excitation's end, its grid, and where its coefficients lie in one flat array.
 """
 
 from __future__ import annotations
@@ -300,7 +300,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
                 break
         if side * th1 >= thover:  # overturning
             tau, th, v, ns = reach_in(0, thover, side * th - thover, t, th, v, a, 0.0, hh, tn,
-                                    side, sthc, cthc, xi, fx, rec)
+                                      side, sthc, cthc, xi, fx, rec)
             n_step += ns
             t = out_f[TF_TOVER] = t + tau
             n_tr = _keep(traj, n_tr, t, th, v)
@@ -308,7 +308,7 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
             status = ST_OVERTURNED
             break
         impact_at, ns = impact_in(crest, t, th, v, a, hh, tn, th1, v1, side, sthc, cthc, xi,
-                                   fx, rec)
+                                  fx, rec)
         n_step += ns
         if impact_at < 0.0:
             if t < end <= tn:  # the excitation ends here: free rocking from f = 0 on
@@ -318,8 +318,8 @@ def run_cell(x, rec, b, s, t_lim, max_impacts, decide, th0, v0, side0, imp, traj
             max_th = max(max_th, abs(th))
             continue
         # ---- impact --------------------------------------------------------------------------
-        tau, th2, v2, ns = reach_in(0, 0.0, side * th if lo == 0.0 else side * th_c, t, th, v, a,
-                                  lo, impact_at, tn, side, sthc, cthc, xi, fx, rec)
+        tau, th2, v2, ns = reach_in(0, 0.0, side * th if lo == 0.0 else side * th_c, t, th, v,
+                                    a, lo, impact_at, tn, side, sthc, cthc, xi, fx, rec)
         n_step += ns
         t = t + tau
         n_tr = _keep(traj, n_tr, t, 0.0, v2)

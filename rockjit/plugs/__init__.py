@@ -4,8 +4,8 @@ functions of its own.
 The harmonic forcing of the study, ``rockjit.plugs.harmonic``, is the plug of the periodic
 kernels (single runs, sweeps, basins, the lanes and the GPU's cells): its closed form, the
 rotations of its phase over a step, its derivatives, the instant it lifts a block at rest and
-its oscillator. Every other module of this package defines and registers one transient plug
-(:mod:`rockjit.plugs.base` says what a plug gives): :class:`rockjit.HarmonicSum`, a sum of
+its oscillator. Every other module but ``base`` (which says what a plug gives,
+:mod:`rockjit.plugs.base`) defines and registers one transient plug: :class:`rockjit.HarmonicSum`, a sum of
 harmonics over a given duration; :class:`rockjit.Pulse`, the one-sine, one-cosine and Ricker
 pulses; :class:`rockjit.Record`, a recorded ground motion. When the package is imported, the
 transient kernel's two entry points are rendered over the registered plugs: ``plug_value`` and

@@ -1,9 +1,12 @@
 """The harmonic forcing ``f = alpha omega^2 sin(omega t + phi)``: the periodic kernels' plug.
 
-The study's excitation, in its two forms, and every rule of it that the compiled kernels of
-periodic runs (``rockjit._engine.integrate``, the lanes, the GPU driver) and the scipy
-reference path (``rockjit.reference``) use; the kernels call these functions and write no
-sine of the forcing of their own. Its Python side is :class:`rockjit.Harmonic`.
+The study's excitation, in its two forms: the functions of time and phase that the compiled
+kernels of periodic runs (``rockjit._engine.integrate``, the lanes, the GPU driver) and the
+scipy reference path (``rockjit.reference``) call, instead of a sine of the forcing of their
+own. They give ``r``, the forcing over its amplitude: the kernels scale it by the parameter
+``aw2 = alpha omega^2``, and the block's rule of rest (it lifts where ``|f| > cot(thc)``,
+docs/theory/impacts.md) applies to ``f = aw2 r`` whatever the excitation. Its Python side is
+:class:`rockjit.Harmonic`.
 
 - The closed form ``r = sin(omega t + phi)`` (:func:`forcing_closed`), its phase at a time
   (:func:`phase_at`) and at the start of grid step ``j`` of a period of ``N`` steps
@@ -17,7 +20,10 @@ sine of the forcing of their own. Its Python side is :class:`rockjit.Harmonic`.
   (:func:`uplift_time`, in closed form).
 - The autonomous form: the oscillator ``(r, s)`` whose limit cycle is the closed form
   (:func:`oscillator`, :func:`oscillator_jac`), which the embedding integrates with the block
-  (docs/theory/model.md).
+  (docs/theory/model.md), and the largest ``|r|`` it reaches from a radius (:func:`peak_after`).
+
+The pairs come back as ``(sin, cos)``, except :func:`advance_rotation`'s ``(cos, sin)`` (the
+order of the step table's rows).
 
 The small functions of the phase are inlined in numba's IR where they are called (no compiled
 function of their own: a cold start compiles less). Every function takes numbers, not the
@@ -35,7 +41,7 @@ from ..model import NEAR_RANGE, near_poly, sincos, sincos_poly
 
 __all__ = ["advance", "advance_rotation", "advance_slope", "curvature", "forcing_closed",
            "grid_advance", "grid_phase", "oscillator", "oscillator_jac", "phase_at",
-           "phase_before", "slope", "uplift_time"]
+           "peak_after", "phase_before", "slope", "uplift_time"]
 
 
 # ---- the closed form --------------------------------------------------------------------------
@@ -154,3 +160,11 @@ def oscillator_jac(r, s, omega):
     q = r * r + s * s
     return (1.0 - q - 2.0 * r * r, omega - 2.0 * r * s,
             -omega - 2.0 * r * s, 1.0 - q - 2.0 * s * s)
+
+
+@jit(ir_inline=True)
+def peak_after(rad):
+    """The largest ``|r|`` the oscillator reaches from radius ``rad``: it relaxes monotonically
+    to its unit circle, so ``max(1, rad)`` (a block at rest whose ``aw2`` times this stays at
+    or below ``cot(thc)`` stays at rest for good)."""
+    return max(1.0, rad)
