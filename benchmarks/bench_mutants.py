@@ -80,6 +80,7 @@ def _m(name, area, file, old, new, breaks, tests):
 
 
 MODEL = "rockjit/model.py"
+HARMONIC = "rockjit/plugs/harmonic.py"
 HOUSNER = "rockjit/laws/housner.py"
 MAO = "rockjit/laws/mao.py"
 SPEED = "rockjit/laws/speed.py"
@@ -116,11 +117,11 @@ MUTANTS = [
        "1.0, -0.1666666666666666, 0.00833333333333,",
        "a coefficient of the sine polynomial, rounded at 1e-14",
        ["tests/test_model.py::test_sincos_polynomial_matches_libm_on_its_range"]),
-    _m("oscillator", "vector field", MODEL,
+    _m("oscillator", "vector field", HARMONIC,
        "return r + omega * s - r * q, s - omega * r - s * q",
        "return r + omega * s - r * q, s - omega * r - r * q",
        "the forcing oscillator's radial term of s",
-       ["tests/test_model.py::test_oscillator_on_the_circle_is_the_closed_form"]),
+       ["tests/plugs/test_harmonic.py::test_oscillator_on_the_circle_is_the_closed_form"]),
     # ---- Jacobian
     _m("jacobian-slope", "Jacobian", MODEL,
        "return fma(Q, c, -(P * s))", "return fma(Q, c, P * s)",
@@ -155,7 +156,7 @@ MUTANTS = [
        "if abs(dth_m) < par[P_REST] or dth_p == 0.0:",
        "the Zeno cut-off compares the incoming speed, not the outgoing one",
        [RUNS[0] + "[rest-compiled]", RUNS[0] + "[uplift-compiled]"]),
-    _m("uplift-time", "rest/uplift", MODEL,
+    _m("uplift-time", "rest/uplift", HARMONIC,
        "return t + (math.pi - u + a) / omega", "return t + (math.pi - u - a) / omega",
        "the next uplift instant after the forcing's crest", UPLIFT),
     _m("uplift-side", "rest/uplift", INTEG,
@@ -179,7 +180,7 @@ MUTANTS = [
        "Fraction(3, 10), Fraction(8001, 10000), Fraction(8, 9),",
        "the fourth stage's time c_3 = 4/5 off by 1e-4", RUN_SYMMETRIC),
     _m("forcing-jerk", "integrator", INTEG,
-       "ftab[j, FT_DF0] = aw3 * c0", "ftab[j, FT_DF0] = aw3 * s0",
+       "ftab[j, FT_DF0] = harmonic.slope(aw3, c0)", "ftab[j, FT_DF0] = harmonic.slope(aw3, s0)",
        "the forcing's time derivative at a step's start (the event interpolant's data)",
        RUN_SYMMETRIC),
     # ---- event location
