@@ -99,6 +99,14 @@ CASES = [
 ]
 
 
+class _Client:
+    """A stand-in Dask client (only its presence matters), with a repr the same in every
+    process: a test's id must not hold an address."""
+
+    def __repr__(self):
+        return "<a client>"
+
+
 def _id(case):
     changes, _ = case
     return ",".join(f"{k}={v!r}" for k, v in changes.items())
@@ -168,7 +176,7 @@ OBJECT_CASES = [
     (Execution, dict(chunk=0), "chunk"),
     (Execution, dict(lanes=0), "lanes"),
     (Execution, dict(lanes=9), "lanes"),
-    (Execution, dict(client=object(), scheduler="tcp://localhost:8786"), "client or scheduler"),
+    (Execution, dict(client=_Client(), scheduler="tcp://localhost:8786"), "client or scheduler"),
     (Execution, dict(scheduler=" "), "scheduler"),
     (Execution, dict(store=3), "store"),
     (Execution, dict(message="stderr"), "message"),
