@@ -8,21 +8,21 @@ own. They give ``r``, the forcing over its amplitude: the kernels scale it by th
 docs/theory/impacts.md) applies to ``f = aw2 r`` whatever the excitation. Its Python side is
 :class:`rockjit.Harmonic`.
 
-- The closed form ``r = sin(omega t + phi)`` (:func:`forcing_closed`), its phase at a time
-  (:func:`phase_at`) and at the start of grid step ``j`` of a period of ``N`` steps
-  (:func:`grid_phase`, and the advance over a fraction of a grid step, :func:`grid_advance`),
-  the phase advanced by an angle (:func:`advance`, the stages of a step, and its time
-  derivative :func:`advance_slope`) or taken back by one (:func:`phase_before`), the rotation
-  that advance is (:func:`advance_rotation`, within a step); the derivatives the event
-  interpolant needs, ``f' = alpha omega^3 cos`` from the phase (:func:`slope`) and
-  ``f'' = -omega^2 f`` (:func:`curvature`).
+- The closed form ``r = sin(omega t + phi)`` (``forcing_closed``), its phase at a time
+  (``phase_at``) and at the start of grid step ``j`` of a period of ``N`` steps
+  (``grid_phase``, and the advance over a fraction of a grid step, ``grid_advance``),
+  the phase advanced by an angle (``advance``, the stages of a step, and its time
+  derivative ``advance_slope``) or taken back by one (``phase_before``), the rotation
+  that advance is (``advance_rotation``, within a step); the derivatives the event
+  interpolant needs, ``f' = alpha omega^3 cos`` from the phase (``slope``) and
+  ``f'' = -omega^2 f`` (``curvature``).
 - When a block at rest is lifted: the first instant ``|f|`` exceeds ``cot(thc)``
-  (:func:`uplift_time`, in closed form).
+  (``uplift_time``, in closed form).
 - The autonomous form: the oscillator ``(r, s)`` whose limit cycle is the closed form
-  (:func:`oscillator`, :func:`oscillator_jac`), which the embedding integrates with the block
-  (docs/theory/model.md), and the largest ``|r|`` it reaches from a radius (:func:`peak_after`).
+  (``oscillator``, ``oscillator_jac``), which the embedding integrates with the block
+  (docs/theory/model.md), and the largest ``|r|`` it reaches from a radius (``peak_after``).
 
-The pairs come back as ``(sin, cos)``, except :func:`advance_rotation`'s ``(cos, sin)`` (the
+The pairs come back as ``(sin, cos)``, except ``advance_rotation``'s ``(cos, sin)`` (the
 order of the step table's rows).
 
 The small functions of the phase are inlined in numba's IR where they are called (no compiled
