@@ -410,97 +410,6 @@ def _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b
     st[LS_CELL] = -1
 
 
-@jit(ir_inline=True)
-def _fill(n_lanes, j, nxt, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts,
-          n_got, n_imp_got, b):
-    """At a period's start (``j`` 0), each free lane loaded with the next pending cell from
-    ``nxt`` on that runs (a cell that ends before its first step is finished at once). Returns
-    ``(nxt, busy)``: the next pending cell and the number of lanes with a cell (counted at
-    every step)."""
-    busy = 0
-    for l in range(n_lanes):
-        while j == 0 and b.st[l, LS_CELL] < 0 and nxt < i1:
-            i = nxt
-            nxt += 1
-            if not _load(l, i, y0s, pars, ipar, b):
-                b.st[l, LS_CELL] = i
-                _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got,
-                     n_imp_got, b)
-        if b.st[l, LS_CELL] >= 0:
-            busy += 1
-    return nxt, busy
-
-
-@jit(ir_inline=True)
-def _after_vector_step(l, j, n_per, half, st, ipar, b, prof, counts):
-    """Lane ``l`` (its loop state ``st``) after the vector step of step ``j`` of the period:
-    the step kept (:func:`_fast_step`) where the vector step accepted it, or where the lane is
-    at rest with its uplift beyond the grid point (held there, as the scalar step would hold
-    it, :func:`rockjit._engine.integrate.leave_rest`, without taking it); else taken again by
-    the single-lane code (:func:`_scalar_lane`)."""
-    fast = b.lout[LO_FAST * W + l] != 0.0
-    hl = b.par[l, ig.P_H]
-    held = (st[LS_SIDE] == 0
-            and b.fs[l, LF_TUP] - (st[LS_STEP] + 1) * hl > REST_MARGIN * hl)
-    if fast or held:
-        _fast_step(l, j, n_per, half, fast, st, ipar, b, counts)
-    else:
-        _scalar_lane(l, st, ipar, b, prof, counts)
-
-
-@jit(ir_inline=True)
-def _fast_step(l, j, n_per, half, fast, st, ipar, b, counts):
-    """Lane ``l``'s grid step kept as the vector step left it (``fast``) or held at rest:
-    counted, the lane's time advanced, its state checked finite, and at a sample's grid point
-    the grid point's work done on its single-lane state
-    (:func:`rockjit._engine.integrate.grid_point`)."""
-    counts[0] += 1
-    if fast:
-        iout = b.iout[l]
-        iout[ig.O_RHS] += ig.N_STAGES
-        iout[ig.O_SUBSTEPS] += 1
-    step = st[LS_STEP] + 1
-    st[LS_STEP] = step
-    t = step * b.par[l, ig.P_H]
-    b.fs[l, LF_TT] = t
-    if not (math.isfinite(b.lin[LI_X * W + l]) and math.isfinite(b.lin[LI_V * W + l])):
-        st[LS_STATUS] = ig.NONFINITE
-    elif j + 1 != n_per and j + 1 != half:
-        st[LS_JPER] = j + 1
-    else:
-        _sync(l, b)
-        status, j_per, k_per, j_qr, j_rec, collapsed = ig.grid_point(
-            None, None, False, t, step, st[LS_SIDE], st[LS_NIMP], st[LS_NCOL],
-            step - 1 >= ipar[ig.I_WINDOW] * n_per, ipar, b.par[l],
-            lane_outputs(b, l), lane_work(b, l), st[LS_JPER], st[LS_KPER],
-            st[LS_JQR], st[LS_JREC])
-        st[LS_STATUS] = status
-        st[LS_JPER] = j_per
-        st[LS_KPER] = k_per
-        st[LS_JQR] = j_qr
-        st[LS_JREC] = j_rec
-
-
-@jit(ir_inline=True)
-def _scalar_lane(l, st, ipar, b, prof, counts):
-    """Lane ``l``'s grid step taken again by :func:`scalar_step`, the single-lane code: its
-    single-lane state synced from the step input, the vector step's first Runge–Kutta step
-    handed over where it stayed in range, then the step input and the uplift instant
-    refreshed. Counts the scalar step in ``counts[1]`` and, with ``prof``, its cycles in
-    ``counts[4]``."""
-    counts[1] += 1
-    c0 = cycles() if prof else 0
-    _sync(l, b)
-    pre = st[LS_SIDE] != 0 and b.lout[LO_FAR * W + l] <= 1.0
-    if pre:
-        _stages(l, b)
-    scalar_step(None, st, b.fs[l], b.par[l], ipar, lane_outputs(b, l),
-                lane_work(b, l), pre, prof, counts)
-    _refresh(l, b)
-    b.fs[l, LF_TUP] = _uplift(st, b.fs[l], b.par[l])
-    counts[4] += (cycles() - c0) if prof else 0
-
-
 @jit(nrt=False)
 def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts,
               n_got, n_imp_got, b, prof, counts):
@@ -518,9 +427,9 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
     :func:`rockjit._engine.kernel._grid` (the running error estimate ``max_err`` is not kept on
     the fast path: no grid output reads it). ``counts``: the fast steps (with the steps held at
     rest) and the scalar steps, the vector steps taken, and with ``prof`` the cycles
-    (``readcyclecounter``) spent in the vector steps, in the scalar steps, and in all, then the
-    parts of the scalar steps (:func:`scalar_step`); without, the cycle counter is not read (its
-    reads cost ~10 % of a basin's time).
+    (``readcyclecounter``) spent in the vector steps, in the scalar steps, and in all, then the parts of the scalar steps
+    (:func:`scalar_step`); without, the cycle counter is not read (its reads cost ~10 % of a
+    basin's time).
     """
     c_start = cycles() if prof else 0
     n_per = ipar[ig.I_N]
@@ -535,8 +444,17 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
     j = np.int64(0)  # the step's index in the period, the same in every lane (int64, not the
     # literal 0: block_step_lanes would be compiled once more for the literal)
     while True:
-        nxt, busy = _fill(n_lanes, j, nxt, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res,
-                          pts, imp_pts, n_got, n_imp_got, b)
+        busy = 0
+        for l in range(n_lanes):
+            while j == 0 and b.st[l, LS_CELL] < 0 and nxt < i1:
+                i = nxt
+                nxt += 1
+                if not _load(l, i, y0s, pars, ipar, b):
+                    b.st[l, LS_CELL] = i
+                    _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got,
+                         n_imp_got, b)
+            if b.st[l, LS_CELL] >= 0:
+                busy += 1
         if busy == 0:
             if nxt >= i1:
                 break
@@ -554,7 +472,50 @@ def run_lanes(n_lanes, i0, i1, y0s, pars, ipar, cpar, n_pts, n_imp_pts, res, pts
             st = b.st[l]
             if st[LS_CELL] < 0:
                 continue
-            _after_vector_step(l, j, n_per, half, st, ipar, b, prof, counts)
+            fast = lout[LO_FAST * W + l] != 0.0
+            hl = b.par[l, ig.P_H]
+            # at rest with the uplift beyond the grid point: held there, as the scalar step
+            # would (rockjit._engine.integrate.leave_rest), without taking it
+            held = (st[LS_SIDE] == 0
+                    and b.fs[l, LF_TUP] - (st[LS_STEP] + 1) * hl > REST_MARGIN * hl)
+            if fast or held:
+                counts[0] += 1
+                if fast:
+                    iout = b.iout[l]
+                    iout[ig.O_RHS] += ig.N_STAGES
+                    iout[ig.O_SUBSTEPS] += 1
+                step = st[LS_STEP] + 1
+                st[LS_STEP] = step
+                t = step * b.par[l, ig.P_H]
+                b.fs[l, LF_TT] = t
+                if not (math.isfinite(lin[LI_X * W + l]) and math.isfinite(lin[LI_V * W + l])):
+                    st[LS_STATUS] = ig.NONFINITE
+                elif j + 1 != n_per and j + 1 != half:
+                    st[LS_JPER] = j + 1
+                else:
+                    _sync(l, b)
+                    status, j_per, k_per, j_qr, j_rec, collapsed = ig.grid_point(
+                        None, None, False, t, step, st[LS_SIDE], st[LS_NIMP], st[LS_NCOL],
+                        step - 1 >= ipar[ig.I_WINDOW] * n_per, ipar, b.par[l],
+                        lane_outputs(b, l), lane_work(b, l), st[LS_JPER], st[LS_KPER],
+                        st[LS_JQR], st[LS_JREC])
+                    st[LS_STATUS] = status
+                    st[LS_JPER] = j_per
+                    st[LS_KPER] = k_per
+                    st[LS_JQR] = j_qr
+                    st[LS_JREC] = j_rec
+            else:
+                counts[1] += 1
+                c0 = cycles() if prof else 0
+                _sync(l, b)
+                pre = st[LS_SIDE] != 0 and lout[LO_FAR * W + l] <= 1.0
+                if pre:
+                    _stages(l, b)
+                scalar_step(None, st, b.fs[l], b.par[l], ipar, lane_outputs(b, l),
+                            lane_work(b, l), pre, prof, counts)
+                _refresh(l, b)
+                b.fs[l, LF_TUP] = _uplift(st, b.fs[l], b.par[l])
+                counts[4] += (cycles() - c0) if prof else 0
             if st[LS_STATUS] != ig.RUNNING or st[LS_STEP] >= total:
                 _sync(l, b)
                 _end(l, ipar, cpar, n_pts, n_imp_pts, res, pts, imp_pts, n_got, n_imp_got, b)
