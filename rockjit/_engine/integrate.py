@@ -610,56 +610,6 @@ def end_of_grid_step(EMBED4, TANGENT, PROF, record, t, step, side, n_imp, n_col,
     return status, step, j_per, k_per, j_qr, j_rec, n_col, n_col_win
 
 
-@jit(ir_inline=True)
-def rest_phase(EMBED4, PROF, t, t_grid, hold, side, t_lift, fresh, sp, cp, jn, par, out, w,
-               counts):
-    """The block at rest at ``t`` in the grid step to ``t_grid`` (:func:`leave_rest`, timed in
-    ``counts[6]``). Returns ``(action, t, side, t_lift, fresh, sp, cp)``: on an uplift
-    (``REST_LIFT``) its instant, also as ``t_lift``, a step from there no longer a whole grid
-    step under the closed form, and the forcing phase's sine and cosine there."""
-    c0 = tick(PROF)
-    action, t, side = leave_rest(EMBED4, t, t_grid, hold, w.y, side, par, w, out.iout)
-    tock(PROF, counts, np.int64(6), c0)
-    if action == REST_LIFT:
-        t_lift = t
-        fresh = EMBED4 is not None and fresh
-        sp, cp = phase_before_grid(EMBED4, w.ftab, jn, par[P_OMEGA] * (t_grid - t))
-    return action, t, side, t_lift, fresh, sp, cp
-
-
-@jit(ir_inline=True)
-def to_event(EMBED4, TANGENT, PROF, kind, lo, hi, hh, j, jn, t, t_grid, side, par, out, w,
-             counts, sp, cp, f0, df0, f1):
-    """The state taken to the event ``kind`` detected in ``(lo, hi)`` of the step of length
-    ``hh`` from ``t`` (:func:`move_to_event`, timed in ``counts[8]``). Returns ``(t, sp, cp)``:
-    the event's time and the sine and cosine of the forcing phase there, for the rest of the
-    grid step (and its forcing)."""
-    c0 = tick(PROF)
-    tau = move_to_event(EMBED4, TANGENT, kind, lo, hi, hh, j, side, par, out, w, sp, cp, f0,
-                        df0, f1)
-    tock(PROF, counts, np.int64(8), c0)
-    t = t + tau
-    sp, cp = phase_before_grid(EMBED4, w.ftab, jn, par[P_OMEGA] * (t_grid - t))
-    return t, sp, cp
-
-
-@jit(ir_inline=True)
-def on_impact(EMBED4, TANGENT, PROF, t, r, t_lift, side, n_imp, hold, n_col, n_col_win,
-              in_window, par, out, w, counts):
-    """An impact at ``t`` (:func:`impact`, timed in ``counts[9]``; ``r`` the closed-form
-    forcing there) and, where it brings the block to rest, the rest phase's start (``hold``
-    set where it began within rounding of the latest uplift; the tangent vectors,
-    :func:`rest_collapse`). Returns ``(side, n_imp, hold, n_col, n_col_win)``."""
-    c0 = tick(PROF)
-    side, n_imp, rests, held = impact(EMBED4, TANGENT, t, r, t_lift, side, n_imp, in_window,
-                                      par, out, w)
-    tock(PROF, counts, np.int64(9), c0)
-    if rests:
-        hold = hold or held
-        n_col, n_col_win = rest_collapse(EMBED4, TANGENT, in_window, w.y, n_col, n_col_win)
-    return side, n_imp, hold, n_col, n_col_win
-
-
 @jit(nrt=False, inline=True)
 def grid_step(EMBED4, TANGENT, record, PROF, pre, s, par, ipar, out, w, counts):
     """One grid step, from ``t`` (the grid point ``step h``, or the block still at rest) to the
@@ -693,15 +643,18 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, s, par, ipar, out, w, counts):
     hold = step < 0  # False, typed bool rather than the literal (one compilation of leave_rest)
     while True:
         if side == 0:
-            action, t, side, t_lift, fresh, sp, cp = rest_phase(
-                EMBED4, PROF, t, t_grid, hold, side, t_lift, fresh, sp, cp, jn, par, out, w,
-                counts)
+            c0 = tick(PROF)
+            action, t, side = leave_rest(EMBED4, t, t_grid, hold, y, side, par, w, out.iout)
+            tock(PROF, counts, np.int64(6), c0)
             if action == REST_END:
                 status = REST
                 break
             if action == REST_HOLD:
                 break
             if action == REST_LIFT:
+                t_lift = t
+                fresh = EMBED4 is not None and fresh
+                sp, cp = phase_before_grid(EMBED4, w.ftab, jn, par[P_OMEGA] * (t_grid - t))
                 continue
         hh, sp, cp, f0, df0, f1 = substep(EMBED4, TANGENT, PROF, fresh, pre, j, t, t_grid, sp,
                                           cp, side, par, out, w, counts)
@@ -713,9 +666,14 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, s, par, ipar, out, w, counts):
             max_err = accept(EMBED4, TANGENT, side, hh, max_err, w)
             t = t_grid
             break
-        t, sp, cp = to_event(EMBED4, TANGENT, PROF, kind, lo, hi, hh, j, jn, t, t_grid, side,
-                             par, out, w, counts, sp, cp, f0, df0, f1)
+        c0 = tick(PROF)
+        tau = move_to_event(EMBED4, TANGENT, kind, lo, hi, hh, j, side, par, out, w, sp, cp, f0,
+                            df0, f1)
+        tock(PROF, counts, np.int64(8), c0)
+        t = t + tau
         fresh = False
+        # the forcing phase at the event, for the rest of the step (and its forcing)
+        sp, cp = phase_before_grid(EMBED4, w.ftab, jn, par[P_OMEGA] * (t_grid - t))
         if kind == EV_OVERTURN and ipar[I_CONTINUE] == 0:
             status = OVERTURNED
             break
@@ -724,9 +682,13 @@ def grid_step(EMBED4, TANGENT, record, PROF, pre, s, par, ipar, out, w, counts):
                 t_lift = t
             side = pass_event(EMBED4, kind, t, side, par, out, w)
             continue
-        side, n_imp, hold, n_col, n_col_win = on_impact(
-            EMBED4, TANGENT, PROF, t, sp, t_lift, side, n_imp, hold, n_col, n_col_win,
-            in_window, par, out, w, counts)
+        c0 = tick(PROF)
+        side, n_imp, rests, held = impact(EMBED4, TANGENT, t, sp, t_lift, side, n_imp,
+                                          in_window, par, out, w)
+        tock(PROF, counts, np.int64(9), c0)
+        if rests:
+            hold = hold or held
+            n_col, n_col_win = rest_collapse(EMBED4, TANGENT, in_window, y, n_col, n_col_win)
         if n_imp >= ipar[I_MAXIMP]:
             status = MAX_IMPACTS
             break
