@@ -69,15 +69,15 @@ def test_advancing_and_taking_back_the_phase_agree_with_libm():
 def test_the_advance_to_a_node_is_the_rotation_by_its_angle(n_per):
     """Both branches: the short polynomial while omega h <= 0.3 (from N = 21 steps a period on),
     the sine's for N < 21."""
-    for omega in (1.3,):
-        h = 2 * math.pi / omega / n_per
-        for c in (0.0, 0.2, 0.3, 0.8, 8 / 9, 1.0):
-            cs, sn = harmonic.advance_rotation(omega, h, c)
-            assert cs == pytest.approx(math.cos(omega * c * h), abs=1e-15)
-            assert sn == pytest.approx(math.sin(omega * c * h), abs=1e-15)
-            sd, cd = harmonic.grid_advance(c, n_per)
-            assert (sd, cd) == pytest.approx((math.sin(omega * c * h), math.cos(omega * c * h)),
-                                             abs=1e-15)
+    omega = 1.3  # (omega h = 2 pi / N whatever omega)
+    h = 2 * math.pi / omega / n_per
+    for c in (0.0, 0.2, 0.3, 0.8, 8 / 9, 1.0):
+        cs, sn = harmonic.advance_rotation(omega, h, c)
+        assert cs == pytest.approx(math.cos(omega * c * h), abs=1e-15)
+        assert sn == pytest.approx(math.sin(omega * c * h), abs=1e-15)
+        sd, cd = harmonic.grid_advance(c, n_per)
+        assert (sd, cd) == pytest.approx((math.sin(omega * c * h), math.cos(omega * c * h)),
+                                         abs=1e-15)
 
 
 def test_the_phase_at_a_time_and_at_a_grid_step():
